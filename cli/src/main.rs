@@ -1,0 +1,2 @@
+//! granbed-cli placeholder.
+fn main() {}

@@ -1,0 +1,42 @@
+//! Compressible neo-Hookean elasticity in the elastic left Cauchy–Green
+//! tensor b^e (physics.md §1.1).
+//!
+//! ψ = ½μ(tr b^e − 3) + ½λ(J^e − 1)² − μ ln J^e, per unit reference volume;
+//! τ = μ b^e + (1/3) h(J^e) 1 with h(J) = 3[λJ(J − 1) − μ].
+
+use crate::material::Material;
+use crate::tensor::{Voigt, scale_add_identity, trace};
+use crate::{Real, math};
+
+/// Volumetric stress function h(J) = 3[λJ(J − 1) − μ], Pa: the Kirchhoff
+/// trace contributed by the volumetric part, so tr τ = μ tr b^e + h(J^e).
+#[inline]
+pub fn h(mat: &Material, je: Real) -> Real {
+    h_lame(mat.lambda, mat.mu, je)
+}
+
+/// [`h`] from the Lamé constants λ, μ (Pa) directly.
+#[inline]
+pub fn h_lame(lambda: Real, mu: Real, je: Real) -> Real {
+    3.0 * (lambda * je * (je - 1.0) - mu)
+}
+
+/// Derivative h'(J) = 3λ(2J − 1), Pa.
+#[inline]
+pub fn dh(mat: &Material, je: Real) -> Real {
+    3.0 * mat.lambda * (2.0 * je - 1.0)
+}
+
+/// Kirchhoff stress τ = μ b^e + (1/3) h(J^e) 1, Pa, for an elastic left
+/// Cauchy–Green tensor `be` (dimensionless, Voigt) with `je = √det b^e`.
+#[inline]
+pub fn kirchhoff(mat: &Material, be: &Voigt, je: Real) -> Voigt {
+    scale_add_identity(be, mat.mu, h(mat, je) / 3.0)
+}
+
+/// Stored energy density ψ(b^e, J^e), J per m³ of reference volume.
+#[inline]
+pub fn energy_density(mat: &Material, be: &Voigt, je: Real) -> Real {
+    0.5 * mat.mu * (trace(be) - 3.0) + 0.5 * mat.lambda * (je - 1.0) * (je - 1.0)
+        - mat.mu * math::ln(je)
+}

@@ -1,0 +1,297 @@
+//! The plastic corrector: the scalar system in (ε, δ) of physics.md §1.4 and
+//! its solvers.
+//!
+//! With ε = (4/3)γ a1 α and δ = (4/3)γ θ (γ the plastic multiplier), every
+//! quantity of the returned state follows from ε and δ:
+//!
+//! ```text
+//! θ(ε)  = θtr/(1+ε)                  Je(ε) = (1 − 1.5ε) Je_tr
+//! α(ε)  = θ(ε) + h(Je(ε))            β     = βtr/(1 + ε + δ)
+//! R1    = [a1 α(ε) δ − ε θ(ε)] / θtr                  (definition of δ, pole-free)
+//! R2    = [β² + (a1/3) α² − (2/3) a2 σy²] / ((2/3) a2 σy²)   (consistency)
+//! ```
+//!
+//! The default solver is a damped 2×2 Newton on (ε, δ); it needs no switch for
+//! a1 → 0. a1 = 0 (von Mises) uses the closed-form radial return. If Newton
+//! fails within [`MAX_NEWTON_ITERATIONS`], a bisection of the scalar residual
+//! r(ε) on the bracket between 0 and the pole of δ(ε) takes over.
+
+use crate::Real;
+use crate::constitutive::elastic;
+use crate::math;
+
+/// Newton iterations before the bisection fallback takes over.
+pub const MAX_NEWTON_ITERATIONS: u32 = 30;
+/// Relative step size at which Newton has converged.
+pub const NEWTON_STEP_TOL: Real = 1.0e-12;
+/// Largest |R2| accepted from the fallback before the update is declared
+/// non-converged.
+pub const FALLBACK_RESIDUAL_MAX: Real = 1.0e-6;
+/// Smallest admissible 1 + ε and 1 − 1.5ε during damped Newton steps.
+const STEP_FLOOR: Real = 0.05;
+/// Halvings of a Newton step before the damped step gives up on feasibility.
+const MAX_HALVINGS: u32 = 60;
+/// Bisection iterations (each halves the bracket; 200 exhaust f64).
+const MAX_BISECTIONS: u32 = 200;
+
+/// How the plastic corrector was solved.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ReturnMethod {
+    /// No return: the trial state was admissible.
+    Elastic,
+    /// Closed-form radial return (a1 = 0, von Mises).
+    RadialReturn,
+    /// Damped 2×2 Newton on (ε, δ).
+    Newton,
+    /// Bisection of r(ε) after Newton failed.
+    Bisection,
+}
+
+/// The trial-state scalars and coefficients that define the corrector.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ReturnMapSystem {
+    /// θtr = μ tr b^e,tr, Pa (> 0).
+    pub theta_tr: Real,
+    /// Trial elastic volume ratio J^e,tr (> 0).
+    pub je_tr: Real,
+    /// βtr = ‖dev τtr‖, Pa (≥ 0).
+    pub beta_tr: Real,
+    /// Yield-surface coefficient a1 ≥ 0.
+    pub a1: Real,
+    /// Yield scale (2/3) a2 σy², Pa² (> 0).
+    pub yield_scale: Real,
+    /// Lamé λ, Pa.
+    pub lambda: Real,
+    /// Shear modulus μ, Pa.
+    pub mu: Real,
+}
+
+/// A solution (or best iterate) of the corrector.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ReturnSolution {
+    /// ε = (4/3)γ a1 α; has the sign of α.
+    pub eps: Real,
+    /// δ = (4/3)γ θ ≥ 0.
+    pub delta: Real,
+    /// Newton iterations, plus bisection steps if the fallback ran.
+    pub iterations: u32,
+    /// Which solver produced it.
+    pub method: ReturnMethod,
+    /// Final consistency residual R2 = φ/((2/3)a2σy²).
+    pub residual: Real,
+}
+
+impl ReturnMapSystem {
+    /// θ(ε) = θtr/(1+ε), Pa.
+    #[inline]
+    pub fn theta(&self, eps: Real) -> Real {
+        self.theta_tr / (1.0 + eps)
+    }
+
+    /// J^e(ε) = (1 − 1.5ε) J^e,tr (backward-Euler update of J^p).
+    #[inline]
+    pub fn je(&self, eps: Real) -> Real {
+        (1.0 - 1.5 * eps) * self.je_tr
+    }
+
+    /// α(ε) = θ(ε) + h(J^e(ε)) = tr τ, Pa.
+    #[inline]
+    pub fn alpha(&self, eps: Real) -> Real {
+        self.theta(eps) + elastic::h_lame(self.lambda, self.mu, self.je(eps))
+    }
+
+    /// dα/dε, Pa.
+    #[inline]
+    pub fn dalpha(&self, eps: Real) -> Real {
+        -self.theta(eps) / (1.0 + eps) - 4.5 * self.lambda * (2.0 * self.je(eps) - 1.0) * self.je_tr
+    }
+
+    /// β = βtr/(1+ε+δ), Pa.
+    #[inline]
+    pub fn beta(&self, eps: Real, delta: Real) -> Real {
+        self.beta_tr / (1.0 + eps + delta)
+    }
+
+    /// Residuals [R1, R2] (both dimensionless; see the module docs).
+    pub fn residual(&self, eps: Real, delta: Real) -> [Real; 2] {
+        let alpha = self.alpha(eps);
+        let beta = self.beta(eps, delta);
+        [
+            (self.a1 * alpha * delta - eps * self.theta(eps)) / self.theta_tr,
+            (beta * beta + (self.a1 / 3.0) * alpha * alpha - self.yield_scale) / self.yield_scale,
+        ]
+    }
+
+    /// Jacobian `[[∂R1/∂ε, ∂R1/∂δ], [∂R2/∂ε, ∂R2/∂δ]]` of [`Self::residual`].
+    pub fn jacobian(&self, eps: Real, delta: Real) -> [[Real; 2]; 2] {
+        let alpha = self.alpha(eps);
+        let dalpha = self.dalpha(eps);
+        let beta = self.beta(eps, delta);
+        let d_beta2 = -2.0 * beta * beta / (1.0 + eps + delta);
+        [
+            [
+                (self.a1 * dalpha * delta - self.theta(eps) / (1.0 + eps)) / self.theta_tr,
+                self.a1 * alpha / self.theta_tr,
+            ],
+            [
+                (d_beta2 + (2.0 / 3.0) * self.a1 * alpha * dalpha) / self.yield_scale,
+                d_beta2 / self.yield_scale,
+            ],
+        ]
+    }
+
+    /// Solves the corrector: radial return for a1 = 0, otherwise damped
+    /// Newton with the bisection fallback. `Err` carries the best iterate
+    /// when neither reaches |R2| ≤ [`FALLBACK_RESIDUAL_MAX`].
+    pub fn solve(&self) -> Result<ReturnSolution, ReturnSolution> {
+        if self.a1 == 0.0 {
+            return Ok(self.radial_return());
+        }
+        let newton = self.newton();
+        match newton {
+            Ok(sol) => Ok(sol),
+            Err(best) => {
+                let mut sol = self.bisection().unwrap_or(best);
+                sol.iterations += best.iterations;
+                if math::abs(sol.residual) <= FALLBACK_RESIDUAL_MAX {
+                    Ok(sol)
+                } else {
+                    Err(sol)
+                }
+            }
+        }
+    }
+
+    /// Closed form for a1 = 0: ε = 0, β = √((2/3)a2)σy, δ = βtr/β − 1.
+    pub fn radial_return(&self) -> ReturnSolution {
+        let beta = math::sqrt(self.yield_scale);
+        let delta = self.beta_tr / beta - 1.0;
+        ReturnSolution {
+            eps: 0.0,
+            delta,
+            iterations: 0,
+            method: ReturnMethod::RadialReturn,
+            residual: self.residual(0.0, delta)[1],
+        }
+    }
+
+    /// Radial-return estimate of δ used as the Newton start.
+    fn delta_start(&self) -> Real {
+        let alpha = self.alpha(0.0);
+        let room = math::max(
+            self.yield_scale - (self.a1 / 3.0) * alpha * alpha,
+            0.01 * self.yield_scale,
+        );
+        math::max(0.0, self.beta_tr / math::sqrt(room) - 1.0)
+    }
+
+    fn feasible(eps: Real, delta: Real) -> bool {
+        1.0 + eps >= STEP_FLOOR && 1.0 - 1.5 * eps >= STEP_FLOOR && delta >= 0.0
+    }
+
+    /// Damped Newton from (0, δ0); `Err` holds the last iterate.
+    fn newton(&self) -> Result<ReturnSolution, ReturnSolution> {
+        let (mut eps, mut delta) = (0.0, self.delta_start());
+        let sol = |eps, delta, iterations, method| ReturnSolution {
+            eps,
+            delta,
+            iterations,
+            method,
+            residual: self.residual(eps, delta)[1],
+        };
+        for it in 1..=MAX_NEWTON_ITERATIONS {
+            let r = self.residual(eps, delta);
+            let j = self.jacobian(eps, delta);
+            let det = j[0][0] * j[1][1] - j[0][1] * j[1][0];
+            let de = -(j[1][1] * r[0] - j[0][1] * r[1]) / det;
+            let dd = -(j[0][0] * r[1] - j[1][0] * r[0]) / det;
+            if !(de.is_finite() && dd.is_finite()) {
+                return Err(sol(eps, delta, it, ReturnMethod::Newton));
+            }
+            let mut t = 1.0;
+            let mut halvings = 0;
+            while !Self::feasible(eps + t * de, delta + t * dd) && halvings < MAX_HALVINGS {
+                t *= 0.5;
+                halvings += 1;
+            }
+            eps += t * de;
+            delta = math::max(delta + t * dd, 0.0);
+            let converged = t == 1.0
+                && math::abs(de) < NEWTON_STEP_TOL * (1.0 + math::abs(eps))
+                && math::abs(dd) < NEWTON_STEP_TOL * (1.0 + delta);
+            if converged {
+                return Ok(sol(eps, delta, it, ReturnMethod::Newton));
+            }
+        }
+        Err(sol(eps, delta, MAX_NEWTON_ITERATIONS, ReturnMethod::Newton))
+    }
+
+    /// δ(ε) = εθ/(a1 α): the δ that satisfies R1 = 0 exactly.
+    fn delta_of(&self, eps: Real) -> Real {
+        eps * self.theta(eps) / (self.a1 * self.alpha(eps))
+    }
+
+    /// Scalar consistency residual r(ε)/((2/3)a2σy²) with δ = δ(ε).
+    fn scalar_residual(&self, eps: Real) -> Real {
+        self.residual(eps, self.delta_of(eps))[1]
+    }
+
+    /// Bisection of r(ε) between 0 and the pole ε_p of δ(ε) (the zero of α).
+    /// `None` when no bracket is found.
+    fn bisection(&self) -> Option<ReturnSolution> {
+        let pole = self.pole()?;
+        // r(0) = φtr > 0 and r → −1 (normalised) at the pole.
+        let (mut lo, mut hi) = (0.0, pole);
+        let mut iterations = 0;
+        while iterations < MAX_BISECTIONS {
+            let mid = 0.5 * (lo + hi);
+            if mid == lo || mid == hi {
+                break;
+            }
+            if self.scalar_residual(mid) > 0.0 {
+                lo = mid;
+            } else {
+                hi = mid;
+            }
+            iterations += 1;
+        }
+        // Keep the bracket end nearer the surface.
+        let eps = if math::abs(self.scalar_residual(lo)) <= math::abs(self.scalar_residual(hi)) {
+            lo
+        } else {
+            hi
+        };
+        Some(ReturnSolution {
+            eps,
+            delta: self.delta_of(eps),
+            iterations,
+            method: ReturnMethod::Bisection,
+            residual: self.scalar_residual(eps),
+        })
+    }
+
+    /// ε_p, the zero of α(ε) on the side of the sign of αtr, by bisection
+    /// inside the admissible domain −1 < ε < 2/3.
+    fn pole(&self) -> Option<Real> {
+        let alpha0 = self.alpha(0.0);
+        let limit = if alpha0 > 0.0 { 2.0 / 3.0 } else { -1.0 };
+        let (mut lo, mut hi) = (0.0, limit * (1.0 - 1.0e-12));
+        let product = alpha0 * self.alpha(hi);
+        if product.is_nan() || product >= 0.0 {
+            return None;
+        }
+        for _ in 0..MAX_BISECTIONS {
+            let mid = 0.5 * (lo + hi);
+            if mid == lo || mid == hi {
+                break;
+            }
+            if alpha0 * self.alpha(mid) > 0.0 {
+                lo = mid;
+            } else {
+                hi = mid;
+            }
+        }
+        // The open bracket end on the trial side, so that α ≠ 0 there.
+        Some(lo)
+    }
+}

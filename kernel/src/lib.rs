@@ -1,0 +1,30 @@
+#![no_std]
+//! # granbed-kernel
+//!
+//! The physics kernel of granbed, a combined finite/discrete element
+//! simulator of granule-bed die compaction. It is `#![no_std]` without an
+//! allocator: every routine works on caller-provided buffers and reports
+//! failures as values (errors or counted flags), never by panicking.
+//!
+//! Units are SI throughout, scalars are [`Real`] = `f64`, and every
+//! transcendental function goes through [`math`] (libm) so native and wasm
+//! builds agree bit for bit.
+//!
+//! Modules:
+//! * [`material`]: parameters, validation, the nine standard granule types;
+//! * [`constitutive`]: the finite-strain porous elastoplastic update;
+//! * [`material_point`]: one integration point driven along a load path;
+//! * [`tensor`]: 3×3 and symmetric (Voigt) tensor helpers;
+//! * [`math`]: the scalar functions.
+//!
+//! Slice-length policy: batch routines check every buffer length first and
+//! return an error naming the buffer; they never panic on lengths.
+
+/// The one scalar type of the kernel.
+pub type Real = f64;
+
+pub mod constitutive;
+pub mod material;
+pub mod material_point;
+pub mod math;
+pub mod tensor;

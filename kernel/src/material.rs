@@ -1,0 +1,313 @@
+//! Material parameters of a porous granule, their validation, and the nine
+//! standard granule types A1…C3.
+//!
+//! A granule is a porous, plastically deforming solid: compressible
+//! neo-Hookean elasticity (E, ν) and a density-dependent elliptic yield
+//! surface (σ_y, c_p, η_c) whose size depends on the relative density
+//! η = η0/J (physics.md §0–§1).
+
+use core::fmt;
+use core::str::FromStr;
+
+use crate::Real;
+
+/// User-facing material parameters, in SI units.
+///
+/// Build one from a preset with [`GranuleType::params`], edit fields, then call
+/// [`MaterialParams::validate`] to obtain the [`Material`] the kernel uses.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct MaterialParams {
+    /// Young's modulus E of the granule skeleton, Pa. Range: finite, > 0.
+    pub youngs_modulus_pa: Real,
+    /// Poisson's ratio ν. Range: −1 < ν < 0.5.
+    pub poisson_ratio: Real,
+    /// Yield stress σ_y of the solid (Kirchhoff measure), Pa.
+    /// Range: > 0; `+∞` makes the material purely elastic.
+    pub yield_stress_pa: Real,
+    /// Initial relative density η0 (solid fraction). Range: η_c < η0 ≤ 1.
+    pub eta0: Real,
+    /// Yield-surface constant c_p of a1(η) = c_p(1 − η²). Range: finite, ≥ 0.
+    pub cp: Real,
+    /// Critical relative density η_c where the yield surface vanishes.
+    /// Range: 0 ≤ η_c < 1.
+    pub eta_c: Real,
+    /// True (solid) density, kg/m³; the granule's density is η0 times this.
+    /// Range: finite, > 0.
+    pub true_density_kg_m3: Real,
+    /// Coulomb friction coefficient of the granule surface. Range: finite, ≥ 0.
+    pub friction: Real,
+}
+
+/// A rejected material parameter: which field, the value given and the
+/// allowed range.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ParamError {
+    /// Field name as in [`MaterialParams`].
+    pub field: &'static str,
+    /// The rejected value.
+    pub value: Real,
+    /// The allowed range, human readable.
+    pub allowed: &'static str,
+}
+
+impl fmt::Display for ParamError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(
+            f,
+            "invalid material parameter `{}` = {}: allowed range is {}",
+            self.field, self.value, self.allowed
+        )
+    }
+}
+
+impl core::error::Error for ParamError {}
+
+/// Validated parameters with the derived constants the update needs.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Material {
+    /// The parameters this was built from.
+    pub params: MaterialParams,
+    /// Lamé's first parameter λ = Eν/((1+ν)(1−2ν)), Pa.
+    pub lambda: Real,
+    /// Shear modulus μ = E/(2(1+ν)), Pa.
+    pub mu: Real,
+    /// Bulk modulus K = λ + 2μ/3, Pa.
+    pub bulk: Real,
+    /// Reference density ρ0 = η0·ρ_true, kg/m³.
+    pub density0: Real,
+}
+
+impl Material {
+    /// P-wave modulus λ + 2μ, Pa (sets the dilatational wave speed).
+    pub fn p_wave_modulus(&self) -> Real {
+        self.lambda + 2.0 * self.mu
+    }
+}
+
+fn check(
+    ok: bool,
+    field: &'static str,
+    value: Real,
+    allowed: &'static str,
+) -> Result<(), ParamError> {
+    if ok {
+        Ok(())
+    } else {
+        Err(ParamError {
+            field,
+            value,
+            allowed,
+        })
+    }
+}
+
+impl MaterialParams {
+    /// Checks every field against its documented range (NaN is always
+    /// rejected) and derives the elastic constants.
+    pub fn validate(&self) -> Result<Material, ParamError> {
+        let p = self;
+        check(
+            p.youngs_modulus_pa.is_finite() && p.youngs_modulus_pa > 0.0,
+            "youngs_modulus_pa",
+            p.youngs_modulus_pa,
+            "finite and > 0",
+        )?;
+        check(
+            p.poisson_ratio > -1.0 && p.poisson_ratio < 0.5,
+            "poisson_ratio",
+            p.poisson_ratio,
+            "-1 < nu < 0.5",
+        )?;
+        check(
+            p.yield_stress_pa > 0.0,
+            "yield_stress_pa",
+            p.yield_stress_pa,
+            "> 0 (+inf for a purely elastic material)",
+        )?;
+        check(
+            p.eta_c >= 0.0 && p.eta_c < 1.0,
+            "eta_c",
+            p.eta_c,
+            "0 <= eta_c < 1",
+        )?;
+        check(
+            p.eta0 > p.eta_c && p.eta0 <= 1.0,
+            "eta0",
+            p.eta0,
+            "eta_c < eta0 <= 1",
+        )?;
+        check(
+            p.cp.is_finite() && p.cp >= 0.0,
+            "cp",
+            p.cp,
+            "finite and >= 0",
+        )?;
+        check(
+            p.true_density_kg_m3.is_finite() && p.true_density_kg_m3 > 0.0,
+            "true_density_kg_m3",
+            p.true_density_kg_m3,
+            "finite and > 0",
+        )?;
+        check(
+            p.friction.is_finite() && p.friction >= 0.0,
+            "friction",
+            p.friction,
+            "finite and >= 0",
+        )?;
+        let (e, nu) = (p.youngs_modulus_pa, p.poisson_ratio);
+        let lambda = e * nu / ((1.0 + nu) * (1.0 - 2.0 * nu));
+        let mu = e / (2.0 * (1.0 + nu));
+        Ok(Material {
+            params: *p,
+            lambda,
+            mu,
+            bulk: lambda + 2.0 * mu / 3.0,
+            density0: p.eta0 * p.true_density_kg_m3,
+        })
+    }
+}
+
+/// The nine standard granule types of the published study: the letter sets
+/// the yield stress (A 10 kPa, B 30 kPa, C 100 kPa), the digit the initial
+/// relative density (1: 0.6, 2: 0.8, 3: 1.0).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+#[allow(missing_docs)]
+pub enum GranuleType {
+    A1,
+    A2,
+    A3,
+    B1,
+    B2,
+    B3,
+    C1,
+    C2,
+    C3,
+}
+
+impl GranuleType {
+    /// All nine types in the order A1, A2, …, C3.
+    pub const ALL: [GranuleType; 9] = [
+        GranuleType::A1,
+        GranuleType::A2,
+        GranuleType::A3,
+        GranuleType::B1,
+        GranuleType::B2,
+        GranuleType::B3,
+        GranuleType::C1,
+        GranuleType::C2,
+        GranuleType::C3,
+    ];
+
+    /// The type's name, e.g. `"B2"`.
+    pub fn name(self) -> &'static str {
+        const NAMES: [&str; 9] = ["A1", "A2", "A3", "B1", "B2", "B3", "C1", "C2", "C3"];
+        NAMES[self as usize]
+    }
+
+    /// Yield stress σ_y of the type, Pa.
+    pub fn yield_stress_pa(self) -> Real {
+        [10.0e3, 30.0e3, 100.0e3][self as usize / 3]
+    }
+
+    /// Initial relative density η0 of the type.
+    pub fn eta0(self) -> Real {
+        [0.6, 0.8, 1.0][self as usize % 3]
+    }
+
+    /// The preset parameters: σ_y and η0 of the type; E = 1 MPa, ν = 0.3,
+    /// c_p = 0.3, η_c = 0.2, ρ_true = 1500 kg/m³, friction 0.1.
+    pub fn params(self) -> MaterialParams {
+        MaterialParams {
+            youngs_modulus_pa: 1.0e6,
+            poisson_ratio: 0.3,
+            yield_stress_pa: self.yield_stress_pa(),
+            eta0: self.eta0(),
+            cp: 0.3,
+            eta_c: 0.2,
+            true_density_kg_m3: 1500.0,
+            friction: 0.1,
+        }
+    }
+}
+
+impl fmt::Display for GranuleType {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+/// An unknown granule type name.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct UnknownGranuleType;
+
+impl fmt::Display for UnknownGranuleType {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str("unknown granule type: expected one of A1, A2, A3, B1, B2, B3, C1, C2, C3")
+    }
+}
+
+impl core::error::Error for UnknownGranuleType {}
+
+impl FromStr for GranuleType {
+    type Err = UnknownGranuleType;
+
+    /// Parses `"A1"` … `"C3"` (case-insensitive).
+    fn from_str(s: &str) -> Result<Self, Self::Err> {
+        GranuleType::ALL
+            .into_iter()
+            .find(|t| t.name().eq_ignore_ascii_case(s))
+            .ok_or(UnknownGranuleType)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn presets_give_the_published_elastic_constants() {
+        let m = GranuleType::B2.params().validate().unwrap();
+        assert!((m.lambda - 576.923e3).abs() < 1.0);
+        assert!((m.mu - 384.615e3).abs() < 1.0);
+        assert!((m.bulk - 833.333e3).abs() < 1.0);
+        assert_eq!(m.density0, 1200.0);
+        assert_eq!("c3".parse::<GranuleType>(), Ok(GranuleType::C3));
+        assert_eq!(GranuleType::A2.yield_stress_pa(), 10.0e3);
+        assert_eq!(GranuleType::A2.eta0(), 0.8);
+    }
+
+    #[test]
+    fn bad_fields_are_named() {
+        let base = GranuleType::A1.params();
+        let cases: [(MaterialParams, &str); 6] = [
+            (MaterialParams { eta0: 0.2, ..base }, "eta0"),
+            (
+                MaterialParams {
+                    poisson_ratio: 0.5,
+                    ..base
+                },
+                "poisson_ratio",
+            ),
+            (
+                MaterialParams {
+                    youngs_modulus_pa: 0.0,
+                    ..base
+                },
+                "youngs_modulus_pa",
+            ),
+            (
+                MaterialParams {
+                    yield_stress_pa: Real::NAN,
+                    ..base
+                },
+                "yield_stress_pa",
+            ),
+            (MaterialParams { eta0: 1.01, ..base }, "eta0"),
+            (MaterialParams { cp: -0.1, ..base }, "cp"),
+        ];
+        for (p, field) in cases {
+            assert_eq!(p.validate().unwrap_err().field, field);
+        }
+        assert_eq!("D1".parse::<GranuleType>(), Err(UnknownGranuleType));
+    }
+}

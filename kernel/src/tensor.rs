@@ -1,0 +1,172 @@
+//! Second-order tensors in 3-D: full matrices and symmetric tensors in Voigt
+//! storage.
+//!
+//! * [`Mat3`] is a general 3×3 tensor (deformation gradient `F`, rotations),
+//!   `m[(i, j)]` is the component in row `i`, column `j`.
+//! * [`Voigt`] stores a symmetric tensor as six numbers in the order
+//!   `[xx, yy, zz, yz, xz, xy]` (indices [`XX`] … [`XY`]); shear components are
+//!   stored once, without a factor 2.
+
+use crate::{Real, math};
+
+/// General 3×3 tensor.
+pub type Mat3 = nalgebra::Matrix3<Real>;
+
+/// Symmetric tensor in Voigt order `[xx, yy, zz, yz, xz, xy]`.
+pub type Voigt = [Real; 6];
+
+/// Voigt index of the xx component.
+pub const XX: usize = 0;
+/// Voigt index of the yy component.
+pub const YY: usize = 1;
+/// Voigt index of the zz component.
+pub const ZZ: usize = 2;
+/// Voigt index of the yz component.
+pub const YZ: usize = 3;
+/// Voigt index of the xz component.
+pub const XZ: usize = 4;
+/// Voigt index of the xy component.
+pub const XY: usize = 5;
+
+/// The identity in Voigt storage.
+pub const VOIGT_IDENTITY: Voigt = [1.0, 1.0, 1.0, 0.0, 0.0, 0.0];
+
+/// Full symmetric matrix from Voigt storage.
+#[inline]
+pub fn mat_from_voigt(v: &Voigt) -> Mat3 {
+    Mat3::new(
+        v[XX], v[XY], v[XZ], //
+        v[XY], v[YY], v[YZ], //
+        v[XZ], v[YZ], v[ZZ],
+    )
+}
+
+/// Voigt storage of the symmetric part of `m`, `(m + mᵀ)/2`.
+#[inline]
+pub fn voigt_from_mat(m: &Mat3) -> Voigt {
+    [
+        m[(0, 0)],
+        m[(1, 1)],
+        m[(2, 2)],
+        0.5 * (m[(1, 2)] + m[(2, 1)]),
+        0.5 * (m[(0, 2)] + m[(2, 0)]),
+        0.5 * (m[(0, 1)] + m[(1, 0)]),
+    ]
+}
+
+/// Trace of a symmetric tensor.
+#[inline]
+pub fn trace(v: &Voigt) -> Real {
+    v[XX] + v[YY] + v[ZZ]
+}
+
+/// Deviator `v − (tr v / 3) 1`.
+#[inline]
+pub fn deviator(v: &Voigt) -> Voigt {
+    let m = trace(v) / 3.0;
+    [v[XX] - m, v[YY] - m, v[ZZ] - m, v[YZ], v[XZ], v[XY]]
+}
+
+/// Double contraction `a : b` of two symmetric tensors.
+#[inline]
+pub fn ddot(a: &Voigt, b: &Voigt) -> Real {
+    a[XX] * b[XX]
+        + a[YY] * b[YY]
+        + a[ZZ] * b[ZZ]
+        + 2.0 * (a[YZ] * b[YZ] + a[XZ] * b[XZ] + a[XY] * b[XY])
+}
+
+/// Frobenius norm `√(v : v)` of a symmetric tensor.
+#[inline]
+pub fn norm(v: &Voigt) -> Real {
+    math::sqrt(ddot(v, v))
+}
+
+/// Determinant of a symmetric tensor.
+#[inline]
+pub fn det(v: &Voigt) -> Real {
+    v[XX] * (v[YY] * v[ZZ] - v[YZ] * v[YZ]) - v[XY] * (v[XY] * v[ZZ] - v[YZ] * v[XZ])
+        + v[XZ] * (v[XY] * v[YZ] - v[YY] * v[XZ])
+}
+
+/// `a·v + b·1` for a symmetric `v`.
+#[inline]
+pub fn scale_add_identity(v: &Voigt, a: Real, b: Real) -> Voigt {
+    [
+        a * v[XX] + b,
+        a * v[YY] + b,
+        a * v[ZZ] + b,
+        a * v[YZ],
+        a * v[XZ],
+        a * v[XY],
+    ]
+}
+
+/// Push-forward `F S Fᵀ` of a symmetric `S`, returned symmetric.
+#[inline]
+pub fn push_forward(f: &Mat3, s: &Voigt) -> Voigt {
+    voigt_from_mat(&(f * mat_from_voigt(s) * f.transpose()))
+}
+
+/// Inverse of `m` given its (non-zero) determinant, by cofactors.
+///
+/// The caller has checked `det ≠ 0`; no pivoting or rank test is done.
+#[inline]
+pub fn inverse_with_det(m: &Mat3, det: Real) -> Mat3 {
+    let c = |i: usize, j: usize| m[(i, j)];
+    let inv_det = 1.0 / det;
+    Mat3::new(
+        (c(1, 1) * c(2, 2) - c(1, 2) * c(2, 1)) * inv_det,
+        (c(0, 2) * c(2, 1) - c(0, 1) * c(2, 2)) * inv_det,
+        (c(0, 1) * c(1, 2) - c(0, 2) * c(1, 1)) * inv_det,
+        (c(1, 2) * c(2, 0) - c(1, 0) * c(2, 2)) * inv_det,
+        (c(0, 0) * c(2, 2) - c(0, 2) * c(2, 0)) * inv_det,
+        (c(0, 2) * c(1, 0) - c(0, 0) * c(1, 2)) * inv_det,
+        (c(1, 0) * c(2, 1) - c(1, 1) * c(2, 0)) * inv_det,
+        (c(0, 1) * c(2, 0) - c(0, 0) * c(2, 1)) * inv_det,
+        (c(0, 0) * c(1, 1) - c(0, 1) * c(1, 0)) * inv_det,
+    )
+}
+
+/// Determinant of a general 3×3 tensor (cofactor expansion along row 0).
+#[inline]
+pub fn det_mat(m: &Mat3) -> Real {
+    m[(0, 0)] * (m[(1, 1)] * m[(2, 2)] - m[(1, 2)] * m[(2, 1)])
+        - m[(0, 1)] * (m[(1, 0)] * m[(2, 2)] - m[(1, 2)] * m[(2, 0)])
+        + m[(0, 2)] * (m[(1, 0)] * m[(2, 1)] - m[(1, 1)] * m[(2, 0)])
+}
+
+/// Kirchhoff pressure `p = −tr τ / 3` (positive in compression), Pa.
+#[inline]
+pub fn pressure(tau: &Voigt) -> Real {
+    -trace(tau) / 3.0
+}
+
+/// Von Mises equivalent stress `√(3/2) ‖dev s‖` of a symmetric stress, Pa.
+#[inline]
+pub fn von_mises(s: &Voigt) -> Real {
+    math::sqrt(1.5) * norm(&deviator(s))
+}
+
+/// Cauchy stress `σ = τ / J` from Kirchhoff stress `τ` and `J = det F`.
+#[inline]
+pub fn cauchy_from_kirchhoff(tau: &Voigt, j: Real) -> Voigt {
+    scale_add_identity(tau, 1.0 / j, 0.0)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn voigt_round_trip_and_det_match_nalgebra() {
+        let v = [1.3, 0.7, 2.1, 0.11, -0.23, 0.31];
+        let m = mat_from_voigt(&v);
+        assert_eq!(voigt_from_mat(&m), v);
+        assert!((det(&v) - m.determinant()).abs() < 1e-14);
+        assert!((det_mat(&m) - m.determinant()).abs() < 1e-14);
+        let inv = inverse_with_det(&m, det_mat(&m));
+        assert!((inv * m - Mat3::identity()).norm() < 1e-14);
+        assert!((norm(&v) - m.norm()).abs() < 1e-14);
+    }
+}

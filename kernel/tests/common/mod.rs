@@ -1,0 +1,81 @@
+//! Shared helpers of the kernel's test suites: one tolerance check, a seeded
+//! generator, and independent (test-side) formulas of the yield surface.
+#![allow(dead_code)]
+
+use granbed_kernel::Real;
+use granbed_kernel::material::{GranuleType, Material, MaterialParams};
+use granbed_kernel::tensor::{Mat3, Voigt, deviator, norm, trace};
+
+/// Asserts |actual − expected| ≤ abs + rel·|expected|, naming the quantity.
+#[track_caller]
+pub fn assert_close(what: &str, actual: Real, expected: Real, rel: Real, abs: Real) {
+    let err = (actual - expected).abs();
+    let tol = abs + rel * expected.abs();
+    assert!(
+        err <= tol,
+        "{what}: got {actual:.16e}, expected {expected:.16e} (|err| = {err:.3e} > tol = {tol:.3e})"
+    );
+}
+
+/// SplitMix64: a tiny seeded generator, so every test history is reproducible.
+pub struct Rng(u64);
+
+impl Rng {
+    pub fn new(seed: u64) -> Self {
+        Self(seed)
+    }
+    pub fn next_u64(&mut self) -> u64 {
+        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
+        let mut z = self.0;
+        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+        z ^ (z >> 31)
+    }
+    /// Uniform in [lo, hi).
+    pub fn uniform(&mut self, lo: Real, hi: Real) -> Real {
+        lo + (hi - lo) * ((self.next_u64() >> 11) as Real / (1u64 << 53) as Real)
+    }
+    /// 3×3 matrix with entries uniform in [−a, a).
+    pub fn matrix(&mut self, a: Real) -> Mat3 {
+        Mat3::from_fn(|_, _| self.uniform(-a, a))
+    }
+    /// A rotation with angle up to π about a random axis.
+    pub fn rotation(&mut self) -> Mat3 {
+        let axis = nalgebra::Vector3::new(
+            self.uniform(-1.0, 1.0),
+            self.uniform(-1.0, 1.0),
+            self.uniform(-1.0, 1.0),
+        );
+        let angle = self.uniform(-3.1, 3.1);
+        *nalgebra::Rotation3::from_axis_angle(&nalgebra::Unit::new_normalize(axis), angle).matrix()
+    }
+}
+
+pub fn material(t: GranuleType) -> Material {
+    t.params().validate().expect("preset is valid")
+}
+
+pub fn material_with(p: MaterialParams) -> Material {
+    p.validate().expect("test parameters are valid")
+}
+
+/// a1(η), a2(η) written out independently of the kernel (physics.md §1.1).
+pub fn a1_a2(p: &MaterialParams, eta: Real) -> (Real, Real) {
+    if eta >= 1.0 {
+        (0.0, 1.0)
+    } else {
+        (
+            p.cp * (1.0 - eta * eta),
+            (eta * eta - p.eta_c * p.eta_c) / (1.0 - p.eta_c * p.eta_c),
+        )
+    }
+}
+
+/// φ(τ, η)/((2/3)a2σy²) computed from the stress alone.
+pub fn normalised_phi(p: &MaterialParams, tau: &Voigt, j: Real) -> Real {
+    let (a1, a2) = a1_a2(p, p.eta0 / j);
+    let scale = 2.0 / 3.0 * a2 * p.yield_stress_pa * p.yield_stress_pa;
+    let beta = norm(&deviator(tau));
+    let alpha = trace(tau);
+    (beta * beta + a1 / 3.0 * alpha * alpha - scale) / scale
+}

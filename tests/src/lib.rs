@@ -1,0 +1,1 @@
+//! Cross-crate validation suites of granbed; the suites are in `tests/`.
