@@ -92,3 +92,74 @@ pub fn update_points(
     }
     Ok(plastic)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::constitutive::ReturnMethod;
+    use crate::material::GranuleType;
+    use crate::tensor::VOIGT_IDENTITY;
+
+    fn blank_info() -> UpdateInfo {
+        let mut state = VOIGT_IDENTITY;
+        let mat = GranuleType::B2.params().validate().unwrap();
+        update_point(
+            &mat,
+            &UpdateOptions::default(),
+            &Mat3::identity(),
+            &mut state,
+        )
+        .unwrap()
+        .info
+    }
+
+    #[test]
+    fn batch_matches_single_points_and_reports_the_failing_index() {
+        let mat = GranuleType::B1.params().validate().unwrap();
+        let opts = UpdateOptions::default();
+        let f = [
+            Mat3::identity() * 0.95,
+            Mat3::from_diagonal(&[1.0, 1.0, 0.9].into()),
+            Mat3::identity() * -1.0,
+        ];
+        let mut c = [VOIGT_IDENTITY; 3];
+        let mut tau = [[0.0; 6]; 3];
+        let mut info = [blank_info(); 3];
+        let err = update_points(&mat, &opts, &f, &mut c, &mut tau, &mut info).unwrap_err();
+        assert!(matches!(
+            err,
+            BatchError::Point {
+                index: 2,
+                error: UpdateError::InvertedDeformation { .. }
+            }
+        ));
+        assert_eq!(c[2], VOIGT_IDENTITY);
+        let plastic = update_points(
+            &mat,
+            &opts,
+            &f[..2],
+            &mut [VOIGT_IDENTITY; 2],
+            &mut tau[..2],
+            &mut info[..2],
+        )
+        .unwrap();
+        assert_eq!(plastic, 2);
+        for k in 0..2 {
+            let mut s = VOIGT_IDENTITY;
+            assert_eq!(
+                update_point(&mat, &opts, &f[k], &mut s).unwrap().tau,
+                tau[k]
+            );
+            assert_ne!(info[k].method, ReturnMethod::Elastic);
+        }
+        let short = update_points(&mat, &opts, &f, &mut c[..2], &mut tau, &mut info);
+        assert_eq!(
+            short,
+            Err(BatchError::Length {
+                buffer: "cp_inv",
+                expected: 3,
+                got: 2
+            })
+        );
+    }
+}
