@@ -14,6 +14,8 @@
 //! * [`material`]: parameters, validation, the nine standard granule types;
 //! * [`constitutive`]: the finite-strain porous elastoplastic update;
 //! * [`material_point`]: one integration point driven along a load path;
+//! * [`mesh`]: the cubed-sphere reference mesh of a granule;
+//! * [`element`]: the 8-node hexahedron;
 //! * [`tensor`]: 3×3 and symmetric (Voigt) tensor helpers;
 //! * [`math`]: the scalar functions.
 //!
@@ -24,7 +26,9 @@
 pub type Real = f64;
 
 pub mod constitutive;
+pub mod element;
 pub mod material;
 pub mod material_point;
 pub mod math;
+pub mod mesh;
 pub mod tensor;

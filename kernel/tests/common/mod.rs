@@ -79,3 +79,44 @@ pub fn normalised_phi(p: &MaterialParams, tau: &Voigt, j: Real) -> Real {
     let alpha = trace(tau);
     (beta * beta + a1 / 3.0 * alpha * alpha - scale) / scale
 }
+
+/// A generated sphere mesh in owned buffers (test side only: the kernel
+/// itself never allocates).
+pub struct OwnedMesh {
+    pub size: granbed_kernel::mesh::sphere::MeshSize,
+    pub positions: Vec<[Real; 3]>,
+    pub hexes: Vec<[u32; 8]>,
+    pub quads: Vec<[u32; 4]>,
+    pub node_quads: Vec<[u32; 4]>,
+}
+
+pub fn sphere_mesh(p: &granbed_kernel::mesh::sphere::SphereMeshParams) -> OwnedMesh {
+    use granbed_kernel::mesh::sphere::{MeshBuffers, generate};
+    let size = p.size().expect("valid resolution");
+    let mut mesh = OwnedMesh {
+        size,
+        positions: vec![[0.0; 3]; size.nodes],
+        hexes: vec![[0; 8]; size.hexes],
+        quads: vec![[0; 4]; size.quads],
+        node_quads: vec![[0; 4]; size.surface_nodes],
+    };
+    let mut scratch = vec![0; size.scratch];
+    generate(
+        p,
+        &mut MeshBuffers {
+            positions: &mut mesh.positions,
+            hexes: &mut mesh.hexes,
+            quads: &mut mesh.quads,
+            node_quads: &mut mesh.node_quads,
+            scratch: &mut scratch,
+        },
+    )
+    .expect("mesh generates");
+    mesh
+}
+
+impl OwnedMesh {
+    pub fn hex_coords(&self, e: usize) -> [[Real; 3]; 8] {
+        core::array::from_fn(|i| self.positions[self.hexes[e][i] as usize])
+    }
+}
