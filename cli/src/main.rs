@@ -1,2 +1,24 @@
-//! granbed-cli placeholder.
-fn main() {}
+//! `granbed-cli`: the command-line driver of granbed.
+//!
+//! A thin shell over the `granbed_cli` library: see its docs for the
+//! commands and the exit statuses (0 success, 1 runtime failure, 2 usage or
+//! validation error).
+
+use std::io;
+use std::process::ExitCode;
+
+fn main() -> ExitCode {
+    match run() {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(err) => ExitCode::from(granbed_cli::error::report(&err, &mut io::stderr().lock())),
+    }
+}
+
+/// Runs this process's command line on its standard streams.
+fn run() -> anyhow::Result<()> {
+    granbed_cli::run(
+        std::env::args_os(),
+        &mut io::stdout().lock(),
+        &mut io::stderr().lock(),
+    )
+}

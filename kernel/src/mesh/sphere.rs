@@ -55,8 +55,12 @@ impl SphereMeshParams {
     /// Buffer sizes this mesh needs, or an error for an invalid resolution.
     pub fn size(&self) -> Result<MeshSize, MeshError> {
         let (n, m) = (self.n as usize, self.m as usize);
-        let ok = self.n % 2 == 0 && (2..=64).contains(&self.n) && (1..=32).contains(&self.m);
-        if !ok || !(self.radius > 0.0 && self.radius.is_finite()) {
+        let ok = self.n.is_multiple_of(2)
+            && (2..=64).contains(&self.n)
+            && (1..=32).contains(&self.m)
+            && self.radius > 0.0
+            && self.radius.is_finite();
+        if !ok {
             return Err(MeshError::InvalidResolution {
                 n: self.n,
                 m: self.m,
@@ -321,7 +325,8 @@ fn orient(x: &[[Real; 3]], ids: [u32; 8], element: usize) -> Result<[u32; 8], Me
     };
     let coords = gather(x, &ids);
     for corner in 0..8 {
-        if !(hex8::corner_scaled_jacobian(&coords, corner) > 0.0) {
+        let scaled = hex8::corner_scaled_jacobian(&coords, corner);
+        if scaled.is_nan() || scaled <= 0.0 {
             return Err(MeshError::InvertedElement { element, corner });
         }
     }
