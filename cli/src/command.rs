@@ -1,0 +1,39 @@
+//! The top-level command line: [`Cli`] and its subcommands [`Command`].
+//!
+//! A new subcommand (`granule`, `pack`, `bed`) is a variant of [`Command`]
+//! holding its clap `Args` struct from its own module, plus one arm in
+//! [`Command::run`].
+
+use clap::{Parser, Subcommand};
+
+use crate::output::Streams;
+use crate::point::PointArgs;
+
+/// granbed: a combined finite/discrete element simulator of granule-bed die
+/// compaction.
+///
+/// Units are SI throughout; strains are positive in compression.
+#[derive(Parser, Debug)]
+#[command(name = "granbed-cli", version)]
+pub struct Cli {
+    /// What to run.
+    #[command(subcommand)]
+    pub command: Command,
+}
+
+/// The subcommands.
+#[derive(Subcommand, Debug)]
+pub enum Command {
+    /// Drive one material point along a deformation path and write its
+    /// stress history as CSV (calibration of material parameters).
+    Point(PointArgs),
+}
+
+impl Command {
+    /// Runs the subcommand on `streams`.
+    pub fn run(&self, streams: &mut Streams<'_>) -> anyhow::Result<()> {
+        match self {
+            Self::Point(args) => args.run(streams),
+        }
+    }
+}

@@ -1,0 +1,58 @@
+//! # granbed-cli
+//!
+//! The command-line driver of granbed. Everything lives in this library; the
+//! binary (`src/main.rs`) only hands the process's arguments and standard
+//! streams to [`run`] and maps a failure to an exit status with
+//! [`error::report`], so the test suites drive exactly the code a user runs.
+//!
+//! Modules:
+//! * [`command`]: the top-level parser [`Cli`] and its subcommands;
+//! * [`point`]: `granbed-cli point`, the material-point explorer;
+//! * [`material_args`]: `--type` and the material-parameter overrides;
+//! * [`output`]: the standard streams and `--out` destinations;
+//! * [`csv`]: a small CSV writer with round-trip exact floats;
+//! * [`error`]: usage errors and the exit-status mapping.
+//!
+//! Exit status: 0 success (and `--help`, `--version`), 1 runtime failure
+//! (kernel error, I/O error), 2 usage or validation error (unknown flag, bad
+//! value, parameter out of range).
+
+use std::ffi::OsString;
+use std::io::Write;
+
+use clap::Parser;
+
+pub mod command;
+pub mod csv;
+pub mod error;
+pub mod material_args;
+pub mod output;
+pub mod point;
+
+pub use command::{Cli, Command};
+pub use output::Streams;
+
+/// Parses `args` (the first item is the program name, as in
+/// [`std::env::args_os`]) and runs the command.
+///
+/// Results go to `stdout` (or the command's `--out` file), the summary and
+/// diagnostics to `stderr`. `--help` and `--version` print to `stdout` and
+/// succeed. A failure is returned, not printed: pass it to
+/// [`error::report`] for the message and the exit status.
+pub fn run<I, T>(args: I, stdout: &mut dyn Write, stderr: &mut dyn Write) -> anyhow::Result<()>
+where
+    I: IntoIterator<Item = T>,
+    T: Into<OsString> + Clone,
+{
+    let cli = match Cli::try_parse_from(args) {
+        Ok(cli) => cli,
+        // --help and --version arrive as "errors" meant for stdout.
+        Err(e) if !e.use_stderr() => {
+            write!(stdout, "{}", e.render())?;
+            stdout.flush()?;
+            return Ok(());
+        }
+        Err(e) => return Err(e.into()),
+    };
+    cli.command.run(&mut Streams { stdout, stderr })
+}

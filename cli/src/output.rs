@@ -1,0 +1,74 @@
+//! The standard streams a command writes to, and `--out` destinations.
+
+use std::fs::File;
+use std::io::{BufWriter, Write};
+use std::path::Path;
+
+use anyhow::Context as _;
+
+/// The standard streams of a run: results (when not sent to a file) go to
+/// `stdout`; summaries and diagnostics to `stderr`.
+pub struct Streams<'a> {
+    /// Standard output.
+    pub stdout: &'a mut dyn Write,
+    /// Standard error.
+    pub stderr: &'a mut dyn Write,
+}
+
+/// A buffered result destination: a file, or standard output.
+///
+/// Dropping it does not report write errors: call [`Output::finish`] (or
+/// `flush`) before reporting success.
+pub struct Output<'a> {
+    /// Human-readable name for messages: the path, or `stdout`.
+    name: String,
+    writer: BufWriter<Box<dyn Write + 'a>>,
+}
+
+impl<'a> Output<'a> {
+    /// Opens the `--out` destination: `None` or `-` is `stdout`, anything
+    /// else a file created (or truncated) at that path.
+    pub fn open(path: Option<&Path>, stdout: &'a mut dyn Write) -> anyhow::Result<Self> {
+        match path {
+            None => Ok(Self::stdout(stdout)),
+            Some(p) if p == Path::new("-") => Ok(Self::stdout(stdout)),
+            Some(p) => {
+                let file = File::create(p)
+                    .with_context(|| format!("cannot create output file `{}`", p.display()))?;
+                Ok(Self {
+                    name: format!("`{}`", p.display()),
+                    writer: BufWriter::new(Box::new(file)),
+                })
+            }
+        }
+    }
+
+    fn stdout(stdout: &'a mut dyn Write) -> Self {
+        Self {
+            name: "stdout".to_owned(),
+            writer: BufWriter::new(Box::new(stdout)),
+        }
+    }
+
+    /// The destination's name for messages: a quoted path or `stdout`.
+    pub fn name(&self) -> &str {
+        &self.name
+    }
+
+    /// Flushes everything written so far to the destination.
+    pub fn finish(&mut self) -> anyhow::Result<()> {
+        self.writer
+            .flush()
+            .with_context(|| format!("cannot write to {}", self.name))
+    }
+}
+
+impl Write for Output<'_> {
+    fn write(&mut self, buf: &[u8]) -> std::io::Result<usize> {
+        self.writer.write(buf)
+    }
+
+    fn flush(&mut self) -> std::io::Result<()> {
+        self.writer.flush()
+    }
+}
