@@ -16,6 +16,9 @@
 //! * [`material_point`]: one integration point driven along a load path;
 //! * [`mesh`]: the cubed-sphere reference mesh of a granule;
 //! * [`element`]: the 8-node hexahedron;
+//! * [`granule`]: element loop, damping and time step of one granule;
+//! * [`contact`]: contact with rigid walls;
+//! * [`scene`]: complete experiments (single granule between platens);
 //! * [`tensor`]: 3×3 and symmetric (Voigt) tensor helpers;
 //! * [`math`]: the scalar functions.
 //!
@@ -26,9 +29,12 @@
 pub type Real = f64;
 
 pub mod constitutive;
+pub mod contact;
 pub mod element;
+pub mod granule;
 pub mod material;
 pub mod material_point;
 pub mod math;
 pub mod mesh;
+pub mod scene;
 pub mod tensor;

@@ -31,7 +31,8 @@ pub fn dh(mat: &Material, je: Real) -> Real {
 /// Cauchy–Green tensor `be` (dimensionless, Voigt) with `je = √det b^e`.
 #[inline]
 pub fn kirchhoff(mat: &Material, be: &Voigt, je: Real) -> Voigt {
-    scale_add_identity(be, mat.mu, h(mat, je) / 3.0)
+    // h/3 written out, so that b^e = 1 gives exactly τ = 0.
+    scale_add_identity(be, mat.mu, mat.lambda * je * (je - 1.0) - mat.mu)
 }
 
 /// Stored energy density ψ(b^e, J^e), J per m³ of reference volume.

@@ -1,7 +1,9 @@
 //! Hexahedral finite elements.
 //!
+//! * [`force`]: nodal forces of the one-point element with hourglass control;
 //! * [`hex8`]: node ordering, shape functions, Jacobians;
-//! * [`reference`]: per-element reference data (V0, B0, γ0, lumped volumes).
+//! * [`reference`](mod@reference): per-element reference data (V0, B0, γ0, lumped volumes).
 
+pub mod force;
 pub mod hex8;
 pub mod reference;

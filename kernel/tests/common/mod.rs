@@ -120,3 +120,131 @@ impl OwnedMesh {
         core::array::from_fn(|i| self.positions[self.hexes[e][i] as usize])
     }
 }
+
+/// A reference mesh (full or octant) with its element data, owned.
+pub struct OwnedReference {
+    pub positions: Vec<[Real; 3]>,
+    pub hexes: Vec<[u32; 8]>,
+    pub quads: Vec<[u32; 4]>,
+    pub node_quads: Vec<[u32; 4]>,
+    pub surface_nodes: usize,
+    pub elements: Vec<granbed_kernel::element::reference::HexReference>,
+    pub node_volume: Vec<Real>,
+}
+
+pub fn reference_mesh(n: u32, m: u32, octant: bool) -> OwnedReference {
+    use granbed_kernel::mesh::octant::{MeshView, extract_octant, octant_size};
+    use granbed_kernel::mesh::reference::compute_element_data;
+    use granbed_kernel::mesh::sphere::{MeshBuffers, SphereMeshParams};
+    let full = sphere_mesh(&SphereMeshParams::new(0.5e-3, n, m));
+    let (positions, hexes, quads, node_quads, surface_nodes) = if octant {
+        let view = MeshView {
+            positions: &full.positions,
+            hexes: &full.hexes,
+            quads: &full.quads,
+            surface_nodes: full.size.surface_nodes,
+        };
+        let s = octant_size(&view);
+        let mut p = vec![[0.0; 3]; s.nodes];
+        let mut h = vec![[0; 8]; s.hexes];
+        let mut q = vec![[0; 4]; s.quads];
+        let mut nq = vec![[0; 4]; s.surface_nodes];
+        let mut scratch = vec![0; s.scratch];
+        extract_octant(
+            &view,
+            &mut MeshBuffers {
+                positions: &mut p,
+                hexes: &mut h,
+                quads: &mut q,
+                node_quads: &mut nq,
+                scratch: &mut scratch,
+            },
+        )
+        .unwrap();
+        (p, h, q, nq, s.surface_nodes)
+    } else {
+        let s = full.size.surface_nodes;
+        (full.positions, full.hexes, full.quads, full.node_quads, s)
+    };
+    let view = MeshView {
+        positions: &positions,
+        hexes: &hexes,
+        quads: &quads,
+        surface_nodes,
+    };
+    let mut elements = vec![
+        granbed_kernel::element::reference::hex_reference(&[[0.0; 3]; 8])
+            .unwrap_or_else(|| {
+                granbed_kernel::element::reference::hex_reference(
+                    &granbed_kernel::element::hex8::NODE_SIGNS,
+                )
+                .unwrap()
+            });
+        hexes.len()
+    ];
+    let mut node_volume = vec![0.0; positions.len()];
+    compute_element_data(&view, &mut elements, &mut node_volume).unwrap();
+    OwnedReference {
+        positions,
+        hexes,
+        quads,
+        node_quads,
+        surface_nodes,
+        elements,
+        node_volume,
+    }
+}
+
+impl OwnedReference {
+    pub fn view(&self) -> granbed_kernel::mesh::reference::ReferenceMesh<'_> {
+        granbed_kernel::mesh::reference::ReferenceMesh {
+            mesh: granbed_kernel::mesh::octant::MeshView {
+                positions: &self.positions,
+                hexes: &self.hexes,
+                quads: &self.quads,
+                surface_nodes: self.surface_nodes,
+            },
+            node_quads: &self.node_quads,
+            elements: &self.elements,
+            node_volume: &self.node_volume,
+        }
+    }
+}
+
+/// Runs the platen experiment to its end and returns the samples (the first
+/// at t = 0) and the element-step count.
+pub fn run_platens(
+    params: granbed_kernel::scene::platens::PlatenParams,
+    mesh: &OwnedReference,
+) -> (Vec<granbed_kernel::scene::platens::PlatenSample>, u64) {
+    use granbed_kernel::scene::platens::{PlatenBuffers, PlatenScene};
+    let n = mesh.positions.len();
+    let mut node_bufs = vec![vec![[0.0; 3]; n]; 7];
+    let mut mass = vec![0.0; n];
+    let mut fixed = vec![0u8; n];
+    let mut cp = vec![[0.0; 6]; mesh.hexes.len()];
+    let [x, v, vs, xp, fi, fc, fd] = node_bufs.as_mut_slice() else {
+        unreachable!()
+    };
+    let buf = PlatenBuffers {
+        x,
+        v,
+        v_star: vs,
+        x_pred: xp,
+        f_int: fi,
+        f_c: fc,
+        f_d: fd,
+        mass: &mut mass,
+        fixed: &mut fixed,
+        cp_inv: &mut cp,
+    };
+    let mut scene = PlatenScene::new(params, mesh.view(), buf).expect("valid scene");
+    let mut samples = vec![scene.sample()];
+    while !scene.finished() {
+        if let Some(s) = scene.step().unwrap_or_else(|e| panic!("{e}")) {
+            samples.push(s);
+        }
+    }
+    let steps = scene.element_steps();
+    (samples, steps)
+}

@@ -1,0 +1,5 @@
+//! Contact.
+//!
+//! * [`wall`]: kinematic contact of nodes with a rigid plane, with friction.
+
+pub mod wall;

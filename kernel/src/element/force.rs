@@ -1,0 +1,97 @@
+//! Nodal forces of the one-point, uniform-gradient, total-Lagrangian hex
+//! with objective Flanagan–Belytschko hourglass stiffness (physics.md §2.1–§2.2).
+//!
+//! Per element: F̄ = Σ x_I ⊗ B0_I → constitutive update → P = τF̄⁻ᵀ →
+//! f_I = V0 P B0_I; hourglass q_α = Σ x_I γ0_αI, f^hg_I = k Σ q_α γ0_αI,
+//! E_hg = (k/2) Σ|q_α|², k = κ(λ+2μ) V0 Σ|B0_I|²/3.
+
+use crate::Real;
+use crate::constitutive::{UpdateError, UpdateInfo, UpdateOptions, update_point};
+use crate::element::hex8::HexCoords;
+use crate::element::reference::HexReference;
+use crate::material::Material;
+use crate::tensor::{Mat3, Voigt, inverse_with_det, mat_from_voigt};
+
+/// Default hourglass coefficient κ (physics.md §2.2: range 0.02–0.1).
+pub const DEFAULT_HOURGLASS_KAPPA: Real = 0.05;
+
+/// Result of one element evaluation.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct HexForces {
+    /// Internal plus hourglass force of each node, `[node][xyz]`, N; the
+    /// nodal equation of motion subtracts it (m a = f_ext − f).
+    pub f: [[Real; 3]; 8],
+    /// Hourglass energy (k/2)Σ|q_α|², J.
+    pub hourglass_energy: Real,
+    /// J = det F̄ (current volume / reference volume).
+    pub j: Real,
+    /// Kirchhoff stress at the element's point, Pa.
+    pub tau: Voigt,
+    /// Constitutive diagnostics.
+    pub info: UpdateInfo,
+}
+
+/// Mean deformation gradient F̄ = Σ_I x_I ⊗ B0_I (exact for affine motion).
+#[inline]
+pub fn mean_deformation_gradient(r: &HexReference, x: &HexCoords) -> Mat3 {
+    let mut f = Mat3::zeros();
+    for (xi, bi) in x.iter().zip(r.b0.iter()) {
+        for a in 0..3 {
+            for b in 0..3 {
+                f[(a, b)] += xi[a] * bi[b];
+            }
+        }
+    }
+    f
+}
+
+/// Forces of one element at current node positions `x` (m).
+///
+/// * `cp_inv`: in/out, the element's C_p⁻¹ (start → end of step); untouched
+///   on error.
+/// * `kappa`: hourglass coefficient κ (dimensionless).
+#[allow(non_snake_case)]
+pub fn hex_forces(
+    mat: &Material,
+    opts: &UpdateOptions,
+    kappa: Real,
+    r: &HexReference,
+    x: &HexCoords,
+    cp_inv: &mut Voigt,
+) -> Result<HexForces, UpdateError> {
+    let F = mean_deformation_gradient(r, x);
+    let up = update_point(mat, opts, &F, cp_inv)?;
+    let j = crate::tensor::det_mat(&F);
+    // P = τ F⁻ᵀ; f_I = V0 P B0_I.
+    let P = mat_from_voigt(&up.tau) * inverse_with_det(&F, j).transpose() * r.volume;
+    let mut f = [[0.0; 3]; 8];
+    for (fi, bi) in f.iter_mut().zip(r.b0.iter()) {
+        for a in 0..3 {
+            fi[a] = P[(a, 0)] * bi[0] + P[(a, 1)] * bi[1] + P[(a, 2)] * bi[2];
+        }
+    }
+    // Hourglass stiffness.
+    let k = kappa * mat.p_wave_modulus() * r.hourglass_geometry;
+    let mut energy = 0.0;
+    for g in &r.gamma0 {
+        let mut q = [0.0; 3];
+        for (xi, gi) in x.iter().zip(g.iter()) {
+            for a in 0..3 {
+                q[a] += xi[a] * gi;
+            }
+        }
+        energy += 0.5 * k * (q[0] * q[0] + q[1] * q[1] + q[2] * q[2]);
+        for (fi, gi) in f.iter_mut().zip(g.iter()) {
+            for a in 0..3 {
+                fi[a] += k * q[a] * gi;
+            }
+        }
+    }
+    Ok(HexForces {
+        f,
+        hourglass_energy: energy,
+        j,
+        tau: up.tau,
+        info: up.info,
+    })
+}

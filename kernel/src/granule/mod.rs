@@ -1,0 +1,10 @@
+//! Operations on one deformable granule over its own node and element
+//! buffers, using the shared reference mesh.
+//!
+//! * [`forces`]: the element loop (internal + hourglass forces, energies);
+//! * [`damping`]: rigid-body projection and selective damping;
+//! * [`timestep`]: the stable time step.
+
+pub mod damping;
+pub mod forces;
+pub mod timestep;

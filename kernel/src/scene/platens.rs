@@ -1,0 +1,677 @@
+//! The single-granule experiment: one granule compressed between two rigid
+//! platens that approach each other at constant speed (physics.md §4.1, §5.5,
+//! §7 item 7). It lives in the kernel over caller buffers so the CLI and the
+//! browser run the same code and get the same bits.
+//!
+//! One step (central differences, Pronto-style predictor/corrector contact):
+//! 1. element forces f_int(x_n);
+//! 2. selective damping forces f_d from v_{n−½};
+//! 3. v* = v_{n−½} + Δt_n M⁻¹(f_g − f_int + f_d);
+//! 4. predictor x̃ = x_n + Δt v*, platens at t_{n+1};
+//! 5. platen contact forces f_c on x̃;
+//! 6. v_{n+½} = v* + Δt_n M⁻¹f_c, x_{n+1} = x_n + Δt v_{n+½};
+//! 7. energies and platen forces.
+//!
+//! Both platens move toward the centre at half the approach speed. In
+//! [`Symmetry::Octant`] mode only the positive octant of the mesh is
+//! simulated: the planes x = 0, y = 0, z = 0 are symmetry planes, the lower
+//! platen is the mirror image of the upper one, and forces (×4) and energies
+//! (×8) are reported for the whole granule.
+
+use core::fmt;
+
+use crate::Real;
+use crate::contact::wall::{Plane, PredictedNodes, plane_contact};
+use crate::granule::damping::{damping_coefficient, damping_forces};
+use crate::granule::forces::{ElementFailure, ElementSettings, elastic_energy, internal_forces};
+use crate::granule::timestep::element_time_step;
+use crate::material::Material;
+use crate::mesh::reference::ReferenceMesh;
+use crate::tensor::{VOIGT_IDENTITY, Voigt};
+
+/// Which part of the granule is simulated.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Symmetry {
+    /// The positive octant, with three symmetry planes (1/8 of the work).
+    Octant,
+    /// The whole granule.
+    Full,
+}
+
+/// Parameters of the platen experiment.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PlatenParams {
+    /// The granule's material.
+    pub material: Material,
+    /// Element settings (constitutive switches, hourglass κ).
+    pub elements: ElementSettings,
+    /// Fraction ξ of critical damping of the lowest deformational mode; 0 ≤ ξ ≤ 2.
+    pub damping_ratio: Real,
+    /// Speed at which the platens approach each other, m/s; > 0.
+    pub approach_speed_m_s: Real,
+    /// Coulomb friction between granule and platens; ≥ 0.
+    pub friction: Real,
+    /// Platen approach / diameter at which the run ends; 0 < strain ≤ 0.9.
+    pub final_strain: Real,
+    /// Safety factor C of the element time-step estimate; 0 < C ≤ 1.
+    pub time_step_safety: Real,
+    /// Steps between time-step re-estimates; ≥ 1.
+    pub time_step_interval: u32,
+    /// Strain between output samples (forces are averaged over it); > 0.
+    pub output_strain_interval: Real,
+    /// Gravity (acting in −z), m/s²; ≥ 0, and 0 in octant mode.
+    pub gravity_m_s2: Real,
+    /// Octant or full granule.
+    pub symmetry: Symmetry,
+}
+
+impl PlatenParams {
+    /// The standard experiment for `material`: ξ = 0.5, 5 mm/s, the
+    /// material's friction, to 40 % strain, C = 0.9 re-estimated every 100
+    /// steps, samples every 0.5 % strain, no gravity, octant symmetry.
+    pub fn standard(material: Material) -> Self {
+        Self {
+            material,
+            elements: ElementSettings {
+                update: crate::constitutive::UpdateOptions::default(),
+                hourglass_kappa: crate::element::force::DEFAULT_HOURGLASS_KAPPA,
+            },
+            damping_ratio: 0.5,
+            approach_speed_m_s: 5.0e-3,
+            friction: material.params.friction,
+            final_strain: 0.4,
+            time_step_safety: 0.9,
+            time_step_interval: 100,
+            output_strain_interval: 0.005,
+            gravity_m_s2: 0.0,
+            symmetry: Symmetry::Octant,
+        }
+    }
+
+    fn validate(&self) -> Result<(), SceneError> {
+        let checks: [(bool, &'static str, Real, &'static str); 9] = [
+            (
+                (0.0..=2.0).contains(&self.damping_ratio),
+                "damping_ratio",
+                self.damping_ratio,
+                "0 <= xi <= 2",
+            ),
+            (
+                self.approach_speed_m_s > 0.0 && self.approach_speed_m_s <= 10.0,
+                "approach_speed_m_s",
+                self.approach_speed_m_s,
+                "0 < v <= 10 m/s",
+            ),
+            (
+                self.friction >= 0.0 && self.friction <= 10.0,
+                "friction",
+                self.friction,
+                "0 <= mu <= 10",
+            ),
+            (
+                self.final_strain > 0.0 && self.final_strain <= 0.9,
+                "final_strain",
+                self.final_strain,
+                "0 < strain <= 0.9",
+            ),
+            (
+                self.time_step_safety > 0.0 && self.time_step_safety <= 1.0,
+                "time_step_safety",
+                self.time_step_safety,
+                "0 < C <= 1",
+            ),
+            (
+                self.time_step_interval >= 1,
+                "time_step_interval",
+                self.time_step_interval as Real,
+                ">= 1",
+            ),
+            (
+                self.output_strain_interval > 0.0
+                    && self.output_strain_interval <= self.final_strain,
+                "output_strain_interval",
+                self.output_strain_interval,
+                "0 < interval <= final_strain",
+            ),
+            (
+                self.elements.hourglass_kappa >= 0.0 && self.elements.hourglass_kappa <= 1.0,
+                "hourglass_kappa",
+                self.elements.hourglass_kappa,
+                "0 <= kappa <= 1",
+            ),
+            (
+                self.gravity_m_s2 >= 0.0
+                    && self.gravity_m_s2 <= 1.0e3
+                    && (self.symmetry == Symmetry::Full || self.gravity_m_s2 == 0.0),
+                "gravity_m_s2",
+                self.gravity_m_s2,
+                "0 <= g <= 1000, and 0 with octant symmetry",
+            ),
+        ];
+        for (ok, field, value, allowed) in checks {
+            if !ok {
+                return Err(SceneError::InvalidParameter {
+                    field,
+                    value,
+                    allowed,
+                });
+            }
+        }
+        Ok(())
+    }
+}
+
+/// Why the experiment cannot go on.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum SceneError {
+    /// A parameter is out of range.
+    InvalidParameter {
+        /// Field of [`PlatenParams`].
+        field: &'static str,
+        /// Value given.
+        value: Real,
+        /// Allowed range.
+        allowed: &'static str,
+    },
+    /// A buffer has the wrong length.
+    BufferLength {
+        /// Buffer name as in [`PlatenBuffers`].
+        buffer: &'static str,
+        /// Entries expected.
+        expected: usize,
+        /// Entries given.
+        got: usize,
+    },
+    /// An element failed (inverted, no convergence, …) at `step`.
+    Element {
+        /// Step number.
+        step: u64,
+        /// Strain reached.
+        strain: Real,
+        /// The element and its error.
+        failure: ElementFailure,
+    },
+    /// The motion became non-finite or an element inverted while the time
+    /// step was re-estimated.
+    Unstable {
+        /// Step number.
+        step: u64,
+        /// Strain reached.
+        strain: Real,
+    },
+}
+
+impl fmt::Display for SceneError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Self::InvalidParameter {
+                field,
+                value,
+                allowed,
+            } => write!(f, "invalid `{field}` = {value}: allowed range is {allowed}"),
+            Self::BufferLength {
+                buffer,
+                expected,
+                got,
+            } => write!(
+                f,
+                "buffer `{buffer}` has {got} entries, expected {expected}"
+            ),
+            Self::Element {
+                step,
+                strain,
+                failure,
+            } => write!(f, "step {step} (strain {strain:.4}): {failure}"),
+            Self::Unstable { step, strain } => write!(
+                f,
+                "step {step} (strain {strain:.4}): motion became non-finite or an element inverted"
+            ),
+        }
+    }
+}
+
+impl core::error::Error for SceneError {}
+
+/// Caller-owned state of the experiment. Node buffers have one entry per
+/// node of the (octant or full) mesh, `cp_inv` one per hex; all are written
+/// by [`PlatenScene::new`].
+pub struct PlatenBuffers<'a> {
+    /// Positions x_n, m.
+    pub x: &'a mut [[Real; 3]],
+    /// Velocities v_{n−½}, m/s.
+    pub v: &'a mut [[Real; 3]],
+    /// Scratch: velocity update before contact v*, m/s.
+    pub v_star: &'a mut [[Real; 3]],
+    /// Scratch: predicted positions x̃, m.
+    pub x_pred: &'a mut [[Real; 3]],
+    /// Internal + hourglass forces at x_n, N.
+    pub f_int: &'a mut [[Real; 3]],
+    /// Contact forces of the step, N.
+    pub f_c: &'a mut [[Real; 3]],
+    /// Damping forces of the step, N.
+    pub f_d: &'a mut [[Real; 3]],
+    /// Lumped nodal masses, kg.
+    pub mass: &'a mut [Real],
+    /// Per node, bit a set if the velocity component a is held at 0
+    /// (symmetry planes).
+    pub fixed: &'a mut [u8],
+    /// Per element, C_p⁻¹ (Voigt).
+    pub cp_inv: &'a mut [Voigt],
+}
+
+/// The energy ledger of the whole granule (full-granule equivalent), J.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct EnergyLedger {
+    /// Kinetic energy at the last half step.
+    pub kinetic: Real,
+    /// Work of the internal + hourglass forces (stored + dissipated).
+    pub internal_work: Real,
+    /// Stored elastic energy Σ V0 ψ (updated at samples).
+    pub elastic: Real,
+    /// Plastic dissipation Σ V0 Δγ(2β² + ⅔a1α²).
+    pub plastic: Real,
+    /// Hourglass energy (k/2)Σ|q|² at the last step.
+    pub hourglass: Real,
+    /// Energy removed by damping.
+    pub damping: Real,
+    /// Work of the platen contact forces on the nodes.
+    pub contact_work: Real,
+    /// Work of gravity.
+    pub gravity_work: Real,
+    /// Work of the platens: ∫ F·v_platen dt.
+    pub platen_work: Real,
+}
+
+impl EnergyLedger {
+    /// Residual of the balance W_gravity + W_contact = ΔKE + W_int + D_damp
+    /// (physics.md §4.5; W_int includes the hourglass work), J. Every work
+    /// term uses the same midpoint displacement ½(Δx_{n−½} + Δx_{n+½}), for
+    /// which central differences balance exactly: the residual is round-off
+    /// unless a force is missing from the books or the integration broke.
+    pub fn residual(&self) -> Real {
+        self.gravity_work + self.contact_work - (self.kinetic + self.internal_work + self.damping)
+    }
+
+    /// The return map's energy gap W_int − (Ψ + D_plastic + E_hg), J: how far
+    /// the work done on the elements exceeds the stored elastic energy, the
+    /// plastic dissipation Σ V0 Δγ(2β² + ⅔a1α²) and the hourglass energy.
+    /// It measures the energy consistency of the constitutive algorithm
+    /// (the published corrector is not exactly work-conjugate); about 1 % of
+    /// the platen work for B2 with the volume fix, 3 % without.
+    pub fn return_map_gap(&self) -> Real {
+        self.internal_work - (self.elastic + self.plastic + self.hourglass)
+    }
+}
+
+/// One output sample (full-granule equivalents).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PlatenSample {
+    /// Simulated time, s.
+    pub time_s: Real,
+    /// Platen approach x, m.
+    pub approach_m: Real,
+    /// x/d.
+    pub strain: Real,
+    /// Upper platen force, averaged over the sample interval, N.
+    pub force_upper_n: Real,
+    /// Lower platen force, averaged over the sample interval, N.
+    pub force_lower_n: Real,
+    /// Steps so far.
+    pub steps: u64,
+    /// Current time step, s.
+    pub dt_s: Real,
+    /// Smallest element J of the last step.
+    pub min_j: Real,
+    /// Energies.
+    pub energy: EnergyLedger,
+}
+
+/// The running experiment.
+pub struct PlatenScene<'a> {
+    params: PlatenParams,
+    mesh: ReferenceMesh<'a>,
+    buf: PlatenBuffers<'a>,
+    diameter: Real,
+    z_top0: Real,
+    force_scale: Real,
+    energy_scale: Real,
+    damping_c: Real,
+    time: Real,
+    step: u64,
+    dt: Real,
+    dt_prev: Real,
+    min_j: Real,
+    ledger: EnergyLedger,
+    window_impulse: [Real; 2],
+    window_time: Real,
+    next_output: Real,
+    element_steps: u64,
+}
+
+fn check_len(buffer: &'static str, got: usize, expected: usize) -> Result<(), SceneError> {
+    if got == expected {
+        Ok(())
+    } else {
+        Err(SceneError::BufferLength {
+            buffer,
+            expected,
+            got,
+        })
+    }
+}
+
+impl<'a> PlatenScene<'a> {
+    /// Initialises the buffers (x = X, v = 0, C_p⁻¹ = 1, masses, symmetry
+    /// mask) and the first time step.
+    pub fn new(
+        params: PlatenParams,
+        mesh: ReferenceMesh<'a>,
+        buf: PlatenBuffers<'a>,
+    ) -> Result<Self, SceneError> {
+        params.validate()?;
+        let nodes = mesh.mesh.positions.len();
+        for (name, got) in [
+            ("x", buf.x.len()),
+            ("v", buf.v.len()),
+            ("v_star", buf.v_star.len()),
+            ("x_pred", buf.x_pred.len()),
+            ("f_int", buf.f_int.len()),
+            ("f_c", buf.f_c.len()),
+            ("f_d", buf.f_d.len()),
+            ("mass", buf.mass.len()),
+            ("fixed", buf.fixed.len()),
+        ] {
+            check_len(name, got, nodes)?;
+        }
+        check_len("cp_inv", buf.cp_inv.len(), mesh.mesh.hexes.len())?;
+        check_len("node_volume", mesh.node_volume.len(), nodes)?;
+
+        let mat = params.material;
+        buf.x.copy_from_slice(mesh.mesh.positions);
+        buf.v.fill([0.0; 3]);
+        buf.cp_inv.fill(VOIGT_IDENTITY);
+        for (m, vol) in buf.mass.iter_mut().zip(mesh.node_volume) {
+            *m = mat.density0 * vol;
+        }
+        let octant = params.symmetry == Symmetry::Octant;
+        for (fixed, x) in buf.fixed.iter_mut().zip(mesh.mesh.positions) {
+            *fixed = 0;
+            if octant {
+                for (a, c) in x.iter().enumerate() {
+                    if *c == 0.0 {
+                        *fixed |= 1 << a;
+                    }
+                }
+            }
+        }
+        let z_top0 = mesh
+            .mesh
+            .positions
+            .iter()
+            .fold(Real::NEG_INFINITY, |m, x| crate::math::max(m, x[2]));
+        let radius = z_top0;
+        let dt = element_time_step(&mesh, &mat, buf.x, params.time_step_safety).ok_or(
+            SceneError::Unstable {
+                step: 0,
+                strain: 0.0,
+            },
+        )?;
+        let (force_scale, energy_scale) = if octant { (4.0, 8.0) } else { (1.0, 1.0) };
+        Ok(Self {
+            damping_c: damping_coefficient(params.damping_ratio, mat.mu, mat.density0, radius),
+            params,
+            mesh,
+            buf,
+            diameter: 2.0 * radius,
+            z_top0,
+            force_scale,
+            energy_scale,
+            time: 0.0,
+            step: 0,
+            dt,
+            dt_prev: dt,
+            min_j: 1.0,
+            ledger: EnergyLedger::default(),
+            window_impulse: [0.0; 2],
+            window_time: 0.0,
+            next_output: params.output_strain_interval,
+            element_steps: 0,
+        })
+    }
+
+    /// Platen approach at time `t`, m.
+    fn approach_at(&self, t: Real) -> Real {
+        self.params.approach_speed_m_s * t
+    }
+
+    /// Current strain x/d.
+    pub fn strain(&self) -> Real {
+        self.approach_at(self.time) / self.diameter
+    }
+
+    /// True once the final strain is reached.
+    pub fn finished(&self) -> bool {
+        self.strain() >= self.params.final_strain
+    }
+
+    /// Current node positions, m.
+    pub fn positions(&self) -> &[[Real; 3]] {
+        self.buf.x
+    }
+
+    /// Steps taken.
+    pub fn steps(&self) -> u64 {
+        self.step
+    }
+
+    /// Element evaluations so far (steps × elements simulated).
+    pub fn element_steps(&self) -> u64 {
+        self.element_steps
+    }
+
+    /// The granule diameter d used for the strain, m.
+    pub fn diameter(&self) -> Real {
+        self.diameter
+    }
+
+    /// Current time step, s.
+    pub fn time_step(&self) -> Real {
+        self.dt
+    }
+
+    /// The parameters.
+    pub fn params(&self) -> &PlatenParams {
+        &self.params
+    }
+
+    /// The sample at the current instant, with the platen forces averaged
+    /// over the window since the last sample (zero at t = 0). Updates the
+    /// stored elastic energy.
+    pub fn sample(&mut self) -> PlatenSample {
+        self.ledger.elastic = self.energy_scale
+            * elastic_energy(
+                &self.mesh,
+                &self.params.material,
+                self.buf.x,
+                self.buf.cp_inv,
+            );
+        let avg = |impulse: Real| {
+            if self.window_time > 0.0 {
+                self.force_scale * impulse / self.window_time
+            } else {
+                0.0
+            }
+        };
+        let force_upper_n = avg(self.window_impulse[0]);
+        let force_lower_n = if self.params.symmetry == Symmetry::Octant {
+            force_upper_n
+        } else {
+            avg(self.window_impulse[1])
+        };
+        self.window_impulse = [0.0; 2];
+        self.window_time = 0.0;
+        PlatenSample {
+            time_s: self.time,
+            approach_m: self.approach_at(self.time),
+            strain: self.strain(),
+            force_upper_n,
+            force_lower_n,
+            steps: self.step,
+            dt_s: self.dt,
+            min_j: self.min_j,
+            energy: self.ledger,
+        }
+    }
+
+    /// Advances one step. Returns a sample when an output interval ends.
+    pub fn step(&mut self) -> Result<Option<PlatenSample>, SceneError> {
+        let strain = self.strain();
+        let unstable = SceneError::Unstable {
+            step: self.step,
+            strain,
+        };
+        if self.step > 0
+            && self
+                .step
+                .is_multiple_of(u64::from(self.params.time_step_interval))
+        {
+            self.dt_prev = self.dt;
+            self.dt = element_time_step(
+                &self.mesh,
+                &self.params.material,
+                self.buf.x,
+                self.params.time_step_safety,
+            )
+            .ok_or(unstable)?;
+        }
+        let (dt, dt_n) = (self.dt, 0.5 * (self.dt_prev + self.dt));
+        let b = &mut self.buf;
+        let summary = internal_forces(
+            &self.mesh,
+            &self.params.material,
+            &self.params.elements,
+            b.x,
+            b.cp_inv,
+            b.f_int,
+        )
+        .map_err(|failure| SceneError::Element {
+            step: self.step,
+            strain,
+            failure,
+        })?;
+        self.element_steps += self.mesh.mesh.hexes.len() as u64;
+        self.min_j = summary.min_j;
+        let g = self.params.gravity_m_s2;
+
+        // Damping from v_{n−½}, then the velocity update and the predictor.
+        let rigid_modes = self.params.symmetry == Symmetry::Full;
+        damping_forces(b.mass, b.x, b.v, self.damping_c, rigid_modes, b.f_d);
+        for i in 0..b.x.len() {
+            let m = b.mass[i];
+            for a in 0..3 {
+                let fixed = b.fixed[i] & (1 << a) != 0;
+                let f_g = if a == 2 { -g * m } else { 0.0 };
+                let force = f_g - b.f_int[i][a] + b.f_d[i][a];
+                b.v_star[i][a] = if fixed {
+                    0.0
+                } else {
+                    b.v[i][a] + dt_n * force / m
+                };
+                b.x_pred[i][a] = b.x[i][a] + dt * b.v_star[i][a];
+            }
+        }
+
+        // Platen contact on the predicted configuration at t_{n+1}.
+        let half = 0.5 * self.params.approach_speed_m_s * (self.time + dt);
+        b.f_c.fill([0.0; 3]);
+        let surface = self.mesh.first_surface_node()..b.x.len();
+        let body = PredictedNodes {
+            mass: b.mass,
+            x_n: b.x,
+            x_pred: b.x_pred,
+        };
+        let upper = Plane {
+            normal: [0.0, 0.0, -1.0],
+            offset: -(self.z_top0 - half),
+        };
+        let top = plane_contact(
+            &upper,
+            self.params.friction,
+            dt * dt_n,
+            surface.clone(),
+            &body,
+            b.f_c,
+        );
+        let bottom = if self.params.symmetry == Symmetry::Full {
+            let lower = Plane {
+                normal: [0.0, 0.0, 1.0],
+                offset: -self.z_top0 + half,
+            };
+            plane_contact(
+                &lower,
+                self.params.friction,
+                dt * dt_n,
+                surface,
+                &body,
+                b.f_c,
+            )
+        } else {
+            Default::default()
+        };
+
+        // Corrector and energies (midpoint rule on Δx_{n−½} + Δx_{n+½}).
+        let mut w = [0.0; 4]; // internal, contact, damping, gravity
+        let mut kinetic = 0.0;
+        for i in 0..b.x.len() {
+            let m = b.mass[i];
+            for a in 0..3 {
+                let fixed = b.fixed[i] & (1 << a) != 0;
+                let v_new = if fixed {
+                    0.0
+                } else {
+                    b.v_star[i][a] + dt_n * b.f_c[i][a] / m
+                };
+                let dx = 0.5 * (self.dt_prev * b.v[i][a] + dt * v_new);
+                w[0] += b.f_int[i][a] * dx;
+                w[1] += b.f_c[i][a] * dx;
+                w[2] -= b.f_d[i][a] * dx;
+                if a == 2 {
+                    w[3] -= g * m * dx;
+                }
+                b.v[i][a] = v_new;
+                b.x[i][a] += dt * v_new;
+                kinetic += 0.5 * m * v_new * v_new;
+            }
+        }
+        if !kinetic.is_finite() {
+            return Err(unstable);
+        }
+        let s = self.energy_scale;
+        let l = &mut self.ledger;
+        l.internal_work += s * w[0];
+        l.contact_work += s * w[1];
+        l.damping += s * w[2];
+        l.gravity_work += s * w[3];
+        l.kinetic = s * kinetic;
+        l.hourglass = s * summary.hourglass_energy;
+        l.plastic += s * summary.plastic_dissipation;
+        let speed = 0.5 * self.params.approach_speed_m_s;
+        let (f_top, f_bottom) = if self.params.symmetry == Symmetry::Octant {
+            (top.normal, top.normal)
+        } else {
+            (top.normal, bottom.normal)
+        };
+        l.platen_work += self.force_scale * (f_top + f_bottom) * speed * dt;
+        self.window_impulse[0] += top.normal * dt;
+        self.window_impulse[1] += bottom.normal * dt;
+        self.window_time += dt;
+        self.time += dt;
+        self.step += 1;
+        self.dt_prev = dt;
+        if self.strain() + 1e-12 >= self.next_output || self.finished() {
+            self.next_output += self.params.output_strain_interval;
+            return Ok(Some(self.sample()));
+        }
+        Ok(None)
+    }
+}
