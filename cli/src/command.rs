@@ -6,6 +6,7 @@
 
 use clap::{Parser, Subcommand};
 
+use crate::export_mesh::ExportMeshArgs;
 use crate::output::Streams;
 use crate::point::PointArgs;
 
@@ -27,6 +28,9 @@ pub enum Command {
     /// Drive one material point along a deformation path and write its
     /// stress history as CSV (calibration of material parameters).
     Point(PointArgs),
+    /// Export the granule reference mesh (sphere or octant) as a
+    /// CalculiX/Abaqus `.inp` file.
+    ExportMesh(ExportMeshArgs),
 }
 
 impl Command {
@@ -34,6 +38,7 @@ impl Command {
     pub fn run(&self, streams: &mut Streams<'_>) -> anyhow::Result<()> {
         match self {
             Self::Point(args) => args.run(streams),
+            Self::ExportMesh(args) => args.run(streams),
         }
     }
 }

@@ -8,6 +8,8 @@
 //! Modules:
 //! * [`command`]: the top-level parser [`Cli`] and its subcommands;
 //! * [`point`]: `granbed-cli point`, the material-point explorer;
+//! * [`export_mesh`]: `granbed-cli export-mesh`, the mesh as CalculiX `.inp`;
+//! * [`model`]: owned buffers for the kernel's meshes;
 //! * [`material_args`]: `--type` and the material-parameter overrides;
 //! * [`output`]: the standard streams and `--out` destinations;
 //! * [`csv`]: a small CSV writer with round-trip exact floats;
@@ -25,7 +27,9 @@ use clap::Parser;
 pub mod command;
 pub mod csv;
 pub mod error;
+pub mod export_mesh;
 pub mod material_args;
+pub mod model;
 pub mod output;
 pub mod point;
 

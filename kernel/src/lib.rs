@@ -18,6 +18,7 @@
 //! * [`element`]: the 8-node hexahedron;
 //! * [`granule`]: element loop, damping and time step of one granule;
 //! * [`contact`]: contact with rigid walls;
+//! * [`analysis`]: post-processing formulas (fits, σ_est);
 //! * [`scene`]: complete experiments (single granule between platens);
 //! * [`tensor`]: 3×3 and symmetric (Voigt) tensor helpers;
 //! * [`math`]: the scalar functions.
@@ -28,6 +29,7 @@
 /// The one scalar type of the kernel.
 pub type Real = f64;
 
+pub mod analysis;
 pub mod constitutive;
 pub mod contact;
 pub mod element;

@@ -1,0 +1,168 @@
+//! Owned storage for the kernel's caller-buffer APIs: a granule reference
+//! mesh (full sphere or octant) with its shared element data.
+
+use anyhow::{Context as _, bail};
+use granbed_kernel::Real;
+use granbed_kernel::element::reference::HexReference;
+use granbed_kernel::mesh::octant::{MeshView, extract_octant, octant_size};
+use granbed_kernel::mesh::reference::{ReferenceMesh, compute_element_data};
+use granbed_kernel::mesh::sphere::{MeshBuffers, MeshSize, SphereMeshParams, generate};
+
+/// A mesh resolution "NxM": n core divisions, m shell layers.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct MeshLevel {
+    /// Core divisions n (even).
+    pub n: u32,
+    /// Shell layers m.
+    pub m: u32,
+}
+
+impl MeshLevel {
+    /// The standard 1280-hex level 8x2.
+    pub const STANDARD: MeshLevel = MeshLevel { n: 8, m: 2 };
+}
+
+impl core::str::FromStr for MeshLevel {
+    type Err = String;
+
+    /// Parses `NxM`, e.g. `8x2` (1280 hexes), `4x1` (160), `16x4`.
+    fn from_str(s: &str) -> Result<Self, Self::Err> {
+        let err = || {
+            format!(
+                "`{s}` is not a mesh level NxM (e.g. 4x1, 8x2, 16x4; n even in 2..=64, m in 1..=32)"
+            )
+        };
+        let (n, m) = s.split_once(['x', 'X']).ok_or_else(err)?;
+        let level = MeshLevel {
+            n: n.trim().parse().map_err(|_| err())?,
+            m: m.trim().parse().map_err(|_| err())?,
+        };
+        SphereMeshParams::new(0.5e-3, level.n, level.m)
+            .size()
+            .map_err(|_| err())?;
+        Ok(level)
+    }
+}
+
+impl core::fmt::Display for MeshLevel {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        write!(f, "{}x{}", self.n, self.m)
+    }
+}
+
+/// A reference mesh and its element data in owned buffers.
+#[derive(Clone, Debug)]
+pub struct OwnedReference {
+    /// Reference node positions, m.
+    pub positions: Vec<[Real; 3]>,
+    /// Hex connectivity.
+    pub hexes: Vec<[u32; 8]>,
+    /// Outer surface quads.
+    pub quads: Vec<[u32; 4]>,
+    /// Quads of each surface node.
+    pub node_quads: Vec<[u32; 4]>,
+    /// Outer surface nodes (the last ones).
+    pub surface_nodes: usize,
+    /// Per-element reference data.
+    pub elements: Vec<HexReference>,
+    /// Lumped nodal volumes, m³.
+    pub node_volume: Vec<Real>,
+}
+
+/// Owned mesh buffers of one size, lent to the kernel as [`MeshBuffers`].
+struct MeshStore {
+    positions: Vec<[Real; 3]>,
+    hexes: Vec<[u32; 8]>,
+    quads: Vec<[u32; 4]>,
+    node_quads: Vec<[u32; 4]>,
+    scratch: Vec<u32>,
+}
+
+impl MeshStore {
+    fn new(size: MeshSize) -> Self {
+        Self {
+            positions: vec![[0.0; 3]; size.nodes],
+            hexes: vec![[0; 8]; size.hexes],
+            quads: vec![[0; 4]; size.quads],
+            node_quads: vec![[0; 4]; size.surface_nodes],
+            scratch: vec![0; size.scratch],
+        }
+    }
+
+    fn buffers(&mut self) -> MeshBuffers<'_> {
+        MeshBuffers {
+            positions: &mut self.positions,
+            hexes: &mut self.hexes,
+            quads: &mut self.quads,
+            node_quads: &mut self.node_quads,
+            scratch: &mut self.scratch,
+        }
+    }
+
+    fn view(&self, surface_nodes: usize) -> MeshView<'_> {
+        MeshView {
+            positions: &self.positions,
+            hexes: &self.hexes,
+            quads: &self.quads,
+            surface_nodes,
+        }
+    }
+}
+
+impl OwnedReference {
+    /// Generates the sphere of `radius` (m) at `level`, the positive octant
+    /// of it when `octant`, and computes the element data.
+    pub fn sphere(radius: Real, level: MeshLevel, octant: bool) -> anyhow::Result<Self> {
+        let params = SphereMeshParams::new(radius, level.n, level.m);
+        let size = params
+            .size()
+            .with_context(|| format!("mesh level {level}"))?;
+        let mut store = MeshStore::new(size);
+        generate(&params, &mut store.buffers())
+            .with_context(|| format!("generating the {level} sphere mesh"))?;
+        let mut surface_nodes = size.surface_nodes;
+        if octant {
+            let full = store.view(surface_nodes);
+            let osize = octant_size(&full);
+            let mut part = MeshStore::new(osize);
+            extract_octant(&full, &mut part.buffers())?;
+            (store, surface_nodes) = (part, osize.surface_nodes);
+        }
+        let Some(first) = store
+            .hexes
+            .first()
+            .map(|hex| core::array::from_fn(|i| store.positions[hex[i] as usize]))
+        else {
+            bail!("mesh level {level} has no elements");
+        };
+        let placeholder = granbed_kernel::element::reference::hex_reference(&first)
+            .context("first element is inverted")?;
+        let mut elements = vec![placeholder; store.hexes.len()];
+        let mut node_volume = vec![0.0; store.positions.len()];
+        compute_element_data(&store.view(surface_nodes), &mut elements, &mut node_volume)?;
+        Ok(Self {
+            positions: store.positions,
+            hexes: store.hexes,
+            quads: store.quads,
+            node_quads: store.node_quads,
+            surface_nodes,
+            elements,
+            node_volume,
+        })
+    }
+
+    /// The kernel's borrowed view.
+    pub fn view(&self) -> ReferenceMesh<'_> {
+        ReferenceMesh {
+            mesh: MeshView {
+                positions: &self.positions,
+                hexes: &self.hexes,
+                quads: &self.quads,
+                surface_nodes: self.surface_nodes,
+            },
+            node_quads: &self.node_quads,
+            elements: &self.elements,
+            node_volume: &self.node_volume,
+        }
+    }
+}

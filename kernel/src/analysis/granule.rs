@@ -1,0 +1,66 @@
+//! Measures of the single-granule experiment (physics.md §7 item 7).
+
+use crate::Real;
+use crate::analysis::fit::{LineFit, linear_fit};
+use crate::constitutive::yield_surface::coefficients;
+use crate::material::MaterialParams;
+
+/// Effective initial yield stress σ_y,eff0 = √a2(η0)·σ_y of a granule, Pa.
+pub fn initial_effective_yield_stress(p: &MaterialParams) -> Real {
+    crate::math::sqrt(coefficients(p, p.eta0).a2) * p.yield_stress_pa
+}
+
+/// Estimated granule yield stress from the platen force: the least-squares
+/// slope dF/dx of `(approach x [m], force F [N])` samples with
+/// `lo ≤ x/d ≤ hi`, and σ_est = 4/(πd)·dF/dx (Thornton–Ning, F = πR p_y x/2).
+/// Returns (σ_est in Pa, the fit), or `None` with fewer than two samples.
+pub fn yield_stress_estimate<I>(
+    samples: I,
+    diameter: Real,
+    lo: Real,
+    hi: Real,
+) -> Option<(Real, LineFit)>
+where
+    I: Iterator<Item = (Real, Real)> + Clone,
+{
+    let fit = linear_fit(samples.filter(move |(x, _)| {
+        let strain = x / diameter;
+        strain >= lo && strain <= hi
+    }))?;
+    Some((4.0 / (core::f64::consts::PI * diameter) * fit.slope, fit))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::material::GranuleType;
+
+    #[test]
+    fn published_effective_yield_stresses() {
+        // physics.md §0: 5.77, 7.91, 10.0, 17.3 kPa for A1, A2, A3, B1
+        // (three significant figures: half a unit of the last digit).
+        let expect = [
+            (GranuleType::A1, 5.77e3),
+            (GranuleType::A2, 7.91e3),
+            (GranuleType::A3, 10.0e3),
+            (GranuleType::B1, 17.3e3),
+        ];
+        for (t, s) in expect {
+            let got = initial_effective_yield_stress(&t.params());
+            assert!((got - s).abs() <= 0.5e-2 * s, "{t}: {got}");
+        }
+    }
+
+    #[test]
+    fn slope_of_a_thornton_ning_line() {
+        // F = π R p x / 2 with p = 20 kPa, d = 1 mm → σ_est = p.
+        let (d, p) = (1e-3, 20e3);
+        let samples = (0..=100).map(|i| {
+            let x = d * i as Real / 200.0;
+            (x, core::f64::consts::PI * d / 2.0 * p * x / 2.0 + 1e-4)
+        });
+        let (sigma, fit) = yield_stress_estimate(samples, d, 0.1, 0.4).unwrap();
+        assert!((sigma - p).abs() < 1e-9 * p);
+        assert_eq!(fit.points, 61);
+    }
+}
