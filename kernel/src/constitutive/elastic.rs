@@ -41,3 +41,11 @@ pub fn energy_density(mat: &Material, be: &Voigt, je: Real) -> Real {
     0.5 * mat.mu * (trace(be) - 3.0) + 0.5 * mat.lambda * (je - 1.0) * (je - 1.0)
         - mat.mu * math::ln(je)
 }
+
+/// Stored energy density ψ of a point with deformation gradient `f` and
+/// state `cp_inv` = C_p⁻¹: b^e = F C_p⁻¹ Fᵀ, J^e = det F √det C_p⁻¹; J/m³.
+pub fn energy_density_of(mat: &Material, f: &crate::tensor::Mat3, cp_inv: &Voigt) -> Real {
+    let be = crate::tensor::push_forward(f, cp_inv);
+    let je = crate::tensor::det_mat(f) * math::sqrt(crate::tensor::det(cp_inv));
+    energy_density(mat, &be, je)
+}

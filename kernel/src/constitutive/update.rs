@@ -113,6 +113,20 @@ pub struct PointUpdate {
     pub info: UpdateInfo,
 }
 
+impl PointUpdate {
+    /// Plastic dissipation of the step per unit reference volume,
+    /// Δγ τ:∂φ/∂τ = Δγ(2β² + ⅔ a1 α²), J/m³ (0 for elastic steps).
+    pub fn dissipation_density(&self) -> Real {
+        if !self.info.plastic {
+            return 0.0;
+        }
+        let beta = tensor::norm(&tensor::deviator(&self.tau));
+        let alpha = tensor::trace(&self.tau);
+        self.info.gamma
+            * (2.0 * beta * beta + (2.0 / 3.0) * self.info.coefficients.a1 * alpha * alpha)
+    }
+}
+
 /// Updates one integration point to the end-of-step deformation gradient.
 ///
 /// * `f_np1`: deformation gradient F_{n+1} (reference → current).

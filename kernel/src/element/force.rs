@@ -29,6 +29,8 @@ pub struct HexForces {
     pub tau: Voigt,
     /// Constitutive diagnostics.
     pub info: UpdateInfo,
+    /// Plastic dissipation of the step, V0 × the dissipation density, J.
+    pub plastic_dissipation: Real,
 }
 
 /// Mean deformation gradient F̄ = Σ_I x_I ⊗ B0_I (exact for affine motion).
@@ -93,5 +95,6 @@ pub fn hex_forces(
         j,
         tau: up.tau,
         info: up.info,
+        plastic_dissipation: r.volume * up.dissipation_density(),
     })
 }

@@ -6,18 +6,40 @@ use core::fmt;
 
 use crate::Real;
 use crate::constitutive::{UpdateError, UpdateOptions};
+use crate::element::fbar::{fbar_elastic_energy, fbar_forces};
 use crate::element::force::hex_forces;
 use crate::material::Material;
 use crate::mesh::reference::ReferenceMesh;
-use crate::tensor::{Voigt, deviator, norm, trace};
+use crate::tensor::Voigt;
+
+/// The element formulation.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ElementKind {
+    /// One-point uniform-gradient hex with FB hourglass stiffness (production).
+    OnePoint,
+    /// 2×2×2 F-bar hex (verification; 8 integration points, no hourglass).
+    FBar,
+}
 
 /// Element-loop settings of a granule.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct ElementSettings {
+    /// Element formulation.
+    pub kind: ElementKind,
     /// Constitutive switches.
     pub update: UpdateOptions,
-    /// Hourglass coefficient κ.
+    /// Hourglass coefficient κ (one-point element only).
     pub hourglass_kappa: Real,
+}
+
+impl ElementSettings {
+    /// Integration points, hence C_p⁻¹ states, per element: 1 or 8.
+    pub fn points_per_element(&self) -> usize {
+        match self.kind {
+            ElementKind::OnePoint => 1,
+            ElementKind::FBar => 8,
+        }
+    }
 }
 
 /// An element whose update failed, with the kernel's reason.
@@ -56,10 +78,12 @@ pub struct ForceSummary {
 
 /// Evaluates all elements at positions `x` (`[node][xyz]`, m) and writes the
 /// assembled internal + hourglass force into `f` (`[node][xyz]`, N, zeroed
-/// first). `cp_inv` holds one C_p⁻¹ per element (in/out).
+/// first). `cp_inv` holds [`ElementSettings::points_per_element`] C_p⁻¹ per
+/// element, element by element (in/out).
 ///
-/// Lengths: `x`, `f` = nodes; `cp_inv` = hexes (checked by the caller's
-/// scene setup; a mismatch panics on indexing — see the crate's slice policy).
+/// Lengths: `x`, `f` = nodes; `cp_inv` = hexes × points per element
+/// (checked by the scene's setup; a mismatch panics on indexing — see the
+/// crate's slice policy).
 pub fn internal_forces(
     mesh: &ReferenceMesh<'_>,
     mat: &Material,
@@ -73,60 +97,86 @@ pub fn internal_forces(
         min_j: Real::INFINITY,
         ..ForceSummary::default()
     };
-    for (element, ((hex, r), c)) in mesh
-        .mesh
-        .hexes
-        .iter()
-        .zip(mesh.elements.iter())
-        .zip(cp_inv.iter_mut())
-        .enumerate()
-    {
-        let xe = core::array::from_fn(|i| x[hex[i] as usize]);
-        let out = hex_forces(mat, &settings.update, settings.hourglass_kappa, r, &xe, c)
-            .map_err(|error| ElementFailure { element, error })?;
-        for (id, fe) in hex.iter().zip(out.f.iter()) {
+    let mut scatter = |hex: &[u32; 8], fe: &[[Real; 3]; 8]| {
+        for (id, fe) in hex.iter().zip(fe.iter()) {
             let fi = &mut f[*id as usize];
             fi[0] += fe[0];
             fi[1] += fe[1];
             fi[2] += fe[2];
         }
-        s.hourglass_energy += out.hourglass_energy;
-        s.min_j = crate::math::min(s.min_j, out.j);
-        if out.info.plastic {
-            let beta = norm(&deviator(&out.tau));
-            let alpha = trace(&out.tau);
-            s.plastic_dissipation += r.volume
-                * out.info.gamma
-                * (2.0 * beta * beta + (2.0 / 3.0) * out.info.coefficients.a1 * alpha * alpha);
-            s.plastic_elements += 1;
-            s.max_iterations = s.max_iterations.max(out.info.iterations);
+    };
+    let hexes = mesh.mesh.hexes.iter().enumerate();
+    match settings.kind {
+        ElementKind::OnePoint => {
+            for (((element, hex), r), c) in hexes.zip(mesh.elements.iter()).zip(cp_inv.iter_mut()) {
+                let xe = core::array::from_fn(|i| x[hex[i] as usize]);
+                let out = hex_forces(mat, &settings.update, settings.hourglass_kappa, r, &xe, c)
+                    .map_err(|error| ElementFailure { element, error })?;
+                scatter(hex, &out.f);
+                s.hourglass_energy += out.hourglass_energy;
+                s.plastic_dissipation += out.plastic_dissipation;
+                s.min_j = crate::math::min(s.min_j, out.j);
+                if out.info.plastic {
+                    s.plastic_elements += 1;
+                    s.max_iterations = s.max_iterations.max(out.info.iterations);
+                }
+                s.a2_clamped += usize::from(out.info.coefficients.a2_clamped);
+            }
         }
-        s.a2_clamped += usize::from(out.info.coefficients.a2_clamped);
+        ElementKind::FBar => {
+            let (states, _) = cp_inv.as_chunks_mut::<8>();
+            for ((element, hex), c) in hexes.zip(states.iter_mut()) {
+                let xr = core::array::from_fn(|i| mesh.mesh.positions[hex[i] as usize]);
+                let xe = core::array::from_fn(|i| x[hex[i] as usize]);
+                let out = fbar_forces(mat, &settings.update, &xr, &xe, c)
+                    .map_err(|error| ElementFailure { element, error })?;
+                scatter(hex, &out.f);
+                s.plastic_dissipation += out.plastic_dissipation;
+                s.min_j = crate::math::min(s.min_j, out.min_j);
+                if out.plastic_points > 0 {
+                    s.plastic_elements += 1;
+                    s.max_iterations = s.max_iterations.max(out.max_iterations);
+                }
+                s.a2_clamped += out.a2_clamped;
+            }
+        }
     }
     Ok(s)
 }
 
-/// Stored elastic energy Σ_e V0 ψ(b^e, J^e) of a granule, J, with
-/// b^e = F̄ C_p⁻¹ F̄ᵀ and J^e = det F̄ √det C_p⁻¹ per element.
+/// Stored elastic energy Σ ∫ψ(b^e, J^e) dV0 of a granule, J, with
+/// b^e = F C_p⁻¹ Fᵀ and J^e = det F √det C_p⁻¹ at each integration point
+/// (F = F̄ of the element's formulation). `cp_inv` as in [`internal_forces`].
 pub fn elastic_energy(
     mesh: &ReferenceMesh<'_>,
     mat: &Material,
+    settings: &ElementSettings,
     x: &[[Real; 3]],
     cp_inv: &[Voigt],
 ) -> Real {
     let mut energy = 0.0;
-    for ((hex, r), c) in mesh
-        .mesh
-        .hexes
-        .iter()
-        .zip(mesh.elements.iter())
-        .zip(cp_inv.iter())
-    {
-        let xe = core::array::from_fn(|i| x[hex[i] as usize]);
-        let f = crate::element::force::mean_deformation_gradient(r, &xe);
-        let be = crate::tensor::push_forward(&f, c);
-        let je = crate::tensor::det_mat(&f) * crate::math::sqrt(crate::tensor::det(c));
-        energy += r.volume * crate::constitutive::elastic::energy_density(mat, &be, je);
+    match settings.kind {
+        ElementKind::OnePoint => {
+            for ((hex, r), c) in mesh
+                .mesh
+                .hexes
+                .iter()
+                .zip(mesh.elements.iter())
+                .zip(cp_inv.iter())
+            {
+                let xe = core::array::from_fn(|i| x[hex[i] as usize]);
+                let f = crate::element::force::mean_deformation_gradient(r, &xe);
+                energy += r.volume * crate::constitutive::elastic::energy_density_of(mat, &f, c);
+            }
+        }
+        ElementKind::FBar => {
+            let (states, _) = cp_inv.as_chunks::<8>();
+            for (hex, c) in mesh.mesh.hexes.iter().zip(states.iter()) {
+                let xr = core::array::from_fn(|i| mesh.mesh.positions[hex[i] as usize]);
+                let xe = core::array::from_fn(|i| x[hex[i] as usize]);
+                energy += fbar_elastic_energy(mat, &xr, &xe, c);
+            }
+        }
     }
     energy
 }

@@ -23,7 +23,9 @@ use core::fmt;
 use crate::Real;
 use crate::contact::wall::{Plane, PredictedNodes, plane_contact};
 use crate::granule::damping::{damping_coefficient, damping_forces};
-use crate::granule::forces::{ElementFailure, ElementSettings, elastic_energy, internal_forces};
+use crate::granule::forces::{
+    ElementFailure, ElementKind, ElementSettings, elastic_energy, internal_forces,
+};
 use crate::granule::timestep::element_time_step;
 use crate::material::Material;
 use crate::mesh::reference::ReferenceMesh;
@@ -73,6 +75,7 @@ impl PlatenParams {
         Self {
             material,
             elements: ElementSettings {
+                kind: ElementKind::OnePoint,
                 update: crate::constitutive::UpdateOptions::default(),
                 hourglass_kappa: crate::element::force::DEFAULT_HOURGLASS_KAPPA,
             },
@@ -255,7 +258,8 @@ pub struct PlatenBuffers<'a> {
     /// Per node, bit a set if the velocity component a is held at 0
     /// (symmetry planes).
     pub fixed: &'a mut [u8],
-    /// Per element, C_p⁻¹ (Voigt).
+    /// Per integration point, C_p⁻¹ (Voigt): hexes × points per element
+    /// ([`ElementSettings::points_per_element`]), element by element.
     pub cp_inv: &'a mut [Voigt],
 }
 
@@ -383,7 +387,11 @@ impl<'a> PlatenScene<'a> {
         ] {
             check_len(name, got, nodes)?;
         }
-        check_len("cp_inv", buf.cp_inv.len(), mesh.mesh.hexes.len())?;
+        check_len(
+            "cp_inv",
+            buf.cp_inv.len(),
+            mesh.mesh.hexes.len() * params.elements.points_per_element(),
+        )?;
         check_len("node_volume", mesh.node_volume.len(), nodes)?;
 
         let mat = params.material;
@@ -492,6 +500,7 @@ impl<'a> PlatenScene<'a> {
             * elastic_energy(
                 &self.mesh,
                 &self.params.material,
+                &self.params.elements,
                 self.buf.x,
                 self.buf.cp_inv,
             );
