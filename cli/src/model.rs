@@ -4,6 +4,7 @@
 use anyhow::{Context as _, bail};
 use granbed_kernel::Real;
 use granbed_kernel::element::reference::HexReference;
+use granbed_kernel::granule::dynamics::GranuleBuffers;
 use granbed_kernel::mesh::octant::{MeshView, extract_octant, octant_size};
 use granbed_kernel::mesh::reference::{ReferenceMesh, compute_element_data};
 use granbed_kernel::mesh::sphere::{MeshBuffers, MeshSize, SphereMeshParams, generate};
@@ -20,6 +21,11 @@ pub struct MeshLevel {
 impl MeshLevel {
     /// The standard 1280-hex level 8x2.
     pub const STANDARD: MeshLevel = MeshLevel { n: 8, m: 2 };
+
+    /// The level n×m (validated when the mesh is generated).
+    pub const fn new(n: u32, m: u32) -> Self {
+        Self { n, m }
+    }
 }
 
 impl core::str::FromStr for MeshLevel {
@@ -163,6 +169,62 @@ impl OwnedReference {
             node_quads: &self.node_quads,
             elements: &self.elements,
             node_volume: &self.node_volume,
+        }
+    }
+}
+
+/// Owned per-granule state for the kernel's [`GranuleBuffers`]: node
+/// buffers for every node of the mesh and `points` C_p⁻¹ per element.
+#[derive(Clone, Debug)]
+pub struct GranuleStore {
+    /// Positions, m.
+    pub x: Vec<[Real; 3]>,
+    /// Velocities, m/s.
+    pub v: Vec<[Real; 3]>,
+    v_star: Vec<[Real; 3]>,
+    x_pred: Vec<[Real; 3]>,
+    f_int: Vec<[Real; 3]>,
+    f_c: Vec<[Real; 3]>,
+    f_d: Vec<[Real; 3]>,
+    /// Lumped masses, kg.
+    pub mass: Vec<Real>,
+    fixed: Vec<u8>,
+    /// C_p⁻¹ per integration point.
+    pub cp_inv: Vec<[Real; 6]>,
+}
+
+impl GranuleStore {
+    /// Zeroed buffers for `mesh` with `points` integration points per element
+    /// (the kernel's scene or [`GranuleBuffers::reset`] initialises them).
+    pub fn new(mesh: &OwnedReference, points: usize) -> Self {
+        let n = mesh.positions.len();
+        Self {
+            x: vec![[0.0; 3]; n],
+            v: vec![[0.0; 3]; n],
+            v_star: vec![[0.0; 3]; n],
+            x_pred: vec![[0.0; 3]; n],
+            f_int: vec![[0.0; 3]; n],
+            f_c: vec![[0.0; 3]; n],
+            f_d: vec![[0.0; 3]; n],
+            mass: vec![0.0; n],
+            fixed: vec![0; n],
+            cp_inv: vec![[0.0; 6]; mesh.hexes.len() * points],
+        }
+    }
+
+    /// The kernel's borrowed view.
+    pub fn buffers(&mut self) -> GranuleBuffers<'_> {
+        GranuleBuffers {
+            x: &mut self.x,
+            v: &mut self.v,
+            v_star: &mut self.v_star,
+            x_pred: &mut self.x_pred,
+            f_int: &mut self.f_int,
+            f_c: &mut self.f_c,
+            f_d: &mut self.f_d,
+            mass: &mut self.mass,
+            fixed: &mut self.fixed,
+            cp_inv: &mut self.cp_inv,
         }
     }
 }

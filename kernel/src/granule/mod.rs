@@ -3,8 +3,10 @@
 //!
 //! * [`forces`]: the element loop (internal + hourglass forces, energies);
 //! * [`damping`]: rigid-body projection and selective damping;
+//! * [`dynamics`]: the central-difference step around a contact pass;
 //! * [`timestep`]: the stable time step.
 
 pub mod damping;
+pub mod dynamics;
 pub mod forces;
 pub mod timestep;

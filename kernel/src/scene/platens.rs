@@ -22,14 +22,12 @@ use core::fmt;
 
 use crate::Real;
 use crate::contact::wall::{Plane, PredictedNodes, plane_contact};
-use crate::granule::damping::{damping_coefficient, damping_forces};
-use crate::granule::forces::{
-    ElementFailure, ElementKind, ElementSettings, elastic_energy, internal_forces,
-};
+use crate::granule::damping::damping_coefficient;
+use crate::granule::dynamics::{GranuleBuffers, Loads, StepSizes, correct, predict};
+use crate::granule::forces::{ElementFailure, ElementKind, ElementSettings, elastic_energy};
 use crate::granule::timestep::element_time_step;
 use crate::material::Material;
 use crate::mesh::reference::ReferenceMesh;
-use crate::tensor::{VOIGT_IDENTITY, Voigt};
 
 /// Which part of the granule is simulated.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -235,33 +233,9 @@ impl fmt::Display for SceneError {
 
 impl core::error::Error for SceneError {}
 
-/// Caller-owned state of the experiment. Node buffers have one entry per
-/// node of the (octant or full) mesh, `cp_inv` one per hex; all are written
-/// by [`PlatenScene::new`].
-pub struct PlatenBuffers<'a> {
-    /// Positions x_n, m.
-    pub x: &'a mut [[Real; 3]],
-    /// Velocities v_{n−½}, m/s.
-    pub v: &'a mut [[Real; 3]],
-    /// Scratch: velocity update before contact v*, m/s.
-    pub v_star: &'a mut [[Real; 3]],
-    /// Scratch: predicted positions x̃, m.
-    pub x_pred: &'a mut [[Real; 3]],
-    /// Internal + hourglass forces at x_n, N.
-    pub f_int: &'a mut [[Real; 3]],
-    /// Contact forces of the step, N.
-    pub f_c: &'a mut [[Real; 3]],
-    /// Damping forces of the step, N.
-    pub f_d: &'a mut [[Real; 3]],
-    /// Lumped nodal masses, kg.
-    pub mass: &'a mut [Real],
-    /// Per node, bit a set if the velocity component a is held at 0
-    /// (symmetry planes).
-    pub fixed: &'a mut [u8],
-    /// Per integration point, C_p⁻¹ (Voigt): hexes × points per element
-    /// ([`ElementSettings::points_per_element`]), element by element.
-    pub cp_inv: &'a mut [Voigt],
-}
+/// Caller-owned state of the experiment (see [`GranuleBuffers`]); all
+/// buffers are written by [`PlatenScene::new`].
+pub type PlatenBuffers<'a> = GranuleBuffers<'a>;
 
 /// The energy ledger of the whole granule (full-granule equivalent), J.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -374,37 +348,20 @@ impl<'a> PlatenScene<'a> {
     ) -> Result<Self, SceneError> {
         params.validate()?;
         let nodes = mesh.mesh.positions.len();
-        for (name, got) in [
-            ("x", buf.x.len()),
-            ("v", buf.v.len()),
-            ("v_star", buf.v_star.len()),
-            ("x_pred", buf.x_pred.len()),
-            ("f_int", buf.f_int.len()),
-            ("f_c", buf.f_c.len()),
-            ("f_d", buf.f_d.len()),
-            ("mass", buf.mass.len()),
-            ("fixed", buf.fixed.len()),
-        ] {
-            check_len(name, got, nodes)?;
+        let states = mesh.mesh.hexes.len() * params.elements.points_per_element();
+        if let Some((buffer, expected, got)) = buf.wrong_length(nodes, states) {
+            return Err(SceneError::BufferLength {
+                buffer,
+                expected,
+                got,
+            });
         }
-        check_len(
-            "cp_inv",
-            buf.cp_inv.len(),
-            mesh.mesh.hexes.len() * params.elements.points_per_element(),
-        )?;
         check_len("node_volume", mesh.node_volume.len(), nodes)?;
-
         let mat = params.material;
-        buf.x.copy_from_slice(mesh.mesh.positions);
-        buf.v.fill([0.0; 3]);
-        buf.cp_inv.fill(VOIGT_IDENTITY);
-        for (m, vol) in buf.mass.iter_mut().zip(mesh.node_volume) {
-            *m = mat.density0 * vol;
-        }
-        let octant = params.symmetry == Symmetry::Octant;
-        for (fixed, x) in buf.fixed.iter_mut().zip(mesh.mesh.positions) {
-            *fixed = 0;
-            if octant {
+        let mut buf = buf;
+        buf.reset(&mesh, &mat);
+        if params.symmetry == Symmetry::Octant {
+            for (fixed, x) in buf.fixed.iter_mut().zip(mesh.mesh.positions) {
                 for (a, c) in x.iter().enumerate() {
                     if *c == 0.0 {
                         *fixed |= 1 << a;
@@ -424,7 +381,11 @@ impl<'a> PlatenScene<'a> {
                 strain: 0.0,
             },
         )?;
-        let (force_scale, energy_scale) = if octant { (4.0, 8.0) } else { (1.0, 1.0) };
+        let (force_scale, energy_scale) = if params.symmetry == Symmetry::Octant {
+            (4.0, 8.0)
+        } else {
+            (1.0, 1.0)
+        };
         Ok(Self {
             damping_c: damping_coefficient(params.damping_ratio, mat.mu, mat.density0, radius),
             params,
@@ -553,15 +514,23 @@ impl<'a> PlatenScene<'a> {
             )
             .ok_or(unstable)?;
         }
-        let (dt, dt_n) = (self.dt, 0.5 * (self.dt_prev + self.dt));
+        let sizes = StepSizes {
+            dt_prev: self.dt_prev,
+            dt: self.dt,
+        };
+        let loads = Loads {
+            gravity_m_s2: self.params.gravity_m_s2,
+            damping_c: self.damping_c,
+            rigid_modes: self.params.symmetry == Symmetry::Full,
+        };
         let b = &mut self.buf;
-        let summary = internal_forces(
+        let summary = predict(
             &self.mesh,
             &self.params.material,
             &self.params.elements,
-            b.x,
-            b.cp_inv,
-            b.f_int,
+            b,
+            sizes,
+            &loads,
         )
         .map_err(|failure| SceneError::Element {
             step: self.step,
@@ -570,29 +539,10 @@ impl<'a> PlatenScene<'a> {
         })?;
         self.element_steps += self.mesh.mesh.hexes.len() as u64;
         self.min_j = summary.min_j;
-        let g = self.params.gravity_m_s2;
-
-        // Damping from v_{n−½}, then the velocity update and the predictor.
-        let rigid_modes = self.params.symmetry == Symmetry::Full;
-        damping_forces(b.mass, b.x, b.v, self.damping_c, rigid_modes, b.f_d);
-        for i in 0..b.x.len() {
-            let m = b.mass[i];
-            for a in 0..3 {
-                let fixed = b.fixed[i] & (1 << a) != 0;
-                let f_g = if a == 2 { -g * m } else { 0.0 };
-                let force = f_g - b.f_int[i][a] + b.f_d[i][a];
-                b.v_star[i][a] = if fixed {
-                    0.0
-                } else {
-                    b.v[i][a] + dt_n * force / m
-                };
-                b.x_pred[i][a] = b.x[i][a] + dt * b.v_star[i][a];
-            }
-        }
 
         // Platen contact on the predicted configuration at t_{n+1}.
+        let dt = sizes.dt;
         let half = 0.5 * self.params.approach_speed_m_s * (self.time + dt);
-        b.f_c.fill([0.0; 3]);
         let surface = self.mesh.first_surface_node()..b.x.len();
         let body = PredictedNodes {
             mass: b.mass,
@@ -603,10 +553,11 @@ impl<'a> PlatenScene<'a> {
             normal: [0.0, 0.0, -1.0],
             offset: -(self.z_top0 - half),
         };
+        let friction = self.params.friction;
         let top = plane_contact(
             &upper,
-            self.params.friction,
-            dt * dt_n,
+            friction,
+            sizes.contact_dt_squared(),
             surface.clone(),
             &body,
             b.f_c,
@@ -618,8 +569,8 @@ impl<'a> PlatenScene<'a> {
             };
             plane_contact(
                 &lower,
-                self.params.friction,
-                dt * dt_n,
+                friction,
+                sizes.contact_dt_squared(),
                 surface,
                 &body,
                 b.f_c,
@@ -628,39 +579,17 @@ impl<'a> PlatenScene<'a> {
             Default::default()
         };
 
-        // Corrector and energies (midpoint rule on Δx_{n−½} + Δx_{n+½}).
-        let mut w = [0.0; 4]; // internal, contact, damping, gravity
-        let mut kinetic = 0.0;
-        for i in 0..b.x.len() {
-            let m = b.mass[i];
-            for a in 0..3 {
-                let fixed = b.fixed[i] & (1 << a) != 0;
-                let v_new = if fixed {
-                    0.0
-                } else {
-                    b.v_star[i][a] + dt_n * b.f_c[i][a] / m
-                };
-                let dx = 0.5 * (self.dt_prev * b.v[i][a] + dt * v_new);
-                w[0] += b.f_int[i][a] * dx;
-                w[1] += b.f_c[i][a] * dx;
-                w[2] -= b.f_d[i][a] * dx;
-                if a == 2 {
-                    w[3] -= g * m * dx;
-                }
-                b.v[i][a] = v_new;
-                b.x[i][a] += dt * v_new;
-                kinetic += 0.5 * m * v_new * v_new;
-            }
-        }
+        let w = correct(b, sizes, self.params.gravity_m_s2);
+        let kinetic = w.kinetic;
         if !kinetic.is_finite() {
             return Err(unstable);
         }
         let s = self.energy_scale;
         let l = &mut self.ledger;
-        l.internal_work += s * w[0];
-        l.contact_work += s * w[1];
-        l.damping += s * w[2];
-        l.gravity_work += s * w[3];
+        l.internal_work += s * w.internal;
+        l.contact_work += s * w.contact;
+        l.damping += s * w.damping;
+        l.gravity_work += s * w.gravity;
         l.kinetic = s * kinetic;
         l.hourglass = s * summary.hourglass_energy;
         l.plastic += s * summary.plastic_dissipation;

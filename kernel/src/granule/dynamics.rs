@@ -1,0 +1,188 @@
+//! The explicit central-difference step of one granule, split around the
+//! contact pass (physics.md §4.1, Pronto-style predictor/corrector):
+//!
+//! * [`predict`]: element forces f_int(x_n), selective damping forces f_d
+//!   from v_{n−½}, v* = v_{n−½} + Δt_n M⁻¹(f_g − f_int + f_d), predictor
+//!   x̃ = x_n + Δt v*, and f_c cleared for the contact pass;
+//! * the caller adds contact forces f_c computed on x̃;
+//! * [`correct`]: v_{n+½} = v* + Δt_n M⁻¹ f_c, x_{n+1} = x_n + Δt v_{n+½},
+//!   and the work of every force over the step.
+//!
+//! Δt_n = (Δt_{n−½} + Δt_{n+½})/2. Components flagged in `fixed` (symmetry
+//! planes) keep zero velocity.
+
+use crate::Real;
+use crate::granule::damping::damping_forces;
+use crate::granule::forces::{ElementFailure, ElementSettings, ForceSummary, internal_forces};
+use crate::material::Material;
+use crate::mesh::reference::ReferenceMesh;
+use crate::tensor::{VOIGT_IDENTITY, Voigt};
+
+/// Caller-owned state of one granule. Node buffers have one entry per node
+/// of its mesh; `cp_inv` has hexes × points per element entries.
+pub struct GranuleBuffers<'a> {
+    /// Positions x_n, m.
+    pub x: &'a mut [[Real; 3]],
+    /// Velocities v_{n−½}, m/s.
+    pub v: &'a mut [[Real; 3]],
+    /// Scratch: velocity update before contact v*, m/s.
+    pub v_star: &'a mut [[Real; 3]],
+    /// Scratch: predicted positions x̃, m.
+    pub x_pred: &'a mut [[Real; 3]],
+    /// Internal + hourglass forces at x_n, N.
+    pub f_int: &'a mut [[Real; 3]],
+    /// Contact forces of the step, N (filled by the caller's contact pass).
+    pub f_c: &'a mut [[Real; 3]],
+    /// Damping forces of the step, N.
+    pub f_d: &'a mut [[Real; 3]],
+    /// Lumped nodal masses, kg.
+    pub mass: &'a mut [Real],
+    /// Per node, bit a set if velocity component a is held at 0.
+    pub fixed: &'a mut [u8],
+    /// Per integration point, C_p⁻¹ (Voigt), element by element.
+    pub cp_inv: &'a mut [Voigt],
+}
+
+impl GranuleBuffers<'_> {
+    /// The first buffer whose length is wrong: (name, expected, got).
+    pub fn wrong_length(
+        &self,
+        nodes: usize,
+        states: usize,
+    ) -> Option<(&'static str, usize, usize)> {
+        [
+            ("x", self.x.len()),
+            ("v", self.v.len()),
+            ("v_star", self.v_star.len()),
+            ("x_pred", self.x_pred.len()),
+            ("f_int", self.f_int.len()),
+            ("f_c", self.f_c.len()),
+            ("f_d", self.f_d.len()),
+            ("mass", self.mass.len()),
+            ("fixed", self.fixed.len()),
+        ]
+        .into_iter()
+        .map(|(name, got)| (name, nodes, got))
+        .chain(core::iter::once(("cp_inv", states, self.cp_inv.len())))
+        .find(|(_, expected, got)| expected != got)
+    }
+
+    /// The virgin state on `mesh`: x = X, v = 0, C_p⁻¹ = 1, masses ρ0 × the
+    /// lumped volumes, nothing fixed. Lengths must be right.
+    pub fn reset(&mut self, mesh: &ReferenceMesh<'_>, mat: &Material) {
+        self.x.copy_from_slice(mesh.mesh.positions);
+        self.v.fill([0.0; 3]);
+        self.cp_inv.fill(VOIGT_IDENTITY);
+        self.fixed.fill(0);
+        for (m, vol) in self.mass.iter_mut().zip(mesh.node_volume) {
+            *m = mat.density0 * vol;
+        }
+    }
+}
+
+/// Time-step sizes around step n, s.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct StepSizes {
+    /// Δt_{n−½}, the previous step.
+    pub dt_prev: Real,
+    /// Δt_{n+½}, this step.
+    pub dt: Real,
+}
+
+impl StepSizes {
+    /// Δt_n = (Δt_{n−½} + Δt_{n+½})/2, the velocity-update step.
+    pub fn dt_n(&self) -> Real {
+        0.5 * (self.dt_prev + self.dt)
+    }
+
+    /// Δt_{n+½}·Δt_n, which maps a contact force to this step's position
+    /// change (for the kinematic contact passes).
+    pub fn contact_dt_squared(&self) -> Real {
+        self.dt * self.dt_n()
+    }
+}
+
+/// Body loads and damping of a step.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Loads {
+    /// Gravity acting in −z, m/s².
+    pub gravity_m_s2: Real,
+    /// Damping coefficient c, 1/s.
+    pub damping_c: Real,
+    /// Whether the granule has free rigid modes (false with symmetry planes).
+    pub rigid_modes: bool,
+}
+
+/// Work of each force over one step (midpoint rule on
+/// ½(Δx_{n−½} + Δx_{n+½})), J, and the kinetic energy at n+½.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct StepWork {
+    /// Work of the internal + hourglass forces (energy taken up by the body).
+    pub internal: Real,
+    /// Work of the contact forces on the nodes.
+    pub contact: Real,
+    /// Energy removed by damping.
+    pub damping: Real,
+    /// Work of gravity.
+    pub gravity: Real,
+    /// Kinetic energy ½ Σ m v_{n+½}².
+    pub kinetic: Real,
+}
+
+/// First half of a step: forces at x_n, damping, v*, x̃; clears `f_c`.
+pub fn predict(
+    mesh: &ReferenceMesh<'_>,
+    mat: &Material,
+    settings: &ElementSettings,
+    b: &mut GranuleBuffers<'_>,
+    sizes: StepSizes,
+    loads: &Loads,
+) -> Result<ForceSummary, ElementFailure> {
+    let summary = internal_forces(mesh, mat, settings, b.x, b.cp_inv, b.f_int)?;
+    damping_forces(b.mass, b.x, b.v, loads.damping_c, loads.rigid_modes, b.f_d);
+    let (dt, dt_n, g) = (sizes.dt, sizes.dt_n(), loads.gravity_m_s2);
+    for i in 0..b.x.len() {
+        let m = b.mass[i];
+        for a in 0..3 {
+            let f_g = if a == 2 { -g * m } else { 0.0 };
+            let force = f_g - b.f_int[i][a] + b.f_d[i][a];
+            b.v_star[i][a] = if b.fixed[i] & (1 << a) != 0 {
+                0.0
+            } else {
+                b.v[i][a] + dt_n * force / m
+            };
+            b.x_pred[i][a] = b.x[i][a] + dt * b.v_star[i][a];
+        }
+    }
+    b.f_c.fill([0.0; 3]);
+    Ok(summary)
+}
+
+/// Second half of a step: applies the contact forces in `f_c`, advances x
+/// and v, and returns the work of every force (`gravity_m_s2` as in
+/// [`Loads`]).
+pub fn correct(b: &mut GranuleBuffers<'_>, sizes: StepSizes, gravity_m_s2: Real) -> StepWork {
+    let (dt, dt_n) = (sizes.dt, sizes.dt_n());
+    let mut w = StepWork::default();
+    for i in 0..b.x.len() {
+        let m = b.mass[i];
+        for a in 0..3 {
+            let v_new = if b.fixed[i] & (1 << a) != 0 {
+                0.0
+            } else {
+                b.v_star[i][a] + dt_n * b.f_c[i][a] / m
+            };
+            let dx = 0.5 * (sizes.dt_prev * b.v[i][a] + dt * v_new);
+            w.internal += b.f_int[i][a] * dx;
+            w.contact += b.f_c[i][a] * dx;
+            w.damping -= b.f_d[i][a] * dx;
+            if a == 2 {
+                w.gravity -= gravity_m_s2 * m * dx;
+            }
+            b.v[i][a] = v_new;
+            b.x[i][a] += dt * v_new;
+            w.kinetic += 0.5 * m * v_new * v_new;
+        }
+    }
+    w
+}
