@@ -38,7 +38,7 @@ fn ring(
     shape: impl Fn(&[Real; 3]) -> [Real; 3],
     steps: usize,
     damping_c: Real,
-) -> (Vec<Real>, Real, GranuleStore) {
+) -> (Vec<Real>, Real) {
     let view = mesh.view();
     let mut store = GranuleStore::new(mesh, 1);
     let el = settings(0.05);
@@ -70,8 +70,7 @@ fn ring(
             .sum();
         series.push(s);
     }
-    drop(b);
-    (series, dt, store)
+    (series, dt)
 }
 
 /// Mean angular frequency from the zero crossings of `series` (linear
@@ -107,9 +106,9 @@ fn e3_lowest_deformational_frequencies() {
     let torsion = |x: &[Real; 3]| [x[1] * x[2] / R, -x[0] * x[2] / R, 0.0];
     // l = 2 spheroidal field ∇(3z² − r²)/2 ∝ (−x, −y, 2z), divergence-free.
     let spheroid = |x: &[Real; 3]| [-x[0], -x[1], 2.0 * x[2]];
-    let (s, dt, _) = ring(&mesh, &mat, torsion, 3000, 0.0);
+    let (s, dt) = ring(&mesh, &mat, torsion, 3000, 0.0);
     let w_t = frequency(&s, dt) * R / cs;
-    let (s, dt, _) = ring(&mesh, &mat, spheroid, 3000, 0.0);
+    let (s, dt) = ring(&mesh, &mat, spheroid, 3000, 0.0);
     let w_s = frequency(&s, dt) * R / cs;
     println!("torsional n=2: {w_t:.4}, spheroidal n=2: {w_s:.4} (x c_s/R)");
     assert!((w_t / 2.501 - 1.0).abs() < 0.03, "torsional {w_t}");
