@@ -231,3 +231,104 @@ fn rigid_motion_is_not_damped() {
         "rigid motion lost {loss:e} of its energy"
     );
 }
+
+/// T1 (physics.md §4.2): the element estimate 0.9·min L_e/c_d is 1.48 µs and
+/// the global limit 2/ω_max (power iteration, κ = 0.05) 2.17 µs at ρ = 1500;
+/// an undamped run at 0.95·2/ω_max stays bounded, at 1.1·2/ω_max it diverges.
+#[test]
+fn t1_time_step_estimates_and_the_stability_limit() {
+    use granbed_kernel::granule::timestep::{Linearisation, PowerIterationBuffers, max_frequency};
+    let mesh = OwnedReference::sphere(R, MeshLevel::STANDARD, false).unwrap();
+    let view = mesh.view();
+    let mat = elastic_solid();
+    assert_eq!(mat.density0, 1500.0);
+    let mut store = GranuleStore::new(&mesh, 1);
+    let mut b = store.buffers();
+    b.reset(&view, &mat);
+    let dt_element = element_time_step(&view, &mat, b.x, 0.9).unwrap();
+    assert!(
+        (dt_element / 1.48e-6 - 1.0).abs() < 0.005,
+        "element estimate {dt_element:e}"
+    );
+
+    let n = mesh.positions.len();
+    let mut rng = 12345u64;
+    let mut random = || {
+        rng ^= rng << 13;
+        rng ^= rng >> 7;
+        rng ^= rng << 17;
+        (rng >> 11) as Real / (1u64 << 53) as Real - 0.5
+    };
+    let mut mode: Vec<[Real; 3]> = (0..n).map(|_| [random(), random(), random()]).collect();
+    let (mut xp, mut fp, mut fm) = (vec![[0.0; 3]; n], vec![[0.0; 3]; n], vec![[0.0; 3]; n]);
+    let mut cp = b.cp_inv.to_vec();
+    let at = Linearisation {
+        mass: b.mass,
+        x: b.x,
+        cp_inv: b.cp_inv,
+    };
+    let mut pb = PowerIterationBuffers {
+        mode: &mut mode,
+        x_pert: &mut xp,
+        f_plus: &mut fp,
+        f_minus: &mut fm,
+        cp_scratch: &mut cp,
+    };
+    let omega = max_frequency(&view, &mat, &settings(0.05), &at, &mut pb, 300).unwrap();
+    let dt_crit = 2.0 / omega;
+    println!(
+        "element estimate {dt_element:.4e} s, 2/omega_max {dt_crit:.4e} s (ratio {:.3})",
+        dt_crit / dt_element
+    );
+    assert!(
+        (dt_crit / 2.17e-6 - 1.0).abs() < 0.01,
+        "2/omega_max = {dt_crit:e}"
+    );
+
+    let run = |dt: Real| -> Real {
+        let mut store = GranuleStore::new(&mesh, 1);
+        let mut b = store.buffers();
+        b.reset(&view, &mat);
+        let mut rng = 99u64;
+        for v in b.v.iter_mut() {
+            for c in v.iter_mut() {
+                rng = rng
+                    .wrapping_mul(6364136223846793005)
+                    .wrapping_add(1442695040888963407);
+                *c = 1e-4 * ((rng >> 11) as Real / (1u64 << 53) as Real - 0.5);
+            }
+        }
+        let sizes = StepSizes { dt_prev: dt, dt };
+        let loads = Loads {
+            gravity_m_s2: 0.0,
+            damping_c: 0.0,
+            rigid_modes: true,
+        };
+        let (mut e0, mut internal, mut worst) = (None, 0.0, 0.0 as Real);
+        for _ in 0..2000 {
+            if predict(&view, &mat, &settings(0.05), &mut b, sizes, &loads).is_err() {
+                return Real::INFINITY; // an element inverted: the run blew up
+            }
+            let w = correct(&mut b, sizes, 0.0);
+            internal += w.internal;
+            let e = w.kinetic + internal;
+            let e0 = *e0.get_or_insert(e);
+            worst = worst.max(e / e0);
+            if worst.is_nan() || worst >= 1e6 {
+                break;
+            }
+        }
+        worst
+    };
+    let stable = run(0.95 * dt_crit);
+    let unstable = run(1.1 * dt_crit);
+    println!("energy growth: {stable:.3} at 0.95 dt_crit, {unstable:.3e} at 1.1 dt_crit");
+    assert!(
+        stable < 2.0,
+        "0.95 of the limit must be stable (energy x{stable})"
+    );
+    assert!(
+        unstable > 1e3,
+        "1.1 of the limit must diverge (energy x{unstable})"
+    );
+}

@@ -1,11 +1,14 @@
-//! The stable time step of a granule (physics.md §4.2): Δt = C·min_e L_e/c_d,
-//! L_e = V_e/A_e,max from the current geometry, c_d = √((λ+2μ)/ρ0).
+//! The stable time step of a granule (physics.md §4.2): the element estimate
+//! Δt = C·min_e L_e/c_d (L_e = V_e/A_e,max from the current geometry,
+//! c_d = √((λ+2μ)/ρ0)), and the global estimate 2/ω_max by power iteration.
 
 use crate::Real;
 use crate::element::hex8;
 use crate::element::reference::hex_reference;
+use crate::granule::forces::{ElementSettings, internal_forces};
 use crate::material::Material;
 use crate::mesh::reference::ReferenceMesh;
+use crate::tensor::Voigt;
 
 /// Smallest characteristic length min_e V_e/A_e,max at positions `x` (m);
 /// `None` if an element is inverted.
@@ -33,4 +36,98 @@ pub fn element_time_step(
     safety: Real,
 ) -> Option<Real> {
     Some(safety * min_element_length(mesh, x)? / wave_speed(mat))
+}
+
+/// Scratch buffers of [`max_frequency`]: node buffers have one entry per
+/// node, `cp_scratch` as many entries as the granule's `cp_inv`.
+pub struct PowerIterationBuffers<'a> {
+    /// In: start vector (any non-zero field; the previous result converges
+    /// fastest). Out: the dominant mode estimate, M-normalised.
+    pub mode: &'a mut [[Real; 3]],
+    /// Scratch: perturbed positions.
+    pub x_pert: &'a mut [[Real; 3]],
+    /// Scratch: forces at x + h·mode.
+    pub f_plus: &'a mut [[Real; 3]],
+    /// Scratch: forces at x − h·mode.
+    pub f_minus: &'a mut [[Real; 3]],
+    /// Scratch: a copy of the state, so the estimate leaves it untouched.
+    pub cp_scratch: &'a mut [Voigt],
+}
+
+/// The configuration a granule is linearised about.
+#[derive(Clone, Copy, Debug)]
+pub struct Linearisation<'a> {
+    /// Lumped nodal masses, kg.
+    pub mass: &'a [Real],
+    /// Node positions, m.
+    pub x: &'a [[Real; 3]],
+    /// Integration-point states C_p⁻¹ (left untouched).
+    pub cp_inv: &'a [Voigt],
+}
+
+/// Largest angular frequency ω_max (rad/s) of the granule linearised at
+/// `at`, by `iterations` power iterations on M⁻¹K with matrix-free products
+/// K·u ≈ [f(x + hu) − f(x − hu)]/(2h). The stable central-difference step
+/// is 2/ω_max. `None` if an element fails at a perturbed configuration.
+pub fn max_frequency(
+    mesh: &ReferenceMesh<'_>,
+    mat: &Material,
+    settings: &ElementSettings,
+    at: &Linearisation<'_>,
+    buf: &mut PowerIterationBuffers<'_>,
+    iterations: u32,
+) -> Option<Real> {
+    let (mass, x, cp_inv) = (at.mass, at.x, at.cp_inv);
+    let size = crate::math::max(min_element_length(mesh, x)?, Real::MIN_POSITIVE);
+    let mut lambda = 0.0;
+    for _ in 0..iterations {
+        // Normalise the mode to unit M-norm, scaled so h·u is 1e-7 of an element.
+        let norm2: Real = buf
+            .mode
+            .iter()
+            .zip(mass)
+            .map(|(u, m)| m * (u[0] * u[0] + u[1] * u[1] + u[2] * u[2]))
+            .sum();
+        if norm2.is_nan() || norm2 <= 0.0 {
+            return None;
+        }
+        let inv = 1.0 / crate::math::sqrt(norm2);
+        let umax = buf
+            .mode
+            .iter()
+            .flatten()
+            .fold(0.0, |m: Real, c| crate::math::max(m, crate::math::abs(*c)))
+            * inv;
+        let h = 1e-7 * size / umax;
+        for sign in [1.0, -1.0] {
+            for ((xp, xi), u) in buf.x_pert.iter_mut().zip(x).zip(buf.mode.iter()) {
+                for a in 0..3 {
+                    xp[a] = xi[a] + sign * h * u[a] * inv;
+                }
+            }
+            buf.cp_scratch.copy_from_slice(cp_inv);
+            let f = if sign > 0.0 {
+                &mut *buf.f_plus
+            } else {
+                &mut *buf.f_minus
+            };
+            internal_forces(mesh, mat, settings, buf.x_pert, buf.cp_scratch, f).ok()?;
+        }
+        // y = M⁻¹ K u; Rayleigh quotient λ = uᵀ K u (u M-normalised).
+        lambda = 0.0;
+        for (((u, fp), fm), m) in buf
+            .mode
+            .iter_mut()
+            .zip(buf.f_plus.iter())
+            .zip(buf.f_minus.iter())
+            .zip(mass)
+        {
+            for a in 0..3 {
+                let ku = (fp[a] - fm[a]) / (2.0 * h);
+                lambda += u[a] * inv * ku;
+                u[a] = ku / m;
+            }
+        }
+    }
+    Some(crate::math::sqrt(crate::math::max(lambda, 0.0)))
 }
