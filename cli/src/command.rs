@@ -7,6 +7,7 @@
 use clap::{Parser, Subcommand};
 
 use crate::export_mesh::ExportMeshArgs;
+use crate::granule::GranuleArgs;
 use crate::output::Streams;
 use crate::point::PointArgs;
 
@@ -31,6 +32,10 @@ pub enum Command {
     /// Export the granule reference mesh (sphere or octant) as a
     /// CalculiX/Abaqus `.inp` file.
     ExportMesh(ExportMeshArgs),
+    /// Compress one granule between two rigid platens; write the
+    /// force–displacement table, a summary with the granule yield stress
+    /// estimate σ_est, and a plot to a directory.
+    Granule(GranuleArgs),
 }
 
 impl Command {
@@ -39,6 +44,7 @@ impl Command {
         match self {
             Self::Point(args) => args.run(streams),
             Self::ExportMesh(args) => args.run(streams),
+            Self::Granule(args) => args.run(streams),
         }
     }
 }

@@ -1,6 +1,7 @@
 //! A minimal CSV writer for numeric tables: a header row, then rows of
-//! integers and floats, comma separated, `\n` line ends, no quoting (column
-//! names must not contain commas, quotes or line breaks).
+//! integers, floats and short names, comma separated, `\n` line ends, no
+//! quoting (column names and text cells must not contain commas, quotes or
+//! line breaks).
 //!
 //! Floats are written round-trip exact: the shortest decimal that parses
 //! back to the same `f64` (Rust's `Display`, or `LowerExp` for magnitudes
@@ -16,6 +17,9 @@ pub enum Field {
     Int(u64),
     /// A float, written round-trip exact.
     Real(f64),
+    /// A name (e.g. a granule type), written as is: no commas, quotes or
+    /// line breaks.
+    Text(&'static str),
 }
 
 impl From<u32> for Field {
@@ -84,6 +88,7 @@ impl<W: Write> CsvWriter<W> {
             match *field {
                 Field::Int(v) => write!(self.out, "{v}")?,
                 Field::Real(x) => write_real(&mut self.out, x)?,
+                Field::Text(t) => self.out.write_all(t.as_bytes())?,
             }
         }
         self.out.write_all(b"\n")?;
@@ -144,11 +149,14 @@ mod tests {
 
     #[test]
     fn rows_match_the_header() {
-        let mut w = CsvWriter::new(Vec::new(), &["n", "x"]).unwrap();
-        w.write_row(&[Field::from(3_u32), Field::from(0.5)])
+        let mut w = CsvWriter::new(Vec::new(), &["n", "x", "name"]).unwrap();
+        w.write_row(&[Field::from(3_u32), Field::from(0.5), Field::Text("B2")])
             .unwrap();
         assert!(w.write_row(&[Field::from(true)]).is_err());
         assert_eq!(w.rows(), 1);
-        assert_eq!(String::from_utf8(w.into_inner()).unwrap(), "n,x\n3,0.5\n");
+        assert_eq!(
+            String::from_utf8(w.into_inner()).unwrap(),
+            "n,x,name\n3,0.5,B2\n"
+        );
     }
 }

@@ -96,38 +96,31 @@ fn write_inp(
     scale: f64,
     args: &ExportMeshArgs,
 ) -> std::io::Result<()> {
+    let unit = match args.length_unit {
+        LengthUnit::M => "m",
+        LengthUnit::Mm => "mm",
+    };
+    let part = if args.octant {
+        "positive octant"
+    } else {
+        "full sphere"
+    };
     writeln!(
         w,
-        "** granbed granule mesh {} ({}), diameter {} mm, coordinates in {:?}",
-        args.mesh,
-        if args.octant {
-            "positive octant"
-        } else {
-            "full sphere"
-        },
-        args.diameter_mm,
-        args.length_unit
+        "** granbed granule mesh {} ({part}), diameter {} mm, coordinates in {unit}",
+        args.mesh, args.diameter_mm
     )?;
     writeln!(
         w,
-        "** regenerate: granbed-cli export-mesh --mesh {}{} --length-unit {}",
+        "** regenerate: granbed-cli export-mesh --mesh {}{} --length-unit {unit}",
         args.mesh,
         if args.octant { " --octant" } else { "" },
-        match args.length_unit {
-            LengthUnit::M => "m",
-            LengthUnit::Mm => "mm",
-        }
     )?;
     writeln!(w, "*NODE, NSET=NALL")?;
     for (i, x) in mesh.positions.iter().enumerate() {
-        writeln!(
-            w,
-            "{}, {:e}, {:e}, {:e}",
-            i + 1,
-            x[0] * scale,
-            x[1] * scale,
-            x[2] * scale
-        )?;
+        // 13 significant digits: every field fits CalculiX's 20-character limit.
+        let [a, b, c] = x.map(|v| v * scale);
+        writeln!(w, "{}, {a:.12e}, {b:.12e}, {c:.12e}", i + 1)?;
     }
     writeln!(w, "*ELEMENT, TYPE=C3D8, ELSET=EALL")?;
     for (e, h) in mesh.hexes.iter().enumerate() {

@@ -9,6 +9,7 @@
 //! * [`command`]: the top-level parser [`Cli`] and its subcommands;
 //! * [`point`]: `granbed-cli point`, the material-point explorer;
 //! * [`export_mesh`]: `granbed-cli export-mesh`, the mesh as CalculiX `.inp`;
+//! * [`granule`]: `granbed-cli granule`, the single-granule platen experiment;
 //! * [`model`]: owned buffers for the kernel's meshes;
 //! * [`material_args`]: `--type` and the material-parameter overrides;
 //! * [`output`]: the standard streams and `--out` destinations;
@@ -28,6 +29,7 @@ pub mod command;
 pub mod csv;
 pub mod error;
 pub mod export_mesh;
+pub mod granule;
 pub mod material_args;
 pub mod model;
 pub mod output;

@@ -15,10 +15,14 @@ fn main() -> ExitCode {
 }
 
 /// Runs this process's command line on its standard streams.
+///
+/// stderr is passed unlocked: the progress bars (indicatif) write to it from
+/// worker threads while a command runs, and would wait forever for a lock
+/// held here by the main thread.
 fn run() -> anyhow::Result<()> {
     granbed_cli::run(
         std::env::args_os(),
         &mut io::stdout().lock(),
-        &mut io::stderr().lock(),
+        &mut io::stderr(),
     )
 }

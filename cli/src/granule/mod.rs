@@ -1,0 +1,544 @@
+//! `granbed-cli granule`: one granule compressed between two rigid platens
+//! (the kernel's [`granbed_kernel::scene::platens`]), for one granule type
+//! or several, with the force–displacement table, a summary with σ_est, and
+//! a plot written to an output directory.
+//!
+//! * [`run`](mod@run): owned buffers and the loop over the kernel's scene;
+//! * [`summary`]: σ_est, σ_y,eff0, energy checks, cost (`summary.json`);
+//! * [`outputs`]: the CSV, JSON and text writers;
+//! * [`plot`]: the SVG plots;
+//! * [`progress`]: the progress bars on stderr.
+
+use core::fmt;
+use core::str::FromStr;
+use std::path::{Path, PathBuf};
+
+use anyhow::Context as _;
+use clap::{Args, ValueEnum};
+use granbed_kernel::Real;
+use granbed_kernel::granule::forces::ElementKind;
+use granbed_kernel::material::{GranuleType, Material};
+use granbed_kernel::scene::platens::{PlatenParams, SceneError, Symmetry};
+use indicatif::MultiProgress;
+use rayon::prelude::*;
+
+use crate::error::InputError;
+use crate::material_args::MaterialArgs;
+use crate::model::{MeshLevel, OwnedReference};
+use crate::output::Streams;
+
+pub mod outputs;
+pub mod plot;
+pub mod progress;
+pub mod run;
+pub mod summary;
+
+use run::RunResult;
+use summary::{RunSetup, Summary, symmetry_name};
+
+/// Radius of the simulated granule, m (the published 1 mm granule).
+pub const GRANULE_RADIUS_M: Real = 0.5e-3;
+
+/// Gravity of `--gravity`, m/s².
+pub const GRAVITY_M_S2: Real = 9.81;
+
+/// The output description shown at the end of `granule --help`.
+const OUTPUT_HELP: &str = "\
+Output, in --out DIR (created if missing; with --types in DIR/<TYPE>/ per type):
+  force_displacement.csv  one row per sample: the unloaded state at t = 0, then
+                          every --output-strain of platen approach:
+    time_s                simulated time, s
+    displacement_m        platen approach x (both platens together), m
+    strain                x / d (d = 1 mm granule diameter)
+    force_n               mean of the upper and lower platen force, N
+    force_upper_n         upper platen force, averaged over the sample interval, N
+    force_lower_n         lower platen force (= upper in octant mode), N
+    kinetic_j internal_work_j elastic_j plastic_j hourglass_j damping_j
+    contact_work_j gravity_work_j platen_work_j
+                          energy ledger of the whole granule, J
+    min_j                 smallest element volume ratio J of the last step
+    dt_s                  current time step, s
+    steps                 time steps so far
+  summary.json            every input, sigma_est (4/(pi d) dF/dx fitted over
+                          strain 0.1 to 0.4; null with fewer than two samples
+                          there), sigma_eff0, fit, energy checks, cost, and
+                          \"error\" if the kernel stopped the run
+  force_displacement.svg  force against approach, with the sigma_est fit line
+With --types, also in DIR: types.csv (one row per type) and
+force_displacement_types.svg (all types overlaid).
+Floats are written round-trip exact. Progress bars go to stderr when it is a
+terminal, then one summary line per type. If the kernel fails, the rows so far,
+the summary (with its \"error\") and the plot are still written, and the error
+names the type, step, strain and element.
+
+Exit status: 0 success, 1 runtime failure (kernel or I/O error), 2 usage or
+validation error.";
+
+/// `--symmetry`: which part of the granule is simulated.
+#[derive(ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
+pub enum SymmetryArg {
+    /// The positive octant with three symmetry planes (1/8 of the work);
+    /// forces and energies are reported for the whole granule
+    Octant,
+    /// The whole granule between both platens
+    Full,
+}
+
+/// `--element`: the element formulation.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum ElementArg {
+    /// One-point uniform-gradient hex with Flanagan–Belytschko hourglass
+    /// stiffness (production element)
+    OnePoint,
+    /// 2×2×2 F-bar hex, mean dilatation, no hourglass control (verification
+    /// element; about 8× the cost)
+    Fbar,
+}
+
+impl From<ElementArg> for ElementKind {
+    fn from(e: ElementArg) -> Self {
+        match e {
+            ElementArg::OnePoint => Self::OnePoint,
+            ElementArg::Fbar => Self::FBar,
+        }
+    }
+}
+
+impl From<SymmetryArg> for Symmetry {
+    fn from(s: SymmetryArg) -> Self {
+        match s {
+            SymmetryArg::Octant => Self::Octant,
+            SymmetryArg::Full => Self::Full,
+        }
+    }
+}
+
+/// `--types`: `all` or a comma list of distinct granule types.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct TypeList(pub Vec<GranuleType>);
+
+impl FromStr for TypeList {
+    type Err = String;
+
+    /// Parses `all` (A1…C3) or a comma list such as `A1,b2,C3`
+    /// (case-insensitive, each type at most once).
+    fn from_str(s: &str) -> Result<Self, Self::Err> {
+        if s.trim().eq_ignore_ascii_case("all") {
+            return Ok(Self(GranuleType::ALL.to_vec()));
+        }
+        let mut types = Vec::new();
+        for name in s.split(',').map(str::trim) {
+            let t: GranuleType = name
+                .parse()
+                .map_err(|e| format!("`{name}`: {e}, or `all`"))?;
+            if types.contains(&t) {
+                return Err(format!("{t} is listed twice"));
+            }
+            types.push(t);
+        }
+        Ok(Self(types))
+    }
+}
+
+impl fmt::Display for TypeList {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let names: Vec<&str> = self.0.iter().map(|t| t.name()).collect();
+        f.write_str(&names.join(","))
+    }
+}
+
+/// Options of `granbed-cli granule`.
+#[derive(Args, Debug, Clone, PartialEq)]
+#[command(after_long_help = OUTPUT_HELP)]
+pub struct GranuleArgs {
+    /// Output directory, created if missing; existing files of the same
+    /// names are replaced.
+    #[arg(long, value_name = "DIR")]
+    pub out: PathBuf,
+
+    /// Run several granule types instead of --type: `all` (A1…C3) or a
+    /// comma list such as `A1,B2,C3`. The material overrides apply to every
+    /// type. Writes `DIR/<TYPE>/…` per type plus `DIR/types.csv` and
+    /// `DIR/force_displacement_types.svg`.
+    #[arg(long, value_name = "LIST", conflicts_with = "granule_type")]
+    pub types: Option<TypeList>,
+
+    /// Mesh level NxM of the full sphere: n core divisions (even), m shell
+    /// layers; 8x2 is the standard 1280-hex granule (160 hexes per octant),
+    /// 4x1 the coarse 160-hex one.
+    #[arg(long, default_value = "8x2")]
+    pub mesh: MeshLevel,
+
+    /// Simulated part of the granule.
+    #[arg(long, value_enum, default_value_t = SymmetryArg::Octant)]
+    pub symmetry: SymmetryArg,
+
+    /// Element formulation.
+    #[arg(long, value_enum, default_value_t = ElementArg::OnePoint)]
+    pub element: ElementArg,
+
+    /// Final strain: platen approach / granule diameter (0 < strain ≤ 0.9).
+    #[arg(long, default_value_t = 0.4, allow_negative_numbers = true)]
+    pub strain: f64,
+
+    /// Speed at which the platens approach each other, mm/s
+    /// (0 < speed ≤ 10000); each platen moves at half of it.
+    #[arg(
+        long,
+        value_name = "MM_S",
+        default_value_t = 5.0,
+        allow_negative_numbers = true
+    )]
+    pub speed_mm_s: f64,
+
+    /// Fraction ξ of critical damping of the granule's lowest
+    /// deformational mode (0 ≤ ξ ≤ 2).
+    #[arg(
+        long,
+        value_name = "XI",
+        default_value_t = 0.5,
+        allow_negative_numbers = true
+    )]
+    pub damping_ratio: f64,
+
+    /// Hourglass stiffness coefficient κ of the one-point hexes
+    /// (0 ≤ κ ≤ 1).
+    #[arg(
+        long,
+        value_name = "KAPPA",
+        default_value_t = 0.05,
+        allow_negative_numbers = true
+    )]
+    pub hourglass_kappa: f64,
+
+    /// Use the published return map literally, without the volume-drift fix.
+    #[arg(long)]
+    pub literal_return: bool,
+
+    /// Strain between samples (CSV rows); the platen forces are averaged
+    /// over each interval (0 < interval ≤ --strain).
+    #[arg(
+        long,
+        value_name = "STRAIN",
+        default_value_t = 0.005,
+        allow_negative_numbers = true
+    )]
+    pub output_strain: f64,
+
+    /// Safety factor C of the element time-step estimate (0 < C ≤ 1).
+    #[arg(
+        long,
+        value_name = "C",
+        default_value_t = 0.9,
+        allow_negative_numbers = true
+    )]
+    pub time_step_safety: f64,
+
+    /// Apply gravity (9.81 m/s² in −z); only with `--symmetry full`.
+    #[arg(long)]
+    pub gravity: bool,
+
+    /// Threads for --types (one type per thread; 0 = all cores). Results
+    /// do not depend on it; wall times may.
+    #[arg(short = 'j', long, value_name = "N", default_value_t = 0)]
+    pub threads: usize,
+
+    /// No progress bars and no summary lines on stderr (errors are still
+    /// reported).
+    #[arg(short, long)]
+    pub quiet: bool,
+
+    /// Granule type and parameter overrides (`--friction` is also the
+    /// granule–platen friction).
+    #[command(flatten)]
+    pub material: MaterialArgs,
+}
+
+/// One granule type to run, validated.
+#[derive(Clone, Debug)]
+struct Job {
+    granule_type: GranuleType,
+    params: PlatenParams,
+    dir: PathBuf,
+}
+
+/// What one type's run left behind (its files are written).
+struct Outcome {
+    job: Job,
+    result: RunResult,
+    summary: Summary,
+}
+
+impl GranuleArgs {
+    /// The experiment's parameters for `material`: the kernel's standard
+    /// experiment with every option applied.
+    pub fn params(&self, material: Material) -> PlatenParams {
+        let mut p = PlatenParams::standard(material);
+        p.elements.kind = self.element.into();
+        p.elements.update.volume_fix = !self.literal_return;
+        p.elements.hourglass_kappa = self.hourglass_kappa;
+        p.damping_ratio = self.damping_ratio;
+        p.approach_speed_m_s = self.speed_mm_s * 1.0e-3;
+        p.final_strain = self.strain;
+        p.time_step_safety = self.time_step_safety;
+        p.output_strain_interval = self.output_strain;
+        p.gravity_m_s2 = if self.gravity { GRAVITY_M_S2 } else { 0.0 };
+        p.symmetry = self.symmetry.into();
+        p
+    }
+
+    /// Turns a kernel parameter rejection into a usage error naming the
+    /// command-line flag (and the kernel field and range in its cause);
+    /// other setup errors stay runtime errors.
+    pub fn scene_error(&self, err: SceneError) -> anyhow::Error {
+        let SceneError::InvalidParameter { field, value, .. } = err else {
+            return anyhow::Error::new(err).context("cannot set up the platen experiment");
+        };
+        let message = match field {
+            "damping_ratio" => format!("`--damping-ratio {value}` rejected"),
+            "approach_speed_m_s" => format!(
+                "`--speed-mm-s {}` rejected (allowed: 0 < speed <= 10000 mm/s)",
+                self.speed_mm_s
+            ),
+            "friction" => format!("`--friction {value}` rejected (granule-platen friction)"),
+            "final_strain" => format!("`--strain {value}` rejected"),
+            "time_step_safety" => format!("`--time-step-safety {value}` rejected"),
+            "output_strain_interval" => format!(
+                "`--output-strain {value}` rejected (with `--strain {}`)",
+                self.strain
+            ),
+            "hourglass_kappa" => format!("`--hourglass-kappa {value}` rejected"),
+            "gravity_m_s2" => {
+                "`--gravity` rejected: it needs `--symmetry full` (in octant mode z = 0 is a \
+                 symmetry plane)"
+                    .to_owned()
+            }
+            other => format!("experiment parameter `{other}` = {value} rejected"),
+        };
+        anyhow::Error::new(err).context(InputError(message))
+    }
+
+    /// The granule types to run.
+    fn types(&self) -> Vec<GranuleType> {
+        match &self.types {
+            Some(list) => list.0.clone(),
+            None => vec![self.material.granule_type],
+        }
+    }
+
+    /// Validates every type's material and experiment (usage errors name
+    /// the flag) before anything is written.
+    fn jobs(&self, mesh: &OwnedReference) -> anyhow::Result<Vec<Job>> {
+        let mut jobs = Vec::new();
+        for granule_type in self.types() {
+            let material = MaterialArgs {
+                granule_type,
+                ..self.material
+            }
+            .material()?;
+            let params = self.params(material);
+            run::check(params, mesh).map_err(|e| self.scene_error(e))?;
+            let dir = if self.types.is_some() {
+                self.out.join(granule_type.name())
+            } else {
+                self.out.clone()
+            };
+            jobs.push(Job {
+                granule_type,
+                params,
+                dir,
+            });
+        }
+        Ok(jobs)
+    }
+
+    /// Runs `job` on `mesh` and writes its CSV, summary and plot.
+    fn run_job(
+        &self,
+        job: Job,
+        mesh: &OwnedReference,
+        bars: &MultiProgress,
+    ) -> anyhow::Result<Outcome> {
+        let name = job.granule_type.name();
+        let bar = progress::Progress::new(bars, name, job.params.final_strain);
+        let result = run::run_platens(job.params, mesh, &mut |s, t| bar.update(s, t));
+        bar.finish();
+        let result =
+            result.map_err(|e| anyhow::Error::new(e).context(format!("granule {name}")))?;
+        let setup = RunSetup {
+            granule_type: name,
+            mesh: self.mesh,
+            nodes: mesh.positions.len(),
+            hexes: mesh.hexes.len(),
+            params: &job.params,
+        };
+        let summary = Summary::new(&setup, &result);
+        write_outputs(&job.dir, &result, &summary)
+            .with_context(|| format!("granule {name}: writing the outputs"))?;
+        Ok(Outcome {
+            job,
+            result,
+            summary,
+        })
+    }
+
+    /// Validates the options, runs every type (in parallel over types with
+    /// `--types`), writes the outputs and the summary lines.
+    pub fn run(&self, streams: &mut Streams<'_>) -> anyhow::Result<()> {
+        let octant = self.symmetry == SymmetryArg::Octant;
+        let mesh = OwnedReference::sphere(GRANULE_RADIUS_M, self.mesh, octant)?;
+        let jobs = self.jobs(&mesh)?;
+        for dir in core::iter::once(&self.out).chain(jobs.iter().map(|j| &j.dir)) {
+            std::fs::create_dir_all(dir)
+                .with_context(|| format!("cannot create output directory `{}`", dir.display()))?;
+        }
+        let bars = progress::bars(self.quiet);
+        let outcomes: Vec<anyhow::Result<Outcome>> = if jobs.len() == 1 {
+            jobs.into_iter()
+                .map(|j| self.run_job(j, &mesh, &bars))
+                .collect()
+        } else {
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(self.threads)
+                .build()
+                .context("cannot start the worker threads")?;
+            pool.install(|| {
+                jobs.into_par_iter()
+                    .map(|j| self.run_job(j, &mesh, &bars))
+                    .collect()
+            })
+        };
+        let outcomes: Vec<Outcome> = outcomes.into_iter().collect::<anyhow::Result<_>>()?;
+        if self.types.is_some() {
+            write_type_outputs(&self.out, &outcomes, self.mesh, self.symmetry.into())?;
+        }
+        if !self.quiet {
+            for o in &outcomes {
+                writeln!(streams.stderr, "{}", o.summary.line())?;
+            }
+        }
+        kernel_failures(&outcomes)
+    }
+}
+
+/// Writes the CSV, summary and plot of one run into `dir`.
+fn write_outputs(dir: &Path, result: &RunResult, summary: &Summary) -> anyhow::Result<()> {
+    outputs::write_force_csv(&dir.join(outputs::FORCE_CSV), &result.samples)?;
+    outputs::write_summary_json(&dir.join(outputs::SUMMARY_JSON), summary)?;
+    let fit = match (
+        summary.slope_n_per_m,
+        summary.intercept_n,
+        summary.sigma_est_pa,
+    ) {
+        (Some(slope), Some(intercept), Some(sigma)) => {
+            let [lo, hi] = summary.sigma_est_strain_range;
+            Some(plot::FitLine {
+                slope_n_per_m: slope,
+                intercept_n: intercept,
+                x_range_m: [lo, hi.min(summary.final_strain)].map(|e| e * result.diameter_m),
+                label: format!("fit: sigma_est = {sigma:.4e} Pa"),
+            })
+        }
+        _ => None,
+    };
+    let title = format!(
+        "Granule {} ({} {}): platen force",
+        summary.granule_type, summary.mesh, summary.symmetry
+    );
+    let label = format!("{} mean force", summary.granule_type);
+    let curve = plot::Curve {
+        label: &label,
+        samples: &result.samples,
+    };
+    let svg = plot::force_displacement_svg(&title, &[curve], fit.as_ref())?;
+    outputs::write_text(&dir.join(outputs::FORCE_SVG), &svg)
+}
+
+/// Writes `types.csv` and the overlaid plot of a `--types` run into `dir`.
+fn write_type_outputs(
+    dir: &Path,
+    outcomes: &[Outcome],
+    mesh: MeshLevel,
+    symmetry: Symmetry,
+) -> anyhow::Result<()> {
+    let rows: Vec<(GranuleType, &Summary)> = outcomes
+        .iter()
+        .map(|o| (o.job.granule_type, &o.summary))
+        .collect();
+    outputs::write_types_csv(&dir.join(outputs::TYPES_CSV), &rows)?;
+    let curves: Vec<plot::Curve<'_>> = outcomes
+        .iter()
+        .map(|o| plot::Curve {
+            label: o.job.granule_type.name(),
+            samples: &o.result.samples,
+        })
+        .collect();
+    let title = format!(
+        "Granule types ({mesh} {}): platen force",
+        symmetry_name(symmetry)
+    );
+    let svg = plot::force_displacement_svg(&title, &curves, None)?;
+    outputs::write_text(&dir.join(outputs::TYPES_SVG), &svg)
+}
+
+/// The error of the runs the kernel stopped (naming type, step, strain,
+/// element and where the partial results are), or `Ok` if none.
+fn kernel_failures(outcomes: &[Outcome]) -> anyhow::Result<()> {
+    let mut failed = outcomes.iter().filter_map(|o| {
+        let err = o.result.error?;
+        let context = format!(
+            "granule {}: the kernel stopped the run; the {} samples before it are in `{}` and \
+             the summary (with its \"error\") in `{}`",
+            o.job.granule_type,
+            o.result.samples.len(),
+            o.job.dir.join(outputs::FORCE_CSV).display(),
+            o.job.dir.join(outputs::SUMMARY_JSON).display()
+        );
+        Some(anyhow::Error::new(err).context(context))
+    });
+    let Some(first) = failed.next() else {
+        return Ok(());
+    };
+    let others: Vec<String> = failed.map(|e| format!("{e:#}")).collect();
+    if others.is_empty() {
+        Err(first)
+    } else {
+        Err(first.context(format!(
+            "{} granule types failed; also: {}",
+            others.len() + 1,
+            others.join("; ")
+        )))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use granbed_kernel::element::force::DEFAULT_HOURGLASS_KAPPA;
+
+    #[test]
+    fn defaults_are_the_kernels_standard_experiment() {
+        use clap::Parser;
+        #[derive(Parser)]
+        struct Wrapper {
+            #[command(flatten)]
+            granule: GranuleArgs,
+        }
+        let args = Wrapper::try_parse_from(["test", "--out", "x"])
+            .unwrap()
+            .granule;
+        let material = GranuleType::B2.params().validate().unwrap();
+        assert_eq!(args.params(material), PlatenParams::standard(material));
+        assert_eq!(args.hourglass_kappa, DEFAULT_HOURGLASS_KAPPA);
+        assert_eq!(args.mesh, MeshLevel::STANDARD);
+    }
+
+    #[test]
+    fn type_lists() {
+        assert_eq!("all".parse::<TypeList>().unwrap().0, GranuleType::ALL);
+        let list: TypeList = "a1, B2,c3".parse().unwrap();
+        assert_eq!(list.to_string(), "A1,B2,C3");
+        assert!("A1,A1".parse::<TypeList>().unwrap_err().contains("twice"));
+        assert!("A1,D4".parse::<TypeList>().unwrap_err().contains("`D4`"));
+    }
+}

@@ -1,0 +1,159 @@
+//! The files `granbed-cli granule` writes: the force–displacement CSV, the
+//! summary JSON, the per-type table of `--types`, and text files (SVG).
+//! Every writer names the file in its error.
+
+use std::fs::File;
+use std::io::{BufWriter, Write};
+use std::path::Path;
+
+use anyhow::Context as _;
+use granbed_kernel::material::GranuleType;
+use granbed_kernel::scene::platens::PlatenSample;
+
+use super::run::mean_force;
+use super::summary::Summary;
+use crate::csv::{CsvWriter, Field};
+
+/// File name of the force–displacement table.
+pub const FORCE_CSV: &str = "force_displacement.csv";
+/// File name of the run summary.
+pub const SUMMARY_JSON: &str = "summary.json";
+/// File name of the force–displacement plot.
+pub const FORCE_SVG: &str = "force_displacement.svg";
+/// File name of the per-type table of `--types`.
+pub const TYPES_CSV: &str = "types.csv";
+/// File name of the overlaid plot of `--types`.
+pub const TYPES_SVG: &str = "force_displacement_types.svg";
+
+/// Header of [`FORCE_CSV`] (units in the names; energies are whole-granule
+/// equivalents).
+pub const FORCE_COLUMNS: [&str; 18] = [
+    "time_s",
+    "displacement_m",
+    "strain",
+    "force_n",
+    "force_upper_n",
+    "force_lower_n",
+    "kinetic_j",
+    "internal_work_j",
+    "elastic_j",
+    "plastic_j",
+    "hourglass_j",
+    "damping_j",
+    "contact_work_j",
+    "gravity_work_j",
+    "platen_work_j",
+    "min_j",
+    "dt_s",
+    "steps",
+];
+
+/// Header of [`TYPES_CSV`].
+pub const TYPES_COLUMNS: [&str; 10] = [
+    "type",
+    "sigma_y_pa",
+    "eta0",
+    "sigma_eff0_pa",
+    "sigma_est_pa",
+    "slope_n_per_m",
+    "steps",
+    "wall_time_s",
+    "energy_residual_rel",
+    "return_map_gap_rel",
+];
+
+/// Creates (or truncates) `path` for buffered writing.
+fn create(path: &Path) -> anyhow::Result<BufWriter<File>> {
+    let file = File::create(path)
+        .with_context(|| format!("cannot create output file `{}`", path.display()))?;
+    Ok(BufWriter::new(file))
+}
+
+/// Flushes `w`, naming `path` on failure.
+fn finish(mut w: impl Write, path: &Path) -> anyhow::Result<()> {
+    w.flush()
+        .with_context(|| format!("cannot write to `{}`", path.display()))
+}
+
+/// The cells of one sample, in the order of [`FORCE_COLUMNS`].
+pub fn force_row(s: &PlatenSample) -> [Field; FORCE_COLUMNS.len()] {
+    let e = &s.energy;
+    let r = Field::Real;
+    [
+        r(s.time_s),
+        r(s.approach_m),
+        r(s.strain),
+        r(mean_force(s)),
+        r(s.force_upper_n),
+        r(s.force_lower_n),
+        r(e.kinetic),
+        r(e.internal_work),
+        r(e.elastic),
+        r(e.plastic),
+        r(e.hourglass),
+        r(e.damping),
+        r(e.contact_work),
+        r(e.gravity_work),
+        r(e.platen_work),
+        r(s.min_j),
+        r(s.dt_s),
+        Field::Int(s.steps),
+    ]
+}
+
+/// Writes `samples` as [`FORCE_CSV`] rows to `path`.
+pub fn write_force_csv(path: &Path, samples: &[PlatenSample]) -> anyhow::Result<()> {
+    let ctx = || format!("cannot write to `{}`", path.display());
+    let mut csv = CsvWriter::new(create(path)?, &FORCE_COLUMNS).with_context(ctx)?;
+    for s in samples {
+        csv.write_row(&force_row(s)).with_context(ctx)?;
+    }
+    finish(csv.into_inner(), path)
+}
+
+/// Writes `summary` as pretty-printed JSON (and a final line break) to
+/// `path`. Floats are round-trip exact; non-finite ones become `null`.
+pub fn write_summary_json(path: &Path, summary: &Summary) -> anyhow::Result<()> {
+    let mut w = create(path)?;
+    serde_json::to_writer_pretty(&mut w, summary)
+        .and_then(|()| writeln!(w).map_err(serde_json::Error::io))
+        .with_context(|| format!("cannot write to `{}`", path.display()))?;
+    finish(w, path)
+}
+
+/// Writes `text` to `path`.
+pub fn write_text(path: &Path, text: &str) -> anyhow::Result<()> {
+    let mut w = create(path)?;
+    w.write_all(text.as_bytes())
+        .with_context(|| format!("cannot write to `{}`", path.display()))?;
+    finish(w, path)
+}
+
+/// The [`TYPES_CSV`] row of one type's summary (`NaN` for a measure that
+/// is `null` in its summary).
+fn types_row(t: GranuleType, s: &Summary) -> [Field; TYPES_COLUMNS.len()] {
+    let r = Field::Real;
+    let opt = |x: Option<f64>| Field::Real(x.unwrap_or(f64::NAN));
+    [
+        Field::Text(t.name()),
+        r(s.yield_stress_pa),
+        r(s.eta0),
+        r(s.sigma_eff0_pa),
+        opt(s.sigma_est_pa),
+        opt(s.slope_n_per_m),
+        Field::Int(s.steps),
+        r(s.wall_time_s),
+        opt(s.energy_residual_rel),
+        opt(s.return_map_gap_rel),
+    ]
+}
+
+/// Writes one [`TYPES_CSV`] row per `(type, summary)`, in the given order.
+pub fn write_types_csv(path: &Path, runs: &[(GranuleType, &Summary)]) -> anyhow::Result<()> {
+    let ctx = || format!("cannot write to `{}`", path.display());
+    let mut csv = CsvWriter::new(create(path)?, &TYPES_COLUMNS).with_context(ctx)?;
+    for (t, s) in runs {
+        csv.write_row(&types_row(*t, s)).with_context(ctx)?;
+    }
+    finish(csv.into_inner(), path)
+}

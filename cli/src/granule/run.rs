@@ -1,0 +1,98 @@
+//! Owned buffers for the kernel's platen experiment
+//! ([`granbed_kernel::scene::platens`]) and the loop that drives it to its
+//! final strain, collecting every sample.
+//!
+//! The kernel works over caller buffers; [`GranuleStore`] owns them (one
+//! allocation per buffer, sized from the mesh and the element's integration
+//! points) and [`run_platens`] lends them to a [`PlatenScene`] for one run. Nothing here depends on clap, so the
+//! test suites and the `--types` loop drive exactly this code.
+
+use std::time::Instant;
+
+use granbed_kernel::Real;
+use granbed_kernel::scene::platens::{PlatenParams, PlatenSample, PlatenScene, SceneError};
+
+use crate::model::{GranuleStore, OwnedReference};
+
+/// Everything one run produced. A run stopped by a kernel error keeps the
+/// samples taken before it and holds the error in [`RunResult::error`].
+#[derive(Clone, Debug)]
+pub struct RunResult {
+    /// Samples in time order: [`PlatenScene::sample`] at t = 0 first, then
+    /// every sample [`PlatenScene::step`] returned.
+    pub samples: Vec<PlatenSample>,
+    /// Granule diameter d that strains are measured against, m.
+    pub diameter_m: Real,
+    /// Time step of the first step, s.
+    pub initial_dt_s: Real,
+    /// Steps completed (a failed step is not counted).
+    pub steps: u64,
+    /// Element evaluations (steps × simulated hexes).
+    pub element_steps: u64,
+    /// Wall-clock time from the scene's construction to the end of the
+    /// loop (stepping and sampling; not the mesh generation), s.
+    pub wall_time_s: f64,
+    /// The kernel error that stopped the run early, if any.
+    pub error: Option<SceneError>,
+}
+
+/// Checks `params` against `mesh` the way a run would (the kernel's
+/// parameter validation and buffer checks), without stepping.
+///
+/// Errors are those of [`PlatenScene::new`].
+pub fn check(params: PlatenParams, mesh: &OwnedReference) -> Result<(), SceneError> {
+    let mut store = GranuleStore::new(mesh, params.elements.points_per_element());
+    PlatenScene::new(params, mesh.view(), store.buffers()).map(drop)
+}
+
+/// Runs the platen experiment `params` on `mesh` to its final strain.
+///
+/// `on_sample` sees every sample as it is taken, with the wall time since
+/// the start in seconds (for progress reports); it cannot stop the run.
+///
+/// Returns `Err` only if the scene cannot be set up (invalid parameter,
+/// unstable initial time step); an error while stepping ends the run and is
+/// returned inside the [`RunResult`] with the samples so far.
+pub fn run_platens(
+    params: PlatenParams,
+    mesh: &OwnedReference,
+    on_sample: &mut dyn FnMut(&PlatenSample, f64),
+) -> Result<RunResult, SceneError> {
+    let mut store = GranuleStore::new(mesh, params.elements.points_per_element());
+    let start = Instant::now();
+    let mut scene = PlatenScene::new(params, mesh.view(), store.buffers())?;
+    let initial_dt_s = scene.time_step();
+    let first = scene.sample();
+    on_sample(&first, start.elapsed().as_secs_f64());
+    let mut samples = vec![first];
+    let mut error = None;
+    while !scene.finished() {
+        match scene.step() {
+            Ok(Some(sample)) => {
+                on_sample(&sample, start.elapsed().as_secs_f64());
+                samples.push(sample);
+            }
+            Ok(None) => {}
+            Err(e) => {
+                error = Some(e);
+                break;
+            }
+        }
+    }
+    let wall_time_s = start.elapsed().as_secs_f64();
+    Ok(RunResult {
+        samples,
+        diameter_m: scene.diameter(),
+        initial_dt_s,
+        steps: scene.steps(),
+        element_steps: scene.element_steps(),
+        wall_time_s,
+        error,
+    })
+}
+
+/// The platen force of a sample: the mean of the upper and lower platen
+/// forces, N. The CSV's `force_n` and the σ_est fit both use it.
+pub fn mean_force(s: &PlatenSample) -> Real {
+    0.5 * (s.force_upper_n + s.force_lower_n)
+}

@@ -1,0 +1,271 @@
+//! The measures of one single-granule run (`summary.json`): σ_est from the
+//! force–displacement slope, σ_y,eff0, the energy checks, the cost, and
+//! every input parameter for provenance.
+
+use granbed_kernel::Real;
+use granbed_kernel::analysis::granule::{initial_effective_yield_stress, yield_stress_estimate};
+use granbed_kernel::granule::forces::ElementKind;
+use granbed_kernel::scene::platens::{PlatenParams, SceneError, Symmetry};
+use serde::Serialize;
+
+use super::run::{RunResult, mean_force};
+use crate::model::MeshLevel;
+
+/// Name of the `summary.json` format (its `format` field).
+pub const FORMAT: &str = "granbed-granule-summary";
+/// Version of the `summary.json` format; bumped when a field changes
+/// meaning or disappears (adding a field does not bump it).
+pub const FORMAT_VERSION: u32 = 1;
+
+/// Strain range of the σ_est fit, x/d (physics.md §7 item 7).
+pub const FIT_STRAIN_RANGE: [Real; 2] = [0.1, 0.4];
+
+/// The command-line name of a symmetry mode (`octant` or `full`).
+pub fn symmetry_name(s: Symmetry) -> &'static str {
+    match s {
+        Symmetry::Octant => "octant",
+        Symmetry::Full => "full",
+    }
+}
+
+/// What was run: the inputs of a summary that are not in [`PlatenParams`].
+#[derive(Clone, Copy, Debug)]
+pub struct RunSetup<'a> {
+    /// Granule type name the material preset came from, e.g. `B2`.
+    pub granule_type: &'a str,
+    /// Mesh level of the full sphere.
+    pub mesh: MeshLevel,
+    /// Nodes of the simulated (octant or full) mesh.
+    pub nodes: usize,
+    /// Hexes of the simulated mesh.
+    pub hexes: usize,
+    /// The experiment's parameters.
+    pub params: &'a PlatenParams,
+}
+
+/// `summary.json`: one run's inputs and measures. Units are in the field
+/// names; a measure that cannot be computed (too few samples, zero
+/// denominator) is `null`.
+#[derive(Clone, Debug, Serialize)]
+pub struct Summary {
+    /// Always [`FORMAT`].
+    pub format: &'static str,
+    /// [`FORMAT_VERSION`].
+    pub format_version: u32,
+    /// Version of granbed that wrote the file.
+    pub granbed_version: &'static str,
+    /// Granule type of the material preset, e.g. `B2` (overrides below).
+    pub granule_type: String,
+    /// Mesh level `NxM` of the full sphere.
+    pub mesh: String,
+    /// `octant` or `full`.
+    pub symmetry: &'static str,
+    /// Nodes simulated.
+    pub mesh_nodes: usize,
+    /// Hexes simulated.
+    pub mesh_hexes: usize,
+    /// Granule diameter d, m.
+    pub diameter_m: Real,
+
+    /// Young's modulus E, Pa.
+    pub youngs_modulus_pa: Real,
+    /// Poisson's ratio ν.
+    pub poisson_ratio: Real,
+    /// Solid yield stress σ_y, Pa.
+    pub yield_stress_pa: Real,
+    /// Initial relative density η0.
+    pub eta0: Real,
+    /// Yield-surface constant c_p.
+    pub cp: Real,
+    /// Critical relative density η_c.
+    pub eta_c: Real,
+    /// True density, kg/m³.
+    pub true_density_kg_m3: Real,
+    /// Granule–platen Coulomb friction coefficient.
+    pub friction: Real,
+
+    /// Element formulation: `one-point` (production) or `f-bar`.
+    pub element: &'static str,
+    /// Requested final strain (platen approach / d).
+    pub target_strain: Real,
+    /// Platen approach speed, m/s.
+    pub approach_speed_m_s: Real,
+    /// Damping ratio ξ.
+    pub damping_ratio: Real,
+    /// Hourglass coefficient κ.
+    pub hourglass_kappa: Real,
+    /// True if the return map ran without the volume-drift fix.
+    pub literal_return: bool,
+    /// Relative yield tolerance of the constitutive update.
+    pub yield_tolerance: Real,
+    /// Safety factor C of the time step.
+    pub time_step_safety: Real,
+    /// Steps between time-step re-estimates.
+    pub time_step_interval: u32,
+    /// Strain between samples.
+    pub output_strain_interval: Real,
+    /// Gravity, m/s² (in −z).
+    pub gravity_m_s2: Real,
+
+    /// Granule yield stress estimate σ_est = 4/(πd)·dF/dx over
+    /// [`Summary::sigma_est_strain_range`], Pa; `null` with fewer than two
+    /// samples in range.
+    pub sigma_est_pa: Option<Real>,
+    /// Strain range of the fit, x/d.
+    pub sigma_est_strain_range: [Real; 2],
+    /// σ_y,eff0 = √a2(η0)·σ_y, Pa.
+    pub sigma_eff0_pa: Real,
+    /// Fitted slope dF/dx, N/m.
+    pub slope_n_per_m: Option<Real>,
+    /// Fitted intercept, N.
+    pub intercept_n: Option<Real>,
+    /// R² of the fit.
+    pub fit_r_squared: Option<Real>,
+    /// Samples in the fit.
+    pub fit_points: usize,
+    /// Samples written (rows of `force_displacement.csv`).
+    pub samples: usize,
+    /// Time steps taken.
+    pub steps: u64,
+    /// Initial time step, s.
+    pub dt_s: Real,
+    /// Time step at the last sample, s.
+    pub final_dt_s: Real,
+    /// Element evaluations (steps × hexes simulated).
+    pub element_steps: u64,
+    /// Wall time of the run (stepping and sampling), s.
+    pub wall_time_s: f64,
+    /// Wall time per element evaluation, ns.
+    pub ns_per_element_step: Option<f64>,
+    /// Energy-balance residual / contact work at the last sample (round-off
+    /// by construction).
+    pub energy_residual_rel: Option<Real>,
+    /// Return-map energy gap / contact work at the last sample.
+    pub return_map_gap_rel: Option<Real>,
+    /// Hourglass energy / internal work at the last sample.
+    pub hourglass_energy_rel: Option<Real>,
+    /// Damping dissipation / contact work at the last sample.
+    pub damping_rel: Option<Real>,
+    /// Smallest element J over all samples.
+    pub min_jacobian: Real,
+    /// Strain of the last sample.
+    pub final_strain: Real,
+    /// Largest mean platen force over the samples, N.
+    pub max_force_n: Real,
+    /// Remarks on the measures (e.g. why σ_est is null).
+    pub notes: Vec<String>,
+    /// The kernel error that stopped the run, or `null`.
+    pub error: Option<String>,
+}
+
+/// `num / den`, or `None` if that is not a finite number.
+fn ratio(num: Real, den: Real) -> Option<Real> {
+    let r = num / den;
+    r.is_finite().then_some(r)
+}
+
+impl Summary {
+    /// The summary of `result`, a run of `setup`.
+    pub fn new(setup: &RunSetup<'_>, result: &RunResult) -> Self {
+        let p = setup.params;
+        let m = &p.material.params;
+        let samples = &result.samples;
+        let last = samples.last();
+        let [lo, hi] = FIT_STRAIN_RANGE;
+        let points = samples.iter().map(|s| (s.approach_m, mean_force(s)));
+        let fit = yield_stress_estimate(points, result.diameter_m, lo, hi);
+        let final_strain = last.map_or(0.0, |s| s.strain);
+        let mut notes = Vec::new();
+        match fit {
+            None => notes.push(format!(
+                "sigma_est needs at least two samples with {lo} <= strain <= {hi}; the run \
+                 ended at strain {final_strain}"
+            )),
+            Some(_) if final_strain < hi => notes.push(format!(
+                "sigma_est was fitted over strain {lo} to {final_strain} only: the run ended \
+                 before strain {hi}"
+            )),
+            Some(_) => {}
+        }
+        let e = last.map(|s| s.energy).unwrap_or_default();
+        Self {
+            format: FORMAT,
+            format_version: FORMAT_VERSION,
+            granbed_version: env!("CARGO_PKG_VERSION"),
+            granule_type: setup.granule_type.to_owned(),
+            mesh: setup.mesh.to_string(),
+            symmetry: symmetry_name(p.symmetry),
+            mesh_nodes: setup.nodes,
+            mesh_hexes: setup.hexes,
+            diameter_m: result.diameter_m,
+            youngs_modulus_pa: m.youngs_modulus_pa,
+            poisson_ratio: m.poisson_ratio,
+            yield_stress_pa: m.yield_stress_pa,
+            eta0: m.eta0,
+            cp: m.cp,
+            eta_c: m.eta_c,
+            true_density_kg_m3: m.true_density_kg_m3,
+            friction: p.friction,
+            element: match p.elements.kind {
+                ElementKind::OnePoint => "one-point",
+                ElementKind::FBar => "f-bar",
+            },
+            target_strain: p.final_strain,
+            approach_speed_m_s: p.approach_speed_m_s,
+            damping_ratio: p.damping_ratio,
+            hourglass_kappa: p.elements.hourglass_kappa,
+            literal_return: !p.elements.update.volume_fix,
+            yield_tolerance: p.elements.update.yield_tolerance,
+            time_step_safety: p.time_step_safety,
+            time_step_interval: p.time_step_interval,
+            output_strain_interval: p.output_strain_interval,
+            gravity_m_s2: p.gravity_m_s2,
+            sigma_est_pa: fit.map(|(sigma, _)| sigma),
+            sigma_est_strain_range: FIT_STRAIN_RANGE,
+            sigma_eff0_pa: initial_effective_yield_stress(m),
+            slope_n_per_m: fit.map(|(_, f)| f.slope),
+            intercept_n: fit.map(|(_, f)| f.intercept),
+            fit_r_squared: fit.and_then(|(_, f)| f.r_squared.is_finite().then_some(f.r_squared)),
+            fit_points: fit.map_or(0, |(_, f)| f.points),
+            samples: samples.len(),
+            steps: result.steps,
+            dt_s: result.initial_dt_s,
+            final_dt_s: last.map_or(result.initial_dt_s, |s| s.dt_s),
+            element_steps: result.element_steps,
+            wall_time_s: result.wall_time_s,
+            ns_per_element_step: ratio(result.wall_time_s * 1.0e9, result.element_steps as f64),
+            energy_residual_rel: ratio(e.residual(), e.contact_work),
+            return_map_gap_rel: ratio(e.return_map_gap(), e.contact_work),
+            hourglass_energy_rel: ratio(e.hourglass, e.internal_work),
+            damping_rel: ratio(e.damping, e.contact_work),
+            min_jacobian: samples.iter().fold(Real::INFINITY, |j, s| j.min(s.min_j)),
+            final_strain,
+            max_force_n: samples
+                .iter()
+                .fold(Real::NEG_INFINITY, |f, s| f.max(mean_force(s))),
+            notes,
+            error: result.error.as_ref().map(SceneError::to_string),
+        }
+    }
+
+    /// The one-line stderr report of the run.
+    pub fn line(&self) -> String {
+        let sigma_est = self
+            .sigma_est_pa
+            .map_or_else(|| "n/a".to_owned(), |s| format!("{s:.4e} Pa"));
+        let ns = self
+            .ns_per_element_step
+            .map_or_else(|| "n/a".to_owned(), |ns| format!("{ns:.1}"));
+        format!(
+            "granule {} ({} {}) to strain {:.4}: sigma_est {sigma_est}, sigma_eff0 {:.4e} Pa, \
+             {} steps, {:.3} s, {ns} ns/element-step",
+            self.granule_type,
+            self.mesh,
+            self.symmetry,
+            self.final_strain,
+            self.sigma_eff0_pa,
+            self.steps,
+            self.wall_time_s
+        )
+    }
+}
