@@ -428,6 +428,11 @@ impl<'a> PlatenScene<'a> {
         self.buf.x
     }
 
+    /// Simulated time, s.
+    pub fn time(&self) -> Real {
+        self.time
+    }
+
     /// Steps taken.
     pub fn steps(&self) -> u64 {
         self.step

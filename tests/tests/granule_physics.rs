@@ -1,0 +1,262 @@
+//! The single-granule experiment against physics (physics.md §5.6, §7 item 7,
+//! §8 K1–K3, P1) and against an established FE code (CalculiX), through the
+//! same run loop the CLI uses.
+
+use std::path::Path;
+
+use granbed_cli::granule::run::{mean_force, run_platens};
+use granbed_cli::model::{GranuleStore, MeshLevel, OwnedReference};
+use granbed_kernel::Real;
+use granbed_kernel::analysis::granule::yield_stress_estimate;
+use granbed_kernel::material::{GranuleType, MaterialParams};
+use granbed_kernel::scene::platens::{PlatenParams, PlatenSample, PlatenScene, Symmetry};
+
+const R: Real = 0.5e-3;
+
+fn mesh(level: MeshLevel, octant: bool) -> OwnedReference {
+    OwnedReference::sphere(R, level, octant).unwrap()
+}
+
+fn run(params: PlatenParams, mesh: &OwnedReference) -> Vec<PlatenSample> {
+    let result = run_platens(params, mesh, &mut |_, _| {}).unwrap();
+    assert!(result.error.is_none(), "{:?}", result.error);
+    result.samples
+}
+
+/// (approach x, mean platen force) of every sample.
+fn curve(samples: &[PlatenSample]) -> Vec<(Real, Real)> {
+    samples
+        .iter()
+        .map(|s| (s.approach_m, mean_force(s)))
+        .collect()
+}
+
+/// Work ∫₀ˣ F dx of a piecewise-linear curve, J.
+fn work(points: &[(Real, Real)], x_end: Real) -> Real {
+    let mut w = 0.0;
+    for pair in points.windows(2) {
+        let ((x0, f0), (x1, mut f1)) = (pair[0], pair[1]);
+        if x0 >= x_end {
+            break;
+        }
+        let mut x1 = x1;
+        if x1 > x_end {
+            f1 = f0 + (f1 - f0) * (x_end - x0) / (x1 - x0);
+            x1 = x_end;
+        }
+        w += 0.5 * (f0 + f1) * (x1 - x0);
+    }
+    w
+}
+
+/// Linear interpolation of F at approach `x`.
+fn force_at(points: &[(Real, Real)], x: Real) -> Real {
+    let k = points
+        .iter()
+        .position(|p| p.0 >= x)
+        .expect("curve reaches x");
+    let ((x0, f0), (x1, f1)) = (points[k - 1], points[k]);
+    f0 + (f1 - f0) * (x - x0) / (x1 - x0)
+}
+
+/// §7 item 7 and issue #3: the octant with three symmetry planes gives the
+/// full-sphere answer within 1 % (4x1 mesh: the symmetry argument does not
+/// depend on the resolution) — every sample's force from 5 % strain on and σ_est.
+#[test]
+fn octant_equals_full_sphere() {
+    let mat = GranuleType::B2.params().validate().unwrap();
+    let mut p = PlatenParams::standard(mat);
+    let octant = curve(&run(p, &mesh(MeshLevel::new(4, 1), true)));
+    p.symmetry = Symmetry::Full;
+    let full = curve(&run(p, &mesh(MeshLevel::new(4, 1), false)));
+    assert_eq!(octant.len(), full.len());
+    for (o, f) in octant.iter().zip(&full) {
+        if o.0 >= 0.05e-3 {
+            assert!(
+                (o.1 / f.1 - 1.0).abs() < 0.01,
+                "octant {} vs full {} at x = {}",
+                o.1,
+                f.1,
+                o.0
+            );
+        }
+    }
+    let sigma = |c: &[(Real, Real)]| {
+        yield_stress_estimate(c.iter().copied(), 2.0 * R, 0.1, 0.4)
+            .unwrap()
+            .0
+    };
+    assert!((sigma(&octant) / sigma(&full) - 1.0).abs() < 0.01);
+}
+
+/// Hertz force F = (4/3)E*√R (x/2)^{3/2} of a sphere between two plates, N.
+fn hertz(e_star: Real, x: Real) -> Real {
+    4.0 / 3.0 * e_star * R.sqrt() * (x / 2.0).powf(1.5)
+}
+
+/// An elastic granule (σy = ∞) between frictionless plates, compressed at
+/// 2 mm/s with damping to `strain` on `level`: its (approach, force) curve.
+fn elastic_curve(level: MeshLevel, strain: Real) -> (Vec<(Real, Real)>, Real) {
+    let mat = MaterialParams {
+        yield_stress_pa: Real::INFINITY,
+        ..GranuleType::A3.params()
+    }
+    .validate()
+    .unwrap();
+    let mut p = PlatenParams::standard(mat);
+    p.friction = 0.0;
+    p.approach_speed_m_s = 2e-3;
+    p.final_strain = strain;
+    p.output_strain_interval = 0.0025;
+    let e_star = mat.params.youngs_modulus_pa / (1.0 - mat.params.poisson_ratio.powi(2));
+    (curve(&run(p, &mesh(level, true))), e_star)
+}
+
+/// K2 (§5.6 item 4): the elastic granule follows Hertz: 1.036 / 4.095 /
+/// 11.58 mN at 2 / 5 / 10 % strain, within 20 / 15 / 15 %. On the standard
+/// 8x2 mesh only the pole node touches the plate below 2 % strain (the first
+/// ring of surface nodes, 0.1 mm from the axis, touches at 2 %), so the 2 %
+/// point is checked on the 16x4 mesh, whose first ring touches at 0.5 %;
+/// 5 and 10 % on the standard mesh.
+#[test]
+fn k2_elastic_granule_follows_hertz() {
+    let (fine, e_star) = elastic_curve(MeshLevel::new(16, 4), 0.02);
+    let (standard, _) = elastic_curve(MeshLevel::STANDARD, 0.1);
+    for (c, strain, published, tol) in [
+        (&fine, 0.02, 1.036e-3, 0.20),
+        (&standard, 0.05, 4.095e-3, 0.15),
+        (&standard, 0.10, 11.58e-3, 0.15),
+    ] {
+        let x = strain * 2.0 * R;
+        let h = hertz(e_star, x);
+        assert!(
+            (h / published - 1.0).abs() < 1e-3,
+            "Hertz formula {h} vs {published}"
+        );
+        let f = force_at(c, x);
+        println!(
+            "Hertz at {strain}: granbed {f:.4e} N, Hertz {h:.4e} N ({:+.1} %)",
+            100.0 * (f / h - 1.0)
+        );
+        assert!((f / h - 1.0).abs() < tol, "strain {strain}: {f} vs {h}");
+    }
+}
+
+/// K3 (§5.6 item 3): a granule resting on the lower platen under gravity
+/// (full sphere, damped; the upper platen drifts away at 1 µm/s) presses on
+/// it with its weight m g = ρ0 V_mesh g = 7.57 µN (η0 = 1), to 1 % in the
+/// time average over 5–30 ms; the upper platen carries nothing. The granule
+/// keeps rocking on its contact at about 1 kHz (that mode is nearly a rigid
+/// translation, which the selective damping leaves alone), so the force is
+/// averaged over ~25 periods. K1: no node stays below the lower platen by
+/// more than round-off after the corrector.
+#[test]
+fn k3_resting_granule_weighs_m_g_and_k1_no_penetration() {
+    let mat = GranuleType::A3.params().validate().unwrap();
+    let m = mesh(MeshLevel::STANDARD, false);
+    let weight = mat.density0 * m.view().volume() * 9.81;
+    assert!((weight / 7.57e-6 - 1.0).abs() < 1e-3, "m g = {weight}");
+    let mut p = PlatenParams::standard(mat);
+    p.symmetry = Symmetry::Full;
+    p.gravity_m_s2 = 9.81;
+    p.approach_speed_m_s = 1e-6;
+    p.final_strain = 30e-6; // 30 ms of simulated time
+    p.output_strain_interval = 0.5e-6; // 0.5 ms windows
+    let mut store = GranuleStore::new(&m, 1);
+    let mut scene = PlatenScene::new(p, m.view(), store.buffers()).unwrap();
+    let (mut impulse, mut span, mut upper) = (0.0, 0.0, 0.0 as Real);
+    let mut previous_time = 0.0;
+    let mut lowest: Real = 0.0;
+    while !scene.finished() {
+        if let Some(s) = scene.step().unwrap() {
+            if s.time_s > 5e-3 {
+                impulse += s.force_lower_n * (s.time_s - previous_time);
+                span += s.time_s - previous_time;
+                upper = upper.max(s.force_upper_n);
+            }
+            previous_time = s.time_s;
+        }
+        let floor = -R + 0.5 * p.approach_speed_m_s * scene.time();
+        let min_z = scene
+            .positions()
+            .iter()
+            .fold(Real::INFINITY, |a, x| a.min(x[2]));
+        lowest = lowest.min(min_z - floor);
+    }
+    let mean = impulse / span;
+    println!(
+        "mean lower force {mean:.5e} N over {span:.4} s, m g {weight:.5e} N, upper {upper:e} N, deepest {lowest:e} m"
+    );
+    assert!(
+        (mean / weight - 1.0).abs() < 0.01,
+        "lower platen {mean} vs m g {weight}"
+    );
+    assert!(upper == 0.0, "upper platen {upper}");
+    assert!(
+        lowest >= -1e-12,
+        "a node sank {lowest:e} m below the platen"
+    );
+}
+
+fn fixture(name: &str) -> Vec<(Real, Real)> {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../fixtures/peers/calculix")
+        .join(name);
+    let text = std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    text.lines()
+        .skip(1)
+        .map(|l| {
+            let v: Vec<Real> = l.split(',').map(|x| x.parse().unwrap()).collect();
+            (v[1], v[2])
+        })
+        .collect()
+}
+
+/// Agreement with CalculiX 2.20 (C3D8R, implicit, NLGEOM; fixtures/peers/
+/// calculix) for non-porous granules A3/B3/C3 at 5 mm/s, μ = 0.1: the work
+/// ∫F dx up to 10/20/30/40 % strain within 5 % and σ_est within 5 %.
+///
+/// The work, not the point force, is compared: both curves rise in steps as
+/// each ring of surface nodes (0.1 mm quads) touches the platen, and the
+/// node-based kinematic contact picks a ring up at a slightly different strain
+/// than CalculiX's penalty surface-to-surface contact (A3: 0.26 against 0.33),
+/// so point forces differ by up to 7 % between the steps while the work and
+/// the slope differ by less than 4 %.
+#[test]
+fn agrees_with_calculix() {
+    let m = mesh(MeshLevel::STANDARD, true);
+    for t in [GranuleType::A3, GranuleType::B3, GranuleType::C3] {
+        let reference = fixture(&format!("reference_{t}.csv"));
+        let ours = curve(&run(
+            PlatenParams::standard(t.params().validate().unwrap()),
+            &m,
+        ));
+        for strain in [0.1, 0.2, 0.3, 0.4] {
+            let x = strain * 2.0 * R;
+            let (w, w_ref) = (work(&ours, x), work(&reference, x));
+            println!(
+                "{t} work to {strain}: {:+.1} %, force {:+.1} %",
+                100.0 * (w / w_ref - 1.0),
+                100.0 * (force_at(&ours, x) / force_at(&reference, x) - 1.0)
+            );
+            assert!(
+                (w / w_ref - 1.0).abs() < 0.05,
+                "{t}: work to strain {strain}: {w} vs CalculiX {w_ref}"
+            );
+        }
+        let sigma = |c: &[(Real, Real)]| {
+            yield_stress_estimate(c.iter().copied(), 2.0 * R, 0.1, 0.4)
+                .unwrap()
+                .0
+        };
+        let (s, s_ref) = (sigma(&ours), sigma(&reference));
+        println!(
+            "{t} sigma_est {s:.0} Pa vs CalculiX {s_ref:.0} Pa ({:+.1} %)",
+            100.0 * (s / s_ref - 1.0)
+        );
+        assert!(
+            (s / s_ref - 1.0).abs() < 0.05,
+            "{t}: sigma_est {s} vs CalculiX {s_ref}"
+        );
+    }
+}
