@@ -1,0 +1,114 @@
+//! Criterion benches of the element loop: ns per element-step (forces +
+//! constitutive update + hourglass + assembly) on the standard 1280-hex
+//! granule of type B2, in a uniaxial-strain field with a little shear:
+//! elastic (0.1 % from the virgin state) and plastic (the step from 19.99 %
+//! to 20 %, the state loaded there in 2000 increments, as in an explicit
+//! run), for the one-point element and the F-bar verification element.
+
+use core::hint::black_box;
+
+use criterion::{Criterion, Throughput, criterion_group, criterion_main};
+use granbed_kernel::element::reference::{HexReference, hex_reference};
+use granbed_kernel::granule::forces::{ElementKind, ElementSettings, internal_forces};
+use granbed_kernel::material::GranuleType;
+use granbed_kernel::mesh::octant::MeshView;
+use granbed_kernel::mesh::reference::{ReferenceMesh, compute_element_data};
+use granbed_kernel::mesh::sphere::{MeshBuffers, SphereMeshParams, generate};
+use granbed_kernel::tensor::VOIGT_IDENTITY;
+
+struct Mesh {
+    positions: Vec<[f64; 3]>,
+    hexes: Vec<[u32; 8]>,
+    quads: Vec<[u32; 4]>,
+    node_quads: Vec<[u32; 4]>,
+    elements: Vec<HexReference>,
+    node_volume: Vec<f64>,
+    surface: usize,
+}
+
+fn standard_mesh() -> Mesh {
+    let p = SphereMeshParams::standard();
+    let s = p.size().unwrap();
+    let mut m = Mesh {
+        positions: vec![[0.0; 3]; s.nodes],
+        hexes: vec![[0; 8]; s.hexes],
+        quads: vec![[0; 4]; s.quads],
+        node_quads: vec![[0; 4]; s.surface_nodes],
+        elements: Vec::new(),
+        node_volume: vec![0.0; s.nodes],
+        surface: s.surface_nodes,
+    };
+    let mut scratch = vec![0; s.scratch];
+    generate(
+        &p,
+        &mut MeshBuffers {
+            positions: &mut m.positions,
+            hexes: &mut m.hexes,
+            quads: &mut m.quads,
+            node_quads: &mut m.node_quads,
+            scratch: &mut scratch,
+        },
+    )
+    .unwrap();
+    let first: [[f64; 3]; 8] = core::array::from_fn(|i| m.positions[m.hexes[0][i] as usize]);
+    m.elements = vec![hex_reference(&first).unwrap(); s.hexes];
+    let view = MeshView {
+        positions: &m.positions,
+        hexes: &m.hexes,
+        quads: &m.quads,
+        surface_nodes: m.surface,
+    };
+    compute_element_data(&view, &mut m.elements, &mut m.node_volume).unwrap();
+    m
+}
+
+fn bench_elements(c: &mut Criterion) {
+    let m = standard_mesh();
+    let mesh = ReferenceMesh {
+        mesh: MeshView {
+            positions: &m.positions,
+            hexes: &m.hexes,
+            quads: &m.quads,
+            surface_nodes: m.surface,
+        },
+        node_quads: &m.node_quads,
+        elements: &m.elements,
+        node_volume: &m.node_volume,
+    };
+    let mat = GranuleType::B2.params().validate().unwrap();
+    let mut group = c.benchmark_group("element_step");
+    group.throughput(Throughput::Elements(m.hexes.len() as u64));
+    for (name, kind, squeeze) in [
+        ("one_point_elastic", ElementKind::OnePoint, 0.999),
+        ("one_point_plastic", ElementKind::OnePoint, 0.8),
+        ("fbar_plastic", ElementKind::FBar, 0.8),
+    ] {
+        let settings = ElementSettings {
+            kind,
+            update: Default::default(),
+            hourglass_kappa: 0.05,
+        };
+        // Uniaxial-strain field with a little shear, so every element has a general stress.
+        let x: Vec<[f64; 3]> = m
+            .positions
+            .iter()
+            .map(|p| [p[0] + 0.05 * (1.0 - squeeze) * p[2], p[1], p[2] * squeeze])
+            .collect();
+        // Start every step from the virgin state, so each element-step does the same work.
+        let start = vec![VOIGT_IDENTITY; m.hexes.len() * settings.points_per_element()];
+        let mut cp = start.clone();
+        let mut f = vec![[0.0; 3]; m.positions.len()];
+        group.bench_function(name, |b| {
+            b.iter(|| {
+                cp.copy_from_slice(&start);
+                let s = internal_forces(&mesh, &mat, &settings, black_box(&x), &mut cp, &mut f)
+                    .unwrap();
+                black_box(s.plastic_elements)
+            })
+        });
+    }
+    group.finish();
+}
+
+criterion_group!(benches, bench_elements);
+criterion_main!(benches);
