@@ -5,9 +5,11 @@ use anyhow::{Context as _, bail};
 use granbed_kernel::Real;
 use granbed_kernel::element::reference::HexReference;
 use granbed_kernel::granule::dynamics::GranuleBuffers;
+use granbed_kernel::granule::timestep::PowerIterationBuffers;
 use granbed_kernel::mesh::octant::{MeshView, extract_octant, octant_size};
 use granbed_kernel::mesh::reference::{ReferenceMesh, compute_element_data};
 use granbed_kernel::mesh::sphere::{MeshBuffers, MeshSize, SphereMeshParams, generate};
+use granbed_kernel::scene::platens::PlatenBuffers;
 
 /// A mesh resolution "NxM": n core divisions, m shell layers.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -225,6 +227,69 @@ impl GranuleStore {
             mass: &mut self.mass,
             fixed: &mut self.fixed,
             cp_inv: &mut self.cp_inv,
+        }
+    }
+}
+
+/// Owned scratch for the kernel's power iteration (the global time-step
+/// estimate) of one granule.
+#[derive(Clone, Debug)]
+pub struct PowerStore {
+    mode: Vec<[Real; 3]>,
+    x_pert: Vec<[Real; 3]>,
+    f_plus: Vec<[Real; 3]>,
+    f_minus: Vec<[Real; 3]>,
+    cp_scratch: Vec<[Real; 6]>,
+}
+
+impl PowerStore {
+    /// Buffers for `mesh` with `points` integration points per element.
+    pub fn new(mesh: &OwnedReference, points: usize) -> Self {
+        let n = mesh.positions.len();
+        Self {
+            mode: vec![[0.0; 3]; n],
+            x_pert: vec![[0.0; 3]; n],
+            f_plus: vec![[0.0; 3]; n],
+            f_minus: vec![[0.0; 3]; n],
+            cp_scratch: vec![[0.0; 6]; mesh.hexes.len() * points],
+        }
+    }
+
+    /// The kernel's borrowed view.
+    pub fn buffers(&mut self) -> PowerIterationBuffers<'_> {
+        PowerIterationBuffers {
+            mode: &mut self.mode,
+            x_pert: &mut self.x_pert,
+            f_plus: &mut self.f_plus,
+            f_minus: &mut self.f_minus,
+            cp_scratch: &mut self.cp_scratch,
+        }
+    }
+}
+
+/// Owned state of the single-granule platen experiment.
+#[derive(Clone, Debug)]
+pub struct PlatenStore {
+    /// The granule.
+    pub granule: GranuleStore,
+    /// Time-step scratch.
+    pub power: PowerStore,
+}
+
+impl PlatenStore {
+    /// Buffers for `mesh` with `points` integration points per element.
+    pub fn new(mesh: &OwnedReference, points: usize) -> Self {
+        Self {
+            granule: GranuleStore::new(mesh, points),
+            power: PowerStore::new(mesh, points),
+        }
+    }
+
+    /// The kernel's borrowed view.
+    pub fn buffers(&mut self) -> PlatenBuffers<'_> {
+        PlatenBuffers {
+            granule: self.granule.buffers(),
+            power: self.power.buffers(),
         }
     }
 }

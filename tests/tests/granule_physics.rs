@@ -5,7 +5,7 @@
 use std::path::Path;
 
 use granbed_cli::granule::run::{mean_force, run_platens};
-use granbed_cli::model::{GranuleStore, MeshLevel, OwnedReference};
+use granbed_cli::model::{MeshLevel, OwnedReference, PlatenStore};
 use granbed_kernel::Real;
 use granbed_kernel::analysis::granule::yield_stress_estimate;
 use granbed_kernel::material::{GranuleType, MaterialParams};
@@ -162,7 +162,7 @@ fn k3_resting_granule_weighs_m_g_and_k1_no_penetration() {
     p.approach_speed_m_s = 1e-6;
     p.final_strain = 30e-6; // 30 ms of simulated time
     p.output_strain_interval = 0.5e-6; // 0.5 ms windows
-    let mut store = GranuleStore::new(&m, 1);
+    let mut store = PlatenStore::new(&m, 1);
     let mut scene = PlatenScene::new(p, m.view(), store.buffers()).unwrap();
     let (mut impulse, mut span, mut upper) = (0.0, 0.0, 0.0 as Real);
     let mut previous_time = 0.0;

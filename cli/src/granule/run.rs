@@ -2,7 +2,7 @@
 //! ([`granbed_kernel::scene::platens`]) and the loop that drives it to its
 //! final strain, collecting every sample.
 //!
-//! The kernel works over caller buffers; [`GranuleStore`] owns them (one
+//! The kernel works over caller buffers; [`PlatenStore`] owns them (one
 //! allocation per buffer, sized from the mesh and the element's integration
 //! points) and [`run_platens`] lends them to a [`PlatenScene`] for one run. Nothing here depends on clap, so the
 //! test suites and the `--types` loop drive exactly this code.
@@ -12,7 +12,7 @@ use std::time::Instant;
 use granbed_kernel::Real;
 use granbed_kernel::scene::platens::{PlatenParams, PlatenSample, PlatenScene, SceneError};
 
-use crate::model::{GranuleStore, OwnedReference};
+use crate::model::{OwnedReference, PlatenStore};
 
 /// Everything one run produced. A run stopped by a kernel error keeps the
 /// samples taken before it and holds the error in [`RunResult::error`].
@@ -41,7 +41,7 @@ pub struct RunResult {
 ///
 /// Errors are those of [`PlatenScene::new`].
 pub fn check(params: PlatenParams, mesh: &OwnedReference) -> Result<(), SceneError> {
-    let mut store = GranuleStore::new(mesh, params.elements.points_per_element());
+    let mut store = PlatenStore::new(mesh, params.elements.points_per_element());
     PlatenScene::new(params, mesh.view(), store.buffers()).map(drop)
 }
 
@@ -58,7 +58,7 @@ pub fn run_platens(
     mesh: &OwnedReference,
     on_sample: &mut dyn FnMut(&PlatenSample, f64),
 ) -> Result<RunResult, SceneError> {
-    let mut store = GranuleStore::new(mesh, params.elements.points_per_element());
+    let mut store = PlatenStore::new(mesh, params.elements.points_per_element());
     let start = Instant::now();
     let mut scene = PlatenScene::new(params, mesh.view(), store.buffers())?;
     let initial_dt_s = scene.time_step();
