@@ -5,6 +5,7 @@
 use granbed_kernel::Real;
 use granbed_kernel::analysis::granule::{initial_effective_yield_stress, yield_stress_estimate};
 use granbed_kernel::granule::forces::ElementKind;
+use granbed_kernel::granule::timestep::TimeStepMethod;
 use granbed_kernel::scene::platens::{PlatenParams, SceneError, Symmetry};
 use serde::Serialize;
 
@@ -102,6 +103,8 @@ pub struct Summary {
     pub time_step_safety: Real,
     /// Steps between time-step re-estimates.
     pub time_step_interval: u32,
+    /// Time-step estimate: "global" (power iteration) or "element".
+    pub time_step_method: &'static str,
     /// Strain between samples.
     pub output_strain_interval: Real,
     /// Gravity, m/s² (in −z).
@@ -218,6 +221,10 @@ impl Summary {
             yield_tolerance: p.elements.update.yield_tolerance,
             time_step_safety: p.time_step_safety,
             time_step_interval: p.time_step_interval,
+            time_step_method: match p.time_step_method {
+                TimeStepMethod::Element => "element",
+                TimeStepMethod::Global { .. } => "global",
+            },
             output_strain_interval: p.output_strain_interval,
             gravity_m_s2: p.gravity_m_s2,
             sigma_est_pa: fit.map(|(sigma, _)| sigma),
