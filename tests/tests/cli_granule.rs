@@ -7,30 +7,12 @@
 //! mesh (see `energy_balances_and_hourglass_is_small`). Every run writes to
 //! its own directory under Cargo's per-target temporary directory.
 
-use std::collections::HashMap;
+mod common;
+
 use std::path::{Path, PathBuf};
 
+use common::{Run, Table, assert_close, cli};
 use serde_json::Value;
-
-/// What a run of the CLI produced.
-struct Run {
-    code: u8,
-    stderr: String,
-}
-
-/// Runs `granbed-cli ARGS` in-process.
-fn cli(args: &[&str]) -> Run {
-    let (mut out, mut err) = (Vec::new(), Vec::new());
-    let argv = core::iter::once("granbed-cli").chain(args.iter().copied());
-    let code = match granbed_cli::run(argv, &mut out, &mut err) {
-        Ok(()) => 0,
-        Err(e) => granbed_cli::error::report(&e, &mut err),
-    };
-    Run {
-        code,
-        stderr: String::from_utf8(err).expect("stderr is UTF-8"),
-    }
-}
 
 /// A fresh (emptied) output directory named `name`.
 fn out_dir(name: &str) -> PathBuf {
@@ -48,65 +30,6 @@ fn granule_ok(dir: &Path, args: &[&str]) -> Run {
     run
 }
 
-/// A parsed CSV table of numbers (text cells: see [`Table::text`]).
-struct Table {
-    columns: HashMap<String, usize>,
-    header: String,
-    cells: Vec<Vec<String>>,
-}
-
-impl Table {
-    fn read(path: &Path) -> Self {
-        let text = std::fs::read_to_string(path)
-            .unwrap_or_else(|e| panic!("cannot read {}: {e}", path.display()));
-        let mut lines = text.lines();
-        let header = lines.next().expect("CSV has a header").to_owned();
-        let columns = header
-            .split(',')
-            .enumerate()
-            .map(|(i, name)| (name.to_owned(), i))
-            .collect::<HashMap<_, _>>();
-        let cells: Vec<Vec<String>> = lines
-            .map(|line| {
-                let row: Vec<String> = line.split(',').map(str::to_owned).collect();
-                assert_eq!(row.len(), columns.len(), "row {line:?}");
-                row
-            })
-            .collect();
-        Self {
-            columns,
-            header,
-            cells,
-        }
-    }
-
-    fn col(&self, name: &str) -> usize {
-        *self
-            .columns
-            .get(name)
-            .unwrap_or_else(|| panic!("no column {name}"))
-    }
-
-    /// Column `name` as numbers.
-    fn num(&self, name: &str) -> Vec<f64> {
-        let c = self.col(name);
-        self.cells
-            .iter()
-            .map(|row| {
-                row[c]
-                    .parse()
-                    .unwrap_or_else(|_| panic!("bad cell {:?} in {name}", row[c]))
-            })
-            .collect()
-    }
-
-    /// Column `name` as text.
-    fn text(&self, name: &str) -> Vec<&str> {
-        let c = self.col(name);
-        self.cells.iter().map(|row| row[c].as_str()).collect()
-    }
-}
-
 /// The parsed `summary.json` in `dir`.
 fn summary(dir: &Path) -> Value {
     let path = dir.join("summary.json");
@@ -120,17 +43,6 @@ fn number(summary: &Value, key: &str) -> f64 {
     summary[key]
         .as_f64()
         .unwrap_or_else(|| panic!("summary field {key} is {:?}", summary[key]))
-}
-
-/// Asserts |actual − expected| ≤ abs + rel·|expected|, naming the quantity.
-#[track_caller]
-fn assert_close(what: &str, actual: f64, expected: f64, rel: f64, abs: f64) {
-    let err = (actual - expected).abs();
-    let tol = abs + rel * expected.abs();
-    assert!(
-        err <= tol,
-        "{what}: got {actual:.16e}, expected {expected:.16e} (|err| = {err:.3e} > tol = {tol:.3e})"
-    );
 }
 
 /// The header `force_displacement.csv` must have, in this order.

@@ -8,32 +8,11 @@
 //! sets `CARGO_BIN_EXE_granbed-cli` only for integration tests of the CLI
 //! package, and does not build a dependency's binaries.
 
-use std::collections::HashMap;
+mod common;
 
 use clap::CommandFactory as _;
+use common::{Run, Table, assert_close, cli};
 use granbed_kernel::material::GranuleType;
-
-/// What a run of the CLI produced.
-struct Run {
-    code: u8,
-    stdout: String,
-    stderr: String,
-}
-
-/// Runs `granbed-cli ARGS` in-process.
-fn cli(args: &[&str]) -> Run {
-    let (mut out, mut err) = (Vec::new(), Vec::new());
-    let argv = core::iter::once("granbed-cli").chain(args.iter().copied());
-    let code = match granbed_cli::run(argv, &mut out, &mut err) {
-        Ok(()) => 0,
-        Err(e) => granbed_cli::error::report(&e, &mut err),
-    };
-    Run {
-        code,
-        stdout: String::from_utf8(out).expect("stdout is UTF-8"),
-        stderr: String::from_utf8(err).expect("stderr is UTF-8"),
-    }
-}
 
 /// Runs `granbed-cli point ARGS` and asserts success.
 fn point_ok(args: &[&str]) -> Run {
@@ -45,58 +24,10 @@ fn point_ok(args: &[&str]) -> Run {
     run
 }
 
-/// A parsed CSV table of numbers.
-struct Table {
-    columns: HashMap<String, usize>,
-    rows: Vec<Vec<f64>>,
-}
-
-impl Table {
-    fn parse(text: &str) -> Self {
-        let mut lines = text.lines();
-        let header = lines.next().expect("CSV has a header");
-        let columns: HashMap<String, usize> = header
-            .split(',')
-            .enumerate()
-            .map(|(i, name)| (name.to_owned(), i))
-            .collect();
-        let rows: Vec<Vec<f64>> = lines
-            .map(|line| {
-                let row: Vec<f64> = line
-                    .split(',')
-                    .map(|cell| cell.parse().unwrap_or_else(|_| panic!("bad cell {cell:?}")))
-                    .collect();
-                assert_eq!(row.len(), columns.len(), "row {line:?}");
-                row
-            })
-            .collect();
-        Self { columns, rows }
-    }
-
-    /// Index of column `name`.
-    fn col(&self, name: &str) -> usize {
-        *self
-            .columns
-            .get(name)
-            .unwrap_or_else(|| panic!("no column {name}"))
-    }
-}
-
 /// The header `point` must write, in this order.
 const HEADER: &str = "step,strain,f_xx,f_yy,f_zz,f_xy,j,tau_xx,tau_yy,tau_zz,tau_yz,tau_xz,\
                       tau_xy,sigma_xx,sigma_yy,sigma_zz,sigma_yz,sigma_xz,sigma_xy,\
                       pressure_pa,von_mises_pa,eta,plastic,iterations";
-
-/// Asserts |actual − expected| ≤ abs + rel·|expected|, naming the quantity.
-#[track_caller]
-fn assert_close(what: &str, actual: f64, expected: f64, rel: f64, abs: f64) {
-    let err = (actual - expected).abs();
-    let tol = abs + rel * expected.abs();
-    assert!(
-        err <= tol,
-        "{what}: got {actual:.16e}, expected {expected:.16e} (|err| = {err:.3e} > tol = {tol:.3e})"
-    );
-}
 
 /// Hydrostatic compression stays on the yield surface's pressure cap: with
 /// dev τ = 0, φ = 0 gives p = (σy/3)·√(2 a2(η)/a1(η)). Checked on every
@@ -117,8 +48,9 @@ fn hydrostatic_a1_plastic_rows_sit_on_the_pressure_cap() {
     ]);
     assert_eq!(run.stdout.lines().next(), Some(HEADER));
     let t = Table::parse(&run.stdout);
-    assert_eq!(t.rows.len(), 2001, "rows for steps 0..=2000");
-    let last = t.rows.last().unwrap();
+    let rows = t.rows();
+    assert_eq!(rows.len(), 2001, "rows for steps 0..=2000");
+    let last = rows.last().unwrap();
     assert_eq!(
         last[t.col("strain")],
         0.35,
@@ -128,7 +60,7 @@ fn hydrostatic_a1_plastic_rows_sit_on_the_pressure_cap() {
 
     let (sy, cp, ec) = (preset.yield_stress_pa, preset.cp, preset.eta_c);
     let mut plastic = 0;
-    for row in &t.rows {
+    for row in &rows {
         if row[t.col("plastic")] == 0.0 {
             continue;
         }
@@ -318,10 +250,11 @@ fn uniaxial_stress_rows_have_no_lateral_stress() {
         "300",
     ]);
     let t = Table::parse(&run.stdout);
-    assert_eq!(t.rows.len(), 301);
+    let rows = t.rows();
+    assert_eq!(rows.len(), 301);
     // The kernel solves |τ_xx + τ_yy|/2 ≤ 1e-13·E = 1e-7 Pa; 1e-6 Pa allows
     // for the split between the two (equal by symmetry).
-    for row in &t.rows {
+    for row in &rows {
         for c in ["tau_xx", "tau_yy"] {
             let v = row[t.col(c)];
             assert!(
@@ -331,10 +264,10 @@ fn uniaxial_stress_rows_have_no_lateral_stress() {
             );
         }
     }
-    let last = t.rows.last().unwrap();
+    let last = rows.last().unwrap();
     assert!(last[t.col("tau_zz")] < -1.0e3, "axial stress builds up");
     assert!(last[t.col("f_xx")] > 1.0, "lateral faces move out");
-    assert!(t.rows.iter().any(|r| r[t.col("plastic")] == 1.0));
+    assert!(rows.iter().any(|r| r[t.col("plastic")] == 1.0));
 }
 
 /// `--out FILE` writes the same bytes as stdout, and `--out -` is stdout.
@@ -365,12 +298,11 @@ fn literal_return_changes_shear_response() {
     let fixed = Table::parse(&point_ok(&args).stdout);
     let literal: Vec<&str> = args.iter().copied().chain(["--literal-return"]).collect();
     let literal = Table::parse(&point_ok(&literal).stdout);
-    let p = fixed.col("pressure_pa");
     let differs = fixed
-        .rows
+        .num("pressure_pa")
         .iter()
-        .zip(&literal.rows)
-        .any(|(a, b)| a[p] != b[p]);
+        .zip(literal.num("pressure_pa"))
+        .any(|(a, b)| *a != b);
     assert!(differs, "--literal-return made no difference");
 }
 
@@ -385,9 +317,9 @@ fn kernel_failure_keeps_rows_and_names_the_step() {
     ]);
     let t = Table::parse(&run.stdout);
     match run.code {
-        0 => assert_eq!(t.rows.len(), 2),
+        0 => assert_eq!(t.cells.len(), 2),
         1 => {
-            assert_eq!(t.rows.len(), 1, "row 0 is kept");
+            assert_eq!(t.cells.len(), 1, "row 0 is kept");
             for needle in ["error: ", "step 1 of 1", "strain 9.99", "stdout"] {
                 assert!(
                     run.stderr.contains(needle),

@@ -5,7 +5,9 @@
 
 use granbed_cli::model::{GranuleStore, MeshLevel, OwnedReference};
 use granbed_kernel::Real;
-use granbed_kernel::granule::dynamics::{Loads, StepSizes, correct, predict};
+use granbed_kernel::granule::dynamics::{
+    GranuleBuffers, Loads, StepSizes, StepWork, correct, predict,
+};
 use granbed_kernel::granule::forces::{ElementKind, ElementSettings};
 use granbed_kernel::granule::timestep::element_time_step;
 use granbed_kernel::material::{GranuleType, Material, MaterialParams};
@@ -29,35 +31,56 @@ fn settings(kappa: Real) -> ElementSettings {
     }
 }
 
-/// Runs the undamped free granule from initial velocity `shape(x)` (scaled
-/// to a small amplitude) for `steps` steps and returns the time series of
-/// the modal coordinate Σ m v·shape(x) and the time step.
-fn ring(
+/// A free, undamped-or-damped elastic granule started with velocities
+/// `v0(x)` and stepped `steps` times at `dt` (the 0.9 element estimate if
+/// `None`). After every step `observe` sees the buffers and the step's work
+/// and returns false to stop. Returns the time step, or `None` if an
+/// element inverted (the run blew up).
+fn free_run(
     mesh: &OwnedReference,
     mat: &Material,
-    shape: impl Fn(&[Real; 3]) -> [Real; 3],
+    v0: &dyn Fn(&[Real; 3]) -> [Real; 3],
     steps: usize,
     damping_c: Real,
-) -> (Vec<Real>, Real) {
+    dt: Option<Real>,
+    observe: &mut dyn FnMut(&GranuleBuffers<'_>, &StepWork) -> bool,
+) -> Option<Real> {
     let view = mesh.view();
     let mut store = GranuleStore::new(mesh, 1);
-    let el = settings(0.05);
     let mut b = store.buffers();
     b.reset(&view, mat);
     for (v, x) in b.v.iter_mut().zip(mesh.positions.iter()) {
-        *v = shape(x).map(|c| 1e-4 * c / R);
+        *v = v0(x);
     }
-    let dt = element_time_step(&view, mat, b.x, 0.9).unwrap();
+    let dt = dt.unwrap_or_else(|| element_time_step(&view, mat, b.x, 0.9).unwrap());
     let sizes = StepSizes { dt_prev: dt, dt };
     let loads = Loads {
         gravity_m_s2: 0.0,
         damping_c,
         rigid_modes: true,
     };
-    let mut series = Vec::with_capacity(steps);
     for _ in 0..steps {
-        predict(&view, mat, &el, &mut b, sizes, &loads).unwrap();
-        correct(&mut b, sizes, 0.0);
+        predict(&view, mat, &settings(0.05), &mut b, sizes, &loads).ok()?;
+        let w = correct(&mut b, sizes, 0.0);
+        if !observe(&b, &w) {
+            break;
+        }
+    }
+    Some(dt)
+}
+
+/// The undamped free granule started in the shape `shape(x)` (small
+/// amplitude): the time series of the modal coordinate Σ m v·shape(x) over
+/// `steps` steps, and the time step.
+fn ring(
+    mesh: &OwnedReference,
+    mat: &Material,
+    shape: impl Fn(&[Real; 3]) -> [Real; 3],
+    steps: usize,
+) -> (Vec<Real>, Real) {
+    let mut series = Vec::with_capacity(steps);
+    let v0 = |x: &[Real; 3]| shape(x).map(|c| 1e-4 * c / R);
+    let dt = free_run(mesh, mat, &v0, steps, 0.0, None, &mut |b, _| {
         let s: Real = b
             .mass
             .iter()
@@ -69,7 +92,9 @@ fn ring(
             })
             .sum();
         series.push(s);
-    }
+        true
+    })
+    .unwrap();
     (series, dt)
 }
 
@@ -106,9 +131,9 @@ fn e3_lowest_deformational_frequencies() {
     let torsion = |x: &[Real; 3]| [x[1] * x[2] / R, -x[0] * x[2] / R, 0.0];
     // l = 2 spheroidal field ∇(3z² − r²)/2 ∝ (−x, −y, 2z), divergence-free.
     let spheroid = |x: &[Real; 3]| [-x[0], -x[1], 2.0 * x[2]];
-    let (s, dt) = ring(&mesh, &mat, torsion, 3000, 0.0);
+    let (s, dt) = ring(&mesh, &mat, torsion, 3000);
     let w_t = frequency(&s, dt) * R / cs;
-    let (s, dt) = ring(&mesh, &mat, spheroid, 3000, 0.0);
+    let (s, dt) = ring(&mesh, &mat, spheroid, 3000);
     let w_s = frequency(&s, dt) * R / cs;
     println!("torsional n=2: {w_t:.4}, spheroidal n=2: {w_s:.4} (x c_s/R)");
     assert!((w_t / 2.501 - 1.0).abs() < 0.03, "torsional {w_t}");
@@ -123,8 +148,9 @@ fn e3_lowest_deformational_frequencies() {
     );
 }
 
-/// Total mechanical energy KE + W_int over a run (W_int is the elastic
-/// energy taken up, the material being elastic).
+/// Total mechanical energy KE + W_int (W_int is the elastic energy taken
+/// up, the material being elastic) at the start and after each of `steps`
+/// steps, and the time step.
 fn energy_history(
     mesh: &OwnedReference,
     mat: &Material,
@@ -132,33 +158,22 @@ fn energy_history(
     steps: usize,
     damping_c: Real,
 ) -> (Vec<Real>, Real) {
-    let view = mesh.view();
-    let mut store = GranuleStore::new(mesh, 1);
-    let mut b = store.buffers();
-    b.reset(&view, mat);
-    for (v, x) in b.v.iter_mut().zip(mesh.positions.iter()) {
-        *v = v0(x);
-    }
-    let dt = element_time_step(&view, mat, b.x, 0.9).unwrap();
-    let sizes = StepSizes { dt_prev: dt, dt };
-    let loads = Loads {
-        gravity_m_s2: 0.0,
-        damping_c,
-        rigid_modes: true,
-    };
-    let kinetic0: Real = b
-        .mass
+    let mass: Vec<Real> = mesh.node_volume.iter().map(|v| mat.density0 * v).collect();
+    let kinetic0: Real = mass
         .iter()
-        .zip(b.v.iter())
-        .map(|(m, v)| 0.5 * m * (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]))
+        .zip(mesh.positions.iter())
+        .map(|(m, x)| {
+            let v = v0(x);
+            0.5 * m * (v[0] * v[0] + v[1] * v[1] + v[2] * v[2])
+        })
         .sum();
     let (mut internal, mut out) = (0.0, vec![kinetic0]);
-    for _ in 0..steps {
-        predict(&view, mat, &settings(0.05), &mut b, sizes, &loads).unwrap();
-        let w = correct(&mut b, sizes, 0.0);
+    let dt = free_run(mesh, mat, &v0, steps, damping_c, None, &mut |_, w| {
         internal += w.internal;
         out.push(w.kinetic + internal);
-    }
+        true
+    })
+    .unwrap();
     (out, dt)
 }
 
@@ -286,39 +301,30 @@ fn t1_time_step_estimates_and_the_stability_limit() {
     );
 
     let run = |dt: Real| -> Real {
-        let mut store = GranuleStore::new(&mesh, 1);
-        let mut b = store.buffers();
-        b.reset(&view, &mat);
-        let mut rng = 99u64;
-        for v in b.v.iter_mut() {
-            for c in v.iter_mut() {
-                rng = rng
-                    .wrapping_mul(6364136223846793005)
-                    .wrapping_add(1442695040888963407);
-                *c = 1e-4 * ((rng >> 11) as Real / (1u64 << 53) as Real - 0.5);
-            }
-        }
-        let sizes = StepSizes { dt_prev: dt, dt };
-        let loads = Loads {
-            gravity_m_s2: 0.0,
-            damping_c: 0.0,
-            rigid_modes: true,
+        // Random small velocities, a deterministic function of the position.
+        let v0 = |x: &[Real; 3]| {
+            let mut h = x.iter().fold(0x9E37_79B9_7F4A_7C15u64, |h, c| {
+                (h ^ c.to_bits()).wrapping_mul(0xBF58_476D_1CE4_E5B9)
+            });
+            [0, 1, 2].map(|_| {
+                h = (h ^ (h >> 31)).wrapping_mul(0x94D0_49BB_1331_11EB);
+                1e-4 * ((h >> 11) as Real / (1u64 << 53) as Real - 0.5)
+            })
         };
         let (mut e0, mut internal, mut worst) = (None, 0.0, 0.0 as Real);
-        for _ in 0..2000 {
-            if predict(&view, &mat, &settings(0.05), &mut b, sizes, &loads).is_err() {
-                return Real::INFINITY; // an element inverted: the run blew up
-            }
-            let w = correct(&mut b, sizes, 0.0);
+        let finished = free_run(&mesh, &mat, &v0, 2000, 0.0, Some(dt), &mut |_, w| {
             internal += w.internal;
             let e = w.kinetic + internal;
             let e0 = *e0.get_or_insert(e);
             worst = worst.max(e / e0);
-            if worst.is_nan() || worst >= 1e6 {
-                break;
-            }
+            !(worst.is_nan() || worst >= 1e6)
+        });
+        // An inverted element means the run blew up.
+        if finished.is_none() {
+            Real::INFINITY
+        } else {
+            worst
         }
-        worst
     };
     let stable = run(0.95 * dt_crit);
     let unstable = run(1.1 * dt_crit);

@@ -1,0 +1,126 @@
+//! Helpers shared by the CLI suites: running the command line in-process,
+//! reading its CSV output, and one tolerance check.
+#![allow(dead_code)]
+
+use std::collections::HashMap;
+use std::path::Path;
+
+/// What a run of the CLI produced.
+pub struct Run {
+    /// Exit status the binary would return.
+    pub code: u8,
+    /// Standard output.
+    pub stdout: String,
+    /// Standard error.
+    pub stderr: String,
+}
+
+/// Runs `granbed-cli ARGS` in-process: exactly the two calls the binary's
+/// `main` makes (`granbed_cli::run`, then `granbed_cli::error::report` on
+/// failure), with in-memory streams. The binary itself cannot be spawned
+/// from this package: Cargo sets `CARGO_BIN_EXE_granbed-cli` only for the
+/// CLI package's own integration tests.
+pub fn cli(args: &[&str]) -> Run {
+    let (mut out, mut err) = (Vec::new(), Vec::new());
+    let argv = core::iter::once("granbed-cli").chain(args.iter().copied());
+    let code = match granbed_cli::run(argv, &mut out, &mut err) {
+        Ok(()) => 0,
+        Err(e) => granbed_cli::error::report(&e, &mut err),
+    };
+    Run {
+        code,
+        stdout: String::from_utf8(out).expect("stdout is UTF-8"),
+        stderr: String::from_utf8(err).expect("stderr is UTF-8"),
+    }
+}
+
+/// A parsed CSV table (numbers or text cells).
+pub struct Table {
+    columns: HashMap<String, usize>,
+    /// The header line.
+    pub header: String,
+    /// The cells, row by row.
+    pub cells: Vec<Vec<String>>,
+}
+
+impl Table {
+    /// Parses CSV text with a header row; every row has the header's width.
+    pub fn parse(text: &str) -> Self {
+        let mut lines = text.lines();
+        let header = lines.next().expect("CSV has a header").to_owned();
+        let columns = header
+            .split(',')
+            .enumerate()
+            .map(|(i, name)| (name.to_owned(), i))
+            .collect::<HashMap<_, _>>();
+        let cells: Vec<Vec<String>> = lines
+            .map(|line| {
+                let row: Vec<String> = line.split(',').map(str::to_owned).collect();
+                assert_eq!(row.len(), columns.len(), "row {line:?}");
+                row
+            })
+            .collect();
+        Self {
+            columns,
+            header,
+            cells,
+        }
+    }
+
+    /// Reads and parses the CSV file at `path`.
+    pub fn read(path: &Path) -> Self {
+        let text = std::fs::read_to_string(path)
+            .unwrap_or_else(|e| panic!("cannot read {}: {e}", path.display()));
+        Self::parse(&text)
+    }
+
+    /// Index of column `name`.
+    pub fn col(&self, name: &str) -> usize {
+        *self
+            .columns
+            .get(name)
+            .unwrap_or_else(|| panic!("no column {name}"))
+    }
+
+    /// Every row as numbers (panics on a non-numeric cell).
+    pub fn rows(&self) -> Vec<Vec<f64>> {
+        self.cells
+            .iter()
+            .map(|row| {
+                row.iter()
+                    .map(|cell| cell.parse().unwrap_or_else(|_| panic!("bad cell {cell:?}")))
+                    .collect()
+            })
+            .collect()
+    }
+
+    /// Column `name` as numbers.
+    pub fn num(&self, name: &str) -> Vec<f64> {
+        let c = self.col(name);
+        self.cells
+            .iter()
+            .map(|row| {
+                row[c]
+                    .parse()
+                    .unwrap_or_else(|_| panic!("bad cell {:?} in {name}", row[c]))
+            })
+            .collect()
+    }
+
+    /// Column `name` as text.
+    pub fn text(&self, name: &str) -> Vec<&str> {
+        let c = self.col(name);
+        self.cells.iter().map(|row| row[c].as_str()).collect()
+    }
+}
+
+/// Asserts |actual − expected| ≤ abs + rel·|expected|, naming the quantity.
+#[track_caller]
+pub fn assert_close(what: &str, actual: f64, expected: f64, rel: f64, abs: f64) {
+    let err = (actual - expected).abs();
+    let tol = abs + rel * expected.abs();
+    assert!(
+        err <= tol,
+        "{what}: got {actual:.16e}, expected {expected:.16e} (|err| = {err:.3e} > tol = {tol:.3e})"
+    );
+}
