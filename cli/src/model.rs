@@ -3,6 +3,8 @@
 
 use anyhow::{Context as _, bail};
 use granbed_kernel::Real;
+use granbed_kernel::dem::neighbors::Pair;
+use granbed_kernel::dem::pour::{PourBuffers, PourParams};
 use granbed_kernel::element::reference::HexReference;
 use granbed_kernel::granule::dynamics::GranuleBuffers;
 use granbed_kernel::granule::timestep::PowerIterationBuffers;
@@ -290,6 +292,60 @@ impl PlatenStore {
         PlatenBuffers {
             granule: self.granule.buffers(),
             power: self.power.buffers(),
+        }
+    }
+}
+
+/// Owned buffers of the discrete-element pour ([`PourBuffers`]).
+#[derive(Clone, Debug)]
+pub struct PourStore {
+    /// Centres, m.
+    pub x: Vec<[Real; 3]>,
+    /// Velocities, m/s.
+    pub v: Vec<[Real; 3]>,
+    omega: Vec<[Real; 3]>,
+    f: Vec<[Real; 3]>,
+    torque: Vec<[Real; 3]>,
+    x_built: Vec<[Real; 3]>,
+    pairs: Vec<Pair>,
+    pairs_old: Vec<Pair>,
+    head: Vec<u32>,
+    next: Vec<u32>,
+}
+
+impl PourStore {
+    /// Buffers for `params`, with room for 12 candidate pairs per sphere.
+    pub fn new(params: &PourParams) -> Self {
+        let n = params.granules;
+        let z = [0.0; 3];
+        let empty = Pair { i: 0, j: 0, xi: z };
+        Self {
+            x: vec![z; n],
+            v: vec![z; n],
+            omega: vec![z; n],
+            f: vec![z; n],
+            torque: vec![z; n],
+            x_built: vec![z; n],
+            pairs: vec![empty; 12 * n],
+            pairs_old: vec![empty; 12 * n],
+            head: vec![0; params.grid().cells()],
+            next: vec![0; n],
+        }
+    }
+
+    /// The kernel's borrowed view.
+    pub fn buffers(&mut self) -> PourBuffers<'_> {
+        PourBuffers {
+            x: &mut self.x,
+            v: &mut self.v,
+            omega: &mut self.omega,
+            f: &mut self.f,
+            torque: &mut self.torque,
+            x_built: &mut self.x_built,
+            pairs: &mut self.pairs,
+            pairs_old: &mut self.pairs_old,
+            head: &mut self.head,
+            next: &mut self.next,
         }
     }
 }

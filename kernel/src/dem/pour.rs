@@ -1,0 +1,731 @@
+//! The pour: rigid spheres dropped from a loose lattice with random
+//! velocities into the die settle under gravity while dissipation is ramped
+//! up until they are at rest (physics.md §6). Velocity Verlet with a fixed
+//! step; forces summed in the sorted pair order, so a seed gives the same
+//! bed bit for bit.
+
+use core::fmt;
+
+use crate::Real;
+use crate::dem::contact::{ContactLaw, hertz_beta, hertz_mindlin};
+use crate::dem::neighbors::{DIE, FLOOR, Grid, GridScratch, Pair, PairOverflow, build_pairs};
+use crate::math;
+use crate::rng::Rng;
+
+/// Parameters of the pour (SI).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PourParams {
+    /// Number of spheres; 1 ≤ N ≤ 100 000.
+    pub granules: usize,
+    /// Sphere radius, m; > 0.
+    pub radius: Real,
+    /// Sphere density, kg/m³ (η0 × true density); > 0.
+    pub density: Real,
+    /// Contact Young's modulus E_DE, Pa (stiffer than the granule so resting
+    /// overlaps stay below 0.3 µm); > 0.
+    pub youngs_modulus_pa: Real,
+    /// Contact Poisson's ratio; −1 < ν < 0.5.
+    pub poisson_ratio: Real,
+    /// Sphere–sphere friction; ≥ 0.
+    pub friction_particle: Real,
+    /// Sphere–wall friction; ≥ 0.
+    pub friction_wall: Real,
+    /// Die radius, m; > 2·radius.
+    pub die_radius: Real,
+    /// Gravity, m/s² (in −z); > 0.
+    pub gravity_m_s2: Real,
+    /// Spacing of the initial square lattice, m; ≥ 2·radius + 2·jitter.
+    pub lattice_spacing: Real,
+    /// Random jitter of the initial positions, ± m per component.
+    pub jitter: Real,
+    /// Random initial velocity, ± m/s per component.
+    pub initial_speed: Real,
+    /// Coefficient of restitution before the dissipation ramp; (0, 1].
+    pub restitution_start: Real,
+    /// Coefficient of restitution after the ramp; (0, 1].
+    pub restitution_end: Real,
+    /// Global damping coefficient after the ramp, 1/s (0 before it).
+    pub damping_max: Real,
+    /// Ramp start and end times, s.
+    pub ramp: (Real, Real),
+    /// At rest when every speed is below this, m/s.
+    pub rest_speed: Real,
+    /// … and the kinetic energy per sphere below this, J.
+    pub rest_kinetic_energy: Real,
+    /// Give up (error) after this simulated time, s.
+    pub max_time: Real,
+    /// Time step as a fraction of the Hertz contact time at 0.1 m/s.
+    pub time_step_fraction: Real,
+    /// Neighbour-list skin, m.
+    pub skin: Real,
+    /// Random seed.
+    pub seed: u64,
+}
+
+impl PourParams {
+    /// The published setup (physics.md §6): 1000 spheres of d = 1 mm and
+    /// density `density` into the 11.3 mm die, E_DE = 100 MPa, ν = 0.3,
+    /// μ = 0.1, lattice 1.15 mm ± 0.05 mm, velocities ± 0.1 m/s, restitution
+    /// 0.9 → 0.3 and damping 0 → 200 /s over 0.05–0.25 s, Δt = t_c/50.
+    pub fn standard(density: Real, seed: u64) -> Self {
+        Self {
+            granules: 1000,
+            radius: 0.5e-3,
+            density,
+            youngs_modulus_pa: 100e6,
+            poisson_ratio: 0.3,
+            friction_particle: 0.1,
+            friction_wall: 0.1,
+            die_radius: 5.65e-3,
+            gravity_m_s2: 9.81,
+            lattice_spacing: 1.15e-3,
+            jitter: 0.05e-3,
+            initial_speed: 0.1,
+            restitution_start: 0.9,
+            restitution_end: 0.3,
+            damping_max: 200.0,
+            ramp: (0.05, 0.25),
+            rest_speed: 1e-5,
+            rest_kinetic_energy: 1e-13,
+            max_time: 3.0,
+            time_step_fraction: 1.0 / 50.0,
+            skin: 0.1e-3,
+            seed,
+        }
+    }
+
+    /// Sphere mass, kg.
+    pub fn mass(&self) -> Real {
+        self.density * 4.0 / 3.0 * core::f64::consts::PI * self.radius * self.radius * self.radius
+    }
+
+    /// Lattice sites per layer: the square-lattice points whose jittered
+    /// sphere stays inside the die.
+    fn sites(&self) -> impl Iterator<Item = [Real; 2]> + '_ {
+        let reach = self.die_radius - self.radius - self.jitter * core::f64::consts::SQRT_2;
+        let k = libm::floor(reach / self.lattice_spacing) as i64;
+        (-k..=k)
+            .flat_map(move |j| {
+                (-k..=k).map(move |i| {
+                    [
+                        i as Real * self.lattice_spacing,
+                        j as Real * self.lattice_spacing,
+                    ]
+                })
+            })
+            .filter(move |p| p[0] * p[0] + p[1] * p[1] <= reach * reach)
+    }
+
+    /// Height of the initial lattice (top of the highest sphere), m.
+    pub fn fill_height(&self) -> Real {
+        let per_layer = self.sites().count().max(1);
+        let layers = self.granules.div_ceil(per_layer);
+        self.radius
+            + self.jitter
+            + (layers as Real - 1.0) * self.lattice_spacing
+            + self.radius
+            + self.jitter
+    }
+
+    /// The neighbour grid (its `cells()` sizes the `head` buffer).
+    pub fn grid(&self) -> Grid {
+        Grid::new(
+            self.die_radius,
+            self.fill_height() + 2.0 * self.radius,
+            2.0 * self.radius + self.skin,
+        )
+    }
+
+    /// Hertz contact time of two spheres meeting at 0.1 m/s, s.
+    pub fn contact_time(&self) -> Real {
+        let law = ContactLaw::sphere_sphere(
+            self.youngs_modulus_pa,
+            self.poisson_ratio,
+            self.radius,
+            self.mass(),
+            0.0,
+        );
+        let v = 0.1;
+        2.87 * libm::pow(
+            law.m_star * law.m_star / (law.r_star * law.e_star * law.e_star * v),
+            0.2,
+        )
+    }
+
+    fn validate(&self) -> Result<(), PourError> {
+        let d = 2.0 * self.radius;
+        let checks: [(bool, &'static str, Real, &'static str); 12] = [
+            (
+                (1..=100_000).contains(&self.granules),
+                "granules",
+                self.granules as Real,
+                "1 ..= 100000",
+            ),
+            (
+                self.radius > 0.0 && self.radius < 1.0,
+                "radius",
+                self.radius,
+                "0 < r < 1 m",
+            ),
+            (
+                self.density > 0.0 && self.density.is_finite(),
+                "density",
+                self.density,
+                "> 0",
+            ),
+            (
+                self.youngs_modulus_pa > 0.0 && self.youngs_modulus_pa.is_finite(),
+                "youngs_modulus_pa",
+                self.youngs_modulus_pa,
+                "> 0",
+            ),
+            (
+                self.poisson_ratio > -1.0 && self.poisson_ratio < 0.5,
+                "poisson_ratio",
+                self.poisson_ratio,
+                "-1 < nu < 0.5",
+            ),
+            (
+                self.friction_particle >= 0.0 && self.friction_wall >= 0.0,
+                "friction",
+                self.friction_particle.min(self.friction_wall),
+                ">= 0",
+            ),
+            (
+                self.die_radius > 2.0 * d,
+                "die_radius",
+                self.die_radius,
+                "> 2 diameters",
+            ),
+            (
+                self.gravity_m_s2 > 0.0,
+                "gravity_m_s2",
+                self.gravity_m_s2,
+                "> 0",
+            ),
+            (
+                self.lattice_spacing >= d + 2.0 * self.jitter && self.jitter >= 0.0,
+                "lattice_spacing",
+                self.lattice_spacing,
+                ">= diameter + 2 jitter",
+            ),
+            (
+                self.restitution_start > 0.0
+                    && self.restitution_start <= 1.0
+                    && self.restitution_end > 0.0
+                    && self.restitution_end <= 1.0,
+                "restitution",
+                self.restitution_end,
+                "0 < e <= 1",
+            ),
+            (
+                self.ramp.0 >= 0.0 && self.ramp.1 > self.ramp.0 && self.max_time > self.ramp.1,
+                "ramp",
+                self.ramp.1,
+                "0 <= start < end < max_time",
+            ),
+            (
+                self.time_step_fraction > 0.0 && self.time_step_fraction <= 0.2 && self.skin > 0.0,
+                "time_step_fraction",
+                self.time_step_fraction,
+                "0 < f <= 0.2",
+            ),
+        ];
+        for (ok, field, value, allowed) in checks {
+            if !ok {
+                return Err(PourError::InvalidParameter {
+                    field,
+                    value,
+                    allowed,
+                });
+            }
+        }
+        if self.sites().count() == 0 {
+            return Err(PourError::InvalidParameter {
+                field: "die_radius",
+                value: self.die_radius,
+                allowed: "wide enough for one lattice site",
+            });
+        }
+        Ok(())
+    }
+}
+
+/// Why the pour cannot go on.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum PourError {
+    /// A parameter is out of range.
+    InvalidParameter {
+        /// Field of [`PourParams`].
+        field: &'static str,
+        /// Value given.
+        value: Real,
+        /// Allowed range.
+        allowed: &'static str,
+    },
+    /// A buffer has the wrong length.
+    BufferLength {
+        /// Buffer name as in [`PourBuffers`].
+        buffer: &'static str,
+        /// Entries expected.
+        expected: usize,
+        /// Entries given.
+        got: usize,
+    },
+    /// The candidate-pair buffers are too small.
+    Pairs(PairOverflow),
+    /// The spheres did not come to rest within `max_time`.
+    NotSettled {
+        /// Simulated time, s.
+        time: Real,
+        /// Largest speed, m/s.
+        max_speed: Real,
+    },
+    /// A position or velocity became non-finite.
+    Unstable {
+        /// Step number.
+        step: u64,
+    },
+}
+
+impl fmt::Display for PourError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Self::InvalidParameter {
+                field,
+                value,
+                allowed,
+            } => {
+                write!(f, "invalid `{field}` = {value}: allowed range is {allowed}")
+            }
+            Self::BufferLength {
+                buffer,
+                expected,
+                got,
+            } => {
+                write!(
+                    f,
+                    "buffer `{buffer}` has {got} entries, expected {expected}"
+                )
+            }
+            Self::Pairs(e) => write!(f, "{e}"),
+            Self::NotSettled { time, max_speed } => write!(
+                f,
+                "the spheres did not come to rest within {time} s (largest speed {max_speed:e} m/s)"
+            ),
+            Self::Unstable { step } => write!(f, "step {step}: the motion became non-finite"),
+        }
+    }
+}
+
+impl core::error::Error for PourError {}
+
+/// Caller-owned buffers of the pour: sphere buffers have `granules`
+/// entries, the two pair buffers the same capacity (≥ 8 × granules is
+/// ample), `head` [`Grid::cells`] of [`PourParams::grid`].
+pub struct PourBuffers<'a> {
+    /// Centres, m.
+    pub x: &'a mut [[Real; 3]],
+    /// Velocities, m/s.
+    pub v: &'a mut [[Real; 3]],
+    /// Angular velocities, rad/s.
+    pub omega: &'a mut [[Real; 3]],
+    /// Forces of the last evaluation, N.
+    pub f: &'a mut [[Real; 3]],
+    /// Torques of the last evaluation, N m.
+    pub torque: &'a mut [[Real; 3]],
+    /// Centres when the pair list was built, m.
+    pub x_built: &'a mut [[Real; 3]],
+    /// Candidate pairs (current list).
+    pub pairs: &'a mut [Pair],
+    /// Candidate pairs (the previous list; scratch).
+    pub pairs_old: &'a mut [Pair],
+    /// Grid cell heads (scratch).
+    pub head: &'a mut [u32],
+    /// Grid chains (scratch, one per sphere).
+    pub next: &'a mut [u32],
+}
+
+/// A snapshot of the pour.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PourStatus {
+    /// Simulated time, s.
+    pub time: Real,
+    /// Steps taken.
+    pub steps: u64,
+    /// Total kinetic energy (translation + rotation), J.
+    pub kinetic_energy: Real,
+    /// Largest sphere speed, m/s.
+    pub max_speed: Real,
+    /// Highest sphere top max(z) + r, m.
+    pub height: Real,
+    /// Floor reaction (upward), N.
+    pub floor_force: Real,
+    /// Vertical friction force of the die wall on the spheres (upward
+    /// positive), N.
+    pub wall_friction_z: Real,
+    /// Candidate pairs in the list.
+    pub pairs: usize,
+    /// True once at rest after the ramp.
+    pub settled: bool,
+}
+
+/// The running pour.
+pub struct PourScene<'a> {
+    p: PourParams,
+    buf: PourBuffers<'a>,
+    grid: Grid,
+    law_pp: ContactLaw,
+    law_pw: ContactLaw,
+    mass: Real,
+    inertia: Real,
+    /// Damping β at the start and the end of the ramp.
+    beta: (Real, Real),
+    dt: Real,
+    time: Real,
+    steps: u64,
+    n_pairs: usize,
+    floor_force: Real,
+    wall_friction_z: Real,
+}
+
+impl<'a> PourScene<'a> {
+    /// Places the spheres on the jittered lattice with random velocities
+    /// (from `params.seed`), builds the pair list and the first forces.
+    pub fn new(params: PourParams, buf: PourBuffers<'a>) -> Result<Self, PourError> {
+        Self::start(params, buf, true)
+    }
+
+    /// Starts from the positions and velocities already in `buf.x` and
+    /// `buf.v` (for tests and custom layouts); nothing is placed.
+    pub fn from_state(params: PourParams, buf: PourBuffers<'a>) -> Result<Self, PourError> {
+        Self::start(params, buf, false)
+    }
+
+    fn start(params: PourParams, buf: PourBuffers<'a>, place: bool) -> Result<Self, PourError> {
+        params.validate()?;
+        let n = params.granules;
+        let grid = params.grid();
+        let cap = buf.pairs.len();
+        for (buffer, got, expected) in [
+            ("x", buf.x.len(), n),
+            ("v", buf.v.len(), n),
+            ("omega", buf.omega.len(), n),
+            ("f", buf.f.len(), n),
+            ("torque", buf.torque.len(), n),
+            ("x_built", buf.x_built.len(), n),
+            ("next", buf.next.len(), n),
+            ("head", buf.head.len(), grid.cells()),
+            ("pairs_old", buf.pairs_old.len(), cap),
+        ] {
+            if got != expected {
+                return Err(PourError::BufferLength {
+                    buffer,
+                    expected,
+                    got,
+                });
+            }
+        }
+        let mut rng = Rng::new(params.seed);
+        let sites = params.sites().count();
+        let placed = if place { buf.x.len() } else { 0 };
+        for (k, (x, v)) in buf
+            .x
+            .iter_mut()
+            .zip(buf.v.iter_mut())
+            .take(placed)
+            .enumerate()
+        {
+            let site = params.sites().nth(k % sites).unwrap_or([0.0; 2]);
+            let layer = (k / sites) as Real;
+            let z = params.radius + params.jitter + layer * params.lattice_spacing;
+            let j = params.jitter;
+            *x = [
+                site[0] + rng.uniform(-j, j),
+                site[1] + rng.uniform(-j, j),
+                z + rng.uniform(-j, j),
+            ];
+            let s = params.initial_speed;
+            *v = [rng.uniform(-s, s), rng.uniform(-s, s), rng.uniform(-s, s)];
+        }
+        buf.omega.fill([0.0; 3]);
+        let mass = params.mass();
+        let law_pp = ContactLaw::sphere_sphere(
+            params.youngs_modulus_pa,
+            params.poisson_ratio,
+            params.radius,
+            mass,
+            params.friction_particle,
+        );
+        let law_pw = ContactLaw::sphere_wall(
+            params.youngs_modulus_pa,
+            params.poisson_ratio,
+            params.radius,
+            mass,
+            params.friction_wall,
+        );
+        let mut scene = Self {
+            dt: params.time_step_fraction * params.contact_time(),
+            p: params,
+            buf,
+            grid,
+            law_pp,
+            law_pw,
+            mass,
+            inertia: 0.4 * mass * params.radius * params.radius,
+            beta: (
+                hertz_beta(params.restitution_start),
+                hertz_beta(params.restitution_end),
+            ),
+            time: 0.0,
+            steps: 0,
+            n_pairs: 0,
+            floor_force: 0.0,
+            wall_friction_z: 0.0,
+        };
+        scene.rebuild()?;
+        scene.forces();
+        Ok(scene)
+    }
+
+    /// The time step, s.
+    pub fn time_step(&self) -> Real {
+        self.dt
+    }
+
+    /// Sphere centres, m.
+    pub fn positions(&self) -> &[[Real; 3]] {
+        self.buf.x
+    }
+
+    /// The current candidate pairs (sorted by (i, j)).
+    pub fn pairs(&self) -> &[Pair] {
+        &self.buf.pairs[..self.n_pairs]
+    }
+
+    /// The parameters.
+    pub fn params(&self) -> &PourParams {
+        &self.p
+    }
+
+    fn rebuild(&mut self) -> Result<(), PourError> {
+        let b = &mut self.buf;
+        let old_len = self.n_pairs;
+        b.pairs_old[..old_len].copy_from_slice(&b.pairs[..old_len]);
+        let mut scratch = GridScratch {
+            head: b.head,
+            next: b.next,
+        };
+        self.n_pairs = build_pairs(
+            &self.grid,
+            b.x,
+            self.p.radius,
+            2.0 * self.p.radius + self.p.skin,
+            &mut scratch,
+            &b.pairs_old[..old_len],
+            b.pairs,
+        )
+        .map_err(PourError::Pairs)?;
+        b.x_built.copy_from_slice(b.x);
+        Ok(())
+    }
+
+    fn ramp(&self, start: Real, end: Real) -> Real {
+        let (t0, t1) = self.p.ramp;
+        let s = ((self.time - t0) / (t1 - t0)).clamp(0.0, 1.0);
+        start + (end - start) * s
+    }
+
+    /// Forces and torques at the current positions and velocities.
+    fn forces(&mut self) {
+        let c = self.ramp(0.0, self.p.damping_max);
+        // β is ramped linearly between the values that give the start and
+        // end restitutions exactly.
+        let beta = self.ramp(self.beta.0, self.beta.1);
+        let (m, inertia, g, r, dt) = (
+            self.mass,
+            self.inertia,
+            self.p.gravity_m_s2,
+            self.p.radius,
+            self.dt,
+        );
+        let b = &mut self.buf;
+        for k in 0..b.x.len() {
+            b.f[k] = [
+                -c * m * b.v[k][0],
+                -c * m * b.v[k][1],
+                -c * m * (b.v[k][2]) - m * g,
+            ];
+            b.torque[k] = b.omega[k].map(|w| -c * inertia * w);
+        }
+        let (mut floor, mut wall_z) = (0.0, 0.0);
+        for pair in b.pairs[..self.n_pairs].iter_mut() {
+            let i = pair.i as usize;
+            let xi = b.x[i];
+            let (n, delta, law, vj, wj) = match pair.j {
+                FLOOR => ([0.0, 0.0, 1.0], r - xi[2], &self.law_pw, [0.0; 3], [0.0; 3]),
+                DIE => {
+                    let rr = math::sqrt(xi[0] * xi[0] + xi[1] * xi[1]);
+                    let n = if rr > 0.0 {
+                        [-xi[0] / rr, -xi[1] / rr, 0.0]
+                    } else {
+                        [1.0, 0.0, 0.0]
+                    };
+                    (
+                        n,
+                        rr + r - self.p.die_radius,
+                        &self.law_pw,
+                        [0.0; 3],
+                        [0.0; 3],
+                    )
+                }
+                j => {
+                    let xj = b.x[j as usize];
+                    let d = [xi[0] - xj[0], xi[1] - xj[1], xi[2] - xj[2]];
+                    let dist = math::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+                    let n = if dist > 0.0 {
+                        d.map(|c| c / dist)
+                    } else {
+                        [0.0, 0.0, 1.0]
+                    };
+                    (
+                        n,
+                        2.0 * r - dist,
+                        &self.law_pp,
+                        b.v[j as usize],
+                        b.omega[j as usize],
+                    )
+                }
+            };
+            if delta <= 0.0 {
+                pair.xi = [0.0; 3];
+                continue;
+            }
+            // Relative velocity of i at the contact point: the contact sits at
+            // −r n from i and, for a sphere partner, +r n from j.
+            let wi = b.omega[i];
+            let w = [wi[0] + wj[0], wi[1] + wj[1], wi[2] + wj[2]];
+            let wxn = [
+                w[1] * n[2] - w[2] * n[1],
+                w[2] * n[0] - w[0] * n[2],
+                w[0] * n[1] - w[1] * n[0],
+            ];
+            let v_rel: [Real; 3] = core::array::from_fn(|a| b.v[i][a] - vj[a] - r * wxn[a]);
+            let cf = hertz_mindlin(law, beta, delta, &n, &v_rel, &mut pair.xi, dt);
+            let ft = cf.tangential;
+            // Torque on i: (−r n) × F_t; on a sphere j: (r n) × (−F_t), the same.
+            let t = [
+                -r * (n[1] * ft[2] - n[2] * ft[1]),
+                -r * (n[2] * ft[0] - n[0] * ft[2]),
+                -r * (n[0] * ft[1] - n[1] * ft[0]),
+            ];
+            for (a, ta) in t.iter().enumerate() {
+                b.f[i][a] += cf.force[a];
+                b.torque[i][a] += ta;
+            }
+            match pair.j {
+                FLOOR => floor += cf.force[2],
+                DIE => wall_z += cf.force[2],
+                j => {
+                    for (a, ta) in t.iter().enumerate() {
+                        b.f[j as usize][a] -= cf.force[a];
+                        b.torque[j as usize][a] += ta;
+                    }
+                }
+            }
+        }
+        self.floor_force = floor;
+        self.wall_friction_z = wall_z;
+    }
+
+    /// One velocity-Verlet step.
+    pub fn step(&mut self) -> Result<(), PourError> {
+        let (dt, m, inertia) = (self.dt, self.mass, self.inertia);
+        let half = 0.5 * dt;
+        let b = &mut self.buf;
+        let mut moved: Real = 0.0;
+        for k in 0..b.x.len() {
+            for a in 0..3 {
+                b.v[k][a] += half * b.f[k][a] / m;
+                b.omega[k][a] += half * b.torque[k][a] / inertia;
+                b.x[k][a] += dt * b.v[k][a];
+            }
+            let d = [
+                b.x[k][0] - b.x_built[k][0],
+                b.x[k][1] - b.x_built[k][1],
+                b.x[k][2] - b.x_built[k][2],
+            ];
+            moved = moved.max(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+        }
+        if !moved.is_finite() {
+            return Err(PourError::Unstable { step: self.steps });
+        }
+        self.time += dt;
+        self.steps += 1;
+        // Rebuild once any sphere may have crossed half the skin.
+        if 4.0 * moved > self.p.skin * self.p.skin {
+            self.rebuild()?;
+        }
+        self.forces();
+        let b = &mut self.buf;
+        for k in 0..b.x.len() {
+            for a in 0..3 {
+                b.v[k][a] += half * b.f[k][a] / m;
+                b.omega[k][a] += half * b.torque[k][a] / inertia;
+            }
+        }
+        Ok(())
+    }
+
+    /// The current state.
+    pub fn status(&self) -> PourStatus {
+        let b = &self.buf;
+        let (mut ke, mut vmax, mut top) = (0.0, 0.0 as Real, Real::NEG_INFINITY);
+        for ((v, w), x) in b.v.iter().zip(b.omega.iter()).zip(b.x.iter()) {
+            let v2 = v[0] * v[0] + v[1] * v[1] + v[2] * v[2];
+            ke += 0.5 * self.mass * v2
+                + 0.5 * self.inertia * (w[0] * w[0] + w[1] * w[1] + w[2] * w[2]);
+            vmax = vmax.max(math::sqrt(v2));
+            top = top.max(x[2] + self.p.radius);
+        }
+        let settled = self.time > self.p.ramp.1
+            && vmax < self.p.rest_speed
+            && ke < self.p.rest_kinetic_energy * b.x.len() as Real;
+        PourStatus {
+            time: self.time,
+            steps: self.steps,
+            kinetic_energy: ke,
+            max_speed: vmax,
+            height: top,
+            floor_force: self.floor_force,
+            wall_friction_z: self.wall_friction_z,
+            pairs: self.n_pairs,
+            settled,
+        }
+    }
+
+    /// Steps until the spheres are at rest (checked every `check` steps,
+    /// with `on_check` called for progress) or `max_time` passes.
+    pub fn run_to_rest(
+        &mut self,
+        check: u64,
+        on_check: &mut dyn FnMut(&PourStatus),
+    ) -> Result<PourStatus, PourError> {
+        loop {
+            for _ in 0..check.max(1) {
+                self.step()?;
+            }
+            let s = self.status();
+            on_check(&s);
+            if s.settled {
+                return Ok(s);
+            }
+            if s.time > self.p.max_time {
+                return Err(PourError::NotSettled {
+                    time: s.time,
+                    max_speed: s.max_speed,
+                });
+            }
+        }
+    }
+}
