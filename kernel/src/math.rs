@@ -48,14 +48,17 @@ pub fn tan(x: Real) -> Real {
     libm::tan(x)
 }
 
-/// Larger of two numbers; a NaN argument yields the other one (IEEE `maxNum`).
+/// Larger of two numbers; a NaN argument yields the other one (IEEE
+/// `maxNum`). Written out (libm's `fmax` is an out-of-line call in the hot
+/// loops); deterministic on every target.
 #[inline]
 pub fn max(a: Real, b: Real) -> Real {
-    libm::fmax(a, b)
+    if a.is_nan() || b > a { b } else { a }
 }
 
-/// Smaller of two numbers; a NaN argument yields the other one (IEEE `minNum`).
+/// Smaller of two numbers; a NaN argument yields the other one (IEEE
+/// `minNum`).
 #[inline]
 pub fn min(a: Real, b: Real) -> Real {
-    libm::fmin(a, b)
+    if a.is_nan() || b < a { b } else { a }
 }

@@ -24,29 +24,48 @@ pub struct ContactLaw {
     pub m_star: Real,
     /// Coulomb friction coefficient μ.
     pub friction: Real,
+    /// 2√(5/6)·√(2E* m*): γ_n = −β × this × (R*δ)^{1/4}.
+    pub damping_normal: Real,
+    /// 2√(5/6)·√(8G* m*): γ_t = −β × this × (R*δ)^{1/4}.
+    pub damping_tangential: Real,
 }
 
 impl ContactLaw {
+    fn new(e_star: Real, g_star: Real, r_star: Real, m_star: Real, friction: Real) -> Self {
+        let k = 2.0 * math::sqrt(5.0 / 6.0);
+        Self {
+            e_star,
+            g_star,
+            r_star,
+            m_star,
+            friction,
+            damping_normal: k * math::sqrt(2.0 * e_star * m_star),
+            damping_tangential: k * math::sqrt(8.0 * g_star * m_star),
+        }
+    }
+
     /// Two identical spheres (radius `r`, mass `m`) of an isotropic solid (E, ν).
     pub fn sphere_sphere(youngs: Real, poisson: Real, r: Real, m: Real, friction: Real) -> Self {
-        Self {
-            e_star: youngs / (2.0 * (1.0 - poisson * poisson)),
-            g_star: youngs / (2.0 * (1.0 + poisson)) / (2.0 * (2.0 - poisson)),
-            r_star: 0.5 * r,
-            m_star: 0.5 * m,
+        let g = youngs / (2.0 * (1.0 + poisson));
+        Self::new(
+            youngs / (2.0 * (1.0 - poisson * poisson)),
+            g / (2.0 * (2.0 - poisson)),
+            0.5 * r,
+            0.5 * m,
             friction,
-        }
+        )
     }
 
     /// A sphere against a rigid flat wall.
     pub fn sphere_wall(youngs: Real, poisson: Real, r: Real, m: Real, friction: Real) -> Self {
-        Self {
-            e_star: youngs / (1.0 - poisson * poisson),
-            g_star: youngs / (2.0 * (1.0 + poisson)) / (2.0 - poisson),
-            r_star: r,
-            m_star: m,
+        let g = youngs / (2.0 * (1.0 + poisson));
+        Self::new(
+            youngs / (1.0 - poisson * poisson),
+            g / (2.0 - poisson),
+            r,
+            m,
             friction,
-        }
+        )
     }
 }
 
@@ -141,11 +160,13 @@ pub fn hertz_mindlin(
     let root = math::sqrt(law.r_star * delta);
     let s_n = 2.0 * law.e_star * root;
     let s_t = 8.0 * law.g_star * root;
-    let k = -2.0 * math::sqrt(5.0 / 6.0) * beta;
-    let gamma_n = k * math::sqrt(s_n * law.m_star);
-    let gamma_t = k * math::sqrt(s_t * law.m_star);
+    // γ = −2√(5/6) β √(S m*), with √S = √(2E* or 8G*) · (R*δ)^{1/4}.
+    let quarter = -beta * math::sqrt(root);
+    let gamma_n = quarter * law.damping_normal;
+    let gamma_t = quarter * law.damping_tangential;
     let vn = dot(v_rel, n);
-    let normal = math::max(0.0, (2.0 / 3.0) * s_n * delta - gamma_n * vn);
+    let push = (2.0 / 3.0) * s_n * delta - gamma_n * vn;
+    let normal = if push > 0.0 { push } else { 0.0 };
     let vt: [Real; 3] = core::array::from_fn(|a| v_rel[a] - vn * n[a]);
     // Keep the history in the current tangent plane, then load it.
     let xn = dot(xi, n);
@@ -153,9 +174,10 @@ pub fn hertz_mindlin(
         xi[a] += -xn * n[a] + vt[a] * dt;
     }
     let mut ft: [Real; 3] = core::array::from_fn(|a| -s_t * xi[a] - gamma_t * vt[a]);
-    let ft_mag = math::sqrt(dot(&ft, &ft));
+    let ft2 = dot(&ft, &ft);
     let cap = law.friction * normal;
-    if ft_mag > cap {
+    if ft2 > cap * cap {
+        let ft_mag = math::sqrt(ft2);
         let scale = if ft_mag > 0.0 { cap / ft_mag } else { 0.0 };
         for a in 0..3 {
             ft[a] *= scale;
