@@ -9,6 +9,7 @@ use clap::{Parser, Subcommand};
 use crate::export_mesh::ExportMeshArgs;
 use crate::granule::GranuleArgs;
 use crate::output::Streams;
+use crate::pack::PackArgs;
 use crate::point::PointArgs;
 
 /// granbed: a combined finite/discrete element simulator of granule-bed die
@@ -36,6 +37,11 @@ pub enum Command {
     /// force–displacement table, a summary with the granule yield stress
     /// estimate σ_est, and a plot to a directory.
     Granule(GranuleArgs),
+    /// Pour rigid spheres into the die and let them settle under gravity;
+    /// write the packing (the start of a bed compression), a summary with
+    /// the bed height, packing fractions and coordination number, and a
+    /// VTK view to a directory.
+    Pack(PackArgs),
 }
 
 impl Command {
@@ -45,6 +51,7 @@ impl Command {
             Self::Point(args) => args.run(streams),
             Self::ExportMesh(args) => args.run(streams),
             Self::Granule(args) => args.run(streams),
+            Self::Pack(args) => args.run(streams),
         }
     }
 }

@@ -10,10 +10,12 @@
 //! * [`point`]: `granbed-cli point`, the material-point explorer;
 //! * [`export_mesh`]: `granbed-cli export-mesh`, the mesh as CalculiX `.inp`;
 //! * [`granule`]: `granbed-cli granule`, the single-granule platen experiment;
+//! * [`pack`]: `granbed-cli pack`, the pour of rigid spheres into the die;
 //! * [`model`]: owned buffers for the kernel's meshes;
 //! * [`material_args`]: `--type` and the material-parameter overrides;
 //! * [`output`]: the standard streams and `--out` destinations;
 //! * [`csv`]: a small CSV writer with round-trip exact floats;
+//! * [`vtk`]: a VTK XML unstructured-grid (`.vtu`) writer;
 //! * [`error`]: usage errors and the exit-status mapping.
 //!
 //! Exit status: 0 success (and `--help`, `--version`), 1 runtime failure
@@ -33,7 +35,9 @@ pub mod granule;
 pub mod material_args;
 pub mod model;
 pub mod output;
+pub mod pack;
 pub mod point;
+pub mod vtk;
 
 pub use command::{Cli, Command};
 pub use output::Streams;
