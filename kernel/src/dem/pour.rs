@@ -366,7 +366,7 @@ pub struct PourStatus {
     pub wall_friction_z: Real,
     /// Candidate pairs in the list.
     pub pairs: usize,
-    /// True once at rest after the ramp.
+    /// True once every sphere is at rest (checked after the ramp has begun).
     pub settled: bool,
 }
 
@@ -688,7 +688,9 @@ impl<'a> PourScene<'a> {
             vmax = vmax.max(math::sqrt(v2));
             top = top.max(x[2] + self.p.radius);
         }
-        let settled = self.time > self.p.ramp.1
+        // At rest is at rest, whether or not the damping ramp has finished:
+        // a falling or bouncing bed never has every speed below 1e-5 m/s.
+        let settled = self.time > self.p.ramp.0
             && vmax < self.p.rest_speed
             && ke < self.p.rest_kinetic_energy * b.x.len() as Real;
         PourStatus {
