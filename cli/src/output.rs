@@ -72,3 +72,16 @@ impl Write for Output<'_> {
         self.writer.flush()
     }
 }
+
+/// Creates (or truncates) the output file `path` for buffered writing.
+pub fn create_file(path: &Path) -> anyhow::Result<BufWriter<File>> {
+    let file = File::create(path)
+        .with_context(|| format!("cannot create output file `{}`", path.display()))?;
+    Ok(BufWriter::new(file))
+}
+
+/// Flushes `w`, naming `path` on failure.
+pub fn finish_file(mut w: impl Write, path: &Path) -> anyhow::Result<()> {
+    w.flush()
+        .with_context(|| format!("cannot write to `{}`", path.display()))
+}

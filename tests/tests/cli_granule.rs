@@ -11,7 +11,7 @@ mod common;
 
 use std::path::{Path, PathBuf};
 
-use common::{Run, Table, assert_close, cli};
+use common::{Run, Table, assert_close, cli, number, summary};
 use serde_json::Value;
 
 /// A fresh (emptied) output directory named `name`.
@@ -28,21 +28,6 @@ fn granule_ok(dir: &Path, args: &[&str]) -> Run {
     let run = cli(&argv);
     assert_eq!(run.code, 0, "granule {args:?} failed:\n{}", run.stderr);
     run
-}
-
-/// The parsed `summary.json` in `dir`.
-fn summary(dir: &Path) -> Value {
-    let path = dir.join("summary.json");
-    let text = std::fs::read_to_string(&path)
-        .unwrap_or_else(|e| panic!("cannot read {}: {e}", path.display()));
-    serde_json::from_str(&text).expect("summary.json is JSON")
-}
-
-/// Field `key` of a summary as a number (panics if missing or null).
-fn number(summary: &Value, key: &str) -> f64 {
-    summary[key]
-        .as_f64()
-        .unwrap_or_else(|| panic!("summary field {key} is {:?}", summary[key]))
 }
 
 /// The header `force_displacement.csv` must have, in this order.

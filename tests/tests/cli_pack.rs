@@ -13,7 +13,7 @@ mod common;
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 
-use common::{Run, Table, assert_close, cli};
+use common::{Run, Table, assert_close, cli, number, summary};
 use granbed_cli::pack::measures::{self, Region};
 use granbed_cli::pack::{outputs, read_packing};
 use serde_json::Value;
@@ -37,21 +37,6 @@ fn pack_ok(dir: &Path, args: &[&str]) -> Run {
     let run = pack(dir, args);
     assert_eq!(run.code, 0, "pack {args:?} failed:\n{}", run.stderr);
     run
-}
-
-/// The parsed `summary.json` in `dir`.
-fn summary(dir: &Path) -> Value {
-    let path = dir.join("summary.json");
-    let text = std::fs::read_to_string(&path)
-        .unwrap_or_else(|e| panic!("cannot read {}: {e}", path.display()));
-    serde_json::from_str(&text).expect("summary.json is JSON")
-}
-
-/// Field `key` of a summary as a number (panics if missing or null).
-fn number(summary: &Value, key: &str) -> f64 {
-    summary[key]
-        .as_f64()
-        .unwrap_or_else(|| panic!("summary field {key} is {:?}", summary[key]))
 }
 
 /// Keys `summary.json` must have.

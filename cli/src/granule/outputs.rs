@@ -2,8 +2,8 @@
 //! summary JSON, the per-type table of `--types`, and text files (SVG).
 //! Every writer names the file in its error.
 
-use std::fs::File;
-use std::io::{BufWriter, Write};
+use crate::output::{create_file, finish_file};
+use std::io::Write;
 use std::path::Path;
 
 use anyhow::Context as _;
@@ -62,19 +62,6 @@ pub const TYPES_COLUMNS: [&str; 10] = [
     "return_map_gap_rel",
 ];
 
-/// Creates (or truncates) `path` for buffered writing.
-fn create(path: &Path) -> anyhow::Result<BufWriter<File>> {
-    let file = File::create(path)
-        .with_context(|| format!("cannot create output file `{}`", path.display()))?;
-    Ok(BufWriter::new(file))
-}
-
-/// Flushes `w`, naming `path` on failure.
-fn finish(mut w: impl Write, path: &Path) -> anyhow::Result<()> {
-    w.flush()
-        .with_context(|| format!("cannot write to `{}`", path.display()))
-}
-
 /// The cells of one sample, in the order of [`FORCE_COLUMNS`].
 pub fn force_row(s: &PlatenSample) -> [Field; FORCE_COLUMNS.len()] {
     let e = &s.energy;
@@ -104,29 +91,29 @@ pub fn force_row(s: &PlatenSample) -> [Field; FORCE_COLUMNS.len()] {
 /// Writes `samples` as [`FORCE_CSV`] rows to `path`.
 pub fn write_force_csv(path: &Path, samples: &[PlatenSample]) -> anyhow::Result<()> {
     let ctx = || format!("cannot write to `{}`", path.display());
-    let mut csv = CsvWriter::new(create(path)?, &FORCE_COLUMNS).with_context(ctx)?;
+    let mut csv = CsvWriter::new(create_file(path)?, &FORCE_COLUMNS).with_context(ctx)?;
     for s in samples {
         csv.write_row(&force_row(s)).with_context(ctx)?;
     }
-    finish(csv.into_inner(), path)
+    finish_file(csv.into_inner(), path)
 }
 
 /// Writes `summary` as pretty-printed JSON (and a final line break) to
 /// `path`. Floats are round-trip exact; non-finite ones become `null`.
 pub fn write_summary_json(path: &Path, summary: &Summary) -> anyhow::Result<()> {
-    let mut w = create(path)?;
+    let mut w = create_file(path)?;
     serde_json::to_writer_pretty(&mut w, summary)
         .and_then(|()| writeln!(w).map_err(serde_json::Error::io))
         .with_context(|| format!("cannot write to `{}`", path.display()))?;
-    finish(w, path)
+    finish_file(w, path)
 }
 
 /// Writes `text` to `path`.
 pub fn write_text(path: &Path, text: &str) -> anyhow::Result<()> {
-    let mut w = create(path)?;
+    let mut w = create_file(path)?;
     w.write_all(text.as_bytes())
         .with_context(|| format!("cannot write to `{}`", path.display()))?;
-    finish(w, path)
+    finish_file(w, path)
 }
 
 /// The [`TYPES_CSV`] row of one type's summary (`NaN` for a measure that
@@ -151,9 +138,9 @@ fn types_row(t: GranuleType, s: &Summary) -> [Field; TYPES_COLUMNS.len()] {
 /// Writes one [`TYPES_CSV`] row per `(type, summary)`, in the given order.
 pub fn write_types_csv(path: &Path, runs: &[(GranuleType, &Summary)]) -> anyhow::Result<()> {
     let ctx = || format!("cannot write to `{}`", path.display());
-    let mut csv = CsvWriter::new(create(path)?, &TYPES_COLUMNS).with_context(ctx)?;
+    let mut csv = CsvWriter::new(create_file(path)?, &TYPES_COLUMNS).with_context(ctx)?;
     for (t, s) in runs {
         csv.write_row(&types_row(*t, s)).with_context(ctx)?;
     }
-    finish(csv.into_inner(), path)
+    finish_file(csv.into_inner(), path)
 }

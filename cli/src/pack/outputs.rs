@@ -3,8 +3,8 @@
 //! the packing reader. Every writer and the reader name the file in their
 //! errors.
 
-use std::fs::File;
-use std::io::{BufWriter, Write};
+use crate::output::{create_file, finish_file};
+use std::io::Write;
 use std::path::Path;
 
 use anyhow::{Context as _, bail};
@@ -27,30 +27,17 @@ pub const PACKING_COLUMNS: [&str; 4] = ["x_m", "y_m", "z_m", "radius_m"];
 /// One granule of a packing: centre (m) and radius (m).
 pub type Sphere = ([Real; 3], Real);
 
-/// Creates (or truncates) `path` for buffered writing.
-fn create(path: &Path) -> anyhow::Result<BufWriter<File>> {
-    let file = File::create(path)
-        .with_context(|| format!("cannot create output file `{}`", path.display()))?;
-    Ok(BufWriter::new(file))
-}
-
-/// Flushes `w`, naming `path` on failure.
-fn finish(mut w: impl Write, path: &Path) -> anyhow::Result<()> {
-    w.flush()
-        .with_context(|| format!("cannot write to `{}`", path.display()))
-}
-
 /// Writes the packing, one row per granule in granule order, to `path`
 /// ([`PACKING_COLUMNS`]; floats round-trip exact, so [`read_packing`]
 /// gives back the same bits).
 pub fn write_packing(path: &Path, centres: &[[Real; 3]], radius: Real) -> anyhow::Result<()> {
     let ctx = || format!("cannot write to `{}`", path.display());
-    let mut csv = CsvWriter::new(create(path)?, &PACKING_COLUMNS).with_context(ctx)?;
+    let mut csv = CsvWriter::new(create_file(path)?, &PACKING_COLUMNS).with_context(ctx)?;
     for c in centres {
         let row = [c[0], c[1], c[2], radius].map(Field::Real);
         csv.write_row(&row).with_context(ctx)?;
     }
-    finish(csv.into_inner(), path)
+    finish_file(csv.into_inner(), path)
 }
 
 /// Reads a packing written by `granbed-cli pack` ([`PACKING_CSV`]): the
@@ -111,11 +98,11 @@ pub fn parse_packing(text: &str) -> anyhow::Result<Vec<Sphere>> {
 /// Writes `summary` as pretty-printed JSON (and a final line break) to
 /// `path`. Floats are round-trip exact; non-finite ones become `null`.
 pub fn write_summary_json(path: &Path, summary: &Summary) -> anyhow::Result<()> {
-    let mut w = create(path)?;
+    let mut w = create_file(path)?;
     serde_json::to_writer_pretty(&mut w, summary)
         .and_then(|()| writeln!(w).map_err(serde_json::Error::io))
         .with_context(|| format!("cannot write to `{}`", path.display()))?;
-    finish(w, path)
+    finish_file(w, path)
 }
 
 /// Writes the packing as a VTK unstructured grid to `path`: one
@@ -143,10 +130,10 @@ pub fn write_packing_vtu(path: &Path, centres: &[[Real; 3]], radius: Real) -> an
         point_data: &point_data,
         cell_data: &[],
     };
-    let mut w = create(path)?;
+    let mut w = create_file(path)?;
     grid.write(&mut w)
         .with_context(|| format!("cannot write to `{}`", path.display()))?;
-    finish(w, path)
+    finish_file(w, path)
 }
 
 #[cfg(test)]

@@ -124,3 +124,18 @@ pub fn assert_close(what: &str, actual: f64, expected: f64, rel: f64, abs: f64) 
         "{what}: got {actual:.16e}, expected {expected:.16e} (|err| = {err:.3e} > tol = {tol:.3e})"
     );
 }
+
+/// The parsed `summary.json` in `dir`.
+pub fn summary(dir: &Path) -> serde_json::Value {
+    let path = dir.join("summary.json");
+    let text = std::fs::read_to_string(&path)
+        .unwrap_or_else(|e| panic!("cannot read {}: {e}", path.display()));
+    serde_json::from_str(&text).expect("summary.json is JSON")
+}
+
+/// Field `key` of a summary as a number (panics if missing or null).
+pub fn number(summary: &serde_json::Value, key: &str) -> f64 {
+    summary[key]
+        .as_f64()
+        .unwrap_or_else(|| panic!("summary field {key} is {:?}", summary[key]))
+}
