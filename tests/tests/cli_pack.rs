@@ -390,20 +390,22 @@ fn bad_input_exits_2_naming_the_flag() {
 
 #[test]
 fn unsettled_pour_writes_outputs_and_fails() {
-    // A 9 cm column of 400 granules in a 4.1 mm die (5 per layer) is still
-    // falling at 0.26 s; a soft contact keeps the run short.
+    // A 46 cm column of 2000 granules in a 4.1 mm die (5 per layer) is still
+    // falling at 0.31 s (its top needs 0.31 s to reach the floor in free
+    // fall, and the dissipation ramp ends at 0.30 s); a soft contact keeps
+    // the run short (~5 s).
     let dir = out_dir("unsettled");
     let run = pack(
         &dir,
         &[
             "--granules",
-            "400",
+            "2000",
             "--die-diameter-mm",
             "4.1",
             "--youngs-modulus-mpa",
             "1",
             "--max-time-s",
-            "0.26",
+            "0.31",
         ],
     );
     assert_eq!(run.code, 1, "{}", run.stderr);
@@ -422,6 +424,6 @@ fn unsettled_pour_writes_outputs_and_fails() {
             .unwrap()
             .contains("did not come to rest")
     );
-    assert_eq!(read_packing(&dir.join("packing.csv")).unwrap().len(), 400);
+    assert_eq!(read_packing(&dir.join("packing.csv")).unwrap().len(), 2000);
     assert!(dir.join("packing.vtu").exists());
 }

@@ -238,7 +238,7 @@ pub struct PackArgs {
 
     /// Give up (exit status 1, outputs still written) if the spheres are not
     /// at rest after this simulated time, s (finite, after the end of the
-    /// dissipation ramp at 0.25 s).
+    /// dissipation ramp at 0.30 s).
     #[arg(
         long,
         value_name = "S",
