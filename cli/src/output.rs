@@ -85,3 +85,19 @@ pub fn finish_file(mut w: impl Write, path: &Path) -> anyhow::Result<()> {
     w.flush()
         .with_context(|| format!("cannot write to `{}`", path.display()))
 }
+
+/// Writes `value` as pretty-printed JSON (and a final line break) to `path`.
+/// Floats are round-trip exact; non-finite ones become `null`.
+pub fn write_json(path: &Path, value: &impl serde::Serialize) -> anyhow::Result<()> {
+    let mut w = create_file(path)?;
+    serde_json::to_writer_pretty(&mut w, value)
+        .and_then(|()| writeln!(w).map_err(serde_json::Error::io))
+        .with_context(|| format!("cannot write to `{}`", path.display()))?;
+    finish_file(w, path)
+}
+
+/// `num / den`, or `None` (JSON `null`) if that is not a finite number.
+pub fn finite_ratio(num: f64, den: f64) -> Option<f64> {
+    let r = num / den;
+    r.is_finite().then_some(r)
+}

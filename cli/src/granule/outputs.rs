@@ -98,14 +98,10 @@ pub fn write_force_csv(path: &Path, samples: &[PlatenSample]) -> anyhow::Result<
     finish_file(csv.into_inner(), path)
 }
 
-/// Writes `summary` as pretty-printed JSON (and a final line break) to
-/// `path`. Floats are round-trip exact; non-finite ones become `null`.
+/// Writes `summary` as pretty-printed JSON to `path` (see
+/// [`crate::output::write_json`]).
 pub fn write_summary_json(path: &Path, summary: &Summary) -> anyhow::Result<()> {
-    let mut w = create_file(path)?;
-    serde_json::to_writer_pretty(&mut w, summary)
-        .and_then(|()| writeln!(w).map_err(serde_json::Error::io))
-        .with_context(|| format!("cannot write to `{}`", path.display()))?;
-    finish_file(w, path)
+    crate::output::write_json(path, summary)
 }
 
 /// Writes `text` to `path`.

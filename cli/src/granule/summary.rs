@@ -2,6 +2,7 @@
 //! force–displacement slope, σ_y,eff0, the energy checks, the cost, and
 //! every input parameter for provenance.
 
+use crate::output::finite_ratio as ratio;
 use granbed_kernel::Real;
 use granbed_kernel::analysis::granule::{initial_effective_yield_stress, yield_stress_estimate};
 use granbed_kernel::granule::forces::ElementKind;
@@ -159,12 +160,6 @@ pub struct Summary {
     pub notes: Vec<String>,
     /// The kernel error that stopped the run, or `null`.
     pub error: Option<String>,
-}
-
-/// `num / den`, or `None` if that is not a finite number.
-fn ratio(num: Real, den: Real) -> Option<Real> {
-    let r = num / den;
-    r.is_finite().then_some(r)
 }
 
 impl Summary {

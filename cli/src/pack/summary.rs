@@ -1,6 +1,7 @@
 //! The measures of one pour (`summary.json`): bed height, packing fractions,
 //! contacts, force balance, cost, and every parameter for provenance.
 
+use crate::output::finite_ratio as ratio;
 use granbed_kernel::Real;
 use granbed_kernel::dem::pour::{PourParams, PourStatus};
 use serde::Serialize;
@@ -167,12 +168,6 @@ pub struct Summary {
     pub force_balance_rel: Real,
     /// The kernel error that stopped the pour, or `null`.
     pub error: Option<String>,
-}
-
-/// `num / den`, or `None` if that is not a finite number.
-fn ratio(num: f64, den: f64) -> Option<f64> {
-    let r = num / den;
-    r.is_finite().then_some(r)
 }
 
 impl Summary {
