@@ -11,6 +11,7 @@
 //! * [`export_mesh`]: `granbed-cli export-mesh`, the mesh as CalculiX `.inp`;
 //! * [`granule`]: `granbed-cli granule`, the single-granule platen experiment;
 //! * [`pack`]: `granbed-cli pack`, the pour of rigid spheres into the die;
+//! * [`assembly`]: many finite-element granules in contact with each other and walls;
 //! * [`model`]: owned buffers for the kernel's meshes;
 //! * [`material_args`]: `--type` and the material-parameter overrides;
 //! * [`output`]: the standard streams and `--out` destinations;
@@ -27,6 +28,7 @@ use std::io::Write;
 
 use clap::Parser;
 
+pub mod assembly;
 pub mod command;
 pub mod csv;
 pub mod error;

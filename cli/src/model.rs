@@ -185,14 +185,20 @@ pub struct GranuleStore {
     pub x: Vec<[Real; 3]>,
     /// Velocities, m/s.
     pub v: Vec<[Real; 3]>,
-    v_star: Vec<[Real; 3]>,
-    x_pred: Vec<[Real; 3]>,
-    f_int: Vec<[Real; 3]>,
-    f_c: Vec<[Real; 3]>,
-    f_d: Vec<[Real; 3]>,
+    /// Scratch: velocity before contact v*, m/s.
+    pub v_star: Vec<[Real; 3]>,
+    /// Predicted positions x̃, m.
+    pub x_pred: Vec<[Real; 3]>,
+    /// Internal + hourglass forces, N.
+    pub f_int: Vec<[Real; 3]>,
+    /// Contact forces of the step, N.
+    pub f_c: Vec<[Real; 3]>,
+    /// Damping forces, N.
+    pub f_d: Vec<[Real; 3]>,
     /// Lumped masses, kg.
     pub mass: Vec<Real>,
-    fixed: Vec<u8>,
+    /// Per node, bit a = velocity component a held at zero.
+    pub fixed: Vec<u8>,
     /// C_p⁻¹ per integration point.
     pub cp_inv: Vec<[Real; 6]>,
 }

@@ -1,5 +1,15 @@
-//! Contact.
+//! Contact of granule surfaces with each other and with rigid walls
+//! (physics.md §5).
 //!
-//! * [`wall`]: kinematic contact of nodes with a rigid plane, with friction.
+//! * [`quad`]: closest point of a node on a bilinear quad;
+//! * [`surface`]: a granule's surface on the predicted configuration, boxes;
+//! * [`broad`]: candidate granule pairs from bounding spheres on a grid;
+//! * [`pair`]: node-to-surface detection and kinematic forces between two
+//!   granules (symmetric two-pass, mass sharing, Coulomb friction);
+//! * [`wall`]: kinematic contact with rigid planes and the die cylinder.
 
+pub mod broad;
+pub mod pair;
+pub mod quad;
+pub mod surface;
 pub mod wall;

@@ -1,7 +1,8 @@
 //! Kinematic (defence-node style) contact of granule nodes with a rigid
-//! plane, with Coulomb friction (physics.md §5.4–§5.5).
+//! wall (a plane or the die cylinder), with Coulomb friction (physics.md
+//! §5.4–§5.5).
 //!
-//! On the predicted configuration x̃, a node with gap g = n·x̃ − d < 0 gets
+//! On the predicted configuration x̃, a node with gap g < 0 gets
 //! the normal force F_n = m(−g)/Δt² along the inward normal n, which closes
 //! the gap in one step. The stick trial F_t* = −m Δu_t/Δt² cancels the
 //! tangential slip Δu_t of the step; if |F_t*| > μF_n the node slips with
@@ -43,11 +44,43 @@ pub struct PredictedNodes<'a> {
     pub x_pred: &'a [[Real; 3]],
 }
 
+/// A rigid wall the granule surface nodes touch (physics.md §5.5).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Wall {
+    /// A plane (a punch, a platen, a box side); it moves only along its
+    /// normal, so it has no tangential motion.
+    Plane(Plane),
+    /// The inside of the die, a cylinder of `radius` (m) about the z axis:
+    /// gap g = R − √(x² + y²), inward normal −(x, y, 0)/r.
+    Die {
+        /// Die radius R_d, m.
+        radius: Real,
+    },
+}
+
+impl Wall {
+    /// Gap (m) and inward unit normal at point `x`.
+    pub fn gap(&self, x: &[Real; 3]) -> (Real, [Real; 3]) {
+        match self {
+            Wall::Plane(p) => {
+                let n = p.normal;
+                (n[0] * x[0] + n[1] * x[1] + n[2] * x[2] - p.offset, n)
+            }
+            Wall::Die { radius } => {
+                let r = crate::math::sqrt(x[0] * x[0] + x[1] * x[1]);
+                if r > 0.0 {
+                    (radius - r, [-x[0] / r, -x[1] / r, 0.0])
+                } else {
+                    (*radius, [1.0, 0.0, 0.0])
+                }
+            }
+        }
+    }
+}
+
 /// Adds the contact forces of `plane` on the nodes `nodes` (a range of node
-/// indices, usually the surface nodes) into `f_c` (N). `friction` is the
-/// Coulomb μ (0 skips the friction work). `dt_squared` is Δt_{n+½}·Δt_n, the
-/// product that maps a force to the position change of this step
-/// (Δx = Δt_{n+½} Δt_n F/m), so the gap closes exactly even when Δt changes.
+/// indices, usually the surface nodes) into `f_c` (N), without mass
+/// sharing; see [`wall_contact`].
 pub fn plane_contact(
     plane: &Plane,
     friction: Real,
@@ -56,17 +89,59 @@ pub fn plane_contact(
     body: &PredictedNodes<'_>,
     f_c: &mut [[Real; 3]],
 ) -> WallForce {
+    wall_contact(
+        &Wall::Plane(*plane),
+        friction,
+        dt_squared,
+        nodes,
+        body,
+        &[],
+        f_c,
+    )
+}
+
+/// Counts (in `count`, one per node) the nodes of `nodes` that penetrate
+/// `wall` on the predicted configuration: each wall is one contact for the
+/// mass sharing of §5.3.
+pub fn count_wall_contacts(
+    wall: &Wall,
+    nodes: core::ops::Range<usize>,
+    x_pred: &[[Real; 3]],
+    count: &mut [u16],
+) {
+    for i in nodes {
+        if wall.gap(&x_pred[i]).0 < 0.0 {
+            count[i] = count[i].saturating_add(1);
+        }
+    }
+}
+
+/// Adds the contact forces of `wall` on the nodes `nodes` (a range of node
+/// indices, usually the surface nodes) into `f_c` (N). `friction` is the
+/// Coulomb μ (0 skips the friction work). `dt_squared` is Δt_{n+½}·Δt_n, the
+/// product that maps a force to the position change of this step
+/// (Δx = Δt_{n+½} Δt_n F/m), so the gap closes exactly even when Δt changes.
+/// `share` holds each node's contact count n for the shared mass m/n
+/// (empty: no sharing, the gap closes fully in one step).
+pub fn wall_contact(
+    wall: &Wall,
+    friction: Real,
+    dt_squared: Real,
+    nodes: core::ops::Range<usize>,
+    body: &PredictedNodes<'_>,
+    share: &[u16],
+    f_c: &mut [[Real; 3]],
+) -> WallForce {
     let (mass, x_n, x_pred) = (body.mass, body.x_n, body.x_pred);
-    let n = plane.normal;
     let inv_dt2 = 1.0 / dt_squared;
     let mut out = WallForce::default();
     for i in nodes {
         let xp = x_pred[i];
-        let gap = n[0] * xp[0] + n[1] * xp[1] + n[2] * xp[2] - plane.offset;
+        let (gap, n) = wall.gap(&xp);
         if gap >= 0.0 {
             continue;
         }
-        let m = mass[i];
+        let m = mass[i] / Real::from(share.get(i).copied().unwrap_or(1).max(1));
         let fn_mag = m * (-gap) * inv_dt2;
         let mut f = [fn_mag * n[0], fn_mag * n[1], fn_mag * n[2]];
         if friction > 0.0 {

@@ -1,0 +1,376 @@
+//! The granule–granule contact phase of an assembly step: broad phase,
+//! detection, mass-sharing counts, forces and the fixed-order gather.
+
+use granbed_kernel::Real;
+use granbed_kernel::contact::broad::{
+    Bound, BroadScratch, GranulePair, bounding_sphere, candidate_pairs, needs_rebuild,
+};
+use granbed_kernel::contact::pair::{
+    Constraint, ContactError, Involvement, NodeForce, PairForce, PairSettings, Side, detect,
+    forces, mark_involvement,
+};
+use granbed_kernel::contact::surface::{Aabb, SurfaceBody};
+use rayon::prelude::*;
+
+use crate::model::{GranuleStore, OwnedReference};
+
+/// The buffers and results of one candidate pair.
+#[derive(Clone, Debug, Default)]
+pub struct PairWork {
+    constraints: Vec<Constraint>,
+    count: usize,
+    forces: Vec<NodeForce>,
+    force_count: usize,
+    scratch: Vec<u32>,
+    /// What the last force pass did.
+    pub result: PairForce,
+}
+
+impl PairWork {
+    /// The constraints found in the last detection.
+    pub fn constraints(&self) -> &[Constraint] {
+        &self.constraints[..self.count]
+    }
+}
+
+/// Contact state carried between steps.
+#[derive(Debug, Default)]
+pub struct ContactPhase {
+    pairs: Vec<GranulePair>,
+    work: Vec<PairWork>,
+    /// Per granule: (pair index, side of the granule in it), pair order.
+    by_granule: Vec<Vec<(u32, Side)>>,
+    built: Vec<Bound>,
+    bounds: Vec<Bound>,
+    boxes: Vec<Aabb>,
+    /// Per granule and node: contacts this step (mass sharing).
+    pub(super) share: Vec<Vec<u16>>,
+    tag: Vec<Vec<u32>>,
+    head: Vec<u32>,
+    next: Vec<u32>,
+    rebuilds: u64,
+}
+
+/// The kernel's view of granule `g` on its predicted configuration.
+fn body<'a>(g: &'a GranuleStore, mesh: &'a OwnedReference, bounds: Aabb) -> SurfaceBody<'a> {
+    SurfaceBody {
+        x_n: &g.x,
+        x_pred: &g.x_pred,
+        mass: &g.mass,
+        first_surface: mesh.positions.len() - mesh.surface_nodes,
+        quads: &mesh.quads,
+        node_quads: &mesh.node_quads,
+        bounds,
+    }
+}
+
+impl ContactPhase {
+    /// Empty contact state for `granules`.
+    pub fn new(granules: &[GranuleStore], mesh: &OwnedReference) -> Self {
+        let n = granules.len();
+        let nodes = mesh.positions.len();
+        Self {
+            by_granule: vec![Vec::new(); n],
+            share: vec![vec![0; nodes]; n],
+            tag: vec![vec![u32::MAX; nodes]; n],
+            head: vec![0; 8 * n + 8],
+            next: vec![0; n],
+            ..Self::default()
+        }
+    }
+
+    /// Candidate pairs of the current list.
+    pub fn pairs(&self) -> &[GranulePair] {
+        &self.pairs
+    }
+
+    /// Per candidate pair, its buffers and last result.
+    pub fn work(&self) -> &[PairWork] {
+        &self.work
+    }
+
+    /// Broad-phase rebuilds so far.
+    pub fn rebuilds(&self) -> u64 {
+        self.rebuilds
+    }
+
+    /// Pairs in contact (at least one constraint) in the last step.
+    pub fn pairs_in_contact(&self) -> usize {
+        self.work.iter().filter(|w| w.count > 0).count()
+    }
+
+    /// Per granule, the number of granules it touched in the last step.
+    pub fn contacts_per_granule(&self) -> Vec<usize> {
+        let mut n = vec![0; self.by_granule.len()];
+        for (p, w) in self.pairs.iter().zip(&self.work) {
+            if w.count > 0 {
+                n[p.a as usize] += 1;
+                n[p.b as usize] += 1;
+            }
+        }
+        n
+    }
+
+    /// Bounding spheres and boxes of every granule's predicted surface,
+    /// then the candidate list, rebuilt if a granule drifted half the margin.
+    pub(super) fn broad(
+        &mut self,
+        granules: &[GranuleStore],
+        mesh: &OwnedReference,
+        margin: Real,
+    ) -> Result<(), ContactError> {
+        let first = mesh.positions.len() - mesh.surface_nodes;
+        (self.bounds, self.boxes) = granules
+            .par_iter()
+            .map(|g| {
+                (
+                    bounding_sphere(&g.x_pred, first),
+                    Aabb::of_surface(&g.x_pred, first),
+                )
+            })
+            .unzip();
+        if !self.built.is_empty() && !needs_rebuild(&self.built, &self.bounds, margin) {
+            return Ok(());
+        }
+        let mut out = vec![GranulePair { a: 0, b: 0 }; 8 * granules.len() + 8];
+        let count = loop {
+            let mut scratch = BroadScratch {
+                head: &mut self.head,
+                next: &mut self.next,
+            };
+            match candidate_pairs(&self.bounds, margin, &mut scratch, &mut out) {
+                Ok(n) => break n,
+                Err(ContactError::Capacity {
+                    buffer: "granule pairs",
+                    capacity,
+                }) => out.resize(2 * capacity.max(8), GranulePair { a: 0, b: 0 }),
+                Err(e) => return Err(e),
+            }
+        };
+        out.truncate(count);
+        self.pairs = out;
+        self.work.resize_with(count, PairWork::default);
+        for list in &mut self.by_granule {
+            list.clear();
+        }
+        for (k, p) in self.pairs.iter().enumerate() {
+            self.by_granule[p.a as usize].push((k as u32, Side::A));
+            self.by_granule[p.b as usize].push((k as u32, Side::B));
+        }
+        self.built.clone_from(&self.bounds);
+        self.rebuilds += 1;
+        Ok(())
+    }
+
+    /// Detection on every candidate pair (in parallel), growing a pair's
+    /// constraint list when it is full.
+    pub(super) fn detect(
+        &mut self,
+        granules: &[GranuleStore],
+        mesh: &OwnedReference,
+        settings: &PairSettings,
+    ) -> Result<(), ContactError> {
+        let boxes = &self.boxes;
+        self.pairs
+            .par_iter()
+            .zip(self.work.par_iter_mut())
+            .try_for_each(|(p, w)| {
+                let (a, b) = (p.a as usize, p.b as usize);
+                let body_a = body(&granules[a], mesh, boxes[a]);
+                let body_b = body(&granules[b], mesh, boxes[b]);
+                detect_growing(&body_a, &body_b, settings, w)
+            })
+    }
+
+    /// Contact counts per node for the mass sharing: pairs in list order,
+    /// then every granule's wall contacts (`walls` adds them).
+    pub(super) fn count_pairs(&mut self, granules: &[GranuleStore], mesh: &OwnedReference) {
+        for (s, t) in self.share.iter_mut().zip(&mut self.tag) {
+            s.fill(0);
+            t.fill(u32::MAX);
+        }
+        for (k, (p, w)) in self.pairs.iter().zip(&self.work).enumerate() {
+            if w.count == 0 {
+                continue;
+            }
+            let (a, b) = (p.a as usize, p.b as usize);
+            let (lo, hi) = self.share.split_at_mut(b);
+            let (tlo, thi) = self.tag.split_at_mut(b);
+            let mut inv_a = Involvement {
+                tag: &mut tlo[a],
+                count: &mut lo[a],
+            };
+            let mut inv_b = Involvement {
+                tag: &mut thi[0],
+                count: &mut hi[0],
+            };
+            let body_a = body(&granules[a], mesh, self.boxes[a]);
+            let body_b = body(&granules[b], mesh, self.boxes[b]);
+            mark_involvement(
+                w.constraints(),
+                (&body_a, &mut inv_a),
+                (&body_b, &mut inv_b),
+                k as u32,
+            );
+        }
+    }
+
+    /// The forces of every pair (in parallel) into the pairs' own lists.
+    /// `sharing` selects the counts of [`Self::count_pairs`] (else none).
+    pub(super) fn forces(
+        &mut self,
+        granules: &[GranuleStore],
+        mesh: &OwnedReference,
+        settings: &PairSettings,
+        dt_squared: Real,
+        sharing: bool,
+    ) -> Result<(), ContactError> {
+        let (boxes, share) = (&self.boxes, &self.share);
+        self.pairs
+            .par_iter()
+            .zip(self.work.par_iter_mut())
+            .try_for_each(|(p, w)| {
+                let (a, b) = (p.a as usize, p.b as usize);
+                let body_a = body(&granules[a], mesh, boxes[a]);
+                let body_b = body(&granules[b], mesh, boxes[b]);
+                let (sa, sb): (&[u16], &[u16]) = if sharing {
+                    (&share[a], &share[b])
+                } else {
+                    (&[], &[])
+                };
+                let need = 5 * w.count;
+                if w.forces.len() < need {
+                    w.forces.resize(
+                        need,
+                        NodeForce {
+                            side: Side::A,
+                            node: 0,
+                            force: [0.0; 3],
+                        },
+                    );
+                }
+                let (k, result) = forces(
+                    (&body_a, sa),
+                    (&body_b, sb),
+                    &w.constraints[..w.count],
+                    settings,
+                    dt_squared,
+                    &mut w.forces,
+                )?;
+                w.force_count = k;
+                w.result = result;
+                Ok(())
+            })
+    }
+
+    /// Adds the pair forces on granule `g` to `f_c`, its pairs in list
+    /// order and each pair's entries in their order.
+    pub(super) fn gather(&self, g: usize, f_c: &mut [[Real; 3]]) {
+        for &(k, side) in &self.by_granule[g] {
+            let w = &self.work[k as usize];
+            for e in &w.forces[..w.force_count] {
+                if e.side == side {
+                    for (f, df) in f_c[e.node as usize].iter_mut().zip(e.force) {
+                        *f += df;
+                    }
+                }
+            }
+        }
+    }
+
+    /// Most negative granule–granule gap on the current positions x_n, m.
+    pub(super) fn penetration(
+        &mut self,
+        granules: &[GranuleStore],
+        mesh: &OwnedReference,
+        settings: &PairSettings,
+    ) -> Result<Real, granbed_kernel::contact::pair::ContactError> {
+        let first = mesh.positions.len() - mesh.surface_nodes;
+        let at_rest: Vec<GranuleStore> = granules
+            .iter()
+            .map(|g| {
+                let mut c = g.clone();
+                c.x_pred.clone_from(&g.x);
+                c
+            })
+            .collect();
+        let bounds: Vec<Bound> = at_rest
+            .iter()
+            .map(|g| bounding_sphere(&g.x, first))
+            .collect();
+        let boxes: Vec<Aabb> = at_rest
+            .iter()
+            .map(|g| Aabb::of_surface(&g.x, first))
+            .collect();
+        let mut head = vec![0; 8 * granules.len() + 8];
+        let mut next = vec![0; granules.len()];
+        let mut pairs = vec![GranulePair { a: 0, b: 0 }; 16 * granules.len() + 16];
+        let n = candidate_pairs(
+            &bounds,
+            settings.margin,
+            &mut BroadScratch {
+                head: &mut head,
+                next: &mut next,
+            },
+            &mut pairs,
+        )?;
+        let mut min_gap: Real = 0.0;
+        for p in &pairs[..n] {
+            let (a, b) = (p.a as usize, p.b as usize);
+            let mut w = PairWork::default();
+            detect_growing(
+                &body(&at_rest[a], mesh, boxes[a]),
+                &body(&at_rest[b], mesh, boxes[b]),
+                settings,
+                &mut w,
+            )?;
+            for c in w.constraints() {
+                min_gap = min_gap.min(c.gap);
+            }
+        }
+        Ok(min_gap)
+    }
+}
+
+/// [`detect`] into `w`, doubling its constraint list until it fits.
+fn detect_growing(
+    a: &SurfaceBody<'_>,
+    b: &SurfaceBody<'_>,
+    settings: &PairSettings,
+    w: &mut PairWork,
+) -> Result<(), ContactError> {
+    let need = a.quads.len().max(b.quads.len());
+    if w.scratch.len() < need {
+        w.scratch.resize(need, 0);
+    }
+    if w.constraints.is_empty() {
+        w.constraints.resize(
+            64,
+            Constraint {
+                side: Side::A,
+                slave: 0,
+                quad: 0,
+                weights: [0.0; 4],
+                normal: [0.0; 3],
+                gap: 0.0,
+            },
+        );
+    }
+    loop {
+        match detect(a, b, settings, &mut w.scratch, &mut w.constraints) {
+            Ok(n) => {
+                w.count = n;
+                return Ok(());
+            }
+            Err(ContactError::Capacity {
+                buffer: "constraints",
+                ..
+            }) => {
+                let grown = 2 * w.constraints.len();
+                let fill = w.constraints[0];
+                w.constraints.resize(grown, fill);
+            }
+            Err(e) => return Err(e),
+        }
+    }
+}

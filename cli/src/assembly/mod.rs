@@ -1,0 +1,320 @@
+//! An assembly of finite-element granules that touch each other and rigid
+//! walls: the combined finite/discrete element system of physics.md §4–§5.
+//!
+//! The CLI owns the memory (one [`GranuleStore`] per granule, all sharing
+//! one reference mesh) and the threads; the kernel does the physics over
+//! borrowed buffers. One step ([`Assembly::step`], §4.1):
+//!
+//! ```text
+//! predict   every granule in parallel: f_int(x_n), damping, v*, x̃
+//! broad     bounding spheres of x̃; rebuild the candidate pairs when a granule
+//!           drifted half the margin (contact::broad)
+//! detect    every candidate pair in parallel: constraints on x̃ (contact::pair)
+//! share     contact counts per node, pairs in list order, then walls
+//! forces    every pair in parallel, into the pair's own force list
+//! gather    every granule in parallel: its pairs' forces in pair order, then
+//!           its wall forces in wall order → f_c
+//! correct   every granule in parallel; energies summed in granule order
+//! ```
+//!
+//! Every sum runs in a fixed order, so the result is bit-identical for any
+//! number of threads.
+
+mod contact;
+mod step;
+
+use granbed_kernel::Real;
+use granbed_kernel::contact::pair::PairSettings;
+use granbed_kernel::contact::wall::Wall;
+use granbed_kernel::granule::damping::damping_coefficient;
+use granbed_kernel::granule::forces::ElementSettings;
+use granbed_kernel::material::Material;
+
+use crate::model::{GranuleStore, OwnedReference};
+
+pub use contact::ContactPhase;
+pub use step::{AssemblyError, Energies, StepReport};
+
+/// Physical and numerical settings of an assembly.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct AssemblyParams {
+    /// Material of every granule.
+    pub material: Material,
+    /// Element formulation and constitutive switches.
+    pub elements: ElementSettings,
+    /// Fraction ξ of critical damping of the non-rigid modes; 0 ≤ ξ ≤ 2.
+    pub damping_ratio: Real,
+    /// Gravity acting in −z, m/s²; ≥ 0.
+    pub gravity_m_s2: Real,
+    /// Coulomb friction of granule–wall contacts; ≥ 0.
+    pub wall_friction: Real,
+    /// Granule–granule contact (friction, window, margin, two-pass).
+    pub contact: PairSettings,
+    /// Divide each node's mass by its number of contacts (physics.md §5.3).
+    pub mass_sharing: bool,
+    /// Safety factor C on the element estimate of the stable step; (0, 1].
+    pub time_step_safety: Real,
+    /// Steps between time-step re-estimates; ≥ 1.
+    pub time_step_interval: u32,
+}
+
+impl AssemblyParams {
+    /// physics.md's choices for `material`: ξ = 0.5, gravity 9.81 m/s²,
+    /// the material's friction on walls and between granules, symmetric
+    /// two-pass with mass sharing, C = 0.9, re-estimated every 100 steps.
+    pub fn standard(material: Material, elements: ElementSettings) -> Self {
+        let mu = material.params.friction;
+        Self {
+            material,
+            elements,
+            damping_ratio: 0.5,
+            gravity_m_s2: 9.81,
+            wall_friction: mu,
+            contact: PairSettings::standard(mu),
+            mass_sharing: true,
+            time_step_safety: 0.9,
+            time_step_interval: 100,
+        }
+    }
+}
+
+/// Where a granule starts: its mesh is rotated by `rotation` (a proper
+/// orthogonal matrix, row-major) about the mesh centre, then moved to
+/// `centre`; every node starts with `velocity`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Placement {
+    /// Centre, m.
+    pub centre: [Real; 3],
+    /// Rotation matrix, row-major.
+    pub rotation: [[Real; 3]; 3],
+    /// Initial velocity, m/s.
+    pub velocity: [Real; 3],
+}
+
+impl Placement {
+    /// At `centre`, unrotated, at rest.
+    pub fn at(centre: [Real; 3]) -> Self {
+        Self {
+            centre,
+            rotation: [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]],
+            velocity: [0.0; 3],
+        }
+    }
+}
+
+/// A rigid wall of the assembly. A [`Wall::Plane`] moves along its own
+/// normal at `speed_m_s` (its offset grows by speed·t; a punch pressing in
+/// has a positive speed); the die does not move.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct WallSpec {
+    /// The wall at t = 0.
+    pub wall: Wall,
+    /// Speed along the inward normal, m/s (planes only).
+    pub speed_m_s: Real,
+}
+
+impl WallSpec {
+    /// A fixed wall.
+    pub fn fixed(wall: Wall) -> Self {
+        Self {
+            wall,
+            speed_m_s: 0.0,
+        }
+    }
+
+    /// The wall at time `t`.
+    pub fn at(&self, t: Real) -> Wall {
+        match self.wall {
+            Wall::Plane(mut p) => {
+                p.offset += self.speed_m_s * t;
+                Wall::Plane(p)
+            }
+            die => die,
+        }
+    }
+}
+
+/// The running assembly.
+pub struct Assembly<'m> {
+    params: AssemblyParams,
+    mesh: &'m OwnedReference,
+    granules: Vec<GranuleStore>,
+    walls: Vec<WallSpec>,
+    contact: ContactPhase,
+    damping_c: Real,
+    time: Real,
+    steps: u64,
+    dt: Real,
+    dt_prev: Real,
+    energies: Energies,
+    last: StepReport,
+}
+
+impl<'m> Assembly<'m> {
+    /// Places one granule per `placements` entry (mesh `mesh`, the full
+    /// sphere) and sets up the walls. Fails on invalid parameters or an
+    /// inverted initial mesh.
+    pub fn new(
+        params: AssemblyParams,
+        mesh: &'m OwnedReference,
+        placements: &[Placement],
+        walls: Vec<WallSpec>,
+    ) -> Result<Self, AssemblyError> {
+        step::validate(&params)?;
+        let view = mesh.view();
+        let points = params.elements.points_per_element();
+        let radius = mesh.positions.iter().fold(0.0, |r: Real, x| {
+            r.max((x[0] * x[0] + x[1] * x[1] + x[2] * x[2]).sqrt())
+        });
+        let granules: Vec<GranuleStore> = placements
+            .iter()
+            .map(|p| {
+                let mut g = GranuleStore::new(mesh, points);
+                g.buffers().reset(&view, &params.material);
+                for (x, x0) in g.x.iter_mut().zip(&mesh.positions) {
+                    let r = p.rotation;
+                    *x = core::array::from_fn(|a| {
+                        p.centre[a] + r[a][0] * x0[0] + r[a][1] * x0[1] + r[a][2] * x0[2]
+                    });
+                }
+                g.v.fill(p.velocity);
+                g
+            })
+            .collect();
+        let mut assembly = Self {
+            damping_c: damping_coefficient(
+                params.damping_ratio,
+                params.material.mu,
+                params.material.density0,
+                radius,
+            ),
+            contact: ContactPhase::new(&granules, mesh),
+            params,
+            mesh,
+            granules,
+            walls,
+            time: 0.0,
+            steps: 0,
+            dt: 0.0,
+            dt_prev: 0.0,
+            energies: Energies::default(),
+            last: StepReport::default(),
+        };
+        let kinetic: Real = assembly
+            .granules
+            .iter()
+            .flat_map(|g| g.mass.iter().zip(&g.v))
+            .map(|(m, v)| 0.5 * m * (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]))
+            .sum();
+        assembly.energies.initial_kinetic = kinetic;
+        assembly.energies.kinetic = kinetic;
+        assembly.dt = assembly.stable_step()?;
+        assembly.dt_prev = assembly.dt;
+        Ok(assembly)
+    }
+
+    /// The parameters.
+    pub fn params(&self) -> &AssemblyParams {
+        &self.params
+    }
+
+    /// The granules' state.
+    pub fn granules(&self) -> &[GranuleStore] {
+        &self.granules
+    }
+
+    /// Mutable granule state (to set velocities or fix nodes before a run).
+    pub fn granules_mut(&mut self) -> &mut [GranuleStore] {
+        &mut self.granules
+    }
+
+    /// The walls at the current time.
+    pub fn walls(&self) -> impl Iterator<Item = Wall> + '_ {
+        self.walls.iter().map(|w| w.at(self.time))
+    }
+
+    /// Simulated time, s.
+    pub fn time(&self) -> Real {
+        self.time
+    }
+
+    /// Steps taken.
+    pub fn steps(&self) -> u64 {
+        self.steps
+    }
+
+    /// Current time step, s.
+    pub fn time_step(&self) -> Real {
+        self.dt
+    }
+
+    /// Energy ledger since the start.
+    pub fn energies(&self) -> &Energies {
+        &self.energies
+    }
+
+    /// What the last step did.
+    pub fn last(&self) -> &StepReport {
+        &self.last
+    }
+
+    /// The contact phase (pairs, per-pair results).
+    pub fn contact(&self) -> &ContactPhase {
+        &self.contact
+    }
+
+    /// Total mass of granule `g`, kg.
+    pub fn granule_mass(&self, g: usize) -> Real {
+        self.granules[g].mass.iter().sum()
+    }
+
+    /// Centre of mass of granule `g`, m.
+    pub fn centre_of_mass(&self, g: usize) -> [Real; 3] {
+        let s = &self.granules[g];
+        let m: Real = s.mass.iter().sum();
+        core::array::from_fn(|a| {
+            s.mass
+                .iter()
+                .zip(&s.x)
+                .map(|(mi, x)| mi * x[a])
+                .sum::<Real>()
+                / m
+        })
+    }
+
+    /// Velocity of the centre of mass of granule `g` (v_{n−½}), m/s.
+    pub fn velocity(&self, g: usize) -> [Real; 3] {
+        let s = &self.granules[g];
+        let m: Real = s.mass.iter().sum();
+        core::array::from_fn(|a| {
+            s.mass
+                .iter()
+                .zip(&s.v)
+                .map(|(mi, v)| mi * v[a])
+                .sum::<Real>()
+                / m
+        })
+    }
+
+    /// Total linear momentum Σ m v, summed in granule and node order, kg m/s.
+    pub fn momentum(&self) -> [Real; 3] {
+        let mut p = [0.0; 3];
+        for s in &self.granules {
+            for (m, v) in s.mass.iter().zip(&s.v) {
+                for a in 0..3 {
+                    p[a] += m * v[a];
+                }
+            }
+        }
+        p
+    }
+
+    /// Most negative gap between granules on the current positions x_n
+    /// (0 if none penetrates), m: the whole detection rerun on x_n.
+    pub fn penetration(&mut self) -> Result<Real, AssemblyError> {
+        let step = self.steps;
+        self.contact
+            .penetration(&self.granules, self.mesh, &self.params.contact)
+            .map_err(|error| AssemblyError::Contact { step, error })
+    }
+}

@@ -1,0 +1,403 @@
+//! One explicit step of an assembly (see the module docs of `assembly`),
+//! its errors and its energy ledger.
+
+use core::fmt;
+
+use granbed_kernel::Real;
+use granbed_kernel::contact::pair::ContactError;
+use granbed_kernel::contact::wall::{PredictedNodes, WallForce, count_wall_contacts, wall_contact};
+use granbed_kernel::granule::dynamics::{Loads, StepSizes, StepWork, correct, predict};
+use granbed_kernel::granule::forces::{ElementFailure, ForceSummary, elastic_energy};
+use granbed_kernel::granule::timestep::element_time_step;
+use rayon::prelude::*;
+
+use super::{Assembly, AssemblyParams};
+
+/// Why an assembly cannot be set up or stopped.
+#[derive(Clone, Debug, PartialEq)]
+pub enum AssemblyError {
+    /// A parameter is out of range.
+    InvalidParameter {
+        /// The parameter.
+        field: &'static str,
+        /// Its value.
+        value: Real,
+        /// The allowed range.
+        allowed: &'static str,
+    },
+    /// An element failed (inverted, no convergence).
+    Element {
+        /// Granule index.
+        granule: usize,
+        /// Step.
+        step: u64,
+        /// The element and what went wrong.
+        failure: ElementFailure,
+    },
+    /// The contact phase could not proceed.
+    Contact {
+        /// Step.
+        step: u64,
+        /// What went wrong.
+        error: ContactError,
+    },
+    /// The stable step could not be estimated or the motion blew up.
+    Unstable {
+        /// Step.
+        step: u64,
+        /// The first granule found inverted or non-finite, if known.
+        granule: Option<usize>,
+    },
+}
+
+impl fmt::Display for AssemblyError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Self::InvalidParameter {
+                field,
+                value,
+                allowed,
+            } => write!(f, "{field} = {value} is out of range (allowed: {allowed})"),
+            Self::Element {
+                granule,
+                step,
+                failure,
+            } => write!(f, "granule {granule}, step {step}: {failure}"),
+            Self::Contact { step, error } => write!(f, "step {step}: {error}"),
+            Self::Unstable { step, granule } => match granule {
+                Some(g) => write!(
+                    f,
+                    "step {step}: granule {g} became unstable (inverted or non-finite)"
+                ),
+                None => write!(f, "step {step}: the motion became unstable"),
+            },
+        }
+    }
+}
+
+impl core::error::Error for AssemblyError {}
+
+pub(super) fn validate(p: &AssemblyParams) -> Result<(), AssemblyError> {
+    let checks: [(bool, &'static str, Real, &'static str); 7] = [
+        (
+            (0.0..=2.0).contains(&p.damping_ratio),
+            "damping_ratio",
+            p.damping_ratio,
+            "0 <= xi <= 2",
+        ),
+        (
+            p.gravity_m_s2 >= 0.0 && p.gravity_m_s2.is_finite(),
+            "gravity_m_s2",
+            p.gravity_m_s2,
+            ">= 0",
+        ),
+        (
+            p.wall_friction >= 0.0 && p.wall_friction.is_finite(),
+            "wall_friction",
+            p.wall_friction,
+            ">= 0",
+        ),
+        (
+            p.contact.friction >= 0.0 && p.contact.friction.is_finite(),
+            "friction",
+            p.contact.friction,
+            ">= 0",
+        ),
+        (
+            p.contact.window_fraction > 0.0 && p.contact.window_fraction <= 1.0,
+            "window_fraction",
+            p.contact.window_fraction,
+            "0 < f <= 1",
+        ),
+        (
+            p.contact.margin > 0.0 && p.contact.margin.is_finite(),
+            "margin",
+            p.contact.margin,
+            "> 0 m",
+        ),
+        (
+            p.time_step_safety > 0.0 && p.time_step_safety <= 1.0 && p.time_step_interval >= 1,
+            "time_step_safety",
+            p.time_step_safety,
+            "0 < C <= 1 (and an interval >= 1)",
+        ),
+    ];
+    match checks.into_iter().find(|c| !c.0) {
+        Some((_, field, value, allowed)) => Err(AssemblyError::InvalidParameter {
+            field,
+            value,
+            allowed,
+        }),
+        None => Ok(()),
+    }
+}
+
+/// Energy ledger of the whole assembly since the start, J.
+///
+/// Central differences balance exactly:
+/// `kinetic − initial_kinetic + internal_work + damping = contact_work +
+/// gravity_work` to round-off ([`Energies::residual`]). `punch_work` is what the moving
+/// walls put in (Σ F_n v Δt); kinematic contact can only take energy out,
+/// so `contact_work ≤ punch_work` ([`Energies::contact_loss`] ≥ 0).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Energies {
+    /// Work of the internal + hourglass forces.
+    pub internal_work: Real,
+    /// Work of every contact force on the nodes (pairs and walls).
+    pub contact_work: Real,
+    /// Work of the moving walls, Σ F_n v Δt.
+    pub punch_work: Real,
+    /// Energy removed by damping.
+    pub damping: Real,
+    /// Work of gravity.
+    pub gravity_work: Real,
+    /// Kinetic energy at n+½.
+    pub kinetic: Real,
+    /// Kinetic energy of the initial velocities.
+    pub initial_kinetic: Real,
+    /// Plastic dissipation.
+    pub plastic: Real,
+    /// Hourglass energy (current).
+    pub hourglass: Real,
+    /// Elastic energy Ψ (updated by [`Assembly::elastic_energy`]).
+    pub elastic: Real,
+}
+
+impl Energies {
+    /// ΔK + internal + damping − contact − gravity (round-off).
+    pub fn residual(&self) -> Real {
+        self.kinetic - self.initial_kinetic + self.internal_work + self.damping - self.contact_work - self.gravity_work
+    }
+
+    /// Energy the contacts took out of what the walls put in:
+    /// punch_work − contact_work (≥ 0: contact never injects energy).
+    pub fn contact_loss(&self) -> Real {
+        self.punch_work - self.contact_work
+    }
+
+    /// internal_work − (Ψ + D_p + E_hg): the return map's energy gap.
+    pub fn return_map_gap(&self) -> Real {
+        self.internal_work - (self.elastic + self.plastic + self.hourglass)
+    }
+}
+
+/// What the last step did.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct StepReport {
+    /// Step size Δt_{n+½}, s.
+    pub dt: Real,
+    /// Smallest element Jacobian ratio.
+    pub min_j: Real,
+    /// Per wall (in wall order), the summed contact result over granules.
+    pub walls: Vec<WallForce>,
+    /// Σ F_n of the granule–granule constraints, N.
+    pub pair_normal: Real,
+    /// Granule–granule constraints that carried a force.
+    pub constraints: usize,
+}
+
+fn add_wall(total: &mut WallForce, w: &WallForce) {
+    total.normal += w.normal;
+    for a in 0..3 {
+        total.tangential[a] += w.tangential[a];
+    }
+    total.contacts += w.contacts;
+    total.min_gap = total.min_gap.min(w.min_gap);
+}
+
+impl Assembly<'_> {
+    /// The stable step: `time_step_safety` × the smallest element estimate
+    /// over all granules.
+    pub(super) fn stable_step(&self) -> Result<Real, AssemblyError> {
+        let view = self.mesh.view();
+        let (mat, c) = (self.params.material, self.params.time_step_safety);
+        let per: Vec<Option<Real>> = self
+            .granules
+            .par_iter()
+            .map(|g| element_time_step(&view, &mat, &g.x, c))
+            .collect();
+        let mut dt = Real::INFINITY;
+        for (g, d) in per.into_iter().enumerate() {
+            match d {
+                Some(d) if d > 0.0 && d.is_finite() => dt = dt.min(d),
+                _ => {
+                    return Err(AssemblyError::Unstable {
+                        step: self.steps,
+                        granule: Some(g),
+                    });
+                }
+            }
+        }
+        if dt.is_finite() { Ok(dt) } else { Ok(1.0) }
+    }
+
+    /// Elastic energy Ψ of every granule (summed in order), stored in the
+    /// ledger and returned, J.
+    pub fn elastic_energy(&mut self) -> Real {
+        let view = self.mesh.view();
+        let p = &self.params;
+        let per: Vec<Real> = self
+            .granules
+            .par_iter()
+            .map(|g| elastic_energy(&view, &p.material, &p.elements, &g.x, &g.cp_inv))
+            .collect();
+        self.energies.elastic = per.iter().sum();
+        self.energies.elastic
+    }
+
+    /// Advances every granule by one step.
+    pub fn step(&mut self) -> Result<(), AssemblyError> {
+        let step = self.steps;
+        if step > 0 && step.is_multiple_of(u64::from(self.params.time_step_interval)) {
+            self.dt_prev = self.dt;
+            self.dt = self.stable_step()?;
+        }
+        let sizes = StepSizes {
+            dt_prev: self.dt_prev,
+            dt: self.dt,
+        };
+        let p = self.params;
+        let loads = Loads {
+            gravity_m_s2: p.gravity_m_s2,
+            damping_c: self.damping_c,
+            rigid_modes: true,
+        };
+        let view = self.mesh.view();
+        let predicted: Vec<Result<ForceSummary, ElementFailure>> = self
+            .granules
+            .par_iter_mut()
+            .map(|g| {
+                predict(
+                    &view,
+                    &p.material,
+                    &p.elements,
+                    &mut g.buffers(),
+                    sizes,
+                    &loads,
+                )
+            })
+            .collect();
+        let mut plastic = 0.0;
+        let mut hourglass = 0.0;
+        let mut min_j = Real::INFINITY;
+        for (granule, r) in predicted.into_iter().enumerate() {
+            let s = r.map_err(|failure| AssemblyError::Element {
+                granule,
+                step,
+                failure,
+            })?;
+            plastic += s.plastic_dissipation;
+            hourglass += s.hourglass_energy;
+            min_j = min_j.min(s.min_j);
+        }
+
+        // Contact on the predicted configuration, walls at t_{n+1}.
+        let contact_error = |error| AssemblyError::Contact { step, error };
+        let dt2 = sizes.contact_dt_squared();
+        let mesh = self.mesh;
+        self.contact
+            .broad(&self.granules, mesh, p.contact.margin)
+            .map_err(contact_error)?;
+        self.contact
+            .detect(&self.granules, mesh, &p.contact)
+            .map_err(contact_error)?;
+        let walls: Vec<_> = self
+            .walls
+            .iter()
+            .map(|w| w.at(self.time + sizes.dt))
+            .collect();
+        let surface = mesh.positions.len() - mesh.surface_nodes..mesh.positions.len();
+        if p.mass_sharing {
+            self.contact.count_pairs(&self.granules, mesh);
+            self.contact
+                .share
+                .par_iter_mut()
+                .zip(self.granules.par_iter())
+                .for_each(|(share, g)| {
+                    for w in &walls {
+                        count_wall_contacts(w, surface.clone(), &g.x_pred, share);
+                    }
+                });
+        }
+        self.contact
+            .forces(&self.granules, mesh, &p.contact, dt2, p.mass_sharing)
+            .map_err(contact_error)?;
+        let contact = &self.contact;
+        let per: Vec<(StepWork, Vec<WallForce>)> = self
+            .granules
+            .par_iter_mut()
+            .enumerate()
+            .map(|(gi, g)| {
+                contact.gather(gi, &mut g.f_c);
+                let share: &[u16] = if p.mass_sharing {
+                    &contact.share[gi]
+                } else {
+                    &[]
+                };
+                let body = PredictedNodes {
+                    mass: &g.mass,
+                    x_n: &g.x,
+                    x_pred: &g.x_pred,
+                };
+                let wall_forces = walls
+                    .iter()
+                    .map(|w| {
+                        wall_contact(
+                            w,
+                            p.wall_friction,
+                            dt2,
+                            surface.clone(),
+                            &body,
+                            share,
+                            &mut g.f_c,
+                        )
+                    })
+                    .collect();
+                (
+                    correct(&mut g.buffers(), sizes, p.gravity_m_s2),
+                    wall_forces,
+                )
+            })
+            .collect();
+
+        let mut report = StepReport {
+            dt: sizes.dt,
+            min_j,
+            walls: vec![WallForce::default(); walls.len()],
+            ..StepReport::default()
+        };
+        let e = &mut self.energies;
+        let mut kinetic = 0.0;
+        for (granule, (w, wall_forces)) in per.iter().enumerate() {
+            if !w.kinetic.is_finite() {
+                return Err(AssemblyError::Unstable {
+                    step,
+                    granule: Some(granule),
+                });
+            }
+            e.internal_work += w.internal;
+            e.contact_work += w.contact;
+            e.damping += w.damping;
+            e.gravity_work += w.gravity;
+            kinetic += w.kinetic;
+            for (total, wf) in report.walls.iter_mut().zip(wall_forces) {
+                add_wall(total, wf);
+            }
+        }
+        e.kinetic = kinetic;
+        e.plastic += plastic;
+        e.hourglass = hourglass;
+        for (spec, w) in self.walls.iter().zip(&report.walls) {
+            e.punch_work += w.normal * spec.speed_m_s * sizes.dt;
+        }
+        for w in self.contact.work() {
+            report.pair_normal += w.result.normal;
+            report.constraints += w.result.constraints;
+        }
+        self.last = report;
+        self.time += sizes.dt;
+        self.steps += 1;
+        self.dt_prev = sizes.dt;
+        Ok(())
+    }
+}

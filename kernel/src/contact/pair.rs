@@ -1,0 +1,509 @@
+//! Contact between two deforming granules: node-to-surface detection on the
+//! predicted configuration and the kinematic ("defence-node") forces with
+//! Coulomb friction (physics.md §5.2–§5.4).
+//!
+//! A pair (A, B) is handled in two steps that the driver may run for many
+//! pairs in parallel:
+//!
+//! 1. [`detect`] finds the constraints: in pass A→B every surface node of A
+//!    inside the pair's overlap box is projected on B's quads (and in pass
+//!    B→A the other way round); a node gets at most one constraint per
+//!    opposing granule. The constraints go into a caller slice; a full
+//!    slice is an error ([`ContactError::Capacity`]), never a silent drop.
+//! 2. [`forces`] turns each constraint into the force that closes its
+//!    predicted gap in one step, shared between the slave node and the
+//!    defence node by their effective masses, and writes one
+//!    [`NodeForce`] per node touched into a per-pair slice. The driver sums
+//!    those per node in a fixed order, so the result does not depend on
+//!    the thread count.
+//!
+//! Between the two, [`mark_involvement`] counts how many contacts each node
+//! takes part in, for the mass sharing m̃ = m/n of §5.3.
+
+use core::fmt;
+
+use crate::Real;
+use crate::contact::quad::{QuadProjection, Vec3, dot, norm, project, project_clamped, sub};
+use crate::contact::surface::{Aabb, SurfaceBody};
+use crate::math::{abs, sqrt};
+
+/// Settings of the granule–granule contact.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PairSettings {
+    /// Coulomb friction coefficient μ; ≥ 0 (0 skips friction).
+    pub friction: Real,
+    /// Tolerance of the inside-the-face test on |ξ|, |η| (physics.md: 1e-6).
+    pub inside_tolerance: Real,
+    /// Gap window g_max as a fraction of the face diagonal (physics.md:
+    /// 0.25): deeper projections are far-side faces, not contacts.
+    pub window_fraction: Real,
+    /// Margin by which the pair's overlap box is grown, m.
+    pub margin: Real,
+    /// Symmetric two-pass (each side slave once, weight ½) or a single pass
+    /// with A's nodes as slaves (weight 1).
+    pub symmetric: bool,
+}
+
+impl PairSettings {
+    /// physics.md's choices: μ = `friction`, inside tolerance 1e-6, window
+    /// 0.25 × face diagonal, 20 µm margin, symmetric two-pass.
+    pub fn standard(friction: Real) -> Self {
+        Self {
+            friction,
+            inside_tolerance: 1e-6,
+            window_fraction: 0.25,
+            margin: 20e-6,
+            symmetric: true,
+        }
+    }
+
+    fn pass_weight(&self) -> Real {
+        if self.symmetric { 0.5 } else { 1.0 }
+    }
+}
+
+/// Which body of the pair holds a node.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Side {
+    /// The pair's first body.
+    A,
+    /// The pair's second body.
+    B,
+}
+
+/// One node-to-face constraint found on the predicted configuration.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Constraint {
+    /// The body that holds the slave node (the face is on the other one).
+    pub side: Side,
+    /// Slave node id in its body.
+    pub slave: u32,
+    /// Master quad id in the other body.
+    pub quad: u32,
+    /// Bilinear weights Nᵢ of the quad's corners at the contact point.
+    pub weights: [Real; 4],
+    /// Master's outward unit normal at the contact point.
+    pub normal: Vec3,
+    /// Signed gap n·(x̃_s − x_c) < 0, m.
+    pub gap: Real,
+}
+
+/// A force on one node, as a pair writes it for the driver to sum.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct NodeForce {
+    /// The body of the node.
+    pub side: Side,
+    /// Node id in that body.
+    pub node: u32,
+    /// Force, N.
+    pub force: Vec3,
+}
+
+/// What one pair's force pass did.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct PairForce {
+    /// Σ F_n over the constraints (both passes), N.
+    pub normal: Real,
+    /// Σ of the friction forces on A, N.
+    pub friction_on_a: Vec3,
+    /// Total force on A (normal + friction), N; B gets the opposite.
+    pub total_on_a: Vec3,
+    /// Constraints that carried a force.
+    pub constraints: usize,
+    /// Constraints at the friction cap (slipping).
+    pub slipping: usize,
+    /// Most negative predicted gap, m (0 if none).
+    pub min_gap: Real,
+}
+
+/// A contact buffer problem; the driver must grow the buffer and retry, or
+/// report it: a contact is never dropped silently.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ContactError {
+    /// A fixed-capacity list is full.
+    Capacity {
+        /// Which list.
+        buffer: &'static str,
+        /// Its capacity.
+        capacity: usize,
+    },
+    /// A buffer has the wrong length.
+    BufferLength {
+        /// Which buffer.
+        buffer: &'static str,
+        /// Length needed.
+        expected: usize,
+        /// Length given.
+        got: usize,
+    },
+}
+
+impl fmt::Display for ContactError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Self::Capacity { buffer, capacity } => {
+                write!(f, "contact list `{buffer}` is full ({capacity} entries)")
+            }
+            Self::BufferLength {
+                buffer,
+                expected,
+                got,
+            } => write!(
+                f,
+                "contact buffer `{buffer}` has length {got}, expected at least {expected}"
+            ),
+        }
+    }
+}
+
+impl core::error::Error for ContactError {}
+
+/// Finds the constraints of the pair (A, B) on the predicted configuration
+/// and writes them to `out`, pass A→B first (A's nodes as slaves, in node
+/// order), then B→A when symmetric. `scratch` holds candidate quad ids and
+/// needs at least as many entries as the larger quad count. Returns the
+/// number of constraints.
+pub fn detect(
+    a: &SurfaceBody<'_>,
+    b: &SurfaceBody<'_>,
+    settings: &PairSettings,
+    scratch: &mut [u32],
+    out: &mut [Constraint],
+) -> Result<usize, ContactError> {
+    let need = a.quads.len().max(b.quads.len());
+    if scratch.len() < need {
+        return Err(ContactError::BufferLength {
+            buffer: "scratch",
+            expected: need,
+            got: scratch.len(),
+        });
+    }
+    let mut count = detect_pass(a, b, Side::A, settings, scratch, out, 0)?;
+    if settings.symmetric {
+        count = detect_pass(b, a, Side::B, settings, scratch, out, count)?;
+    }
+    Ok(count)
+}
+
+/// Largest face diagonal of quad `x`, m.
+fn face_diagonal(x: &[Vec3; 4]) -> Real {
+    let d1 = norm(&sub(&x[2], &x[0]));
+    let d2 = norm(&sub(&x[3], &x[1]));
+    if d1 > d2 { d1 } else { d2 }
+}
+
+/// One pass: `slave`'s nodes against `master`'s faces; appends to `out`
+/// from `start` and returns the new length.
+fn detect_pass(
+    slave: &SurfaceBody<'_>,
+    master: &SurfaceBody<'_>,
+    side: Side,
+    settings: &PairSettings,
+    scratch: &mut [u32],
+    out: &mut [Constraint],
+    start: usize,
+) -> Result<usize, ContactError> {
+    let m = settings.margin;
+    let region = slave
+        .bounds
+        .expanded(m)
+        .intersect(&master.bounds.expanded(m));
+    if region.is_empty() {
+        return Ok(start);
+    }
+    // Master faces near the region.
+    let mut faces = 0;
+    for q in 0..master.quads.len() {
+        let x = master.quad_pred(q);
+        if Aabb::of_points(&x).overlaps(&region) {
+            scratch[faces] = q as u32;
+            faces += 1;
+        }
+    }
+    let candidates = &scratch[..faces];
+    let mut count = start;
+    for s in slave.first_surface..slave.x_pred.len() {
+        let p = slave.x_pred[s];
+        if !region.contains(&p) {
+            continue;
+        }
+        if let Some(c) = closest_face(slave, master, s, candidates, settings) {
+            let slot = out.get_mut(count).ok_or(ContactError::Capacity {
+                buffer: "constraints",
+                capacity: count,
+            })?;
+            *slot = Constraint {
+                side,
+                slave: s as u32,
+                quad: c.quad,
+                weights: c.projection.weights,
+                normal: c.projection.normal,
+                gap: c.projection.gap,
+            };
+            count += 1;
+        }
+    }
+    Ok(count)
+}
+
+struct Hit {
+    quad: u32,
+    projection: QuadProjection,
+}
+
+/// The face node `s` of `slave` penetrates, by physics.md §5.2's tests:
+/// inside the face, −g_max < g < 0, opposing normals; the smallest |g|
+/// wins. With no face, a concave edge or corner shared by several faces is
+/// tried: the closest point on it with the faces' averaged normal.
+fn closest_face(
+    slave: &SurfaceBody<'_>,
+    master: &SurfaceBody<'_>,
+    s: usize,
+    candidates: &[u32],
+    settings: &PairSettings,
+) -> Option<Hit> {
+    let p = slave.x_pred[s];
+    let mut slave_normal: Option<Vec3> = None;
+    let mut opposing = |n: &Vec3| {
+        let ns = *slave_normal.get_or_insert_with(|| slave.node_normal(s));
+        dot(&ns, n) < 0.0
+    };
+    let mut best: Option<Hit> = None;
+    let mut near_outside = false;
+    for &q in candidates {
+        let x = master.quad_pred(q as usize);
+        let window = settings.window_fraction * face_diagonal(&x);
+        if !Aabb::of_points(&x).expanded(window).contains(&p) {
+            continue;
+        }
+        let Some(pr) = project(&p, &x) else {
+            continue;
+        };
+        if !(pr.gap < 0.0 && pr.gap > -window) {
+            continue;
+        }
+        if !pr.inside(settings.inside_tolerance) {
+            near_outside = true;
+            continue;
+        }
+        if best
+            .as_ref()
+            .is_some_and(|h| abs(h.projection.gap) <= abs(pr.gap))
+        {
+            continue;
+        }
+        if opposing(&pr.normal) {
+            best = Some(Hit {
+                quad: q,
+                projection: pr,
+            });
+        }
+    }
+    if best.is_some() || !near_outside {
+        return best;
+    }
+    concave_edge(master, &p, candidates, settings).filter(|h| opposing(&h.projection.normal))
+}
+
+/// The closest point of `p` on the candidate faces confined to their
+/// edges, when two or more faces share it (a concave edge or corner): the
+/// normal is their average, the gap is measured along it.
+fn concave_edge(
+    master: &SurfaceBody<'_>,
+    p: &Vec3,
+    candidates: &[u32],
+    settings: &PairSettings,
+) -> Option<Hit> {
+    let mut best: Option<(Real, u32, QuadProjection, Real)> = None;
+    for &q in candidates {
+        let x = master.quad_pred(q as usize);
+        let window = settings.window_fraction * face_diagonal(&x);
+        if !Aabb::of_points(&x).expanded(window).contains(p) {
+            continue;
+        }
+        if let Some(pr) = project_clamped(p, &x) {
+            let d = norm(&sub(p, &pr.point));
+            if best.as_ref().is_none_or(|b| d < b.0) {
+                best = Some((d, q, pr, window));
+            }
+        }
+    }
+    let (dist, quad, mut pr, window) = best?;
+    // Faces whose clamped closest point is the same point share the edge.
+    let tol = 1e-9 * window + 1e-15;
+    let mut n = [0.0; 3];
+    let mut sharing = 0;
+    for &q in candidates {
+        let x = master.quad_pred(q as usize);
+        if let Some(other) = project_clamped(p, &x)
+            && abs(norm(&sub(p, &other.point)) - dist) <= tol
+            && norm(&sub(&other.point, &pr.point)) <= tol
+        {
+            sharing += 1;
+            for (nk, ok) in n.iter_mut().zip(other.normal) {
+                *nk += ok;
+            }
+        }
+    }
+    let len = norm(&n);
+    if sharing < 2 || len.is_nan() || len <= 0.0 {
+        return None;
+    }
+    pr.normal = n.map(|c| c / len);
+    pr.gap = dot(&pr.normal, &sub(p, &pr.point));
+    (pr.gap < 0.0 && pr.gap > -window).then_some(Hit {
+        quad,
+        projection: pr,
+    })
+}
+
+/// Per-node contact counts of one body for the mass sharing of §5.3.
+pub struct Involvement<'a> {
+    /// Last pair tag that counted the node (the driver resets it each step).
+    pub tag: &'a mut [u32],
+    /// Contacts the node takes part in this step.
+    pub count: &'a mut [u16],
+}
+
+impl Involvement<'_> {
+    /// Counts node `i` once for the contact tagged `tag`.
+    pub fn mark(&mut self, i: usize, tag: u32) {
+        if self.tag[i] != tag {
+            self.tag[i] = tag;
+            self.count[i] = self.count[i].saturating_add(1);
+        }
+    }
+}
+
+/// Counts, once per pair (tag `tag`, unique within the step), every node of
+/// A and B that takes part in one of `constraints` as a slave or as a
+/// master corner with a non-zero weight.
+pub fn mark_involvement(
+    constraints: &[Constraint],
+    a: (&SurfaceBody<'_>, &mut Involvement<'_>),
+    b: (&SurfaceBody<'_>, &mut Involvement<'_>),
+    tag: u32,
+) {
+    let (body_a, inv_a) = a;
+    let (body_b, inv_b) = b;
+    for c in constraints {
+        match c.side {
+            Side::A => mark_constraint(c, inv_a, body_b.quads, inv_b, tag),
+            Side::B => mark_constraint(c, inv_b, body_a.quads, inv_a, tag),
+        }
+    }
+}
+
+fn mark_constraint(
+    c: &Constraint,
+    slave: &mut Involvement<'_>,
+    master_quads: &[[u32; 4]],
+    master: &mut Involvement<'_>,
+    tag: u32,
+) {
+    slave.mark(c.slave as usize, tag);
+    for (id, w) in master_quads[c.quad as usize].iter().zip(c.weights) {
+        if w != 0.0 {
+            master.mark(*id as usize, tag);
+        }
+    }
+}
+
+/// Shared mass m/max(1, n) of node `i` (`share` empty: no sharing).
+fn shared_mass(body: &SurfaceBody<'_>, share: &[u16], i: usize) -> Real {
+    let n = share.get(i).copied().unwrap_or(1).max(1);
+    body.mass[i] / Real::from(n)
+}
+
+/// The forces of `constraints` (from [`detect`] on the same predicted
+/// configuration), written to `out` in constraint order: the slave node,
+/// then the four master corners. `share_a` / `share_b` are the contact
+/// counts of [`mark_involvement`] (one per node; empty slices mean no mass
+/// sharing). `dt_squared` is Δt_{n+½}·Δt_n. Returns the number of entries
+/// written and the pair's totals.
+pub fn forces(
+    a: (&SurfaceBody<'_>, &[u16]),
+    b: (&SurfaceBody<'_>, &[u16]),
+    constraints: &[Constraint],
+    settings: &PairSettings,
+    dt_squared: Real,
+    out: &mut [NodeForce],
+) -> Result<(usize, PairForce), ContactError> {
+    if out.len() < 5 * constraints.len() {
+        return Err(ContactError::BufferLength {
+            buffer: "node forces",
+            expected: 5 * constraints.len(),
+            got: out.len(),
+        });
+    }
+    let w = settings.pass_weight();
+    let mu = settings.friction;
+    let mut total = PairForce::default();
+    let mut k = 0;
+    for c in constraints {
+        let (slave, s_share, master, m_share, master_side) = match c.side {
+            Side::A => (a.0, a.1, b.0, b.1, Side::B),
+            Side::B => (b.0, b.1, a.0, a.1, Side::A),
+        };
+        let s = c.slave as usize;
+        let ids = master.quads[c.quad as usize].map(|i| i as usize);
+        let m_s = shared_mass(slave, s_share, s);
+        let inv_md: Real = (0..4)
+            .map(|i| c.weights[i] * c.weights[i] / shared_mass(master, m_share, ids[i]))
+            .sum();
+        let m_eff = m_s / (1.0 + m_s * inv_md);
+        let n = c.normal;
+        let f_n = w * (-c.gap) * m_eff / dt_squared;
+        let mut f = n.map(|v| f_n * v);
+        let mut f_t = [0.0; 3];
+        if mu > 0.0 {
+            let mut du = sub(&slave.x_pred[s], &slave.x_n[s]);
+            for (i, &id) in ids.iter().enumerate() {
+                let dm = sub(&master.x_pred[id], &master.x_n[id]);
+                for (d, m) in du.iter_mut().zip(dm) {
+                    *d -= c.weights[i] * m;
+                }
+            }
+            let dn = dot(&du, &n);
+            f_t = core::array::from_fn(|a| -w * m_eff * (du[a] - dn * n[a]) / dt_squared);
+            let mag = sqrt(dot(&f_t, &f_t));
+            let cap = mu * f_n;
+            if mag > cap {
+                let scale = cap / mag;
+                f_t = f_t.map(|v| v * scale);
+                total.slipping += 1;
+            }
+            for a in 0..3 {
+                f[a] += f_t[a];
+            }
+        }
+        out[k] = NodeForce {
+            side: c.side,
+            node: c.slave,
+            force: f,
+        };
+        k += 1;
+        for (i, &id) in ids.iter().enumerate() {
+            let wi = c.weights[i];
+            out[k] = NodeForce {
+                side: master_side,
+                node: id as u32,
+                force: f.map(|v| -wi * v),
+            };
+            k += 1;
+        }
+        // Totals on A: the slave's force if A is the slave side, else the
+        // reaction on the master corners (Σ Nᵢ = 1).
+        let sign = if c.side == Side::A { 1.0 } else { -1.0 };
+        for a in 0..3 {
+            total.total_on_a[a] += sign * f[a];
+            total.friction_on_a[a] += sign * f_t[a];
+        }
+        total.normal += f_n;
+        total.constraints += 1;
+        if c.gap < total.min_gap {
+            total.min_gap = c.gap;
+        }
+    }
+    Ok((k, total))
+}

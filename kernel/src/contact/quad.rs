@@ -1,0 +1,217 @@
+//! Closest point of a node on a bilinear quadrilateral (physics.md §5.2).
+//!
+//! The quad x1..x4 (counter-clockwise seen from outside) is written
+//! x(ξ, η) = c + ξ e1 + η e2 + ξη w with c = Σxᵢ/4, e1 = (−x1+x2+x3−x4)/4,
+//! e2 = (−x1−x2+x3+x4)/4 and the warp w = (x1−x2+x3−x4)/4. The closest
+//! point to p minimises ½|x(ξ, η) − p|²: Newton from the parallelogram
+//! start ξ0 = (p−c)·e1/|e1|², η0 = (p−c)·e2/|e2|², with a projected-gradient
+//! step whenever the Hessian is not positive definite.
+
+use crate::Real;
+use crate::math::{abs, max, sqrt};
+
+/// A 3-vector.
+pub type Vec3 = [Real; 3];
+
+/// Where a point projects on a quad.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct QuadProjection {
+    /// Local coordinates (ξ*, η*); inside the face when both are in [−1, 1].
+    pub xi: Real,
+    /// See `xi`.
+    pub eta: Real,
+    /// The closest point x(ξ*, η*), m.
+    pub point: Vec3,
+    /// Unit outward normal x_ξ × x_η / |…| at (ξ*, η*).
+    pub normal: Vec3,
+    /// Signed gap n·(p − x_c), m: negative means p is behind the face.
+    pub gap: Real,
+    /// Bilinear weights Nᵢ = ¼(1+ξᵢξ*)(1+ηᵢη*) of the four corners.
+    pub weights: [Real; 4],
+}
+
+impl QuadProjection {
+    /// True if (ξ*, η*) lies in the face, up to `tol` (physics.md: 1e-6).
+    pub fn inside(&self, tol: Real) -> bool {
+        abs(self.xi) <= 1.0 + tol && abs(self.eta) <= 1.0 + tol
+    }
+}
+
+/// Corner coordinates (ξᵢ, ηᵢ) in the counter-clockwise order x1..x4.
+const CORNERS: [(Real, Real); 4] = [(-1.0, -1.0), (1.0, -1.0), (1.0, 1.0), (-1.0, 1.0)];
+
+/// Newton iterations at most; a parallelogram converges in one.
+const MAX_ITERATIONS: usize = 12;
+
+pub(crate) fn sub(a: &Vec3, b: &Vec3) -> Vec3 {
+    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
+}
+
+pub(crate) fn dot(a: &Vec3, b: &Vec3) -> Real {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+
+pub(crate) fn cross(a: &Vec3, b: &Vec3) -> Vec3 {
+    [
+        a[1] * b[2] - a[2] * b[1],
+        a[2] * b[0] - a[0] * b[2],
+        a[0] * b[1] - a[1] * b[0],
+    ]
+}
+
+pub(crate) fn axpy(a: Real, x: &Vec3, y: &Vec3) -> Vec3 {
+    [y[0] + a * x[0], y[1] + a * x[1], y[2] + a * x[2]]
+}
+
+/// |a|, m.
+pub(crate) fn norm(a: &Vec3) -> Real {
+    sqrt(dot(a, a))
+}
+
+/// The bilinear quad in the form c + ξe1 + ηe2 + ξηw.
+#[derive(Clone, Copy, Debug)]
+struct Bilinear {
+    c: Vec3,
+    e1: Vec3,
+    e2: Vec3,
+    w: Vec3,
+}
+
+impl Bilinear {
+    fn new(x: &[Vec3; 4]) -> Self {
+        let comb = |s: [Real; 4]| -> Vec3 {
+            core::array::from_fn(|a| {
+                0.25 * (s[0] * x[0][a] + s[1] * x[1][a] + s[2] * x[2][a] + s[3] * x[3][a])
+            })
+        };
+        Self {
+            c: comb([1.0, 1.0, 1.0, 1.0]),
+            e1: comb([-1.0, 1.0, 1.0, -1.0]),
+            e2: comb([-1.0, -1.0, 1.0, 1.0]),
+            w: comb([1.0, -1.0, 1.0, -1.0]),
+        }
+    }
+
+    fn at(&self, xi: Real, eta: Real) -> Vec3 {
+        core::array::from_fn(|a| {
+            self.c[a] + xi * self.e1[a] + eta * self.e2[a] + xi * eta * self.w[a]
+        })
+    }
+
+    fn tangents(&self, xi: Real, eta: Real) -> (Vec3, Vec3) {
+        (axpy(eta, &self.w, &self.e1), axpy(xi, &self.w, &self.e2))
+    }
+}
+
+/// The bilinear weights of the corners at (ξ, η).
+pub fn weights(xi: Real, eta: Real) -> [Real; 4] {
+    CORNERS.map(|(a, b)| 0.25 * (1.0 + a * xi) * (1.0 + b * eta))
+}
+
+/// Projects `p` on the quad `x` (corners counter-clockwise from outside).
+/// Returns `None` only for a degenerate quad (zero-length edge vectors or
+/// a zero normal at the closest point) or non-finite input.
+pub fn project(p: &Vec3, x: &[Vec3; 4]) -> Option<QuadProjection> {
+    let q = Bilinear::new(x);
+    let (l1, l2) = (dot(&q.e1, &q.e1), dot(&q.e2, &q.e2));
+    if l1.is_nan() || l2.is_nan() || l1 <= 0.0 || l2 <= 0.0 {
+        return None;
+    }
+    let d = sub(p, &q.c);
+    let (mut xi, mut eta) = (dot(&d, &q.e1) / l1, dot(&d, &q.e2) / l2);
+    for _ in 0..MAX_ITERATIONS {
+        let r = sub(&q.at(xi, eta), p);
+        let (t1, t2) = q.tangents(xi, eta);
+        let g = [dot(&r, &t1), dot(&r, &t2)];
+        let h11 = dot(&t1, &t1);
+        let h22 = dot(&t2, &t2);
+        let h12 = dot(&t1, &t2) + dot(&r, &q.w);
+        let det = h11 * h22 - h12 * h12;
+        let (dxi, deta) = if h11 > 0.0 && det > 1e-12 * h11 * h22 {
+            (
+                (h22 * g[0] - h12 * g[1]) / det,
+                (h11 * g[1] - h12 * g[0]) / det,
+            )
+        } else {
+            // Not positive definite: a gradient step scaled by the
+            // diagonal, which decreases the distance for small steps.
+            (g[0] / max(h11, l1), g[1] / max(h22, l2))
+        };
+        // Keep far-off iterates from running away (the face is [−1, 1]²).
+        xi = (xi - dxi).clamp(-4.0, 4.0);
+        eta = (eta - deta).clamp(-4.0, 4.0);
+        if abs(dxi) < 1e-12 && abs(deta) < 1e-12 {
+            break;
+        }
+    }
+    if !(xi.is_finite() && eta.is_finite()) {
+        return None;
+    }
+    finish(p, &q, xi, eta)
+}
+
+/// The projection record at (ξ, η) (no minimisation).
+fn finish(p: &Vec3, q: &Bilinear, xi: Real, eta: Real) -> Option<QuadProjection> {
+    let point = q.at(xi, eta);
+    let (t1, t2) = q.tangents(xi, eta);
+    let n = cross(&t1, &t2);
+    let len = norm(&n);
+    if len.is_nan() || len <= 0.0 {
+        return None;
+    }
+    let normal = n.map(|c| c / len);
+    Some(QuadProjection {
+        xi,
+        eta,
+        point,
+        normal,
+        gap: dot(&normal, &sub(p, &point)),
+        weights: weights(xi, eta),
+    })
+}
+
+/// The closest point of `p` on the quad when (ξ, η) is confined to the
+/// face [−1, 1]²: the point on the nearest edge or corner when `p`
+/// projects outside. The normal is the face normal at that point and
+/// `gap` is the signed distance along it (the caller replaces the normal
+/// by an average over the faces that share the edge).
+pub fn project_clamped(p: &Vec3, x: &[Vec3; 4]) -> Option<QuadProjection> {
+    let free = project(p, x)?;
+    if free.inside(0.0) {
+        return Some(free);
+    }
+    let q = Bilinear::new(x);
+    // Minimise over each edge (a 1-D Newton on the straight edge is exact:
+    // the edges of a bilinear quad are straight lines) and keep the best.
+    let mut best: Option<(Real, Real, Real)> = None;
+    for (k, &(xi_fixed, eta_fixed)) in [
+        (None, Some(-1.0)),
+        (Some(1.0), None),
+        (None, Some(1.0)),
+        (Some(-1.0), None),
+    ]
+    .iter()
+    .enumerate()
+    {
+        let (a, b) = (x[k], x[(k + 1) % 4]);
+        let e = sub(&b, &a);
+        let l = dot(&e, &e);
+        let s = if l > 0.0 {
+            (dot(&sub(p, &a), &e) / l).clamp(0.0, 1.0)
+        } else {
+            0.0
+        };
+        let y = axpy(s, &e, &a);
+        let dist2 = dot(&sub(p, &y), &sub(p, &y));
+        // Local coordinates of the edge point: the free one runs from the
+        // start corner's value to the end corner's.
+        let (c0, c1) = (CORNERS[k], CORNERS[(k + 1) % 4]);
+        let xi = xi_fixed.unwrap_or(c0.0 + s * (c1.0 - c0.0));
+        let eta = eta_fixed.unwrap_or(c0.1 + s * (c1.1 - c0.1));
+        if best.is_none_or(|(d, _, _)| dist2 < d) {
+            best = Some((dist2, xi, eta));
+        }
+    }
+    let (_, xi, eta) = best?;
+    finish(p, &q, xi, eta)
+}

@@ -1,0 +1,135 @@
+//! Node-to-quad projection (physics.md §5.2): exact on planar quads, a true
+//! minimum of the distance on warped ones, edge clamping, and the broad
+//! phase against brute force.
+
+use granbed_kernel::contact::broad::{
+    Bound, BroadScratch, GranulePair, candidate_pairs, needs_rebuild,
+};
+use granbed_kernel::contact::quad::{project, project_clamped};
+use granbed_kernel::rng::Rng;
+
+type V = [f64; 3];
+
+fn bilinear(x: &[V; 4], xi: f64, eta: f64) -> V {
+    let n = granbed_kernel::contact::quad::weights(xi, eta);
+    core::array::from_fn(|a| (0..4).map(|i| n[i] * x[i][a]).sum())
+}
+
+fn dist(a: &V, b: &V) -> f64 {
+    (0..3).map(|k| (a[k] - b[k]).powi(2)).sum::<f64>().sqrt()
+}
+
+#[test]
+fn planar_square_projection_is_exact() {
+    let x = [
+        [0.0, 0.0, 0.0],
+        [2.0, 0.0, 0.0],
+        [2.0, 2.0, 0.0],
+        [0.0, 2.0, 0.0],
+    ];
+    let p = [1.5, 0.5, -0.25];
+    let pr = project(&p, &x).unwrap();
+    assert!((pr.xi - 0.5).abs() < 1e-14 && (pr.eta + 0.5).abs() < 1e-14);
+    assert!((pr.gap + 0.25).abs() < 1e-14, "gap {}", pr.gap);
+    assert_eq!(pr.normal, [0.0, 0.0, 1.0]);
+    assert!((pr.weights.iter().sum::<f64>() - 1.0).abs() < 1e-15);
+    // The weights interpolate the contact point.
+    let xc = bilinear(&x, pr.xi, pr.eta);
+    assert!(dist(&xc, &pr.point) < 1e-15);
+}
+
+#[test]
+fn warped_quads_give_the_true_closest_point() {
+    let mut rng = Rng::new(7);
+    for _ in 0..500 {
+        // A unit square with random warp and a point near it.
+        let mut x = [
+            [-1.0, -1.0, 0.0],
+            [1.0, -1.0, 0.0],
+            [1.0, 1.0, 0.0],
+            [-1.0, 1.0, 0.0],
+        ];
+        for c in &mut x {
+            for v in c.iter_mut() {
+                *v += 0.3 * (rng.unit() - 0.5);
+            }
+        }
+        let p = [
+            1.6 * (rng.unit() - 0.5),
+            1.6 * (rng.unit() - 0.5),
+            0.6 * (rng.unit() - 0.5),
+        ];
+        let pr = project(&p, &x).unwrap();
+        let d = dist(&p, &pr.point);
+        // No point of the (extended) surface on a fine grid is closer.
+        let mut best = f64::INFINITY;
+        for i in 0..=200 {
+            for j in 0..=200 {
+                let (s, t) = (-1.5 + 3.0 * i as f64 / 200.0, -1.5 + 3.0 * j as f64 / 200.0);
+                best = best.min(dist(&p, &bilinear(&x, s, t)));
+            }
+        }
+        assert!(d <= best + 1e-12, "Newton {d} vs grid {best}");
+        // Stationarity: r ⟂ both tangents.
+        assert!((pr.gap.abs() - d).abs() < 1e-9 * (1.0 + d));
+    }
+}
+
+#[test]
+fn clamped_projection_lands_on_the_nearest_edge() {
+    let x = [
+        [0.0, 0.0, 0.0],
+        [1.0, 0.0, 0.0],
+        [1.0, 1.0, 0.0],
+        [0.0, 1.0, 0.0],
+    ];
+    let p = [1.5, 0.25, -0.1];
+    let free = project(&p, &x).unwrap();
+    assert!(!free.inside(1e-6));
+    let pr = project_clamped(&p, &x).unwrap();
+    assert!((pr.xi - 1.0).abs() < 1e-15 && (pr.eta + 0.5).abs() < 1e-12);
+    assert!(dist(&pr.point, &[1.0, 0.25, 0.0]) < 1e-15);
+}
+
+#[test]
+fn broad_phase_finds_exactly_the_brute_force_pairs() {
+    let mut rng = Rng::new(3);
+    let bounds: Vec<Bound> = (0..300)
+        .map(|_| Bound {
+            centre: [8.0 * rng.unit(), 8.0 * rng.unit(), 20.0 * rng.unit()],
+            radius: 0.4 + 0.2 * rng.unit(),
+        })
+        .collect();
+    let margin = 0.05;
+    let mut head = vec![0; 8 * bounds.len()];
+    let mut next = vec![0; bounds.len()];
+    let mut out = vec![GranulePair { a: 0, b: 0 }; 10_000];
+    let mut scratch = BroadScratch {
+        head: &mut head,
+        next: &mut next,
+    };
+    let n = candidate_pairs(&bounds, margin, &mut scratch, &mut out).unwrap();
+    let mut brute = Vec::new();
+    for i in 0..bounds.len() {
+        for j in i + 1..bounds.len() {
+            if dist(&bounds[i].centre, &bounds[j].centre)
+                < bounds[i].radius + bounds[j].radius + margin
+            {
+                brute.push(GranulePair {
+                    a: i as u32,
+                    b: j as u32,
+                });
+            }
+        }
+    }
+    assert!(!brute.is_empty());
+    assert_eq!(&out[..n], &brute[..]);
+    // A too-small output buffer is an error, not a silent truncation.
+    let mut small = vec![GranulePair { a: 0, b: 0 }; n - 1];
+    assert!(candidate_pairs(&bounds, margin, &mut scratch, &mut small).is_err());
+    // Moving one granule by half the margin asks for a rebuild.
+    let mut moved = bounds.clone();
+    assert!(!needs_rebuild(&bounds, &moved, margin));
+    moved[17].centre[0] += 0.5 * margin;
+    assert!(needs_rebuild(&bounds, &moved, margin));
+}
