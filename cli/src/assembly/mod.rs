@@ -309,6 +309,20 @@ impl<'m> Assembly<'m> {
         p
     }
 
+    /// Total angular momentum Σ m x × v about the origin, in granule and
+    /// node order, kg m²/s.
+    pub fn angular_momentum(&self) -> [Real; 3] {
+        let mut l = [0.0; 3];
+        for s in &self.granules {
+            for ((m, x), v) in s.mass.iter().zip(&s.x).zip(&s.v) {
+                l[0] += m * (x[1] * v[2] - x[2] * v[1]);
+                l[1] += m * (x[2] * v[0] - x[0] * v[2]);
+                l[2] += m * (x[0] * v[1] - x[1] * v[0]);
+            }
+        }
+        l
+    }
+
     /// Most negative gap between granules on the current positions x_n
     /// (0 if none penetrates), m: the whole detection rerun on x_n.
     pub fn penetration(&mut self) -> Result<Real, AssemblyError> {

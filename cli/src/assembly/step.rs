@@ -166,7 +166,9 @@ pub struct Energies {
 impl Energies {
     /// ΔK + internal + damping − contact − gravity (round-off).
     pub fn residual(&self) -> Real {
-        self.kinetic - self.initial_kinetic + self.internal_work + self.damping - self.contact_work - self.gravity_work
+        self.kinetic - self.initial_kinetic + self.internal_work + self.damping
+            - self.contact_work
+            - self.gravity_work
     }
 
     /// Energy the contacts took out of what the walls put in:
