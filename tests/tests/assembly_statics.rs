@@ -100,61 +100,42 @@ fn run(asm: &mut Assembly<'_>, duration: Real, window: Real) -> Averages {
     avg
 }
 
-fn two_stack(params: AssemblyParams, mesh: &OwnedReference) -> Assembly<'_> {
+/// A two-granule stack is an unstable equilibrium (on the faceted mesh a
+/// node resting on a vertex is pushed along one face's normal, which leans
+/// ~11° on the 4x1 mesh: a free stack topples within 20 ms). It stands in
+/// a frictionless tube of its own radius, which carries no vertical load.
+#[test]
+fn a_two_stack_rests_on_the_floor_with_its_weight() {
+    let mesh = OwnedReference::sphere(R, MeshLevel::new(4, 1), false).unwrap();
     let placed = [
         Placement::at([0.0, 0.0, R]),
         Placement::at([0.0, 0.0, 3.0 * R]),
     ];
     let floor = plane([0.0, 0.0, 1.0], 0.0);
-    Assembly::new(params, mesh, &placed, vec![floor]).unwrap()
-}
-
-#[test]
-fn a_two_stack_rests_on_the_floor_with_its_weight() {
-    let mesh = OwnedReference::sphere(R, MeshLevel::new(4, 1), false).unwrap();
-    let mut asm = two_stack(params(), &mesh);
+    let tube = WallSpec::fixed(Wall::Die { radius: R });
+    let mut p = params();
+    p.wall_friction = 0.0;
+    let mut asm = Assembly::new(p, &mesh, &placed, vec![floor, tube]).unwrap();
     let mg = asm.granule_mass(0) * G;
-    let avg = run(&mut asm, 20e-3, 5e-3);
-    eprintln!(
-        "mg {mg:.4e} floor {:.4e} pair {:.4e} {avg:?}",
-        avg.wall_normal[0], avg.pair_normal
-    );
+    // Kinematic contact takes energy out only slowly from the rigid
+    // rattling: average over many rattles (the mean force is the weight
+    // up to Δp/T).
+    let avg = run(&mut asm, 60e-3, 40e-3);
+    eprintln!("mg {mg:.4e} {avg:?}");
+    let floor = avg.wall_normal[0];
     assert!(
-        (avg.wall_normal[0] / (2.0 * mg) - 1.0).abs() < 0.01,
-        "floor {:.4e} vs 2mg {:.4e}",
-        avg.wall_normal[0],
+        (floor / (2.0 * mg) - 1.0).abs() < 0.01,
+        "floor {floor:.4e} vs 2mg {:.4e}",
         2.0 * mg
     );
+    let pair = avg.pair_normal;
     assert!(
-        (avg.pair_normal / mg - 1.0).abs() < 0.01,
-        "pair {:.4e} vs mg {:.4e}",
-        avg.pair_normal,
-        mg
+        (pair / mg - 1.0).abs() < 0.01,
+        "pair {pair:.4e} vs mg {mg:.4e}"
     );
-}
-
-/// The deviation from physics.md §5.2 kept honest: with the face normal the
-/// stack leans over within 20 ms; with the smoothed normal it stays put.
-#[test]
-fn the_face_normal_topples_the_stack_and_the_smoothed_normal_does_not() {
-    let mesh = OwnedReference::sphere(R, MeshLevel::new(4, 1), false).unwrap();
-    let drift = |smooth| {
-        let mut p = params();
-        p.contact.smooth_normal = smooth;
-        let mut asm = two_stack(p, &mesh);
-        while asm.time() < 20e-3 {
-            asm.step().unwrap();
-        }
-        let c = asm.centre_of_mass(1);
-        c[0].hypot(c[1])
-    };
-    let (face, smooth) = (drift(false), drift(true));
+    let c = asm.centre_of_mass(1);
     assert!(
-        face > 10e-6,
-        "face normal: top granule drifted only {face:.3e} m"
-    );
-    assert!(
-        smooth < 1e-9,
-        "smoothed normal: top granule drifted {smooth:.3e} m"
+        c[0].hypot(c[1]) < 1e-6,
+        "the top granule left the axis: {c:?}"
     );
 }

@@ -42,9 +42,6 @@ pub struct PairSettings {
     /// Symmetric two-pass (each side slave once, weight ½) or a single pass
     /// with A's nodes as slaves (weight 1).
     pub symmetric: bool,
-    /// Push along the interpolated nodal normal Σ Nᵢ n̂ᵢ instead of the face
-    /// normal (see [`detect`]).
-    pub smooth_normal: bool,
 }
 
 impl PairSettings {
@@ -57,7 +54,6 @@ impl PairSettings {
             window_fraction: 0.25,
             margin: 20e-6,
             symmetric: true,
-            smooth_normal: true,
         }
     }
 
@@ -164,16 +160,7 @@ impl core::error::Error for ContactError {}
 
 /// Finds the constraints of the pair (A, B) on the predicted configuration
 /// and writes them to `out`, pass A→B first (A's nodes as slaves, in node
-/// order), then B→A when symmetric.
-///
-/// **Deviation from physics.md §5.2 (a choice):** with `smooth_normal`
-/// (the standard setting) the constraint's normal is the interpolated
-/// nodal normal, continuous across edges and vertices, not the face normal
-/// x_ξ × x_η at the contact point. On the faceted sphere a node resting on
-/// a vertex projects into one of four faces whose normals lean ~11° (4x1
-/// mesh) apart; the face normal pushed a two-granule stack sideways until
-/// it toppled within 20 ms (`tests/assembly_statics.rs`). The couple this
-/// leaves is of the order of the penetration, as §5.6 allows. `scratch` holds candidate quad ids and
+/// order), then B→A when symmetric. `scratch` holds candidate quad ids and
 /// needs at least as many entries as the larger quad count. Returns the
 /// number of constraints.
 pub fn detect(
@@ -314,15 +301,13 @@ fn closest_face(
             best = Some(hit);
         }
     }
-    if let Some(hit) = best {
-        return smoothed(master, &p, hit, settings);
+    if best.is_some() {
+        return best;
     }
     if !near_outside {
         return None;
     }
-    concave_edge(master, &p, candidates, settings)
-        .filter(|h| opposing(&h.projection.normal))
-        .and_then(|h| smoothed(master, &p, h, settings))
+    concave_edge(master, &p, candidates, settings).filter(|h| opposing(&h.projection.normal))
 }
 
 /// The closest point of `p` on the candidate faces confined to their
@@ -375,40 +360,6 @@ fn concave_edge(
         quad,
         projection: pr,
     })
-}
-
-/// With [`PairSettings::smooth_normal`], replaces the hit's face normal by
-/// the interpolated nodal normal n = Σ Nᵢ n̂ᵢ / |…| (n̂ᵢ: the averaged
-/// outward normal at corner i) and measures the gap along it; `None` if
-/// the node is then no longer behind the surface.
-fn smoothed(
-    master: &SurfaceBody<'_>,
-    p: &Vec3,
-    mut hit: Hit,
-    settings: &PairSettings,
-) -> Option<Hit> {
-    if !settings.smooth_normal {
-        return Some(hit);
-    }
-    let corners = master.quads[hit.quad as usize];
-    let mut n = [0.0; 3];
-    for (id, w) in corners.iter().zip(hit.projection.weights) {
-        let ni = master.node_normal(*id as usize);
-        let len = norm(&ni);
-        if len > 0.0 {
-            for (nk, c) in n.iter_mut().zip(ni) {
-                *nk += w * c / len;
-            }
-        }
-    }
-    let len = norm(&n);
-    if len.is_nan() || len <= 0.0 {
-        return Some(hit);
-    }
-    let pr = &mut hit.projection;
-    pr.normal = n.map(|c| c / len);
-    pr.gap = dot(&pr.normal, &sub(p, &pr.point));
-    (pr.gap < 0.0).then_some(hit)
 }
 
 /// Per-node contact counts of one body for the mass sharing of §5.3.
