@@ -14,14 +14,23 @@ use granbed_kernel::material::{GranuleType, Material};
 const R: Real = 0.5e-3;
 const G: Real = 9.81;
 
-fn params() -> AssemblyParams {
-    let material: Material = GranuleType::B2.params().validate().unwrap();
+/// B2 granules, plastic (`elastic` false) or with σ_y = ∞.
+fn params_of(elastic: bool) -> AssemblyParams {
+    let mut material = GranuleType::B2.params();
+    if elastic {
+        material.yield_stress_pa = Real::INFINITY;
+    }
+    let material: Material = material.validate().unwrap();
     let elements = ElementSettings {
         kind: ElementKind::OnePoint,
         update: Default::default(),
         hourglass_kappa: granbed_kernel::element::force::DEFAULT_HOURGLASS_KAPPA,
     };
     AssemblyParams::standard(material, elements)
+}
+
+fn params() -> AssemblyParams {
+    params_of(false)
 }
 
 fn plane(normal: [Real; 3], offset: Real) -> WallSpec {
@@ -138,4 +147,59 @@ fn a_two_stack_rests_on_the_floor_with_its_weight() {
         c[0].hypot(c[1]) < 1e-6,
         "the top granule left the axis: {c:?}"
     );
+}
+
+/// A 3×3×3 simple-cubic block of elastic granules in a box, touching
+/// everywhere, pressed by the lid and the four sides by 100 µm (3.3 %) and
+/// held: the floor and the side walls' friction carry the lid force and
+/// the weight, every
+/// neighbour pair touches (the centre granule 6 times, coordination
+/// number 4). Unpressed, the faceted granules balanced vertex on vertex
+/// roll off each other and the lattice sinks (a coarse polyhedron on a
+/// vertex is unstable).
+#[test]
+fn a_simple_cubic_block_in_a_box() {
+    let mesh = OwnedReference::sphere(R, MeshLevel::new(4, 1), false).unwrap();
+    let mut placed = Vec::new();
+    for k in 0..3 {
+        for j in 0..3 {
+            for i in 0..3 {
+                let c = |n: usize| (n as Real - 1.0) * 2.0 * R;
+                placed.push(Placement::at([c(i), c(j), R + c(k) + 2.0 * R]));
+            }
+        }
+    }
+    let half = 3.0 * R;
+    // Floor fixed; the four sides and the lid press in by 100 µm (3.3 %)
+    // at 50 mm/s, then hold.
+    let press = |normal: [Real; 3], offset: Real| {
+        WallSpec::moving(Wall::Plane(Plane { normal, offset }), 50e-3, 2e-3)
+    };
+    let walls = vec![
+        plane([0.0, 0.0, 1.0], 0.0),
+        press([1.0, 0.0, 0.0], -half),
+        press([-1.0, 0.0, 0.0], -half),
+        press([0.0, 1.0, 0.0], -half),
+        press([0.0, -1.0, 0.0], -half),
+        press([0.0, 0.0, -1.0], -6.0 * R),
+    ];
+    let mut asm = Assembly::new(params_of(true), &mesh, &placed, walls).unwrap();
+    let weight = 27.0 * asm.granule_mass(0) * G;
+    let avg = run(&mut asm, 10e-3, 4e-3);
+    let lid_force = avg.wall_normal[5];
+    let support = avg.wall_normal[0] + avg.wall_friction_z.iter().sum::<Real>();
+    let load = lid_force + weight;
+    eprintln!("weight {weight:.4e} lid {lid_force:.4e} support {support:.4e} {avg:?}");
+    assert!(
+        lid_force > 2.0 * weight,
+        "the lid must press: {lid_force:.4e} N"
+    );
+    assert!(
+        (support / load - 1.0).abs() < 0.01,
+        "support {support:.4e} vs load {load:.4e}"
+    );
+    let touching: Vec<usize> = avg.contacts.iter().map(|c| c.round() as usize).collect();
+    assert_eq!(touching[13], 6, "centre granule contacts: {touching:?}");
+    let z = touching.iter().sum::<usize>() as Real / 27.0;
+    assert_eq!(z, 4.0, "coordination number {z}: {touching:?}");
 }

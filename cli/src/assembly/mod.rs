@@ -103,14 +103,17 @@ impl Placement {
 }
 
 /// A rigid wall of the assembly. A [`Wall::Plane`] moves along its own
-/// normal at `speed_m_s` (its offset grows by speed·t; a punch pressing in
-/// has a positive speed); the die does not move.
+/// normal at `speed_m_s` until `stop_s` (its offset grows by speed·t; a
+/// punch pressing in has a positive speed), then holds; the die does not
+/// move.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct WallSpec {
     /// The wall at t = 0.
     pub wall: Wall,
     /// Speed along the inward normal, m/s (planes only).
     pub speed_m_s: Real,
+    /// Time at which the wall stops, s (∞: never).
+    pub stop_s: Real,
 }
 
 impl WallSpec {
@@ -119,14 +122,29 @@ impl WallSpec {
         Self {
             wall,
             speed_m_s: 0.0,
+            stop_s: Real::INFINITY,
         }
+    }
+
+    /// A plane moving along its normal at `speed_m_s` until `stop_s`.
+    pub fn moving(wall: Wall, speed_m_s: Real, stop_s: Real) -> Self {
+        Self {
+            wall,
+            speed_m_s,
+            stop_s,
+        }
+    }
+
+    /// Speed along the normal at time `t`, m/s.
+    pub fn speed_at(&self, t: Real) -> Real {
+        if t < self.stop_s { self.speed_m_s } else { 0.0 }
     }
 
     /// The wall at time `t`.
     pub fn at(&self, t: Real) -> Wall {
         match self.wall {
             Wall::Plane(mut p) => {
-                p.offset += self.speed_m_s * t;
+                p.offset += self.speed_m_s * t.min(self.stop_s);
                 Wall::Plane(p)
             }
             die => die,

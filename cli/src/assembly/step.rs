@@ -390,7 +390,10 @@ impl Assembly<'_> {
         e.plastic += plastic;
         e.hourglass = hourglass;
         for (spec, w) in self.walls.iter().zip(&report.walls) {
-            e.punch_work += w.normal * spec.speed_m_s * sizes.dt;
+            // The wall's displacement over the step, from its positions.
+            let moved = spec.speed_m_s
+                * ((self.time + sizes.dt).min(spec.stop_s) - self.time.min(spec.stop_s));
+            e.punch_work += w.normal * moved;
         }
         for w in self.contact.work() {
             report.pair_normal += w.result.normal;
