@@ -161,6 +161,41 @@ impl OwnedReference {
         })
     }
 
+    /// Generates the hex cube of side `side` (m) with `n` divisions per edge,
+    /// centred at the origin, and computes the element data.
+    pub fn cube(side: Real, n: u32) -> anyhow::Result<Self> {
+        let size = granbed_kernel::mesh::cube::cube_size(n)
+            .with_context(|| format!("cube with {n} divisions"))?;
+        let mut store = MeshStore::new(size);
+        granbed_kernel::mesh::cube::generate_cube(side, n, &mut store.buffers())
+            .with_context(|| format!("generating the {n}x{n}x{n} cube of side {side} m"))?;
+        let Some(first) = store
+            .hexes
+            .first()
+            .map(|hex| core::array::from_fn(|i| store.positions[hex[i] as usize]))
+        else {
+            bail!("the cube has no elements");
+        };
+        let placeholder = granbed_kernel::element::reference::hex_reference(&first)
+            .context("first element is inverted")?;
+        let mut elements = vec![placeholder; store.hexes.len()];
+        let mut node_volume = vec![0.0; store.positions.len()];
+        compute_element_data(
+            &store.view(size.surface_nodes),
+            &mut elements,
+            &mut node_volume,
+        )?;
+        Ok(Self {
+            positions: store.positions,
+            hexes: store.hexes,
+            quads: store.quads,
+            node_quads: store.node_quads,
+            surface_nodes: size.surface_nodes,
+            elements,
+            node_volume,
+        })
+    }
+
     /// The kernel's borrowed view.
     pub fn view(&self) -> ReferenceMesh<'_> {
         ReferenceMesh {
