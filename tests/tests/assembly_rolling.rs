@@ -31,7 +31,10 @@ fn downhill_acceleration(theta_deg: Real, t_fit: Real, t_end: Real) -> Real {
     let params = AssemblyParams::standard(material.validate().unwrap(), elements);
     let n = [-theta.sin(), 0.0, theta.cos()];
     let d = [-theta.cos(), 0.0, -theta.sin()];
-    let slope = WallSpec::fixed(Wall::Plane(Plane { normal: n, offset: 0.0 }));
+    let slope = WallSpec::fixed(Wall::Plane(Plane {
+        normal: n,
+        offset: 0.0,
+    }));
     let placed = [Placement::at(n.map(|c| c * R))];
     let mut asm = Assembly::new(params, &mesh, &placed, vec![slope]).unwrap();
     let (mut t, mut v) = (Vec::new(), Vec::new());
@@ -56,7 +59,10 @@ fn a_granule_rolls_without_slip_below_three_and_a_half_mu() {
     let rolling = 5.0 / 7.0 * G * theta.to_radians().sin();
     let sliding = G * (theta.to_radians().sin() - 0.1 * theta.to_radians().cos());
     eprintln!("theta {theta}: a {a:.4} rolling {rolling:.4} sliding {sliding:.4}");
-    assert!((a / rolling - 1.0).abs() < 0.05, "a = {a:.4} vs (5/7) g sin θ = {rolling:.4}");
+    assert!(
+        (a / rolling - 1.0).abs() < 0.05,
+        "a = {a:.4} vs (5/7) g sin θ = {rolling:.4}"
+    );
 }
 
 #[test]
@@ -66,5 +72,8 @@ fn a_granule_slips_above_three_and_a_half_mu() {
     let sliding = G * (theta.to_radians().sin() - 0.1 * theta.to_radians().cos());
     let rolling = 5.0 / 7.0 * G * theta.to_radians().sin();
     eprintln!("theta {theta}: a {a:.4} sliding {sliding:.4} rolling {rolling:.4}");
-    assert!((a / sliding - 1.0).abs() < 0.03, "a = {a:.4} vs g(sin θ − μ cos θ) = {sliding:.4}");
+    assert!(
+        (a / sliding - 1.0).abs() < 0.03,
+        "a = {a:.4} vs g(sin θ − μ cos θ) = {sliding:.4}"
+    );
 }

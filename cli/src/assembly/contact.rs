@@ -6,8 +6,8 @@ use granbed_kernel::contact::broad::{
     Bound, BroadScratch, GranulePair, bounding_sphere, candidate_pairs, needs_rebuild,
 };
 use granbed_kernel::contact::pair::{
-    Constraint, ContactError, Involvement, NodeForce, PairForce, PairSettings, Side, detect,
-    forces, mark_involvement,
+    CandidateFace, Constraint, ContactError, Involvement, NodeForce, PairForce, PairSettings, Side,
+    detect, forces, mark_involvement,
 };
 use granbed_kernel::contact::surface::{Aabb, SurfaceBody};
 use rayon::prelude::*;
@@ -21,15 +21,22 @@ pub struct PairWork {
     count: usize,
     forces: Vec<NodeForce>,
     force_count: usize,
-    scratch: Vec<u32>,
-    /// What the last force pass did.
+    /// What the last force pass (sweep) did.
     pub result: PairForce,
+    /// What every sweep of the last step did together: forces summed,
+    /// constraint counts of the first sweep, the smallest gap.
+    pub step: PairForce,
 }
 
 impl PairWork {
-    /// The constraints found in the last detection.
+    /// The constraints found in the last detection (sweep).
     pub fn constraints(&self) -> &[Constraint] {
         &self.constraints[..self.count]
+    }
+
+    /// True if the pair touched (had a constraint) in the last step.
+    pub fn touching(&self) -> bool {
+        self.step.constraints > 0
     }
 }
 
@@ -49,10 +56,16 @@ pub struct ContactPhase {
     head: Vec<u32>,
     next: Vec<u32>,
     rebuilds: u64,
+    /// Per granule: f_c before the current sweep (for the x̃ update).
+    pub(super) f_before: Vec<Vec<[Real; 3]>>,
 }
 
 /// The kernel's view of granule `g` on its predicted configuration.
-fn body<'a>(g: &'a GranuleStore, mesh: &'a OwnedReference, bounds: Aabb) -> SurfaceBody<'a> {
+fn body<'a>(
+    g: &'a GranuleStore,
+    mesh: &'a OwnedReference,
+    (bounds, sphere): (Aabb, Bound),
+) -> SurfaceBody<'a> {
     SurfaceBody {
         x_n: &g.x,
         x_pred: &g.x_pred,
@@ -61,6 +74,7 @@ fn body<'a>(g: &'a GranuleStore, mesh: &'a OwnedReference, bounds: Aabb) -> Surf
         quads: &mesh.quads,
         node_quads: &mesh.node_quads,
         bounds,
+        sphere,
     }
 }
 
@@ -96,14 +110,14 @@ impl ContactPhase {
 
     /// Pairs in contact (at least one constraint) in the last step.
     pub fn pairs_in_contact(&self) -> usize {
-        self.work.iter().filter(|w| w.count > 0).count()
+        self.work.iter().filter(|w| w.touching()).count()
     }
 
     /// Per granule, the number of granules it touched in the last step.
     pub fn contacts_per_granule(&self) -> Vec<usize> {
         let mut n = vec![0; self.by_granule.len()];
         for (p, w) in self.pairs.iter().zip(&self.work) {
-            if w.count > 0 {
+            if w.touching() {
                 n[p.a as usize] += 1;
                 n[p.b as usize] += 1;
             }
@@ -170,15 +184,15 @@ impl ContactPhase {
         mesh: &OwnedReference,
         settings: &PairSettings,
     ) -> Result<(), ContactError> {
-        let boxes = &self.boxes;
+        let (boxes, bounds) = (&self.boxes, &self.bounds);
         self.pairs
             .par_iter()
             .zip(self.work.par_iter_mut())
-            .try_for_each(|(p, w)| {
+            .try_for_each_init(Vec::new, |scratch, (p, w)| {
                 let (a, b) = (p.a as usize, p.b as usize);
-                let body_a = body(&granules[a], mesh, boxes[a]);
-                let body_b = body(&granules[b], mesh, boxes[b]);
-                detect_growing(&body_a, &body_b, settings, w)
+                let body_a = body(&granules[a], mesh, (boxes[a], bounds[a]));
+                let body_b = body(&granules[b], mesh, (boxes[b], bounds[b]));
+                detect_growing(&body_a, &body_b, settings, scratch, w)
             })
     }
 
@@ -204,8 +218,8 @@ impl ContactPhase {
                 tag: &mut thi[0],
                 count: &mut hi[0],
             };
-            let body_a = body(&granules[a], mesh, self.boxes[a]);
-            let body_b = body(&granules[b], mesh, self.boxes[b]);
+            let body_a = body(&granules[a], mesh, (self.boxes[a], self.bounds[a]));
+            let body_b = body(&granules[b], mesh, (self.boxes[b], self.bounds[b]));
             mark_involvement(
                 w.constraints(),
                 (&body_a, &mut inv_a),
@@ -217,6 +231,8 @@ impl ContactPhase {
 
     /// The forces of every pair (in parallel) into the pairs' own lists.
     /// `sharing` selects the counts of [`Self::count_pairs`] (else none).
+    /// `first` marks the first sweep of a step (which resets the step's
+    /// per-pair totals).
     pub(super) fn forces(
         &mut self,
         granules: &[GranuleStore],
@@ -224,15 +240,16 @@ impl ContactPhase {
         settings: &PairSettings,
         dt_squared: Real,
         sharing: bool,
+        first: bool,
     ) -> Result<(), ContactError> {
-        let (boxes, share) = (&self.boxes, &self.share);
+        let (boxes, bounds, share) = (&self.boxes, &self.bounds, &self.share);
         self.pairs
             .par_iter()
             .zip(self.work.par_iter_mut())
             .try_for_each(|(p, w)| {
                 let (a, b) = (p.a as usize, p.b as usize);
-                let body_a = body(&granules[a], mesh, boxes[a]);
-                let body_b = body(&granules[b], mesh, boxes[b]);
+                let body_a = body(&granules[a], mesh, (boxes[a], bounds[a]));
+                let body_b = body(&granules[b], mesh, (boxes[b], bounds[b]));
                 let (sa, sb): (&[u16], &[u16]) = if sharing {
                     (&share[a], &share[b])
                 } else {
@@ -259,6 +276,18 @@ impl ContactPhase {
                 )?;
                 w.force_count = k;
                 w.result = result;
+                if first {
+                    w.step = result;
+                } else {
+                    let t = &mut w.step;
+                    t.normal += result.normal;
+                    for a in 0..3 {
+                        t.friction_on_a[a] += result.friction_on_a[a];
+                        t.total_on_a[a] += result.total_on_a[a];
+                    }
+                    t.slipping = t.slipping.max(result.slipping);
+                    t.min_gap = t.min_gap.min(result.min_gap);
+                }
                 Ok(())
             })
     }
@@ -315,13 +344,15 @@ impl ContactPhase {
             &mut pairs,
         )?;
         let mut min_gap: Real = 0.0;
+        let mut scratch = Vec::new();
         for p in &pairs[..n] {
             let (a, b) = (p.a as usize, p.b as usize);
             let mut w = PairWork::default();
             detect_growing(
-                &body(&at_rest[a], mesh, boxes[a]),
-                &body(&at_rest[b], mesh, boxes[b]),
+                &body(&at_rest[a], mesh, (boxes[a], bounds[a])),
+                &body(&at_rest[b], mesh, (boxes[b], bounds[b])),
                 settings,
+                &mut scratch,
                 &mut w,
             )?;
             for c in w.constraints() {
@@ -332,16 +363,18 @@ impl ContactPhase {
     }
 }
 
-/// [`detect`] into `w`, doubling its constraint list until it fits.
+/// [`detect`] into `w` with the (per-thread) candidate-face `scratch`,
+/// doubling the pair's constraint list until it fits.
 fn detect_growing(
     a: &SurfaceBody<'_>,
     b: &SurfaceBody<'_>,
     settings: &PairSettings,
+    scratch: &mut Vec<CandidateFace>,
     w: &mut PairWork,
 ) -> Result<(), ContactError> {
     let need = a.quads.len().max(b.quads.len());
-    if w.scratch.len() < need {
-        w.scratch.resize(need, 0);
+    if scratch.len() < need {
+        scratch.resize(need, CandidateFace::default());
     }
     if w.constraints.is_empty() {
         w.constraints.resize(
@@ -357,7 +390,7 @@ fn detect_growing(
         );
     }
     loop {
-        match detect(a, b, settings, &mut w.scratch, &mut w.constraints) {
+        match detect(a, b, settings, scratch, &mut w.constraints) {
             Ok(n) => {
                 w.count = n;
                 return Ok(());

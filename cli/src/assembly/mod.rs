@@ -21,6 +21,7 @@
 //! number of threads.
 
 mod contact;
+pub mod die;
 mod step;
 
 use granbed_kernel::Real;
@@ -52,6 +53,9 @@ pub struct AssemblyParams {
     pub contact: PairSettings,
     /// Divide each node's mass by its number of contacts (physics.md §5.3).
     pub mass_sharing: bool,
+    /// Contact sweeps per step (≥ 1): each further sweep moves x̃ by the
+    /// forces found so far and corrects the gaps that are left.
+    pub contact_sweeps: u32,
     /// Safety factor C on the element estimate of the stable step; (0, 1].
     pub time_step_safety: Real,
     /// Steps between time-step re-estimates; ≥ 1.
@@ -61,7 +65,7 @@ pub struct AssemblyParams {
 impl AssemblyParams {
     /// physics.md's choices for `material`: ξ = 0.5, gravity 9.81 m/s²,
     /// the material's friction on walls and between granules, symmetric
-    /// two-pass with mass sharing, C = 0.9, re-estimated every 100 steps.
+    /// two-pass with mass sharing and three sweeps, C = 0.9, re-estimated every 100 steps.
     pub fn standard(material: Material, elements: ElementSettings) -> Self {
         let mu = material.params.friction;
         Self {
@@ -72,6 +76,7 @@ impl AssemblyParams {
             wall_friction: mu,
             contact: PairSettings::standard(mu),
             mass_sharing: true,
+            contact_sweeps: 3,
             time_step_safety: 0.9,
             time_step_interval: 100,
         }

@@ -78,7 +78,13 @@ impl fmt::Display for AssemblyError {
 impl core::error::Error for AssemblyError {}
 
 pub(super) fn validate(p: &AssemblyParams) -> Result<(), AssemblyError> {
-    let checks: [(bool, &'static str, Real, &'static str); 7] = [
+    let checks: [(bool, &'static str, Real, &'static str); 8] = [
+        (
+            (1..=10).contains(&p.contact_sweeps),
+            "contact_sweeps",
+            Real::from(p.contact_sweeps),
+            "1..=10",
+        ),
         (
             (0.0..=2.0).contains(&p.damping_ratio),
             "damping_ratio",
@@ -192,24 +198,31 @@ pub struct StepReport {
     pub min_j: Real,
     /// Per wall (in wall order), the summed contact result over granules.
     pub walls: Vec<WallForce>,
-    /// Σ F_n of the granule–granule constraints, N.
+    /// Σ F_n of the granule–granule constraints (all sweeps), N.
     pub pair_normal: Real,
-    /// Granule–granule constraints that carried a force.
+    /// Granule–granule constraints of the first sweep.
     pub constraints: usize,
 }
 
-fn add_wall(total: &mut WallForce, w: &WallForce) {
+/// Adds the forces of `w` to `total`; the contact count is summed
+/// (`sum_contacts`, over granules) or the larger is kept (over sweeps of
+/// one granule, which see the same nodes again).
+fn add_wall(total: &mut WallForce, w: &WallForce, sum_contacts: bool) {
     total.normal += w.normal;
-    for a in 0..3 {
-        total.tangential[a] += w.tangential[a];
+    for (t, f) in total.tangential.iter_mut().zip(w.tangential) {
+        *t += f;
     }
-    total.contacts += w.contacts;
+    total.contacts = if sum_contacts {
+        total.contacts + w.contacts
+    } else {
+        total.contacts.max(w.contacts)
+    };
     total.min_gap = total.min_gap.min(w.min_gap);
 }
 
 impl Assembly<'_> {
     /// The stable step: `time_step_safety` × the smallest element estimate
-    /// over all granules.
+    /// over all granules, reduced for the damping.
     pub(super) fn stable_step(&self) -> Result<Real, AssemblyError> {
         let view = self.mesh.view();
         let (mat, c) = (self.params.material, self.params.time_step_safety);
@@ -230,7 +243,13 @@ impl Assembly<'_> {
                 }
             }
         }
-        if dt.is_finite() { Ok(dt) } else { Ok(1.0) }
+        if !dt.is_finite() {
+            return Ok(1.0);
+        }
+        // The lagged damping force shrinks the stable step of central
+        // differences to Ω² < 4 − 2cΔt (Ω = ω_max Δt): scale by
+        // √(1 − cΔt/2). Without it a regular hex cube diverged at C = 0.85.
+        Ok(dt * (1.0 - 0.5 * self.damping_c * dt).max(0.25).sqrt())
     }
 
     /// Elastic energy Ψ of every granule (summed in order), stored in the
@@ -245,6 +264,76 @@ impl Assembly<'_> {
             .collect();
         self.energies.elastic = per.iter().sum();
         self.energies.elastic
+    }
+
+    /// One contact sweep on the current x̃: broad phase, detection, mass
+    /// sharing counts, pair forces and wall forces, added to every
+    /// granule's f_c (pairs in list order, then walls in wall order) and
+    /// the wall results added to `wall_totals` (per granule, per wall).
+    fn contact_sweep(
+        &mut self,
+        step: u64,
+        walls: &[granbed_kernel::contact::wall::Wall],
+        dt2: Real,
+        first: bool,
+        wall_totals: &mut [Vec<WallForce>],
+    ) -> Result<(), AssemblyError> {
+        let p = self.params;
+        let contact_error = |error| AssemblyError::Contact { step, error };
+        let mesh = self.mesh;
+        self.contact
+            .broad(&self.granules, mesh, p.contact.margin)
+            .map_err(contact_error)?;
+        self.contact
+            .detect(&self.granules, mesh, &p.contact)
+            .map_err(contact_error)?;
+        let surface = mesh.positions.len() - mesh.surface_nodes..mesh.positions.len();
+        if p.mass_sharing {
+            self.contact.count_pairs(&self.granules, mesh);
+            self.contact
+                .share
+                .par_iter_mut()
+                .zip(self.granules.par_iter())
+                .for_each(|(share, g)| {
+                    for w in walls {
+                        count_wall_contacts(w, surface.clone(), &g.x_pred, share);
+                    }
+                });
+        }
+        self.contact
+            .forces(&self.granules, mesh, &p.contact, dt2, p.mass_sharing, first)
+            .map_err(contact_error)?;
+        let contact = &self.contact;
+        self.granules
+            .par_iter_mut()
+            .zip(wall_totals.par_iter_mut())
+            .enumerate()
+            .for_each(|(gi, (g, totals))| {
+                contact.gather(gi, &mut g.f_c);
+                let share: &[u16] = if p.mass_sharing {
+                    &contact.share[gi]
+                } else {
+                    &[]
+                };
+                let body = PredictedNodes {
+                    mass: &g.mass,
+                    x_n: &g.x,
+                    x_pred: &g.x_pred,
+                };
+                for (w, total) in walls.iter().zip(totals.iter_mut()) {
+                    let f = wall_contact(
+                        w,
+                        p.wall_friction,
+                        dt2,
+                        surface.clone(),
+                        &body,
+                        share,
+                        &mut g.f_c,
+                    );
+                    add_wall(total, &f, false);
+                }
+            });
+        Ok(())
     }
 
     /// Advances every granule by one step.
@@ -293,73 +382,46 @@ impl Assembly<'_> {
             min_j = min_j.min(s.min_j);
         }
 
-        // Contact on the predicted configuration, walls at t_{n+1}.
-        let contact_error = |error| AssemblyError::Contact { step, error };
+        // Contact on the predicted configuration, walls at t_{n+1}; each
+        // further sweep moves x̃ by the forces of the last and corrects what
+        // is left (physics.md §5.3's optional Jacobi sweeps).
         let dt2 = sizes.contact_dt_squared();
-        let mesh = self.mesh;
-        self.contact
-            .broad(&self.granules, mesh, p.contact.margin)
-            .map_err(contact_error)?;
-        self.contact
-            .detect(&self.granules, mesh, &p.contact)
-            .map_err(contact_error)?;
         let walls: Vec<_> = self
             .walls
             .iter()
             .map(|w| w.at(self.time + sizes.dt))
             .collect();
-        let surface = mesh.positions.len() - mesh.surface_nodes..mesh.positions.len();
-        if p.mass_sharing {
-            self.contact.count_pairs(&self.granules, mesh);
-            self.contact
-                .share
-                .par_iter_mut()
-                .zip(self.granules.par_iter())
-                .for_each(|(share, g)| {
-                    for w in &walls {
-                        count_wall_contacts(w, surface.clone(), &g.x_pred, share);
-                    }
-                });
+        let mut wall_totals = vec![vec![WallForce::default(); walls.len()]; self.granules.len()];
+        let mut pair_normal = 0.0;
+        let mut constraints = 0;
+        for sweep in 0..p.contact_sweeps {
+            if sweep > 0 {
+                self.granules
+                    .par_iter_mut()
+                    .zip(self.contact.f_before.par_iter())
+                    .for_each(|(g, before)| {
+                        for (((x, f), f0), m) in
+                            g.x_pred.iter_mut().zip(&g.f_c).zip(before).zip(&g.mass)
+                        {
+                            for a in 0..3 {
+                                x[a] += dt2 * (f[a] - f0[a]) / m;
+                            }
+                        }
+                    });
+            }
+            if sweep + 1 < p.contact_sweeps {
+                self.contact.f_before = self.granules.iter().map(|g| g.f_c.clone()).collect();
+            }
+            self.contact_sweep(step, &walls, dt2, sweep == 0, &mut wall_totals)?;
         }
-        self.contact
-            .forces(&self.granules, mesh, &p.contact, dt2, p.mass_sharing)
-            .map_err(contact_error)?;
-        let contact = &self.contact;
-        let per: Vec<(StepWork, Vec<WallForce>)> = self
+        for w in self.contact.work() {
+            pair_normal += w.step.normal;
+            constraints += w.step.constraints;
+        }
+        let per: Vec<StepWork> = self
             .granules
             .par_iter_mut()
-            .enumerate()
-            .map(|(gi, g)| {
-                contact.gather(gi, &mut g.f_c);
-                let share: &[u16] = if p.mass_sharing {
-                    &contact.share[gi]
-                } else {
-                    &[]
-                };
-                let body = PredictedNodes {
-                    mass: &g.mass,
-                    x_n: &g.x,
-                    x_pred: &g.x_pred,
-                };
-                let wall_forces = walls
-                    .iter()
-                    .map(|w| {
-                        wall_contact(
-                            w,
-                            p.wall_friction,
-                            dt2,
-                            surface.clone(),
-                            &body,
-                            share,
-                            &mut g.f_c,
-                        )
-                    })
-                    .collect();
-                (
-                    correct(&mut g.buffers(), sizes, p.gravity_m_s2),
-                    wall_forces,
-                )
-            })
+            .map(|g| correct(&mut g.buffers(), sizes, p.gravity_m_s2))
             .collect();
 
         let mut report = StepReport {
@@ -370,7 +432,7 @@ impl Assembly<'_> {
         };
         let e = &mut self.energies;
         let mut kinetic = 0.0;
-        for (granule, (w, wall_forces)) in per.iter().enumerate() {
+        for (granule, (w, wall_forces)) in per.iter().zip(&wall_totals).enumerate() {
             if !w.kinetic.is_finite() {
                 return Err(AssemblyError::Unstable {
                     step,
@@ -383,7 +445,7 @@ impl Assembly<'_> {
             e.gravity_work += w.gravity;
             kinetic += w.kinetic;
             for (total, wf) in report.walls.iter_mut().zip(wall_forces) {
-                add_wall(total, wf);
+                add_wall(total, wf, true);
             }
         }
         e.kinetic = kinetic;
@@ -395,10 +457,8 @@ impl Assembly<'_> {
                 * ((self.time + sizes.dt).min(spec.stop_s) - self.time.min(spec.stop_s));
             e.punch_work += w.normal * moved;
         }
-        for w in self.contact.work() {
-            report.pair_normal += w.result.normal;
-            report.constraints += w.result.constraints;
-        }
+        report.pair_normal = pair_normal;
+        report.constraints = constraints;
         self.last = report;
         self.time += sizes.dt;
         self.steps += 1;

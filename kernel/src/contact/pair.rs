@@ -39,8 +39,9 @@ pub struct PairSettings {
     pub window_fraction: Real,
     /// Margin by which the pair's overlap box is grown, m.
     pub margin: Real,
-    /// Symmetric two-pass (each side slave once, weight ½) or a single pass
-    /// with A's nodes as slaves (weight 1).
+    /// Symmetric two-pass (each side slave once, weight ½ where both
+    /// passes see the spot, see [`forces`]) or a single pass with A's nodes
+    /// as slaves (weight 1).
     pub symmetric: bool,
 }
 
@@ -56,10 +57,33 @@ impl PairSettings {
             symmetric: true,
         }
     }
+}
 
-    fn pass_weight(&self) -> Real {
-        if self.symmetric { 0.5 } else { 1.0 }
-    }
+/// The partition weight w of constraint `c` among `constraints` (pass A→B
+/// then pass B→A, each in increasing slave order): ½ when the opposite
+/// pass also holds this spot (a corner of `c`'s face is a slave there),
+/// else 1.
+///
+/// **Choice (physics.md §5.3 gives w = ½ throughout):** with ½ on a
+/// one-sided contact (a node of A inside a face of B, no node of B inside
+/// A there, as at a vertex or an edge) only half the gap closed per step,
+/// and a 40-granule die kept up to 5 µm of penetration (3.6 % of the
+/// element size; `tests/assembly_die.rs`). Where both passes see the spot
+/// their two halves still add up to one closure.
+fn partition_weight(c: &Constraint, constraints: &[Constraint], quads: &[[u32; 4]]) -> Real {
+    let other = match c.side {
+        Side::A => Side::B,
+        Side::B => Side::A,
+    };
+    let split = constraints.partition_point(|k| k.side == Side::A);
+    let opposite = match other {
+        Side::A => &constraints[..split],
+        Side::B => &constraints[split..],
+    };
+    let shared = quads[c.quad as usize]
+        .iter()
+        .any(|&id| opposite.binary_search_by(|k| k.slave.cmp(&id)).is_ok());
+    if shared { 0.5 } else { 1.0 }
 }
 
 /// Which body of the pair holds a node.
@@ -158,16 +182,41 @@ impl fmt::Display for ContactError {
 
 impl core::error::Error for ContactError {}
 
+/// A master face near a pair's overlap region, cached once per pass: its
+/// predicted corners, its gap window and its box grown by the window.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct CandidateFace {
+    /// Quad id in the master body.
+    pub quad: u32,
+    /// Predicted corner positions, m.
+    pub corners: [Vec3; 4],
+    /// Gap window g_max of this face, m.
+    pub window: Real,
+    /// The face's box grown by `window`.
+    pub reach: Aabb,
+}
+
+impl Default for CandidateFace {
+    fn default() -> Self {
+        Self {
+            quad: 0,
+            corners: [[0.0; 3]; 4],
+            window: 0.0,
+            reach: Aabb::EMPTY,
+        }
+    }
+}
+
 /// Finds the constraints of the pair (A, B) on the predicted configuration
 /// and writes them to `out`, pass A→B first (A's nodes as slaves, in node
-/// order), then B→A when symmetric. `scratch` holds candidate quad ids and
-/// needs at least as many entries as the larger quad count. Returns the
-/// number of constraints.
+/// order), then B→A when symmetric. `scratch` holds the candidate faces of
+/// a pass and needs at least as many entries as the larger quad count.
+/// Returns the number of constraints.
 pub fn detect(
     a: &SurfaceBody<'_>,
     b: &SurfaceBody<'_>,
     settings: &PairSettings,
-    scratch: &mut [u32],
+    scratch: &mut [CandidateFace],
     out: &mut [Constraint],
 ) -> Result<usize, ContactError> {
     let need = a.quads.len().max(b.quads.len());
@@ -185,6 +234,10 @@ pub fn detect(
     Ok(count)
 }
 
+/// How far outside a face (in ξ, η beyond ±1) a node may project and still
+/// be tried against a concave edge.
+const EDGE_REACH: Real = 0.25;
+
 /// Largest face diagonal of quad `x`, m.
 fn face_diagonal(x: &[Vec3; 4]) -> Real {
     let d1 = norm(&sub(&x[2], &x[0]));
@@ -199,7 +252,7 @@ fn detect_pass(
     master: &SurfaceBody<'_>,
     side: Side,
     settings: &PairSettings,
-    scratch: &mut [u32],
+    scratch: &mut [CandidateFace],
     out: &mut [Constraint],
     start: usize,
 ) -> Result<usize, ContactError> {
@@ -211,23 +264,35 @@ fn detect_pass(
     if region.is_empty() {
         return Ok(start);
     }
-    // Master faces near the region.
+    // Master faces near the region and within reach of the slave's
+    // bounding sphere, with their windows and reach.
+    let slave_reach = slave.sphere.radius + m;
     let mut faces = 0;
     for q in 0..master.quads.len() {
-        let x = master.quad_pred(q);
-        if Aabb::of_points(&x).overlaps(&region) {
-            scratch[faces] = q as u32;
+        let corners = master.quad_pred(q);
+        let bounds = Aabb::of_points(&corners);
+        if bounds.overlaps(&region) && bounds.distance_to(&slave.sphere.centre) <= slave_reach {
+            let window = settings.window_fraction * face_diagonal(&corners);
+            scratch[faces] = CandidateFace {
+                quad: q as u32,
+                corners,
+                window,
+                reach: bounds.expanded(window),
+            };
             faces += 1;
         }
     }
     let candidates = &scratch[..faces];
     let mut count = start;
+    // Only nodes inside the master's bounding sphere can be behind its
+    // surface.
+    let (centre, reach) = (master.sphere.centre, master.sphere.radius + m);
     for s in slave.first_surface..slave.x_pred.len() {
         let p = slave.x_pred[s];
-        if !region.contains(&p) {
+        if !region.contains(&p) || norm(&sub(&p, &centre)) > reach {
             continue;
         }
-        if let Some(c) = closest_face(slave, master, s, candidates, settings) {
+        if let Some(c) = closest_face(slave, s, candidates, settings) {
             let slot = out.get_mut(count).ok_or(ContactError::Capacity {
                 buffer: "constraints",
                 capacity: count,
@@ -258,9 +323,8 @@ struct Hit {
 /// tried: the closest point on it with the faces' averaged normal.
 fn closest_face(
     slave: &SurfaceBody<'_>,
-    master: &SurfaceBody<'_>,
     s: usize,
-    candidates: &[u32],
+    candidates: &[CandidateFace],
     settings: &PairSettings,
 ) -> Option<Hit> {
     let p = slave.x_pred[s];
@@ -271,27 +335,26 @@ fn closest_face(
     };
     let mut best: Option<Hit> = None;
     let mut near_outside = false;
-    for &q in candidates {
-        let x = master.quad_pred(q as usize);
-        let window = settings.window_fraction * face_diagonal(&x);
-        if !Aabb::of_points(&x).expanded(window).contains(&p) {
+    for face in candidates {
+        if !face.reach.contains(&p) {
             continue;
         }
-        let Some(pr) = project(&p, &x) else {
+        let Some(pr) = project(&p, &face.corners) else {
             continue;
         };
-        if !(pr.gap < 0.0 && pr.gap > -window) {
+        if !(pr.gap < 0.0 && pr.gap > -face.window) {
             continue;
         }
         if !pr.inside(settings.inside_tolerance) {
-            near_outside = true;
+            // Only a node just off the face can be at a concave edge.
+            near_outside |= pr.inside(EDGE_REACH);
             continue;
         }
         if !opposing(&pr.normal) {
             continue;
         }
         let hit = Hit {
-            quad: q,
+            quad: face.quad,
             projection: pr,
         };
         if best
@@ -307,29 +370,22 @@ fn closest_face(
     if !near_outside {
         return None;
     }
-    concave_edge(master, &p, candidates, settings).filter(|h| opposing(&h.projection.normal))
+    concave_edge(&p, candidates).filter(|h| opposing(&h.projection.normal))
 }
 
 /// The closest point of `p` on the candidate faces confined to their
 /// edges, when two or more faces share it (a concave edge or corner): the
 /// normal is their average, the gap is measured along it.
-fn concave_edge(
-    master: &SurfaceBody<'_>,
-    p: &Vec3,
-    candidates: &[u32],
-    settings: &PairSettings,
-) -> Option<Hit> {
+fn concave_edge(p: &Vec3, candidates: &[CandidateFace]) -> Option<Hit> {
     let mut best: Option<(Real, u32, QuadProjection, Real)> = None;
-    for &q in candidates {
-        let x = master.quad_pred(q as usize);
-        let window = settings.window_fraction * face_diagonal(&x);
-        if !Aabb::of_points(&x).expanded(window).contains(p) {
+    for face in candidates {
+        if !face.reach.contains(p) {
             continue;
         }
-        if let Some(pr) = project_clamped(p, &x) {
+        if let Some(pr) = project_clamped(p, &face.corners) {
             let d = norm(&sub(p, &pr.point));
             if best.as_ref().is_none_or(|b| d < b.0) {
-                best = Some((d, q, pr, window));
+                best = Some((d, face.quad, pr, face.window));
             }
         }
     }
@@ -338,9 +394,11 @@ fn concave_edge(
     let tol = 1e-9 * window + 1e-15;
     let mut n = [0.0; 3];
     let mut sharing = 0;
-    for &q in candidates {
-        let x = master.quad_pred(q as usize);
-        if let Some(other) = project_clamped(p, &x)
+    for face in candidates {
+        if !face.reach.contains(p) {
+            continue;
+        }
+        if let Some(other) = project_clamped(p, &face.corners)
             && abs(norm(&sub(p, &other.point)) - dist) <= tol
             && norm(&sub(&other.point, &pr.point)) <= tol
         {
@@ -441,7 +499,6 @@ pub fn forces(
             got: out.len(),
         });
     }
-    let w = settings.pass_weight();
     let mu = settings.friction;
     let mut total = PairForce::default();
     let mut k = 0;
@@ -449,6 +506,11 @@ pub fn forces(
         let (slave, s_share, master, m_share, master_side) = match c.side {
             Side::A => (a.0, a.1, b.0, b.1, Side::B),
             Side::B => (b.0, b.1, a.0, a.1, Side::A),
+        };
+        let w = if settings.symmetric {
+            partition_weight(c, constraints, master.quads)
+        } else {
+            1.0
         };
         let s = c.slave as usize;
         let ids = master.quads[c.quad as usize].map(|i| i as usize);

@@ -3,6 +3,7 @@
 //! the axis-aligned boxes used to narrow a pair's work (physics.md §5.1).
 
 use crate::Real;
+use crate::contact::broad::Bound;
 use crate::contact::quad::{Vec3, cross, norm, sub};
 use crate::math::{max, min};
 
@@ -29,6 +30,9 @@ pub struct SurfaceBody<'a> {
     pub node_quads: &'a [[u32; 4]],
     /// Box of the predicted surface nodes ([`Aabb::of_surface`]).
     pub bounds: Aabb,
+    /// Bounding sphere of the predicted surface nodes
+    /// ([`crate::contact::broad::bounding_sphere`]).
+    pub sphere: Bound,
 }
 
 impl SurfaceBody<'_> {
@@ -119,6 +123,12 @@ impl Aabb {
     /// True if the boxes share a point.
     pub fn overlaps(&self, other: &Aabb) -> bool {
         (0..3).all(|a| self.lo[a] <= other.hi[a] && other.lo[a] <= self.hi[a])
+    }
+
+    /// Distance from `p` to the box (0 inside), m.
+    pub fn distance_to(&self, p: &Vec3) -> Real {
+        let d: Vec3 = core::array::from_fn(|a| max(0.0, max(self.lo[a] - p[a], p[a] - self.hi[a])));
+        norm(&d)
     }
 
     /// Length of the diagonal, m (0 for an empty box).
