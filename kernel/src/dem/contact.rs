@@ -148,6 +148,7 @@ pub struct ContactForce {
 /// pointing from the other body to i, relative velocity of i at the contact
 /// point `v_rel` (m/s), and spring history `xi` (m, in/out). `beta` from
 /// [`damping_beta`]; `dt` the step (s).
+#[inline(always)]
 pub fn hertz_mindlin(
     law: &ContactLaw,
     beta: Real,

@@ -543,6 +543,10 @@ impl<'a> PourScene<'a> {
     }
 
     /// Forces and torques at the current positions and velocities.
+    ///
+    /// Every force is summed in the order of the sorted pair list; sphere
+    /// i's own sums are kept in registers over its run of pairs (the pairs
+    /// (k, i) with k < i all come earlier), which adds in the same order.
     fn forces(&mut self) {
         let c = self.ramp(0.0, self.p.damping_max);
         // β is ramped linearly between the values that give the start and
@@ -555,52 +559,77 @@ impl<'a> PourScene<'a> {
             self.p.radius,
             self.dt,
         );
+        let (law_pp, law_pw, die_radius) = (&self.law_pp, &self.law_pw, self.p.die_radius);
         let b = &mut self.buf;
-        for k in 0..b.x.len() {
-            b.f[k] = [
-                -c * m * b.v[k][0],
-                -c * m * b.v[k][1],
-                -c * m * (b.v[k][2]) - m * g,
-            ];
-            b.torque[k] = b.omega[k].map(|w| -c * inertia * w);
+        let (cm, ci, mg) = (-c * m, -c * inertia, m * g);
+        for (((f, t), v), w) in
+            b.f.iter_mut()
+                .zip(b.torque.iter_mut())
+                .zip(b.v.iter())
+                .zip(b.omega.iter())
+        {
+            *f = [cm * v[0], cm * v[1], cm * v[2] - mg];
+            *t = [ci * w[0], ci * w[1], ci * w[2]];
         }
+        let (x, v, omega) = (&*b.x, &*b.v, &*b.omega);
+        let (f, torque) = (&mut *b.f, &mut *b.torque);
+        let two_r = 2.0 * r;
+        // Cheap rejections before any square root, with a margin far above
+        // round-off: beyond these the exact tests below fail anyway.
+        let apart2 = two_r * two_r * (1.0 + 1e-12);
+        let inside = die_radius - r;
+        let inside2 = if inside > 0.0 {
+            inside * inside * (1.0 - 1e-12)
+        } else {
+            0.0
+        };
         let (mut floor, mut wall_z) = (0.0, 0.0);
+        // Sphere i of the current run of pairs and its running sums.
+        let mut cur = usize::MAX;
+        let (mut fi, mut ti) = ([0.0; 3], [0.0; 3]);
+        let (mut xi, mut vi, mut wi) = ([0.0; 3], [0.0; 3], [0.0; 3]);
         for pair in b.pairs[..self.n_pairs].iter_mut() {
             let i = pair.i as usize;
-            let xi = b.x[i];
+            if i != cur {
+                if cur != usize::MAX {
+                    f[cur] = fi;
+                    torque[cur] = ti;
+                }
+                cur = i;
+                (fi, ti) = (f[i], torque[i]);
+                (xi, vi, wi) = (x[i], v[i], omega[i]);
+            }
             let (n, delta, law, vj, wj) = match pair.j {
-                FLOOR => ([0.0, 0.0, 1.0], r - xi[2], &self.law_pw, [0.0; 3], [0.0; 3]),
+                FLOOR => ([0.0, 0.0, 1.0], r - xi[2], law_pw, [0.0; 3], [0.0; 3]),
                 DIE => {
-                    let rr = math::sqrt(xi[0] * xi[0] + xi[1] * xi[1]);
+                    let rr2 = xi[0] * xi[0] + xi[1] * xi[1];
+                    if rr2 < inside2 {
+                        pair.xi = [0.0; 3];
+                        continue;
+                    }
+                    let rr = math::sqrt(rr2);
                     let n = if rr > 0.0 {
                         [-xi[0] / rr, -xi[1] / rr, 0.0]
                     } else {
                         [1.0, 0.0, 0.0]
                     };
-                    (
-                        n,
-                        rr + r - self.p.die_radius,
-                        &self.law_pw,
-                        [0.0; 3],
-                        [0.0; 3],
-                    )
+                    (n, rr + r - die_radius, law_pw, [0.0; 3], [0.0; 3])
                 }
                 j => {
-                    let xj = b.x[j as usize];
+                    let xj = x[j as usize];
                     let d = [xi[0] - xj[0], xi[1] - xj[1], xi[2] - xj[2]];
-                    let dist = math::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+                    let d2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
+                    if d2 > apart2 {
+                        pair.xi = [0.0; 3];
+                        continue;
+                    }
+                    let dist = math::sqrt(d2);
                     let n = if dist > 0.0 {
                         d.map(|c| c / dist)
                     } else {
                         [0.0, 0.0, 1.0]
                     };
-                    (
-                        n,
-                        2.0 * r - dist,
-                        &self.law_pp,
-                        b.v[j as usize],
-                        b.omega[j as usize],
-                    )
+                    (n, two_r - dist, law_pp, v[j as usize], omega[j as usize])
                 }
             };
             if delta <= 0.0 {
@@ -609,14 +638,13 @@ impl<'a> PourScene<'a> {
             }
             // Relative velocity of i at the contact point: the contact sits at
             // −r n from i and, for a sphere partner, +r n from j.
-            let wi = b.omega[i];
             let w = [wi[0] + wj[0], wi[1] + wj[1], wi[2] + wj[2]];
             let wxn = [
                 w[1] * n[2] - w[2] * n[1],
                 w[2] * n[0] - w[0] * n[2],
                 w[0] * n[1] - w[1] * n[0],
             ];
-            let v_rel: [Real; 3] = core::array::from_fn(|a| b.v[i][a] - vj[a] - r * wxn[a]);
+            let v_rel: [Real; 3] = core::array::from_fn(|a| vi[a] - vj[a] - r * wxn[a]);
             let cf = hertz_mindlin(law, beta, delta, &n, &v_rel, &mut pair.xi, dt);
             let ft = cf.tangential;
             // Torque on i: (−r n) × F_t; on a sphere j: (r n) × (−F_t), the same.
@@ -625,42 +653,58 @@ impl<'a> PourScene<'a> {
                 -r * (n[2] * ft[0] - n[0] * ft[2]),
                 -r * (n[0] * ft[1] - n[1] * ft[0]),
             ];
-            for (a, ta) in t.iter().enumerate() {
-                b.f[i][a] += cf.force[a];
-                b.torque[i][a] += ta;
+            for a in 0..3 {
+                fi[a] += cf.force[a];
+                ti[a] += t[a];
             }
             match pair.j {
                 FLOOR => floor += cf.force[2],
                 DIE => wall_z += cf.force[2],
                 j => {
-                    for (a, ta) in t.iter().enumerate() {
-                        b.f[j as usize][a] -= cf.force[a];
-                        b.torque[j as usize][a] += ta;
+                    let (fj, tj) = (&mut f[j as usize], &mut torque[j as usize]);
+                    for a in 0..3 {
+                        fj[a] -= cf.force[a];
+                        tj[a] += t[a];
                     }
                 }
             }
+        }
+        if cur != usize::MAX {
+            f[cur] = fi;
+            torque[cur] = ti;
         }
         self.floor_force = floor;
         self.wall_friction_z = wall_z;
     }
 
+    /// Half a kick of the velocities and spins by the current forces.
+    fn kick(&mut self) {
+        let (half, m, inertia) = (0.5 * self.dt, self.mass, self.inertia);
+        let b = &mut self.buf;
+        for (((v, w), f), t) in
+            b.v.iter_mut()
+                .zip(b.omega.iter_mut())
+                .zip(b.f.iter())
+                .zip(b.torque.iter())
+        {
+            for a in 0..3 {
+                v[a] += half * f[a] / m;
+                w[a] += half * t[a] / inertia;
+            }
+        }
+    }
+
     /// One velocity-Verlet step.
     pub fn step(&mut self) -> Result<(), PourError> {
-        let (dt, m, inertia) = (self.dt, self.mass, self.inertia);
-        let half = 0.5 * dt;
+        let dt = self.dt;
+        self.kick();
         let b = &mut self.buf;
         let mut moved: Real = 0.0;
-        for k in 0..b.x.len() {
+        for ((x, v), xb) in b.x.iter_mut().zip(b.v.iter()).zip(b.x_built.iter()) {
             for a in 0..3 {
-                b.v[k][a] += half * b.f[k][a] / m;
-                b.omega[k][a] += half * b.torque[k][a] / inertia;
-                b.x[k][a] += dt * b.v[k][a];
+                x[a] += dt * v[a];
             }
-            let d = [
-                b.x[k][0] - b.x_built[k][0],
-                b.x[k][1] - b.x_built[k][1],
-                b.x[k][2] - b.x_built[k][2],
-            ];
+            let d = [x[0] - xb[0], x[1] - xb[1], x[2] - xb[2]];
             moved = moved.max(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
         }
         if !moved.is_finite() {
@@ -673,13 +717,7 @@ impl<'a> PourScene<'a> {
             self.rebuild()?;
         }
         self.forces();
-        let b = &mut self.buf;
-        for k in 0..b.x.len() {
-            for a in 0..3 {
-                b.v[k][a] += half * b.f[k][a] / m;
-                b.omega[k][a] += half * b.torque[k][a] / inertia;
-            }
-        }
+        self.kick();
         Ok(())
     }
 
