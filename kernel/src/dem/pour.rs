@@ -336,9 +336,12 @@ pub struct PourBuffers<'a> {
     pub v: &'a mut [[Real; 3]],
     /// Angular velocities, rad/s.
     pub omega: &'a mut [[Real; 3]],
-    /// Forces of the last evaluation, N.
+    /// Forces of the last evaluation, N, turned into the half kick
+    /// Δt/2 · F/m (m/s) once complete: both half kicks around a force
+    /// evaluation add the same increment, so it is divided out once.
     pub f: &'a mut [[Real; 3]],
-    /// Torques of the last evaluation, N m.
+    /// Torques of the last evaluation, N m, turned into the half kick
+    /// Δt/2 · T/I (rad/s) like `f`.
     pub torque: &'a mut [[Real; 3]],
     /// Centres when the pair list was built, m.
     pub x_built: &'a mut [[Real; 3]],
@@ -675,21 +678,31 @@ impl<'a> PourScene<'a> {
         }
         self.floor_force = floor;
         self.wall_friction_z = wall_z;
+        // The half kicks Δt/2 · F/m and Δt/2 · T/I, as velocity Verlet adds
+        // them (the same operations, so the same bits, as dividing in each
+        // of the two kicks).
+        let half = 0.5 * dt;
+        for (fk, tk) in f.iter_mut().zip(torque.iter_mut()) {
+            for a in 0..3 {
+                fk[a] = half * fk[a] / m;
+                tk[a] = half * tk[a] / inertia;
+            }
+        }
     }
 
-    /// Half a kick of the velocities and spins by the current forces.
+    /// Half a kick of the velocities and spins by the current forces
+    /// (already turned into velocity increments by [`Self::forces`]).
     fn kick(&mut self) {
-        let (half, m, inertia) = (0.5 * self.dt, self.mass, self.inertia);
         let b = &mut self.buf;
-        for (((v, w), f), t) in
+        for (((v, w), dv), dw) in
             b.v.iter_mut()
                 .zip(b.omega.iter_mut())
                 .zip(b.f.iter())
                 .zip(b.torque.iter())
         {
             for a in 0..3 {
-                v[a] += half * f[a] / m;
-                w[a] += half * t[a] / inertia;
+                v[a] += dv[a];
+                w[a] += dw[a];
             }
         }
     }
@@ -697,11 +710,18 @@ impl<'a> PourScene<'a> {
     /// One velocity-Verlet step.
     pub fn step(&mut self) -> Result<(), PourError> {
         let dt = self.dt;
-        self.kick();
         let b = &mut self.buf;
         let mut moved: Real = 0.0;
-        for ((x, v), xb) in b.x.iter_mut().zip(b.v.iter()).zip(b.x_built.iter()) {
+        // Half kick and drift.
+        for (((x, v), (w, xb)), (dv, dw)) in
+            b.x.iter_mut()
+                .zip(b.v.iter_mut())
+                .zip(b.omega.iter_mut().zip(b.x_built.iter()))
+                .zip(b.f.iter().zip(b.torque.iter()))
+        {
             for a in 0..3 {
+                v[a] += dv[a];
+                w[a] += dw[a];
                 x[a] += dt * v[a];
             }
             let d = [x[0] - xb[0], x[1] - xb[1], x[2] - xb[2]];
