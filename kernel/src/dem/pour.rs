@@ -7,7 +7,10 @@
 use core::fmt;
 
 use crate::Real;
-use crate::dem::contact::{ContactLaw, hertz_beta, hertz_mindlin};
+use crate::dem::contact::{ContactLanes, ContactLaw, hertz_beta, hertz_mindlin_lanes};
+
+/// Contacts evaluated side by side ([`hertz_mindlin_lanes`]).
+const LANES: usize = 4;
 use crate::dem::neighbors::{DIE, FLOOR, Grid, GridScratch, Pair, PairOverflow, build_pairs};
 use crate::math;
 use crate::rng::Rng;
@@ -590,87 +593,108 @@ impl<'a> PourScene<'a> {
         // Sphere i of the current run of pairs and its running sums.
         let mut cur = usize::MAX;
         let (mut fi, mut ti) = ([0.0; 3], [0.0; 3]);
-        let (mut xi, mut vi, mut wi) = ([0.0; 3], [0.0; 3], [0.0; 3]);
-        for pair in b.pairs[..self.n_pairs].iter_mut() {
-            let i = pair.i as usize;
-            if i != cur {
-                if cur != usize::MAX {
-                    f[cur] = fi;
-                    torque[cur] = ti;
-                }
-                cur = i;
-                (fi, ti) = (f[i], torque[i]);
-                (xi, vi, wi) = (x[i], v[i], omega[i]);
-            }
-            let (n, delta, law, vj, wj) = match pair.j {
-                FLOOR => ([0.0, 0.0, 1.0], r - xi[2], law_pw, [0.0; 3], [0.0; 3]),
-                DIE => {
-                    let rr2 = xi[0] * xi[0] + xi[1] * xi[1];
-                    if rr2 < inside2 {
-                        pair.xi = [0.0; 3];
-                        continue;
+        // Contacts found in pair order wait in `lanes` (pair index in `at`)
+        // until LANES of them can be evaluated together; their forces are
+        // then added in pair order.
+        let mut lanes = ContactLanes::<LANES>::ZERO;
+        let mut at = [0usize; LANES];
+        let mut filled = 0;
+        let pairs = &mut b.pairs[..self.n_pairs];
+        let last = pairs.len();
+        for k in 0..=last {
+            if k < last {
+                let pair = &mut pairs[k];
+                let i = pair.i as usize;
+                let xi = x[i];
+                let (n, delta, law, vj, wj) = match pair.j {
+                    FLOOR => ([0.0, 0.0, 1.0], r - xi[2], law_pw, [0.0; 3], [0.0; 3]),
+                    DIE => {
+                        let rr2 = xi[0] * xi[0] + xi[1] * xi[1];
+                        if rr2 < inside2 {
+                            pair.xi = [0.0; 3];
+                            continue;
+                        }
+                        let rr = math::sqrt(rr2);
+                        let n = if rr > 0.0 {
+                            [-xi[0] / rr, -xi[1] / rr, 0.0]
+                        } else {
+                            [1.0, 0.0, 0.0]
+                        };
+                        (n, rr + r - die_radius, law_pw, [0.0; 3], [0.0; 3])
                     }
-                    let rr = math::sqrt(rr2);
-                    let n = if rr > 0.0 {
-                        [-xi[0] / rr, -xi[1] / rr, 0.0]
-                    } else {
-                        [1.0, 0.0, 0.0]
-                    };
-                    (n, rr + r - die_radius, law_pw, [0.0; 3], [0.0; 3])
-                }
-                j => {
-                    let xj = x[j as usize];
-                    let d = [xi[0] - xj[0], xi[1] - xj[1], xi[2] - xj[2]];
-                    let d2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
-                    if d2 > apart2 {
-                        pair.xi = [0.0; 3];
-                        continue;
+                    j => {
+                        let xj = x[j as usize];
+                        let d = [xi[0] - xj[0], xi[1] - xj[1], xi[2] - xj[2]];
+                        let d2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
+                        if d2 > apart2 {
+                            pair.xi = [0.0; 3];
+                            continue;
+                        }
+                        let dist = math::sqrt(d2);
+                        let n = if dist > 0.0 {
+                            d.map(|c| c / dist)
+                        } else {
+                            [0.0, 0.0, 1.0]
+                        };
+                        (n, two_r - dist, law_pp, v[j as usize], omega[j as usize])
                     }
-                    let dist = math::sqrt(d2);
-                    let n = if dist > 0.0 {
-                        d.map(|c| c / dist)
-                    } else {
-                        [0.0, 0.0, 1.0]
-                    };
-                    (n, two_r - dist, law_pp, v[j as usize], omega[j as usize])
+                };
+                if delta <= 0.0 {
+                    pair.xi = [0.0; 3];
+                    continue;
                 }
-            };
-            if delta <= 0.0 {
-                pair.xi = [0.0; 3];
-                continue;
+                let (vi, wi) = (v[i], omega[i]);
+                let l = filled;
+                lanes.set_law(l, law);
+                lanes.delta[l] = delta;
+                for a in 0..3 {
+                    lanes.n[a][l] = n[a];
+                    lanes.dv[a][l] = vi[a] - vj[a];
+                    lanes.w[a][l] = wi[a] + wj[a];
+                    lanes.xi[a][l] = pair.xi[a];
+                }
+                at[l] = k;
+                filled += 1;
+                if filled < LANES {
+                    continue;
+                }
+            } else if filled == 0 {
+                break;
             }
-            // Relative velocity of i at the contact point: the contact sits at
-            // −r n from i and, for a sphere partner, +r n from j.
-            let w = [wi[0] + wj[0], wi[1] + wj[1], wi[2] + wj[2]];
-            let wxn = [
-                w[1] * n[2] - w[2] * n[1],
-                w[2] * n[0] - w[0] * n[2],
-                w[0] * n[1] - w[1] * n[0],
-            ];
-            let v_rel: [Real; 3] = core::array::from_fn(|a| vi[a] - vj[a] - r * wxn[a]);
-            let cf = hertz_mindlin(law, beta, delta, &n, &v_rel, &mut pair.xi, dt);
-            let ft = cf.tangential;
-            // Torque on i: (−r n) × F_t; on a sphere j: (r n) × (−F_t), the same.
-            let t = [
-                -r * (n[1] * ft[2] - n[2] * ft[1]),
-                -r * (n[2] * ft[0] - n[0] * ft[2]),
-                -r * (n[0] * ft[1] - n[1] * ft[0]),
-            ];
-            for a in 0..3 {
-                fi[a] += cf.force[a];
-                ti[a] += t[a];
-            }
-            match pair.j {
-                FLOOR => floor += cf.force[2],
-                DIE => wall_z += cf.force[2],
-                j => {
-                    let (fj, tj) = (&mut f[j as usize], &mut torque[j as usize]);
-                    for a in 0..3 {
-                        fj[a] -= cf.force[a];
-                        tj[a] += t[a];
+            // Evaluate the waiting contacts (at the end, the unused lanes
+            // repeat old inputs and are ignored).
+            hertz_mindlin_lanes(&mut lanes, beta, r, dt);
+            for l in 0..filled {
+                let pair = &mut pairs[at[l]];
+                let i = pair.i as usize;
+                if i != cur {
+                    if cur != usize::MAX {
+                        f[cur] = fi;
+                        torque[cur] = ti;
+                    }
+                    cur = i;
+                    (fi, ti) = (f[i], torque[i]);
+                }
+                let force = [lanes.force[0][l], lanes.force[1][l], lanes.force[2][l]];
+                let t = [lanes.torque[0][l], lanes.torque[1][l], lanes.torque[2][l]];
+                pair.xi = [lanes.xi[0][l], lanes.xi[1][l], lanes.xi[2][l]];
+                for a in 0..3 {
+                    fi[a] += force[a];
+                    ti[a] += t[a];
+                }
+                match pair.j {
+                    FLOOR => floor += force[2],
+                    DIE => wall_z += force[2],
+                    j => {
+                        let (fj, tj) = (&mut f[j as usize], &mut torque[j as usize]);
+                        for a in 0..3 {
+                            fj[a] -= force[a];
+                            tj[a] += t[a];
+                        }
                     }
                 }
             }
+            filled = 0;
         }
         if cur != usize::MAX {
             f[cur] = fi;
