@@ -1,11 +1,14 @@
 //! Criterion benches of the discrete-element pour: one velocity-Verlet step
 //! of a settled-looking 1000-sphere bed (the state after 150 000 steps of
-//! the standard pour, seed 1), and one Hertz–Mindlin contact evaluation.
+//! the standard pour, seed 1), one Hertz–Mindlin contact evaluation, and
+//! four contacts evaluated together in lanes (as the pour does).
 
 use core::hint::black_box;
 
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
-use granbed_kernel::dem::contact::{ContactLaw, hertz_beta, hertz_mindlin};
+use granbed_kernel::dem::contact::{
+    ContactLanes, ContactLaw, hertz_beta, hertz_mindlin, hertz_mindlin_lanes,
+};
 use granbed_kernel::dem::neighbors::Pair;
 use granbed_kernel::dem::pour::{PourBuffers, PourParams, PourScene};
 
@@ -66,5 +69,31 @@ fn bench_dem(c: &mut Criterion) {
     });
 }
 
-criterion_group!(benches, bench_dem);
+fn bench_lanes(c: &mut Criterion) {
+    let law = ContactLaw::sphere_sphere(100e6, 0.3, 0.5e-3, 6e-7, 0.1);
+    let beta = hertz_beta(0.3);
+    let mut lanes = ContactLanes::<4>::ZERO;
+    for l in 0..4 {
+        lanes.set_law(l, &law);
+        lanes.delta[l] = 1e-7 * (1.0 + 0.1 * l as f64);
+        lanes.n[1][l] = 0.6;
+        lanes.n[2][l] = 0.8;
+        lanes.dv[0][l] = 1e-4;
+        lanes.dv[1][l] = 2e-4;
+        lanes.dv[2][l] = -1e-4;
+        lanes.xi[0][l] = 1e-8;
+    }
+    let mut group = c.benchmark_group("dem");
+    group.throughput(Throughput::Elements(4));
+    group.bench_function("hertz_mindlin_4_lanes", |b| {
+        b.iter(|| {
+            let mut c = black_box(lanes);
+            hertz_mindlin_lanes(&mut c, beta, 0.5e-3, 1e-6);
+            black_box(c.force)
+        })
+    });
+    group.finish();
+}
+
+criterion_group!(benches, bench_dem, bench_lanes);
 criterion_main!(benches);

@@ -148,6 +148,7 @@ pub struct ContactForce {
 /// pointing from the other body to i, relative velocity of i at the contact
 /// point `v_rel` (m/s), and spring history `xi` (m, in/out). `beta` from
 /// [`damping_beta`]; `dt` the step (s).
+#[inline(always)]
 pub fn hertz_mindlin(
     law: &ContactLaw,
     beta: Real,
@@ -195,6 +196,130 @@ pub fn hertz_mindlin(
     }
 }
 
+/// `L` contacts evaluated side by side, component-major (`n[a][l]` is
+/// component a of lane l) so that the compiler can pair the lanes in SIMD
+/// registers. Inputs are set by the caller; [`hertz_mindlin_lanes`] fills
+/// `force`, `torque` and updates `xi`.
+#[derive(Clone, Copy, Debug)]
+pub struct ContactLanes<const L: usize> {
+    /// Effective radius R* of each lane's law, m.
+    pub r_star: [Real; L],
+    /// Effective Young's modulus E* of each lane's law, Pa.
+    pub e_star: [Real; L],
+    /// G* of each lane's law, Pa.
+    pub g_star: [Real; L],
+    /// Friction coefficient of each lane's law.
+    pub friction: [Real; L],
+    /// [`ContactLaw::damping_normal`] of each lane's law.
+    pub damping_normal: [Real; L],
+    /// [`ContactLaw::damping_tangential`] of each lane's law.
+    pub damping_tangential: [Real; L],
+    /// Overlap δ > 0, m.
+    pub delta: [Real; L],
+    /// Unit normal from the partner to sphere i.
+    pub n: [[Real; L]; 3],
+    /// v_i − v_j (v_j = 0 for a wall), m/s.
+    pub dv: [[Real; L]; 3],
+    /// ω_i + ω_j (ω_j = 0 for a wall), rad/s.
+    pub w: [[Real; L]; 3],
+    /// Tangential spring history ξ, m (in/out).
+    pub xi: [[Real; L]; 3],
+    /// Force on sphere i (out), N.
+    pub force: [[Real; L]; 3],
+    /// Torque on sphere i, and on a sphere partner j (out), N m.
+    pub torque: [[Real; L]; 3],
+}
+
+impl<const L: usize> ContactLanes<L> {
+    /// All lanes zero.
+    pub const ZERO: Self = Self {
+        r_star: [0.0; L],
+        e_star: [0.0; L],
+        g_star: [0.0; L],
+        friction: [0.0; L],
+        damping_normal: [0.0; L],
+        damping_tangential: [0.0; L],
+        delta: [0.0; L],
+        n: [[0.0; L]; 3],
+        dv: [[0.0; L]; 3],
+        w: [[0.0; L]; 3],
+        xi: [[0.0; L]; 3],
+        force: [[0.0; L]; 3],
+        torque: [[0.0; L]; 3],
+    };
+
+    /// Sets lane `l`'s law.
+    #[inline(always)]
+    pub fn set_law(&mut self, l: usize, law: &ContactLaw) {
+        self.r_star[l] = law.r_star;
+        self.e_star[l] = law.e_star;
+        self.g_star[l] = law.g_star;
+        self.friction[l] = law.friction;
+        self.damping_normal[l] = law.damping_normal;
+        self.damping_tangential[l] = law.damping_tangential;
+    }
+}
+
+#[inline(always)]
+fn lane<const L: usize>(f: impl FnMut(usize) -> Real) -> [Real; L] {
+    core::array::from_fn(f)
+}
+
+/// [`hertz_mindlin`] for `L` contacts at once, followed by the torque
+/// (−r n) × F_t on sphere i (the same on a sphere partner) of spheres of
+/// radius `r`, with v_rel = (v_i − v_j) − r (ω_i + ω_j) × n. Every lane does
+/// exactly the operations of the single-contact path, in the same order,
+/// so the results are the same bits.
+#[inline(always)]
+pub fn hertz_mindlin_lanes<const L: usize>(c: &mut ContactLanes<L>, beta: Real, r: Real, dt: Real) {
+    let (n, w) = (&c.n, &c.w);
+    let wxn = [
+        lane::<L>(|l| w[1][l] * n[2][l] - w[2][l] * n[1][l]),
+        lane::<L>(|l| w[2][l] * n[0][l] - w[0][l] * n[2][l]),
+        lane::<L>(|l| w[0][l] * n[1][l] - w[1][l] * n[0][l]),
+    ];
+    let v_rel: [[Real; L]; 3] = core::array::from_fn(|a| lane::<L>(|l| c.dv[a][l] - r * wxn[a][l]));
+    let root = lane::<L>(|l| math::sqrt(c.r_star[l] * c.delta[l]));
+    let s_n = lane::<L>(|l| 2.0 * c.e_star[l] * root[l]);
+    let s_t = lane::<L>(|l| 8.0 * c.g_star[l] * root[l]);
+    let quarter = lane::<L>(|l| -beta * math::sqrt(root[l]));
+    let gamma_n = lane::<L>(|l| quarter[l] * c.damping_normal[l]);
+    let gamma_t = lane::<L>(|l| quarter[l] * c.damping_tangential[l]);
+    let vn = lane::<L>(|l| v_rel[0][l] * n[0][l] + v_rel[1][l] * n[1][l] + v_rel[2][l] * n[2][l]);
+    let push = lane::<L>(|l| (2.0 / 3.0) * s_n[l] * c.delta[l] - gamma_n[l] * vn[l]);
+    let normal = lane::<L>(|l| if push[l] > 0.0 { push[l] } else { 0.0 });
+    let vt: [[Real; L]; 3] = core::array::from_fn(|a| lane::<L>(|l| v_rel[a][l] - vn[l] * n[a][l]));
+    let xi = &mut c.xi;
+    let xn = lane::<L>(|l| xi[0][l] * n[0][l] + xi[1][l] * n[1][l] + xi[2][l] * n[2][l]);
+    for a in 0..3 {
+        xi[a] = lane::<L>(|l| xi[a][l] + (-xn[l] * n[a][l] + vt[a][l] * dt));
+    }
+    let mut ft: [[Real; L]; 3] =
+        core::array::from_fn(|a| lane::<L>(|l| -s_t[l] * xi[a][l] - gamma_t[l] * vt[a][l]));
+    let ft2 = lane::<L>(|l| ft[0][l] * ft[0][l] + ft[1][l] * ft[1][l] + ft[2][l] * ft[2][l]);
+    let cap = lane::<L>(|l| c.friction[l] * normal[l]);
+    for l in 0..L {
+        if ft2[l] > cap[l] * cap[l] {
+            let ft_mag = math::sqrt(ft2[l]);
+            let scale = if ft_mag > 0.0 { cap[l] / ft_mag } else { 0.0 };
+            for a in 0..3 {
+                ft[a][l] *= scale;
+                xi[a][l] = if s_t[l] > 0.0 {
+                    -(ft[a][l] + gamma_t[l] * vt[a][l]) / s_t[l]
+                } else {
+                    0.0
+                };
+            }
+        }
+    }
+    c.force = core::array::from_fn(|a| lane::<L>(|l| normal[l] * n[a][l] + ft[a][l]));
+    c.torque = [
+        lane::<L>(|l| -r * (n[1][l] * ft[2][l] - n[2][l] * ft[1][l])),
+        lane::<L>(|l| -r * (n[2][l] * ft[0][l] - n[0][l] * ft[2][l])),
+        lane::<L>(|l| -r * (n[0][l] * ft[1][l] - n[1][l] * ft[0][l])),
+    ];
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -239,5 +364,62 @@ mod tests {
         }
         let f_n = 4.0 / 3.0 * law.e_star * law.r_star.sqrt() * 1e-9;
         assert!((last - 0.1 * f_n).abs() < 1e-9 * f_n, "slides at mu F_n");
+    }
+    #[test]
+    fn lanes_give_the_bits_of_the_single_contact() {
+        let pp = ContactLaw::sphere_sphere(100e6, 0.3, 0.5e-3, 6e-7, 0.1);
+        let pw = ContactLaw::sphere_wall(100e6, 0.3, 0.5e-3, 6e-7, 0.1);
+        let (beta, r, dt) = (hertz_beta(0.5), 0.5e-3, 1e-6);
+        let mut rng = crate::rng::Rng::new(3);
+        let mut slips = 0;
+        for round in 0..500 {
+            let mut c = ContactLanes::<4>::ZERO;
+            let mut single = [([0.0; 3], [0.0; 3], [0.0; 3]); 4];
+            for (l, out) in single.iter_mut().enumerate() {
+                let law = if (round + l) % 3 == 0 { &pw } else { &pp };
+                c.set_law(l, law);
+                let d: [Real; 3] = core::array::from_fn(|_| rng.uniform(-1.0, 1.0));
+                let len = math::sqrt(dot(&d, &d));
+                let n = d.map(|x| x / len);
+                let delta = rng.uniform(1e-9, 1e-6);
+                let dv: [Real; 3] = core::array::from_fn(|_| rng.uniform(-1e-3, 1e-3));
+                let w: [Real; 3] = core::array::from_fn(|_| rng.uniform(-1.0, 1.0));
+                let mut xi: [Real; 3] = core::array::from_fn(|_| rng.uniform(-1e-8, 1e-8));
+                c.delta[l] = delta;
+                for a in 0..3 {
+                    (c.n[a][l], c.dv[a][l], c.w[a][l], c.xi[a][l]) = (n[a], dv[a], w[a], xi[a]);
+                }
+                // The single-contact path of the pour before the lanes.
+                let wxn = [
+                    w[1] * n[2] - w[2] * n[1],
+                    w[2] * n[0] - w[0] * n[2],
+                    w[0] * n[1] - w[1] * n[0],
+                ];
+                let v_rel: [Real; 3] = core::array::from_fn(|a| dv[a] - r * wxn[a]);
+                let f = hertz_mindlin(law, beta, delta, &n, &v_rel, &mut xi, dt);
+                let ft = f.tangential;
+                slips += usize::from(
+                    dot(&ft, &ft) >= (0.1 * f.normal) * (0.1 * f.normal) * (1.0 - 1e-9),
+                );
+                let t = [
+                    -r * (n[1] * ft[2] - n[2] * ft[1]),
+                    -r * (n[2] * ft[0] - n[0] * ft[2]),
+                    -r * (n[0] * ft[1] - n[1] * ft[0]),
+                ];
+                *out = (f.force, t, xi);
+            }
+            hertz_mindlin_lanes(&mut c, beta, r, dt);
+            for (l, (force, t, xi)) in single.iter().enumerate() {
+                for a in 0..3 {
+                    assert_eq!(c.force[a][l].to_bits(), force[a].to_bits());
+                    assert_eq!(c.torque[a][l].to_bits(), t[a].to_bits());
+                    assert_eq!(c.xi[a][l].to_bits(), xi[a].to_bits());
+                }
+            }
+        }
+        assert!(
+            slips > 100 && slips < 1900,
+            "both sticking and sliding: {slips}"
+        );
     }
 }

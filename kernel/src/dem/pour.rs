@@ -7,7 +7,10 @@
 use core::fmt;
 
 use crate::Real;
-use crate::dem::contact::{ContactLaw, hertz_beta, hertz_mindlin};
+use crate::dem::contact::{ContactLanes, ContactLaw, hertz_beta, hertz_mindlin_lanes};
+
+/// Contacts evaluated side by side ([`hertz_mindlin_lanes`]).
+const LANES: usize = 4;
 use crate::dem::neighbors::{DIE, FLOOR, Grid, GridScratch, Pair, PairOverflow, build_pairs};
 use crate::math;
 use crate::rng::Rng;
@@ -336,9 +339,12 @@ pub struct PourBuffers<'a> {
     pub v: &'a mut [[Real; 3]],
     /// Angular velocities, rad/s.
     pub omega: &'a mut [[Real; 3]],
-    /// Forces of the last evaluation, N.
+    /// Forces of the last evaluation, N, turned into the half kick
+    /// Δt/2 · F/m (m/s) once complete: both half kicks around a force
+    /// evaluation add the same increment, so it is divided out once.
     pub f: &'a mut [[Real; 3]],
-    /// Torques of the last evaluation, N m.
+    /// Torques of the last evaluation, N m, turned into the half kick
+    /// Δt/2 · T/I (rad/s) like `f`.
     pub torque: &'a mut [[Real; 3]],
     /// Centres when the pair list was built, m.
     pub x_built: &'a mut [[Real; 3]],
@@ -543,6 +549,10 @@ impl<'a> PourScene<'a> {
     }
 
     /// Forces and torques at the current positions and velocities.
+    ///
+    /// Every force is summed in the order of the sorted pair list; sphere
+    /// i's own sums are kept in registers over its run of pairs (the pairs
+    /// (k, i) with k < i all come earlier), which adds in the same order.
     fn forces(&mut self) {
         let c = self.ramp(0.0, self.p.damping_max);
         // β is ramped linearly between the values that give the start and
@@ -555,112 +565,190 @@ impl<'a> PourScene<'a> {
             self.p.radius,
             self.dt,
         );
+        let (law_pp, law_pw, die_radius) = (&self.law_pp, &self.law_pw, self.p.die_radius);
         let b = &mut self.buf;
-        for k in 0..b.x.len() {
-            b.f[k] = [
-                -c * m * b.v[k][0],
-                -c * m * b.v[k][1],
-                -c * m * (b.v[k][2]) - m * g,
-            ];
-            b.torque[k] = b.omega[k].map(|w| -c * inertia * w);
+        let (cm, ci, mg) = (-c * m, -c * inertia, m * g);
+        for (((f, t), v), w) in
+            b.f.iter_mut()
+                .zip(b.torque.iter_mut())
+                .zip(b.v.iter())
+                .zip(b.omega.iter())
+        {
+            *f = [cm * v[0], cm * v[1], cm * v[2] - mg];
+            *t = [ci * w[0], ci * w[1], ci * w[2]];
         }
+        let (x, v, omega) = (&*b.x, &*b.v, &*b.omega);
+        let (f, torque) = (&mut *b.f, &mut *b.torque);
+        let two_r = 2.0 * r;
+        // Cheap rejections before any square root, with a margin far above
+        // round-off: beyond these the exact tests below fail anyway.
+        let apart2 = two_r * two_r * (1.0 + 1e-12);
+        let inside = die_radius - r;
+        let inside2 = if inside > 0.0 {
+            inside * inside * (1.0 - 1e-12)
+        } else {
+            0.0
+        };
         let (mut floor, mut wall_z) = (0.0, 0.0);
-        for pair in b.pairs[..self.n_pairs].iter_mut() {
-            let i = pair.i as usize;
-            let xi = b.x[i];
-            let (n, delta, law, vj, wj) = match pair.j {
-                FLOOR => ([0.0, 0.0, 1.0], r - xi[2], &self.law_pw, [0.0; 3], [0.0; 3]),
-                DIE => {
-                    let rr = math::sqrt(xi[0] * xi[0] + xi[1] * xi[1]);
-                    let n = if rr > 0.0 {
-                        [-xi[0] / rr, -xi[1] / rr, 0.0]
-                    } else {
-                        [1.0, 0.0, 0.0]
-                    };
-                    (
-                        n,
-                        rr + r - self.p.die_radius,
-                        &self.law_pw,
-                        [0.0; 3],
-                        [0.0; 3],
-                    )
+        // Sphere i of the current run of pairs and its running sums.
+        let mut cur = usize::MAX;
+        let (mut fi, mut ti) = ([0.0; 3], [0.0; 3]);
+        // Contacts found in pair order wait in `lanes` (pair index in `at`)
+        // until LANES of them can be evaluated together; their forces are
+        // then added in pair order.
+        let mut lanes = ContactLanes::<LANES>::ZERO;
+        let mut at = [0usize; LANES];
+        let mut filled = 0;
+        let pairs = &mut b.pairs[..self.n_pairs];
+        let last = pairs.len();
+        for k in 0..=last {
+            if k < last {
+                let pair = &mut pairs[k];
+                let i = pair.i as usize;
+                let xi = x[i];
+                let (n, delta, law, vj, wj) = match pair.j {
+                    FLOOR => ([0.0, 0.0, 1.0], r - xi[2], law_pw, [0.0; 3], [0.0; 3]),
+                    DIE => {
+                        let rr2 = xi[0] * xi[0] + xi[1] * xi[1];
+                        if rr2 < inside2 {
+                            pair.xi = [0.0; 3];
+                            continue;
+                        }
+                        let rr = math::sqrt(rr2);
+                        let n = if rr > 0.0 {
+                            [-xi[0] / rr, -xi[1] / rr, 0.0]
+                        } else {
+                            [1.0, 0.0, 0.0]
+                        };
+                        (n, rr + r - die_radius, law_pw, [0.0; 3], [0.0; 3])
+                    }
+                    j => {
+                        let xj = x[j as usize];
+                        let d = [xi[0] - xj[0], xi[1] - xj[1], xi[2] - xj[2]];
+                        let d2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
+                        if d2 > apart2 {
+                            pair.xi = [0.0; 3];
+                            continue;
+                        }
+                        let dist = math::sqrt(d2);
+                        let n = if dist > 0.0 {
+                            d.map(|c| c / dist)
+                        } else {
+                            [0.0, 0.0, 1.0]
+                        };
+                        (n, two_r - dist, law_pp, v[j as usize], omega[j as usize])
+                    }
+                };
+                if delta <= 0.0 {
+                    pair.xi = [0.0; 3];
+                    continue;
                 }
-                j => {
-                    let xj = b.x[j as usize];
-                    let d = [xi[0] - xj[0], xi[1] - xj[1], xi[2] - xj[2]];
-                    let dist = math::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
-                    let n = if dist > 0.0 {
-                        d.map(|c| c / dist)
-                    } else {
-                        [0.0, 0.0, 1.0]
-                    };
-                    (
-                        n,
-                        2.0 * r - dist,
-                        &self.law_pp,
-                        b.v[j as usize],
-                        b.omega[j as usize],
-                    )
+                let (vi, wi) = (v[i], omega[i]);
+                let l = filled;
+                lanes.set_law(l, law);
+                lanes.delta[l] = delta;
+                for a in 0..3 {
+                    lanes.n[a][l] = n[a];
+                    lanes.dv[a][l] = vi[a] - vj[a];
+                    lanes.w[a][l] = wi[a] + wj[a];
+                    lanes.xi[a][l] = pair.xi[a];
                 }
-            };
-            if delta <= 0.0 {
-                pair.xi = [0.0; 3];
-                continue;
+                at[l] = k;
+                filled += 1;
+                if filled < LANES {
+                    continue;
+                }
+            } else if filled == 0 {
+                break;
             }
-            // Relative velocity of i at the contact point: the contact sits at
-            // −r n from i and, for a sphere partner, +r n from j.
-            let wi = b.omega[i];
-            let w = [wi[0] + wj[0], wi[1] + wj[1], wi[2] + wj[2]];
-            let wxn = [
-                w[1] * n[2] - w[2] * n[1],
-                w[2] * n[0] - w[0] * n[2],
-                w[0] * n[1] - w[1] * n[0],
-            ];
-            let v_rel: [Real; 3] = core::array::from_fn(|a| b.v[i][a] - vj[a] - r * wxn[a]);
-            let cf = hertz_mindlin(law, beta, delta, &n, &v_rel, &mut pair.xi, dt);
-            let ft = cf.tangential;
-            // Torque on i: (−r n) × F_t; on a sphere j: (r n) × (−F_t), the same.
-            let t = [
-                -r * (n[1] * ft[2] - n[2] * ft[1]),
-                -r * (n[2] * ft[0] - n[0] * ft[2]),
-                -r * (n[0] * ft[1] - n[1] * ft[0]),
-            ];
-            for (a, ta) in t.iter().enumerate() {
-                b.f[i][a] += cf.force[a];
-                b.torque[i][a] += ta;
-            }
-            match pair.j {
-                FLOOR => floor += cf.force[2],
-                DIE => wall_z += cf.force[2],
-                j => {
-                    for (a, ta) in t.iter().enumerate() {
-                        b.f[j as usize][a] -= cf.force[a];
-                        b.torque[j as usize][a] += ta;
+            // Evaluate the waiting contacts (at the end, the unused lanes
+            // repeat old inputs and are ignored).
+            hertz_mindlin_lanes(&mut lanes, beta, r, dt);
+            for l in 0..filled {
+                let pair = &mut pairs[at[l]];
+                let i = pair.i as usize;
+                if i != cur {
+                    if cur != usize::MAX {
+                        f[cur] = fi;
+                        torque[cur] = ti;
+                    }
+                    cur = i;
+                    (fi, ti) = (f[i], torque[i]);
+                }
+                let force = [lanes.force[0][l], lanes.force[1][l], lanes.force[2][l]];
+                let t = [lanes.torque[0][l], lanes.torque[1][l], lanes.torque[2][l]];
+                pair.xi = [lanes.xi[0][l], lanes.xi[1][l], lanes.xi[2][l]];
+                for a in 0..3 {
+                    fi[a] += force[a];
+                    ti[a] += t[a];
+                }
+                match pair.j {
+                    FLOOR => floor += force[2],
+                    DIE => wall_z += force[2],
+                    j => {
+                        let (fj, tj) = (&mut f[j as usize], &mut torque[j as usize]);
+                        for a in 0..3 {
+                            fj[a] -= force[a];
+                            tj[a] += t[a];
+                        }
                     }
                 }
             }
+            filled = 0;
+        }
+        if cur != usize::MAX {
+            f[cur] = fi;
+            torque[cur] = ti;
         }
         self.floor_force = floor;
         self.wall_friction_z = wall_z;
+        // The half kicks Δt/2 · F/m and Δt/2 · T/I, as velocity Verlet adds
+        // them (the same operations, so the same bits, as dividing in each
+        // of the two kicks).
+        let half = 0.5 * dt;
+        for (fk, tk) in f.iter_mut().zip(torque.iter_mut()) {
+            for a in 0..3 {
+                fk[a] = half * fk[a] / m;
+                tk[a] = half * tk[a] / inertia;
+            }
+        }
+    }
+
+    /// Half a kick of the velocities and spins by the current forces
+    /// (already turned into velocity increments by [`Self::forces`]).
+    fn kick(&mut self) {
+        let b = &mut self.buf;
+        for (((v, w), dv), dw) in
+            b.v.iter_mut()
+                .zip(b.omega.iter_mut())
+                .zip(b.f.iter())
+                .zip(b.torque.iter())
+        {
+            for a in 0..3 {
+                v[a] += dv[a];
+                w[a] += dw[a];
+            }
+        }
     }
 
     /// One velocity-Verlet step.
     pub fn step(&mut self) -> Result<(), PourError> {
-        let (dt, m, inertia) = (self.dt, self.mass, self.inertia);
-        let half = 0.5 * dt;
+        let dt = self.dt;
         let b = &mut self.buf;
         let mut moved: Real = 0.0;
-        for k in 0..b.x.len() {
+        // Half kick and drift.
+        for (((x, v), (w, xb)), (dv, dw)) in
+            b.x.iter_mut()
+                .zip(b.v.iter_mut())
+                .zip(b.omega.iter_mut().zip(b.x_built.iter()))
+                .zip(b.f.iter().zip(b.torque.iter()))
+        {
             for a in 0..3 {
-                b.v[k][a] += half * b.f[k][a] / m;
-                b.omega[k][a] += half * b.torque[k][a] / inertia;
-                b.x[k][a] += dt * b.v[k][a];
+                v[a] += dv[a];
+                w[a] += dw[a];
+                x[a] += dt * v[a];
             }
-            let d = [
-                b.x[k][0] - b.x_built[k][0],
-                b.x[k][1] - b.x_built[k][1],
-                b.x[k][2] - b.x_built[k][2],
-            ];
+            let d = [x[0] - xb[0], x[1] - xb[1], x[2] - xb[2]];
             moved = moved.max(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
         }
         if !moved.is_finite() {
@@ -673,13 +761,7 @@ impl<'a> PourScene<'a> {
             self.rebuild()?;
         }
         self.forces();
-        let b = &mut self.buf;
-        for k in 0..b.x.len() {
-            for a in 0..3 {
-                b.v[k][a] += half * b.f[k][a] / m;
-                b.omega[k][a] += half * b.torque[k][a] / inertia;
-            }
-        }
+        self.kick();
         Ok(())
     }
 
