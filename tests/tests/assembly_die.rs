@@ -17,8 +17,9 @@ use granbed_kernel::material::GranuleType;
 
 const R: Real = 0.5e-3;
 
-#[test]
-fn a_small_die_compresses_to_thirty_percent() {
+/// 40 spheres poured into a 5 mm die (seed 1), the scene and the
+/// parameters for `mesh`.
+fn small_die() -> (DieScene, Vec<[Real; 3]>, AssemblyParams) {
     let material = GranuleType::B2.params().validate().unwrap();
     let mut pour = PourParams::standard(material.density0, 1);
     pour.granules = 40;
@@ -26,14 +27,20 @@ fn a_small_die_compresses_to_thirty_percent() {
     let poured = run_pour(pour, &mut |_, _| {}).unwrap();
     assert!(poured.error.is_none(), "{:?}", poured.error);
     let scene = DieScene::new(&poured.positions, R, pour.die_radius, 50e-3);
-    let mesh = OwnedReference::sphere(R, MeshLevel::new(4, 1), false).unwrap();
     let elements = ElementSettings {
         kind: ElementKind::OnePoint,
         update: Default::default(),
         hourglass_kappa: granbed_kernel::element::force::DEFAULT_HOURGLASS_KAPPA,
     };
     let params = AssemblyParams::standard(material, elements);
-    let placed = placements(&poured.positions, 7);
+    (scene, poured.positions, params)
+}
+
+#[test]
+fn a_small_die_compresses_to_thirty_percent() {
+    let (scene, centres, params) = small_die();
+    let mesh = OwnedReference::sphere(R, MeshLevel::new(4, 1), false).unwrap();
+    let placed = placements(&centres, 7);
     let mut asm = Assembly::new(params, &mesh, &placed, scene.walls()).unwrap();
     // Element size: the shortest surface edge of the reference mesh.
     let h = mesh
@@ -54,6 +61,8 @@ fn a_small_die_compresses_to_thirty_percent() {
         min_j = min_j.min(asm.last().min_j);
         if asm.steps() % 100 == 0 {
             worst_gap = worst_gap.min(asm.penetration().unwrap());
+            let missed = asm.contact().missed_pairs();
+            assert!(missed.is_empty(), "broad phase missed {missed:?}");
         }
         if asm.time() > 2.0 / 3.0 * end {
             let walls = &asm.last().walls;
@@ -61,6 +70,14 @@ fn a_small_die_compresses_to_thirty_percent() {
             impulse[1] += walls[wall_index::LOWER].normal * asm.last().dt;
         }
     }
+    let times = *asm.times();
+    eprintln!(
+        "phases: predict {:.2} s, contact {:.2} s, correct {:.2} s: contact share {:.1} %",
+        times.predict_s,
+        times.contact_s,
+        times.correct_s,
+        100.0 * times.contact_share()
+    );
     asm.elastic_energy();
     let e = *asm.energies();
     eprintln!(
@@ -70,6 +87,10 @@ fn a_small_die_compresses_to_thirty_percent() {
         e.residual(),
         e.return_map_gap(),
         e.contact_loss()
+    );
+    assert!(
+        asm.contact().rebuilds() > 1,
+        "the skin test never asked for a rebuild"
     );
     assert!(min_j > 0.0);
     assert!(
@@ -96,5 +117,59 @@ fn a_small_die_compresses_to_thirty_percent() {
         "upper {:.4e} < lower {:.4e}",
         impulse[0],
         impulse[1]
+    );
+}
+
+#[test]
+fn the_die_is_bit_identical_on_one_and_two_threads() {
+    let (scene, centres, params) = small_die();
+    let mesh = OwnedReference::sphere(R, MeshLevel::new(4, 1), false).unwrap();
+    let placed = placements(&centres, 7);
+    let run = |threads| {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap();
+        pool.install(|| {
+            let mut asm = Assembly::new(params, &mesh, &placed, scene.walls()).unwrap();
+            // 8 % strain: granules in contact, rebuilds, sweeps.
+            while scene.strain_at(asm.time()) < 0.08 {
+                asm.step().unwrap();
+            }
+            let touching = asm.contact().pairs_in_contact();
+            assert!(touching > 10, "only {touching} pairs in contact");
+            let state: Vec<_> = asm
+                .granules()
+                .iter()
+                .map(|g| (g.x.clone(), g.v.clone()))
+                .collect();
+            (state, asm.energies().punch_work)
+        })
+    };
+    assert!(run(1) == run(2), "the result depends on the thread count");
+}
+
+/// Benchmark (BENCHMARKS.md): the same die with the standard 8x2 mesh to
+/// 10 % strain, printing the share of the contact phase.
+#[test]
+#[ignore = "benchmark: run with --ignored --nocapture"]
+fn small_die_phase_times_standard_mesh() {
+    let (scene, centres, params) = small_die();
+    let mesh = OwnedReference::sphere(R, MeshLevel::STANDARD, false).unwrap();
+    let placed = placements(&centres, 7);
+    let mut asm = Assembly::new(params, &mesh, &placed, scene.walls()).unwrap();
+    let start = std::time::Instant::now();
+    while scene.strain_at(asm.time()) < 0.1 {
+        asm.step().unwrap();
+    }
+    let t = *asm.times();
+    eprintln!(
+        "8x2, 40 granules, 10 %: {} steps in {:.1} s; predict {:.2} s, contact {:.2} s, correct {:.2} s: contact share {:.1} %",
+        asm.steps(),
+        start.elapsed().as_secs_f64(),
+        t.predict_s,
+        t.contact_s,
+        t.correct_s,
+        100.0 * t.contact_share()
     );
 }

@@ -9,7 +9,7 @@ use granbed_kernel::contact::pair::{
     CandidateFace, Constraint, ContactError, Involvement, NodeForce, PairForce, PairSettings, Side,
     detect, forces, mark_involvement,
 };
-use granbed_kernel::contact::surface::{Aabb, SurfaceBody};
+use granbed_kernel::contact::surface::{Aabb, SurfaceBody, quad_bounds};
 use rayon::prelude::*;
 
 use crate::model::{GranuleStore, OwnedReference};
@@ -50,6 +50,8 @@ pub struct ContactPhase {
     built: Vec<Bound>,
     bounds: Vec<Bound>,
     boxes: Vec<Aabb>,
+    /// Per granule, the box of every surface quad on x̃.
+    quad_boxes: Vec<Vec<Aabb>>,
     /// Per granule and node: contacts this step (mass sharing).
     pub(super) share: Vec<Vec<u16>>,
     tag: Vec<Vec<u32>>,
@@ -58,13 +60,16 @@ pub struct ContactPhase {
     rebuilds: u64,
     /// Per granule: f_c before the current sweep (for the x̃ update).
     pub(super) f_before: Vec<Vec<[Real; 3]>>,
+    /// Per granule: whether the last sweep put a contact force on it (only
+    /// then did its x̃ move, so only then can its pairs change).
+    pub(super) touched: Vec<bool>,
 }
 
 /// The kernel's view of granule `g` on its predicted configuration.
 fn body<'a>(
     g: &'a GranuleStore,
     mesh: &'a OwnedReference,
-    (bounds, sphere): (Aabb, Bound),
+    (bounds, sphere, quad_bounds): (Aabb, Bound, &'a [Aabb]),
 ) -> SurfaceBody<'a> {
     SurfaceBody {
         x_n: &g.x,
@@ -75,6 +80,7 @@ fn body<'a>(
         node_quads: &mesh.node_quads,
         bounds,
         sphere,
+        quad_bounds,
     }
 }
 
@@ -101,6 +107,31 @@ impl ContactPhase {
     /// Per candidate pair, its buffers and last result.
     pub fn work(&self) -> &[PairWork] {
         &self.work
+    }
+
+    /// The check the skin argument of `contact::broad` promises: granule
+    /// pairs whose bounding spheres (on the last x̃) overlap but are not in
+    /// the candidate list, found by brute force over all pairs. Always
+    /// empty unless the broad phase is broken; O(N²), for tests.
+    pub fn missed_pairs(&self) -> Vec<GranulePair> {
+        let b = &self.bounds;
+        let mut missed = Vec::new();
+        for i in 0..b.len() {
+            for j in i + 1..b.len() {
+                let d: Real = (0..3)
+                    .map(|k| (b[i].centre[k] - b[j].centre[k]).powi(2))
+                    .sum::<Real>()
+                    .sqrt();
+                let pair = GranulePair {
+                    a: i as u32,
+                    b: j as u32,
+                };
+                if d < b[i].radius + b[j].radius && self.pairs.binary_search(&pair).is_err() {
+                    missed.push(pair);
+                }
+            }
+        }
+        missed
     }
 
     /// Broad-phase rebuilds so far.
@@ -143,6 +174,12 @@ impl ContactPhase {
                 )
             })
             .unzip();
+        self.quad_boxes
+            .resize(granules.len(), vec![Aabb::EMPTY; mesh.quads.len()]);
+        self.quad_boxes
+            .par_iter_mut()
+            .zip(granules.par_iter())
+            .for_each(|(out, g)| quad_bounds(&g.x_pred, &mesh.quads, out));
         if !self.built.is_empty() && !needs_rebuild(&self.built, &self.bounds, margin) {
             return Ok(());
         }
@@ -178,20 +215,30 @@ impl ContactPhase {
 
     /// Detection on every candidate pair (in parallel), growing a pair's
     /// constraint list when it is full.
+    ///
+    /// After the first sweep of a step only pairs with a granule that the
+    /// last sweep moved are searched again: the others found nothing (a
+    /// constraint would have moved both) and their x̃ is unchanged.
     pub(super) fn detect(
         &mut self,
         granules: &[GranuleStore],
         mesh: &OwnedReference,
         settings: &PairSettings,
+        first: bool,
     ) -> Result<(), ContactError> {
-        let (boxes, bounds) = (&self.boxes, &self.bounds);
+        let (boxes, bounds, quad_boxes) = (&self.boxes, &self.bounds, &self.quad_boxes);
+        let touched = &self.touched;
         self.pairs
             .par_iter()
             .zip(self.work.par_iter_mut())
             .try_for_each_init(Vec::new, |scratch, (p, w)| {
                 let (a, b) = (p.a as usize, p.b as usize);
-                let body_a = body(&granules[a], mesh, (boxes[a], bounds[a]));
-                let body_b = body(&granules[b], mesh, (boxes[b], bounds[b]));
+                if !first && !touched[a] && !touched[b] {
+                    w.count = 0;
+                    return Ok(());
+                }
+                let body_a = body(&granules[a], mesh, (boxes[a], bounds[a], &quad_boxes[a]));
+                let body_b = body(&granules[b], mesh, (boxes[b], bounds[b], &quad_boxes[b]));
                 detect_growing(&body_a, &body_b, settings, scratch, w)
             })
     }
@@ -218,8 +265,16 @@ impl ContactPhase {
                 tag: &mut thi[0],
                 count: &mut hi[0],
             };
-            let body_a = body(&granules[a], mesh, (self.boxes[a], self.bounds[a]));
-            let body_b = body(&granules[b], mesh, (self.boxes[b], self.bounds[b]));
+            let body_a = body(
+                &granules[a],
+                mesh,
+                (self.boxes[a], self.bounds[a], &self.quad_boxes[a]),
+            );
+            let body_b = body(
+                &granules[b],
+                mesh,
+                (self.boxes[b], self.bounds[b], &self.quad_boxes[b]),
+            );
             mark_involvement(
                 w.constraints(),
                 (&body_a, &mut inv_a),
@@ -242,14 +297,15 @@ impl ContactPhase {
         sharing: bool,
         first: bool,
     ) -> Result<(), ContactError> {
-        let (boxes, bounds, share) = (&self.boxes, &self.bounds, &self.share);
+        let (boxes, bounds, quad_boxes, share) =
+            (&self.boxes, &self.bounds, &self.quad_boxes, &self.share);
         self.pairs
             .par_iter()
             .zip(self.work.par_iter_mut())
             .try_for_each(|(p, w)| {
                 let (a, b) = (p.a as usize, p.b as usize);
-                let body_a = body(&granules[a], mesh, (boxes[a], bounds[a]));
-                let body_b = body(&granules[b], mesh, (boxes[b], bounds[b]));
+                let body_a = body(&granules[a], mesh, (boxes[a], bounds[a], &quad_boxes[a]));
+                let body_b = body(&granules[b], mesh, (boxes[b], bounds[b], &quad_boxes[b]));
                 let (sa, sb): (&[u16], &[u16]) = if sharing {
                     (&share[a], &share[b])
                 } else {
@@ -293,10 +349,12 @@ impl ContactPhase {
     }
 
     /// Adds the pair forces on granule `g` to `f_c`, its pairs in list
-    /// order and each pair's entries in their order.
-    pub(super) fn gather(&self, g: usize, f_c: &mut [[Real; 3]]) {
+    /// order and each pair's entries in their order; true if there were any.
+    pub(super) fn gather(&self, g: usize, f_c: &mut [[Real; 3]]) -> bool {
+        let mut any = false;
         for &(k, side) in &self.by_granule[g] {
             let w = &self.work[k as usize];
+            any |= w.force_count > 0;
             for e in &w.forces[..w.force_count] {
                 if e.side == side {
                     for (f, df) in f_c[e.node as usize].iter_mut().zip(e.force) {
@@ -305,6 +363,7 @@ impl ContactPhase {
                 }
             }
         }
+        any
     }
 
     /// Most negative granule–granule gap on the current positions x_n, m.
@@ -331,6 +390,14 @@ impl ContactPhase {
             .iter()
             .map(|g| Aabb::of_surface(&g.x, first))
             .collect();
+        let quad_boxes: Vec<Vec<Aabb>> = at_rest
+            .iter()
+            .map(|g| {
+                let mut out = vec![Aabb::EMPTY; mesh.quads.len()];
+                quad_bounds(&g.x, &mesh.quads, &mut out);
+                out
+            })
+            .collect();
         let mut head = vec![0; 8 * granules.len() + 8];
         let mut next = vec![0; granules.len()];
         let mut pairs = vec![GranulePair { a: 0, b: 0 }; 16 * granules.len() + 16];
@@ -349,8 +416,8 @@ impl ContactPhase {
             let (a, b) = (p.a as usize, p.b as usize);
             let mut w = PairWork::default();
             detect_growing(
-                &body(&at_rest[a], mesh, (boxes[a], bounds[a])),
-                &body(&at_rest[b], mesh, (boxes[b], bounds[b])),
+                &body(&at_rest[a], mesh, (boxes[a], bounds[a], &quad_boxes[a])),
+                &body(&at_rest[b], mesh, (boxes[b], bounds[b], &quad_boxes[b])),
                 settings,
                 &mut scratch,
                 &mut w,

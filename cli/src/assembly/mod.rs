@@ -34,7 +34,7 @@ use granbed_kernel::material::Material;
 use crate::model::{GranuleStore, OwnedReference};
 
 pub use contact::ContactPhase;
-pub use step::{AssemblyError, Energies, StepReport};
+pub use step::{AssemblyError, Energies, PhaseTimes, StepReport};
 
 /// Physical and numerical settings of an assembly.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -171,6 +171,7 @@ pub struct Assembly<'m> {
     dt_prev: Real,
     energies: Energies,
     last: StepReport,
+    times: PhaseTimes,
 }
 
 impl<'m> Assembly<'m> {
@@ -222,6 +223,7 @@ impl<'m> Assembly<'m> {
             dt_prev: 0.0,
             energies: Energies::default(),
             last: StepReport::default(),
+            times: PhaseTimes::default(),
         };
         let kinetic: Real = assembly
             .granules
@@ -274,6 +276,11 @@ impl<'m> Assembly<'m> {
     /// Energy ledger since the start.
     pub fn energies(&self) -> &Energies {
         &self.energies
+    }
+
+    /// Wall-clock time per phase so far.
+    pub fn times(&self) -> &PhaseTimes {
+        &self.times
     }
 
     /// What the last step did.

@@ -189,6 +189,25 @@ impl Energies {
     }
 }
 
+/// Wall-clock time spent in each phase of the steps so far, s (for
+/// benchmarks; not part of the physics).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct PhaseTimes {
+    /// Element forces, damping and the predictor.
+    pub predict_s: f64,
+    /// Contact: broad phase, detection, forces, gather, walls (all sweeps).
+    pub contact_s: f64,
+    /// The corrector and the energy sums.
+    pub correct_s: f64,
+}
+
+impl PhaseTimes {
+    /// Share of the contact phase in the total.
+    pub fn contact_share(&self) -> f64 {
+        self.contact_s / (self.predict_s + self.contact_s + self.correct_s)
+    }
+}
+
 /// What the last step did.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct StepReport {
@@ -285,7 +304,7 @@ impl Assembly<'_> {
             .broad(&self.granules, mesh, p.contact.margin)
             .map_err(contact_error)?;
         self.contact
-            .detect(&self.granules, mesh, &p.contact)
+            .detect(&self.granules, mesh, &p.contact, first)
             .map_err(contact_error)?;
         let surface = mesh.positions.len() - mesh.surface_nodes..mesh.positions.len();
         if p.mass_sharing {
@@ -304,12 +323,13 @@ impl Assembly<'_> {
             .forces(&self.granules, mesh, &p.contact, dt2, p.mass_sharing, first)
             .map_err(contact_error)?;
         let contact = &self.contact;
-        self.granules
+        let touched: Vec<bool> = self
+            .granules
             .par_iter_mut()
             .zip(wall_totals.par_iter_mut())
             .enumerate()
-            .for_each(|(gi, (g, totals))| {
-                contact.gather(gi, &mut g.f_c);
+            .map(|(gi, (g, totals))| {
+                let mut touched = contact.gather(gi, &mut g.f_c);
                 let share: &[u16] = if p.mass_sharing {
                     &contact.share[gi]
                 } else {
@@ -330,9 +350,13 @@ impl Assembly<'_> {
                         share,
                         &mut g.f_c,
                     );
+                    touched |= f.contacts > 0;
                     add_wall(total, &f, false);
                 }
-            });
+                touched
+            })
+            .collect();
+        self.contact.touched = touched;
         Ok(())
     }
 
@@ -354,6 +378,7 @@ impl Assembly<'_> {
             rigid_modes: true,
         };
         let view = self.mesh.view();
+        let clock = std::time::Instant::now();
         let predicted: Vec<Result<ForceSummary, ElementFailure>> = self
             .granules
             .par_iter_mut()
@@ -382,6 +407,7 @@ impl Assembly<'_> {
             min_j = min_j.min(s.min_j);
         }
 
+        let predicted_at = clock.elapsed().as_secs_f64();
         // Contact on the predicted configuration, walls at t_{n+1}; each
         // further sweep moves x̃ by the forces of the last and corrects what
         // is left (physics.md §5.3's optional Jacobi sweeps).
@@ -418,6 +444,7 @@ impl Assembly<'_> {
             pair_normal += w.step.normal;
             constraints += w.step.constraints;
         }
+        let contacted_at = clock.elapsed().as_secs_f64();
         let per: Vec<StepWork> = self
             .granules
             .par_iter_mut()
@@ -460,6 +487,10 @@ impl Assembly<'_> {
         report.pair_normal = pair_normal;
         report.constraints = constraints;
         self.last = report;
+        let done_at = clock.elapsed().as_secs_f64();
+        self.times.predict_s += predicted_at;
+        self.times.contact_s += contacted_at - predicted_at;
+        self.times.correct_s += done_at - contacted_at;
         self.time += sizes.dt;
         self.steps += 1;
         self.dt_prev = sizes.dt;

@@ -23,7 +23,9 @@
 use core::fmt;
 
 use crate::Real;
-use crate::contact::quad::{QuadProjection, Vec3, dot, norm, project, project_clamped, sub};
+use crate::contact::quad::{
+    QuadProjection, QuadSieve, Vec3, dot, norm, project, project_clamped, sub,
+};
 use crate::contact::surface::{Aabb, SurfaceBody};
 use crate::math::{abs, sqrt};
 
@@ -194,6 +196,8 @@ pub struct CandidateFace {
     pub window: Real,
     /// The face's box grown by `window`.
     pub reach: Aabb,
+    /// The cheap pre-test of the projection (`None`: degenerate face).
+    pub sieve: Option<QuadSieve>,
 }
 
 impl Default for CandidateFace {
@@ -203,6 +207,7 @@ impl Default for CandidateFace {
             corners: [[0.0; 3]; 4],
             window: 0.0,
             reach: Aabb::EMPTY,
+            sieve: None,
         }
     }
 }
@@ -226,6 +231,15 @@ pub fn detect(
             expected: need,
             got: scratch.len(),
         });
+    }
+    for body in [a, b] {
+        if body.quad_bounds.len() != body.quads.len() {
+            return Err(ContactError::BufferLength {
+                buffer: "quad_bounds",
+                expected: body.quads.len(),
+                got: body.quad_bounds.len(),
+            });
+        }
     }
     let mut count = detect_pass(a, b, Side::A, settings, scratch, out, 0)?;
     if settings.symmetric {
@@ -268,16 +282,16 @@ fn detect_pass(
     // bounding sphere, with their windows and reach.
     let slave_reach = slave.sphere.radius + m;
     let mut faces = 0;
-    for q in 0..master.quads.len() {
-        let corners = master.quad_pred(q);
-        let bounds = Aabb::of_points(&corners);
+    for (q, bounds) in master.quad_bounds.iter().enumerate() {
         if bounds.overlaps(&region) && bounds.distance_to(&slave.sphere.centre) <= slave_reach {
+            let corners = master.quad_pred(q);
             let window = settings.window_fraction * face_diagonal(&corners);
             scratch[faces] = CandidateFace {
                 quad: q as u32,
                 corners,
                 window,
                 reach: bounds.expanded(window),
+                sieve: QuadSieve::new(&corners),
             };
             faces += 1;
         }
@@ -336,7 +350,11 @@ fn closest_face(
     let mut best: Option<Hit> = None;
     let mut near_outside = false;
     for face in candidates {
-        if !face.reach.contains(&p) {
+        if !face.reach.contains(&p)
+            || !face
+                .sieve
+                .is_some_and(|s| s.may_touch(&p, face.window, EDGE_REACH))
+        {
             continue;
         }
         let Some(pr) = project(&p, &face.corners) else {

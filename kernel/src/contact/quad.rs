@@ -215,3 +215,59 @@ pub fn project_clamped(p: &Vec3, x: &[Vec3; 4]) -> Option<QuadProjection> {
     let (_, xi, eta) = best?;
     finish(p, &q, xi, eta)
 }
+
+/// A cheap, conservative pre-test of [`project`]: from the quad's centre
+/// plane and its parallelogram coordinates it rules out points that can
+/// neither lie behind the face within a window nor project near it.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct QuadSieve {
+    centre: Vec3,
+    /// e1/|e1|² and e2/|e2|²: (p − c)·axis is the parallelogram ξ0, η0.
+    axis1: Vec3,
+    axis2: Vec3,
+    /// Unit normal of the centre plane (e1 × e2).
+    normal: Vec3,
+    /// Bound on how far the bilinear face leaves its centre plane, m.
+    warp: Real,
+    /// Bound on how far ξ0, η0 may be off the true ξ*, η*.
+    slack: Real,
+}
+
+impl QuadSieve {
+    /// The sieve of the quad `x`; `None` if it is degenerate.
+    pub fn new(x: &[Vec3; 4]) -> Option<Self> {
+        let q = Bilinear::new(x);
+        let (l1, l2) = (dot(&q.e1, &q.e1), dot(&q.e2, &q.e2));
+        let n = cross(&q.e1, &q.e2);
+        let len = norm(&n);
+        if l1.is_nan() || l2.is_nan() || l1 <= 0.0 || l2 <= 0.0 || len.is_nan() || len <= 0.0 {
+            return None;
+        }
+        let w = norm(&q.w);
+        let shortest = sqrt(if l1 < l2 { l1 } else { l2 });
+        Some(Self {
+            centre: q.c,
+            axis1: q.e1.map(|c| c / l1),
+            axis2: q.e2.map(|c| c / l2),
+            normal: n.map(|c| c / len),
+            // The surface is c + ξe1 + ηe2 + ξηw: |ξη| ≤ 1 over the face;
+            // twice that, and a little for the tilt of the local normal.
+            warp: 2.0 * w + 1e-3 * shortest,
+            // Non-orthogonal axes and the warp move the true projection;
+            // a generous bound keeps the sieve conservative.
+            slack: 0.5 + 4.0 * w / shortest,
+        })
+    }
+
+    /// False only if `p` can be neither behind the face by less than
+    /// `window` nor within `reach` (in ξ, η beyond ±1) of it.
+    pub fn may_touch(&self, p: &Vec3, window: Real, reach: Real) -> bool {
+        let d = sub(p, &self.centre);
+        let g0 = dot(&d, &self.normal);
+        if g0 > self.warp || g0 < -window - self.warp {
+            return false;
+        }
+        let limit = 1.0 + reach + self.slack;
+        abs(dot(&d, &self.axis1)) <= limit && abs(dot(&d, &self.axis2)) <= limit
+    }
+}

@@ -33,6 +33,17 @@ pub struct SurfaceBody<'a> {
     /// Bounding sphere of the predicted surface nodes
     /// ([`crate::contact::broad::bounding_sphere`]).
     pub sphere: Bound,
+    /// Box of each quad's predicted corners ([`quad_bounds`]), one per quad:
+    /// computed once per sweep and shared by all the body's pairs.
+    pub quad_bounds: &'a [Aabb],
+}
+
+/// Fills `out` (one entry per quad) with the box of each quad's corners
+/// in `x`.
+pub fn quad_bounds(x: &[Vec3], quads: &[[u32; 4]], out: &mut [Aabb]) {
+    for (b, q) in out.iter_mut().zip(quads) {
+        *b = Aabb::of_points(q.iter().map(|&i| &x[i as usize]));
+    }
 }
 
 impl SurfaceBody<'_> {
