@@ -134,6 +134,11 @@ impl ContactPhase {
         missed
     }
 
+    /// Bounding sphere of granule `g` on the last x̃.
+    pub fn bound(&self, g: usize) -> Bound {
+        self.bounds[g]
+    }
+
     /// Broad-phase rebuilds so far.
     pub fn rebuilds(&self) -> u64 {
         self.rebuilds
@@ -337,6 +342,7 @@ impl ContactPhase {
                 } else {
                     let t = &mut w.step;
                     t.normal += result.normal;
+                    t.area += result.area;
                     for a in 0..3 {
                         t.friction_on_a[a] += result.friction_on_a[a];
                         t.total_on_a[a] += result.total_on_a[a];

@@ -307,14 +307,18 @@ impl Assembly<'_> {
             .detect(&self.granules, mesh, &p.contact, first)
             .map_err(contact_error)?;
         let surface = mesh.positions.len() - mesh.surface_nodes..mesh.positions.len();
+        let bounds: Vec<_> = (0..self.granules.len())
+            .map(|g| self.contact.bound(g))
+            .collect();
         if p.mass_sharing {
             self.contact.count_pairs(&self.granules, mesh);
             self.contact
                 .share
                 .par_iter_mut()
                 .zip(self.granules.par_iter())
-                .for_each(|(share, g)| {
-                    for w in walls {
+                .zip(bounds.par_iter())
+                .for_each(|((share, g), b)| {
+                    for w in walls.iter().filter(|w| w.may_touch(&b.centre, b.radius)) {
                         count_wall_contacts(w, surface.clone(), &g.x_pred, share);
                     }
                 });
@@ -340,7 +344,11 @@ impl Assembly<'_> {
                     x_n: &g.x,
                     x_pred: &g.x_pred,
                 };
+                let b = bounds[gi];
                 for (w, total) in walls.iter().zip(totals.iter_mut()) {
+                    if !w.may_touch(&b.centre, b.radius) {
+                        continue;
+                    }
                     let f = wall_contact(
                         w,
                         p.wall_friction,

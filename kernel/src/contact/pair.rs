@@ -138,6 +138,10 @@ pub struct PairForce {
     pub constraints: usize,
     /// Constraints at the friction cap (slipping).
     pub slipping: usize,
+    /// Contact area estimate, m²: Σ w × the slave node's tributary area
+    /// (a quarter of its quads' areas), so a spot both passes see counts
+    /// once.
+    pub area: Real,
     /// Most negative predicted gap, m (0 if none).
     pub min_gap: Real,
 }
@@ -585,6 +589,7 @@ pub fn forces(
             total.friction_on_a[a] += sign * f_t[a];
         }
         total.normal += f_n;
+        total.area += w * slave.node_area(s);
         total.constraints += 1;
         if c.gap < total.min_gap {
             total.min_gap = c.gap;

@@ -70,15 +70,15 @@ pub(crate) fn norm(a: &Vec3) -> Real {
 
 /// The bilinear quad in the form c + ξe1 + ηe2 + ξηw.
 #[derive(Clone, Copy, Debug)]
-struct Bilinear {
-    c: Vec3,
-    e1: Vec3,
-    e2: Vec3,
-    w: Vec3,
+pub(crate) struct Bilinear {
+    pub(crate) c: Vec3,
+    pub(crate) e1: Vec3,
+    pub(crate) e2: Vec3,
+    pub(crate) w: Vec3,
 }
 
 impl Bilinear {
-    fn new(x: &[Vec3; 4]) -> Self {
+    pub(crate) fn new(x: &[Vec3; 4]) -> Self {
         let comb = |s: [Real; 4]| -> Vec3 {
             core::array::from_fn(|a| {
                 0.25 * (s[0] * x[0][a] + s[1] * x[1][a] + s[2] * x[2][a] + s[3] * x[3][a])
@@ -92,13 +92,13 @@ impl Bilinear {
         }
     }
 
-    fn at(&self, xi: Real, eta: Real) -> Vec3 {
+    pub(crate) fn at(&self, xi: Real, eta: Real) -> Vec3 {
         core::array::from_fn(|a| {
             self.c[a] + xi * self.e1[a] + eta * self.e2[a] + xi * eta * self.w[a]
         })
     }
 
-    fn tangents(&self, xi: Real, eta: Real) -> (Vec3, Vec3) {
+    pub(crate) fn tangents(&self, xi: Real, eta: Real) -> (Vec3, Vec3) {
         (axpy(eta, &self.w, &self.e1), axpy(xi, &self.w, &self.e2))
     }
 }

@@ -52,6 +52,18 @@ impl SurfaceBody<'_> {
         self.quads[q].map(|i| self.x_pred[i as usize])
     }
 
+    /// Tributary area of surface node `node` on the predicted
+    /// configuration: a quarter of the areas of its quads, m².
+    pub fn node_area(&self, node: usize) -> Real {
+        self.node_quads[node - self.first_surface]
+            .iter()
+            .filter(|&&q| q != u32::MAX)
+            .map(|&q| {
+                0.25 * crate::mesh::surface::quad_area_and_flux(&self.quad_pred(q as usize)).0
+            })
+            .sum()
+    }
+
     /// Averaged outward normal (not normalised; zero if degenerate) of
     /// surface node `node` on the predicted configuration: the sum of the
     /// area vectors of its quads.

@@ -59,6 +59,14 @@ pub enum Wall {
 }
 
 impl Wall {
+    /// False if no point within `radius` of `centre` can be behind the wall
+    /// (the wall candidates of physics.md §5.1 from a bounding sphere): the
+    /// gap of such a point is at least gap(centre) − radius, for the plane
+    /// and for the die alike.
+    pub fn may_touch(&self, centre: &[Real; 3], radius: Real) -> bool {
+        self.gap(centre).0 - radius < 0.0
+    }
+
     /// Gap (m) and inward unit normal at point `x`.
     pub fn gap(&self, x: &[Real; 3]) -> (Real, [Real; 3]) {
         match self {
