@@ -1,7 +1,10 @@
 //! Post-processing formulas (physics.md §7).
 //!
 //! * [`fit`]: least-squares lines;
-//! * [`granule`]: σ_est and σ_y,eff0 of the single-granule experiment.
+//! * [`granule`]: σ_est and σ_y,eff0 of the single-granule experiment;
+//! * [`bed`]: pressure, strain, Kawakita fit, granule η_g and α_SV,
+//!   coordination number and mean relative density of a compressed bed.
 
+pub mod bed;
 pub mod fit;
 pub mod granule;
