@@ -6,6 +6,7 @@
 
 use clap::{Parser, Subcommand};
 
+use crate::bed::BedArgs;
 use crate::export_mesh::ExportMeshArgs;
 use crate::granule::GranuleArgs;
 use crate::output::Streams;
@@ -42,6 +43,11 @@ pub enum Command {
     /// the bed height, packing fractions and coordination number, and a
     /// VTK view to a directory.
     Pack(PackArgs),
+    /// Compress a bed: pour it (as `pack`), make every sphere a
+    /// finite-element granule and press the upper punch to the final
+    /// strain; write the compression profile and a summary with the
+    /// Kawakita fit. Without arguments it runs the published scene.
+    Bed(BedArgs),
 }
 
 impl Command {
@@ -52,6 +58,7 @@ impl Command {
             Self::ExportMesh(args) => args.run(streams),
             Self::Granule(args) => args.run(streams),
             Self::Pack(args) => args.run(streams),
+            Self::Bed(args) => args.run(streams),
         }
     }
 }

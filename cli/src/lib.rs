@@ -11,6 +11,7 @@
 //! * [`export_mesh`]: `granbed-cli export-mesh`, the mesh as CalculiX `.inp`;
 //! * [`granule`]: `granbed-cli granule`, the single-granule platen experiment;
 //! * [`pack`]: `granbed-cli pack`, the pour of rigid spheres into the die;
+//! * [`bed`]: `granbed-cli bed`, the compression of a poured bed (the main job);
 //! * [`assembly`]: many finite-element granules in contact with each other and walls;
 //! * [`model`]: owned buffers for the kernel's meshes;
 //! * [`material_args`]: `--type` and the material-parameter overrides;
@@ -29,6 +30,7 @@ use std::io::Write;
 use clap::Parser;
 
 pub mod assembly;
+pub mod bed;
 pub mod command;
 pub mod csv;
 pub mod error;

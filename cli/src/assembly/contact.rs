@@ -63,6 +63,9 @@ pub struct ContactPhase {
     /// Per granule: whether the last sweep put a contact force on it (only
     /// then did its x̃ move, so only then can its pairs change).
     pub(super) touched: Vec<bool>,
+    /// Per granule: bit k set if it touched wall k (mod 64) in any sweep of
+    /// the step.
+    pub(super) on_wall: Vec<u64>,
 }
 
 /// The kernel's view of granule `g` on its predicted configuration.

@@ -221,6 +221,8 @@ pub struct StepReport {
     pub pair_normal: Real,
     /// Granule–granule constraints of the first sweep.
     pub constraints: usize,
+    /// Distinct (granule, wall) pairs in contact in the step.
+    pub wall_contacts: usize,
 }
 
 /// Adds the forces of `w` to `total`; the contact count is summed
@@ -327,13 +329,14 @@ impl Assembly<'_> {
             .forces(&self.granules, mesh, &p.contact, dt2, p.mass_sharing, first)
             .map_err(contact_error)?;
         let contact = &self.contact;
-        let touched: Vec<bool> = self
+        let touched: Vec<(bool, u64)> = self
             .granules
             .par_iter_mut()
             .zip(wall_totals.par_iter_mut())
             .enumerate()
             .map(|(gi, (g, totals))| {
-                let mut touched = contact.gather(gi, &mut g.f_c);
+                let touched = contact.gather(gi, &mut g.f_c);
+                let mut on_wall = 0u64;
                 let share: &[u16] = if p.mass_sharing {
                     &contact.share[gi]
                 } else {
@@ -345,7 +348,7 @@ impl Assembly<'_> {
                     x_pred: &g.x_pred,
                 };
                 let b = bounds[gi];
-                for (w, total) in walls.iter().zip(totals.iter_mut()) {
+                for (k, (w, total)) in walls.iter().zip(totals.iter_mut()).enumerate() {
                     if !w.may_touch(&b.centre, b.radius) {
                         continue;
                     }
@@ -358,13 +361,22 @@ impl Assembly<'_> {
                         share,
                         &mut g.f_c,
                     );
-                    touched |= f.contacts > 0;
+                    if f.contacts > 0 {
+                        on_wall |= 1 << (k % 64);
+                    }
                     add_wall(total, &f, false);
                 }
-                touched
+                (touched || on_wall != 0, on_wall)
             })
             .collect();
-        self.contact.touched = touched;
+        self.contact.touched = touched.iter().map(|t| t.0).collect();
+        if first {
+            self.contact.on_wall = touched.iter().map(|t| t.1).collect();
+        } else {
+            for (w, t) in self.contact.on_wall.iter_mut().zip(&touched) {
+                *w |= t.1;
+            }
+        }
         Ok(())
     }
 
@@ -494,6 +506,12 @@ impl Assembly<'_> {
         }
         report.pair_normal = pair_normal;
         report.constraints = constraints;
+        report.wall_contacts = self
+            .contact
+            .on_wall
+            .iter()
+            .map(|w| w.count_ones() as usize)
+            .sum();
         self.last = report;
         let done_at = clock.elapsed().as_secs_f64();
         self.times.predict_s += predicted_at;

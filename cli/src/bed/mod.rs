@@ -1,0 +1,153 @@
+//! `granbed-cli bed`: the main job. Pour a bed of spheres (as `pack`),
+//! turn every sphere into a finite-element granule, press the upper punch
+//! down to the final strain and write the compression profile and a
+//! summary with the Kawakita fit.
+//!
+//! * [`scene`]: the TOML scene format and the embedded published scene;
+//! * [`run`](mod@run): the run itself, sampled every output interval;
+//! * [`outputs`]: `compression.csv` and `summary.json`.
+
+use std::path::PathBuf;
+
+use clap::Args;
+use granbed_kernel::material::GranuleType;
+
+use crate::model::MeshLevel;
+use crate::output::Streams;
+
+pub mod outputs;
+pub mod run;
+pub mod scene;
+
+pub use scene::{DEFAULT_SCENE, Scene};
+
+/// The output description shown at the end of `bed --help`.
+const OUTPUT_HELP: &str = "\
+Output, in --out DIR (created if missing):
+  compression.csv  one row per output interval (time averages over it): time_s,
+                   strain (C = (H0 - H)/H0), upper/lower punch force and pressure,
+                   die-wall axial friction, coordination number (granule pairs,
+                   and with walls), mean granule relative density (arithmetic
+                   mean of eta0 V0/V, and solid/total), mean Heywood coefficient
+                   (d_V and nominal d), min Jacobian, steps, energies
+  summary.json     the scene, Kawakita fit (a, 1/b, R^2, points with C >= 0.25),
+                   final strain, max pressure, initial bed height, counts, wall
+                   time, ns per element-step, threads, min Jacobian, energy
+                   residual, peak memory, version
+
+Without --scene the embedded published scene runs (print it with
+--print-scene); the flags below override the scene's fields.
+
+Exit status: 0 success, 1 runtime failure (the run stopped early: the outputs
+so far are written), 2 usage or validation error.";
+
+/// Options of `granbed-cli bed`.
+#[derive(Args, Debug, Clone, PartialEq)]
+#[command(after_long_help = OUTPUT_HELP)]
+pub struct BedArgs {
+    /// Scene file (TOML, format version 1); default: the published scene.
+    #[arg(long, value_name = "FILE")]
+    pub scene: Option<PathBuf>,
+
+    /// Print the scene (after the overrides) as TOML and exit.
+    #[arg(long)]
+    pub print_scene: bool,
+
+    /// Output directory, created if missing.
+    #[arg(long, value_name = "DIR", default_value = "out/bed")]
+    pub out: PathBuf,
+
+    /// Override: standard granule type A1…C3.
+    #[arg(long = "type", value_name = "TYPE")]
+    pub granule_type: Option<GranuleType>,
+
+    /// Override: number of granules (1 ≤ N ≤ 100000).
+    #[arg(long, value_name = "N")]
+    pub granules: Option<usize>,
+
+    /// Override: mesh level NxM (8x2 = 1280 hexes, 4x1 = 160).
+    #[arg(long, value_name = "NxM")]
+    pub mesh: Option<MeshLevel>,
+
+    /// Override: final axial strain (0 < C ≤ 0.9).
+    #[arg(long, value_name = "C")]
+    pub strain: Option<f64>,
+
+    /// Override: seed of the pour and the rotations.
+    #[arg(long, value_name = "SEED")]
+    pub seed: Option<u64>,
+
+    /// Override: die diameter, mm.
+    #[arg(long, value_name = "MM")]
+    pub die_diameter_mm: Option<f64>,
+
+    /// Worker threads (0 = all cores). Results do not depend on it.
+    #[arg(short = 'j', long, value_name = "N", default_value_t = 0)]
+    pub threads: usize,
+
+    /// No progress line and no summary line on stderr.
+    #[arg(short, long)]
+    pub quiet: bool,
+}
+
+impl BedArgs {
+    /// The scene: the file or the published one, with the overrides, validated.
+    pub fn scene(&self) -> anyhow::Result<Scene> {
+        let mut scene = match &self.scene {
+            Some(path) => Scene::read(path)?,
+            None => Scene::published(),
+        };
+        if let Some(t) = self.granule_type {
+            scene.granule_type = t.name().to_string();
+        }
+        if let Some(n) = self.granules {
+            scene.granules = n;
+        }
+        if let Some(m) = self.mesh {
+            scene.mesh = m.to_string();
+        }
+        if let Some(c) = self.strain {
+            scene.final_strain = c;
+        }
+        if let Some(s) = self.seed {
+            scene.seed = s;
+        }
+        if let Some(d) = self.die_diameter_mm {
+            scene.die_diameter_mm = d;
+        }
+        scene.validate()?;
+        Ok(scene)
+    }
+
+    /// Runs the command.
+    pub fn run(&self, streams: &mut Streams<'_>) -> anyhow::Result<()> {
+        let scene = self.scene()?;
+        if self.print_scene {
+            let text = if self.scene.is_none() && scene == Scene::published() {
+                DEFAULT_SCENE.to_string()
+            } else {
+                scene.to_toml()
+            };
+            write!(streams.stdout, "{text}")?;
+            return Ok(());
+        }
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(self.threads)
+            .build()?;
+        let progress = outputs::Progress::new(self.quiet, scene.final_strain);
+        let result =
+            pool.install(|| run::run_bed(&scene, &mut |s, elapsed| progress.update(s, elapsed)))?;
+        progress.finish();
+        outputs::write_all(&self.out, &scene, &result)?;
+        if !self.quiet {
+            writeln!(streams.stderr, "{}", outputs::summary_line(&scene, &result))?;
+        }
+        if let Some(e) = result.error {
+            return Err(anyhow::Error::new(e).context(format!(
+                "the bed compression stopped early (outputs so far in `{}`)",
+                self.out.display()
+            )));
+        }
+        Ok(())
+    }
+}

@@ -1,0 +1,288 @@
+//! What `granbed-cli bed` writes: `compression.csv`, `summary.json`, the
+//! one-line summary, and the progress bar on stderr.
+
+use std::path::Path;
+
+use anyhow::Context as _;
+use granbed_kernel::Real;
+use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+use serde::Serialize;
+
+use super::run::{BedRun, BedSample};
+use super::scene::Scene;
+use crate::csv::{CsvWriter, Field};
+use crate::output::{create_file, finish_file, finite_ratio, write_json};
+
+/// Columns of `compression.csv`, in order.
+pub const COMPRESSION_COLUMNS: [&str; 24] = [
+    "time_s",
+    "strain",
+    "upper_pressure_pa",
+    "lower_pressure_pa",
+    "upper_force_n",
+    "lower_force_n",
+    "die_friction_z_n",
+    "coordination",
+    "coordination_with_walls",
+    "relative_density_mean",
+    "relative_density_solid",
+    "heywood_dv",
+    "heywood_d",
+    "min_jacobian",
+    "steps",
+    "punch_work_j",
+    "internal_work_j",
+    "elastic_j",
+    "plastic_j",
+    "hourglass_j",
+    "damping_j",
+    "kinetic_j",
+    "contact_loss_j",
+    "energy_residual_j",
+];
+
+fn row(s: &BedSample) -> [Field; 24] {
+    let e = &s.energies;
+    [
+        s.time_s.into(),
+        s.strain.into(),
+        s.upper_pressure_pa.into(),
+        s.lower_pressure_pa.into(),
+        s.upper_force_n.into(),
+        s.lower_force_n.into(),
+        s.die_friction_z_n.into(),
+        s.coordination.into(),
+        s.coordination_with_walls.into(),
+        s.relative_density_mean.into(),
+        s.relative_density_solid.into(),
+        s.heywood_dv.into(),
+        s.heywood_d.into(),
+        s.min_jacobian.into(),
+        Field::Int(s.steps),
+        e.punch_work.into(),
+        e.internal_work.into(),
+        e.elastic.into(),
+        e.plastic.into(),
+        e.hourglass.into(),
+        e.damping.into(),
+        e.kinetic.into(),
+        e.contact_loss().into(),
+        e.residual().into(),
+    ]
+}
+
+/// The Kawakita fit of `summary.json`.
+#[derive(Clone, Copy, Debug, Serialize)]
+pub struct KawakitaSummary {
+    /// a (dimensionless).
+    pub a: Option<Real>,
+    /// 1/b, Pa.
+    pub inv_b_pa: Option<Real>,
+    /// R² of the fit.
+    pub r_squared: Option<Real>,
+    /// Points with C ≥ 0.25 used.
+    pub points: usize,
+}
+
+/// The fields of `summary.json`.
+#[derive(Debug, Serialize)]
+pub struct Summary<'a> {
+    /// granbed version.
+    pub version: &'static str,
+    /// The scene as run.
+    pub scene: &'a Scene,
+    /// Kawakita a.
+    pub kawakita_a: Option<Real>,
+    /// Kawakita 1/b, Pa.
+    pub kawakita_inv_b_pa: Option<Real>,
+    /// The fit in full.
+    pub kawakita: KawakitaSummary,
+    /// Strain reached.
+    pub final_strain: Real,
+    /// Largest upper-punch pressure of the samples, Pa.
+    pub max_pressure_pa: Real,
+    /// H0, m.
+    pub initial_bed_height_m: Real,
+    /// Granules.
+    pub granules: usize,
+    /// Hexes in the bed.
+    pub elements: usize,
+    /// Steps.
+    pub steps: u64,
+    /// Element evaluations.
+    pub element_steps: u64,
+    /// Wall time of the compression, s.
+    pub wall_time_s: f64,
+    /// Wall time of the pour, s.
+    pub pour_wall_time_s: f64,
+    /// Compression wall time per element evaluation, ns.
+    pub ns_per_element_step: Option<f64>,
+    /// Share of the contact phase in the compression's wall time.
+    pub contact_share: Option<f64>,
+    /// Threads used.
+    pub threads: usize,
+    /// Smallest element Jacobian ratio.
+    pub min_jacobian: Real,
+    /// |ledger residual| / punch work.
+    pub energy_residual_rel: Option<Real>,
+    /// Contact losses / punch work.
+    pub contact_loss_rel: Option<Real>,
+    /// Peak resident memory of the process, bytes (Linux VmHWM).
+    pub peak_memory_bytes: Option<u64>,
+    /// The error that stopped the run early, if any.
+    pub error: Option<String>,
+}
+
+/// Peak resident set size of this process (Linux `/proc/self/status`
+/// VmHWM), bytes.
+pub fn peak_memory_bytes() -> Option<u64> {
+    let status = std::fs::read_to_string("/proc/self/status").ok()?;
+    let line = status.lines().find(|l| l.starts_with("VmHWM:"))?;
+    let kb: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
+    Some(kb * 1024)
+}
+
+/// The Kawakita fit of the samples (C ≥ 0.25).
+pub fn kawakita(samples: &[BedSample]) -> KawakitaSummary {
+    let points = samples.iter().map(|s| (s.upper_pressure_pa, s.strain));
+    match granbed_kernel::analysis::bed::kawakita_fit(points, 0.25) {
+        Some(f) => KawakitaSummary {
+            a: Some(f.a),
+            inv_b_pa: Some(f.inv_b_pa),
+            r_squared: Some(f.r_squared),
+            points: f.points,
+        },
+        None => KawakitaSummary {
+            a: None,
+            inv_b_pa: None,
+            r_squared: None,
+            points: samples.iter().filter(|s| s.strain >= 0.25).count(),
+        },
+    }
+}
+
+/// The summary of `run`.
+pub fn summary<'a>(scene: &'a Scene, run: &BedRun) -> Summary<'a> {
+    let last = run.samples.last().copied().unwrap_or_default();
+    let k = kawakita(&run.samples);
+    let min_jacobian = run
+        .samples
+        .iter()
+        .map(|s| s.min_jacobian)
+        .fold(Real::INFINITY, Real::min);
+    let e = last.energies;
+    Summary {
+        version: env!("CARGO_PKG_VERSION"),
+        scene,
+        kawakita_a: k.a,
+        kawakita_inv_b_pa: k.inv_b_pa,
+        kawakita: k,
+        final_strain: last.strain,
+        max_pressure_pa: run
+            .samples
+            .iter()
+            .map(|s| s.upper_pressure_pa)
+            .fold(0.0, Real::max),
+        initial_bed_height_m: run.bed_height_m,
+        granules: run.granules,
+        elements: run.granules * run.hexes_per_granule,
+        steps: run.steps,
+        element_steps: run.element_steps,
+        wall_time_s: run.wall_time_s,
+        pour_wall_time_s: run.pour_wall_time_s,
+        ns_per_element_step: finite_ratio(1e9 * run.wall_time_s, run.element_steps as f64),
+        contact_share: Some(run.phase_times.contact_share()).filter(|x| x.is_finite()),
+        threads: run.threads,
+        min_jacobian,
+        energy_residual_rel: finite_ratio(e.residual().abs(), e.punch_work),
+        contact_loss_rel: finite_ratio(e.contact_loss(), e.punch_work),
+        peak_memory_bytes: peak_memory_bytes(),
+        error: run.error.as_ref().map(|e| e.to_string()),
+    }
+}
+
+/// Writes `compression.csv` and `summary.json` into `dir` (created).
+pub fn write_all(dir: &Path, scene: &Scene, run: &BedRun) -> anyhow::Result<()> {
+    std::fs::create_dir_all(dir)
+        .with_context(|| format!("cannot create output directory `{}`", dir.display()))?;
+    let path = dir.join("compression.csv");
+    let mut csv = CsvWriter::new(create_file(&path)?, &COMPRESSION_COLUMNS)
+        .with_context(|| format!("cannot write to `{}`", path.display()))?;
+    for s in &run.samples {
+        csv.write_row(&row(s))
+            .with_context(|| format!("cannot write to `{}`", path.display()))?;
+    }
+    finish_file(csv.into_inner(), &path)?;
+    write_json(&dir.join("summary.json"), &summary(scene, run))
+}
+
+/// One line for stderr at the end.
+pub fn summary_line(scene: &Scene, run: &BedRun) -> String {
+    let s = summary(scene, run);
+    let fmt =
+        |x: Option<Real>, scale: Real| x.map_or("n/a".to_string(), |v| format!("{:.4}", v * scale));
+    format!(
+        "bed {} x {}: C = {:.3} after {} steps in {:.1} s ({} threads, {:.0} ns/element-step); \
+         max pressure {:.1} kPa; Kawakita a = {}, 1/b = {} kPa ({} points)",
+        scene.granules,
+        scene.granule_type,
+        s.final_strain,
+        s.steps,
+        s.wall_time_s,
+        s.threads,
+        s.ns_per_element_step.unwrap_or(f64::NAN),
+        s.max_pressure_pa * 1e-3,
+        fmt(s.kawakita_a, 1.0),
+        fmt(s.kawakita_inv_b_pa, 1e-3),
+        s.kawakita.points,
+    )
+}
+
+/// The progress bar of a bed run on stderr (hidden with `--quiet` or when
+/// stderr is not a terminal): strain as the position, with pressure,
+/// coordination number, steps per second and the ETA.
+pub struct Progress {
+    bar: ProgressBar,
+}
+
+/// Bar positions per unit strain.
+const TICKS: f64 = 10_000.0;
+
+impl Progress {
+    /// A bar up to `final_strain`.
+    pub fn new(quiet: bool, final_strain: Real) -> Self {
+        let target = if quiet {
+            ProgressDrawTarget::hidden()
+        } else {
+            ProgressDrawTarget::stderr()
+        };
+        let style =
+            ProgressStyle::with_template("bed [{elapsed_precise}] {bar:30} C {msg} (ETA {eta})")
+                .unwrap_or_else(|_| ProgressStyle::default_bar());
+        let bar = ProgressBar::with_draw_target(Some((final_strain * TICKS) as u64), target)
+            .with_style(style);
+        Self { bar }
+    }
+
+    /// Shows sample `s`, taken `elapsed_s` into the compression.
+    pub fn update(&self, s: &BedSample, elapsed_s: f64) {
+        let rate = if elapsed_s > 0.0 {
+            s.steps as f64 / elapsed_s
+        } else {
+            0.0
+        };
+        self.bar.set_position((s.strain * TICKS) as u64);
+        self.bar.set_message(format!(
+            "{:.3}, P {:.1} kPa, Z {:.2}, {:.0} steps/s",
+            s.strain,
+            s.upper_pressure_pa * 1e-3,
+            s.coordination,
+            rate
+        ));
+    }
+
+    /// Removes the bar.
+    pub fn finish(&self) {
+        self.bar.finish_and_clear();
+    }
+}

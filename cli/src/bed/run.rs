@@ -1,0 +1,257 @@
+//! The bed compression run: pour the spheres, put a granule mesh at every
+//! centre, press the upper punch to the final strain and sample the
+//! time-averaged state every output interval. Nothing here depends on
+//! clap, so the tests drive exactly this code.
+
+use std::time::Instant;
+
+use anyhow::Context as _;
+use granbed_kernel::Real;
+use granbed_kernel::analysis::bed::{
+    GranuleShape, bed_density, coordination_number, coordination_number_with_walls, granule_shape,
+    surface_geometry,
+};
+use granbed_kernel::dem::pour::PourParams;
+use granbed_kernel::granule::forces::{ElementKind, ElementSettings};
+
+use super::scene::Scene;
+use crate::assembly::die::{DieScene, placements, wall_index};
+use crate::assembly::{Assembly, AssemblyError, AssemblyParams, Energies};
+use crate::model::OwnedReference;
+use crate::pack::run::run_pour;
+
+/// One output row: averages over the interval that ends at `strain`.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct BedSample {
+    /// Time, s.
+    pub time_s: Real,
+    /// Axial strain C = (H0 − H)/H0.
+    pub strain: Real,
+    /// Upper-punch force, N (interval average).
+    pub upper_force_n: Real,
+    /// Lower-punch force, N (interval average).
+    pub lower_force_n: Real,
+    /// Axial (z) friction force of the die wall on the granules, N
+    /// (interval average; positive upwards).
+    pub die_friction_z_n: Real,
+    /// Upper-punch pressure F/(π R_d²), Pa.
+    pub upper_pressure_pa: Real,
+    /// Lower-punch pressure, Pa.
+    pub lower_pressure_pa: Real,
+    /// Coordination number 2 N_pp / N (interval average).
+    pub coordination: Real,
+    /// Coordination number counting granule–wall contacts too,
+    /// (2 N_pp + N_pw)/N with N_pw the (granule, wall) pairs in contact.
+    pub coordination_with_walls: Real,
+    /// Mean granule relative density η0 V0/V (arithmetic mean).
+    pub relative_density_mean: Real,
+    /// Σ solid volume / Σ granule volume.
+    pub relative_density_solid: Real,
+    /// Mean Heywood coefficient d_V S/V.
+    pub heywood_dv: Real,
+    /// Mean Heywood coefficient d S/V with the nominal diameter d.
+    pub heywood_d: Real,
+    /// Smallest element Jacobian ratio in the interval.
+    pub min_jacobian: Real,
+    /// Steps so far.
+    pub steps: u64,
+    /// Energy ledger so far (elastic energy at this instant).
+    pub energies: Energies,
+}
+
+/// What a run produced. A run stopped by a kernel error keeps the samples
+/// so far and holds the error.
+#[derive(Debug)]
+pub struct BedRun {
+    /// Samples in time order, the first at t = 0.
+    pub samples: Vec<BedSample>,
+    /// Initial bed height H0, m.
+    pub bed_height_m: Real,
+    /// Die radius, m.
+    pub die_radius_m: Real,
+    /// Granules.
+    pub granules: usize,
+    /// Hexes per granule.
+    pub hexes_per_granule: usize,
+    /// Steps completed.
+    pub steps: u64,
+    /// Granule-element evaluations (steps × granules × hexes).
+    pub element_steps: u64,
+    /// Wall time of the pour, s.
+    pub pour_wall_time_s: f64,
+    /// Wall time of the compression, s.
+    pub wall_time_s: f64,
+    /// Wall time by phase of the compression.
+    pub phase_times: crate::assembly::PhaseTimes,
+    /// Threads of the pool the run used.
+    pub threads: usize,
+    /// The error that stopped the run, if any.
+    pub error: Option<AssemblyError>,
+}
+
+/// The time-averaging window of the samples.
+#[derive(Default)]
+struct Window {
+    time: Real,
+    impulse: [Real; 3],
+    pairs: Real,
+    walls: Real,
+    min_j: Real,
+}
+
+/// Bed geometry from every granule's current surface (physics.md §7.5–6):
+/// (η arithmetic mean, Σsolid/ΣV, mean α_SV with d_V, mean α_SV with `d`).
+/// A degenerate granule surface gives NaN (reported, never a panic).
+fn geometry(asm: &Assembly<'_>, mesh: &OwnedReference, eta0: Real, d: Real) -> [Real; 4] {
+    let v0 = surface_geometry(&mesh.positions, &mesh.quads).map_or(Real::NAN, |(_, v)| v);
+    let shapes: Option<Vec<GranuleShape>> = asm
+        .granules()
+        .iter()
+        .map(|g| granule_shape(&g.x, &mesh.quads, eta0, v0, d).ok())
+        .collect();
+    let Some(shapes) = shapes else {
+        return [Real::NAN; 4];
+    };
+    let n = shapes.len() as Real;
+    let density = bed_density(&shapes);
+    [
+        density.map_or(Real::NAN, |b| b.arithmetic),
+        density.map_or(Real::NAN, |b| b.solid_over_volume),
+        shapes.iter().map(|s| s.heywood_dv).sum::<Real>() / n,
+        shapes.iter().map(|s| s.heywood_fixed).sum::<Real>() / n,
+    ]
+}
+
+/// Runs `scene`. `on_sample` sees every sample with the wall time since
+/// the start of the compression (for progress). Errors before the first
+/// step (pour failed, bad setup) are returned; an error while stepping
+/// ends the run and is kept in [`BedRun::error`].
+pub fn run_bed(
+    scene: &Scene,
+    on_sample: &mut dyn FnMut(&BedSample, f64),
+) -> anyhow::Result<BedRun> {
+    let material = scene.material()?;
+    let radius = 0.5e-3 * scene.diameter_mm;
+    let mut pour = PourParams::standard(material.density0, scene.seed);
+    let scale = radius / pour.radius;
+    pour.granules = scene.granules;
+    pour.radius = radius;
+    pour.lattice_spacing *= scale;
+    pour.jitter *= scale;
+    pour.skin *= scale;
+    pour.die_radius = 0.5e-3 * scene.die_diameter_mm;
+    pour.friction_particle = material.params.friction;
+    pour.friction_wall = material.params.friction;
+    let pour_start = Instant::now();
+    let poured = run_pour(pour, &mut |_, _| {}).map_err(anyhow::Error::new)?;
+    if let Some(e) = poured.error {
+        return Err(anyhow::Error::new(e).context("the pour did not come to rest"));
+    }
+    let pour_wall_time_s = pour_start.elapsed().as_secs_f64();
+
+    let mesh = OwnedReference::sphere(radius, scene.mesh_level()?, false)?;
+    let die = DieScene::new(
+        &poured.positions,
+        radius,
+        pour.die_radius,
+        scene.punch_speed_m_s,
+    );
+    let elements = ElementSettings {
+        kind: ElementKind::OnePoint,
+        update: Default::default(),
+        hourglass_kappa: granbed_kernel::element::force::DEFAULT_HOURGLASS_KAPPA,
+    };
+    let mut params = AssemblyParams::standard(material, elements);
+    params.damping_ratio = scene.damping_ratio;
+    params.contact_sweeps = scene.contact_sweeps;
+    let placed = placements(&poured.positions, scene.seed);
+    let mut asm = Assembly::new(params, &mesh, &placed, die.walls())
+        .map_err(anyhow::Error::new)
+        .context("cannot set up the bed")?;
+    let area = core::f64::consts::PI * pour.die_radius * pour.die_radius;
+    let granules = scene.granules;
+    let eta0 = material.params.eta0;
+    let d = 2.0 * radius;
+    let start = Instant::now();
+    let sample = |asm: &mut Assembly<'_>, w: &Window| {
+        let [rho, rho_solid, a_dv, a_d] = geometry(asm, &mesh, eta0, d);
+        asm.elastic_energy();
+        let avg = |x: Real| if w.time > 0.0 { x / w.time } else { 0.0 };
+        BedSample {
+            time_s: asm.time(),
+            strain: die.strain_at(asm.time()),
+            upper_force_n: avg(w.impulse[0]),
+            lower_force_n: avg(w.impulse[1]),
+            die_friction_z_n: avg(w.impulse[2]),
+            upper_pressure_pa: avg(w.impulse[0]) / area,
+            lower_pressure_pa: avg(w.impulse[1]) / area,
+            coordination: coordination_number(avg(w.pairs), granules).unwrap_or(Real::NAN),
+            coordination_with_walls: coordination_number_with_walls(
+                avg(w.pairs),
+                avg(w.walls),
+                granules,
+            )
+            .unwrap_or(Real::NAN),
+            relative_density_mean: rho,
+            relative_density_solid: rho_solid,
+            heywood_dv: a_dv,
+            heywood_d: a_d,
+            min_jacobian: if w.time > 0.0 { w.min_j } else { 1.0 },
+            steps: asm.steps(),
+            energies: *asm.energies(),
+        }
+    };
+    let first = sample(&mut asm, &Window::default());
+    on_sample(&first, 0.0);
+    let mut samples = vec![first];
+    let mut window = Window {
+        min_j: Real::INFINITY,
+        ..Window::default()
+    };
+    let mut next = scene.output_strain_interval;
+    let end = die.time_of_strain(scene.final_strain);
+    let mut error = None;
+    while asm.time() < end {
+        if let Err(e) = asm.step() {
+            error = Some(e);
+            break;
+        }
+        let last = asm.last();
+        let dt = last.dt;
+        window.time += dt;
+        window.impulse[0] += last.walls[wall_index::UPPER].normal * dt;
+        window.impulse[1] += last.walls[wall_index::LOWER].normal * dt;
+        window.impulse[2] += last.walls[wall_index::DIE].tangential[2] * dt;
+        window.pairs += asm.contact().pairs_in_contact() as Real * dt;
+        window.walls += last.wall_contacts as Real * dt;
+        window.min_j = window.min_j.min(last.min_j);
+        let strain = die.strain_at(asm.time());
+        if strain + 1e-12 >= next || asm.time() >= end {
+            let s = sample(&mut asm, &window);
+            on_sample(&s, start.elapsed().as_secs_f64());
+            samples.push(s);
+            window = Window {
+                min_j: Real::INFINITY,
+                ..Window::default()
+            };
+            while next <= strain + 1e-12 {
+                next += scene.output_strain_interval;
+            }
+        }
+    }
+    let steps = asm.steps();
+    Ok(BedRun {
+        samples,
+        bed_height_m: die.bed_height_m,
+        die_radius_m: pour.die_radius,
+        granules: scene.granules,
+        hexes_per_granule: mesh.hexes.len(),
+        steps,
+        element_steps: steps * (scene.granules * mesh.hexes.len()) as u64,
+        pour_wall_time_s,
+        wall_time_s: start.elapsed().as_secs_f64(),
+        phase_times: *asm.times(),
+        threads: rayon::current_num_threads(),
+        error,
+    })
+}

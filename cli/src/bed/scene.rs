@@ -1,0 +1,291 @@
+//! The scene of a bed compression: a TOML file (format `version` 1, every
+//! quantity with its unit in the field name, unknown fields rejected), the
+//! embedded default (the published scene) and its validation.
+
+use anyhow::{Context as _, bail};
+use granbed_kernel::material::{GranuleType, Material, MaterialParams};
+use serde::{Deserialize, Serialize};
+
+use crate::error::InputError;
+use crate::model::MeshLevel;
+
+/// The format version this build reads and writes.
+pub const SCENE_VERSION: u32 = 1;
+
+/// The published scene (physics.md §6 and the paper's bed): 1000 B2
+/// granules of 1280 hexes poured into an 11.3 mm die (seed 1), the upper
+/// punch at 50 mm/s to 30 % axial strain, friction 0.1, ξ = 0.5.
+pub const DEFAULT_SCENE: &str = r#"# granbed bed scene (format version 1). Units are in the field names.
+version = 1
+
+# Granules: a standard type A1...C3 (A/B/C: yield stress 10/30/100 kPa;
+# 1/2/3: initial relative density 0.6/0.8/1.0), and [material] overrides.
+granule_type = "B2"
+granules = 1000
+diameter_mm = 1.0
+# Mesh level NxM of the cubed sphere: 8x2 = 1280 hexes (4x1 = 160, 16x4).
+mesh = "8x2"
+
+# The pour (granbed-cli pack) and the random rotations of the meshes.
+seed = 1
+die_diameter_mm = 11.3
+
+# Compression: upper punch speed and the axial strain C = (H0 - H)/H0 to reach.
+punch_speed_m_s = 0.05
+final_strain = 0.3
+# Output rows (time averages) every this much strain.
+output_strain_interval = 0.005
+
+# Selective damping of the non-rigid modes, fraction of critical.
+damping_ratio = 0.5
+# Contact sweeps per step (physics.md 5.3).
+contact_sweeps = 3
+
+# Overrides of the type's preset (SI units), e.g. yield_stress_pa = 30e3.
+[material]
+friction = 0.1
+"#;
+
+/// Overrides of the granule type's preset; every field optional.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MaterialOverrides {
+    /// Young's modulus, Pa.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub youngs_modulus_pa: Option<f64>,
+    /// Poisson's ratio.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub poisson_ratio: Option<f64>,
+    /// Yield stress, Pa.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub yield_stress_pa: Option<f64>,
+    /// Initial relative density η0.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub eta0: Option<f64>,
+    /// Yield-surface constant cp.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub cp: Option<f64>,
+    /// Critical relative density ηc.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub eta_c: Option<f64>,
+    /// True density, kg/m³.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub true_density_kg_m3: Option<f64>,
+    /// Coulomb friction (granule–granule and granule–wall).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub friction: Option<f64>,
+}
+
+/// A bed-compression scene.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Scene {
+    /// Format version; must be [`SCENE_VERSION`].
+    pub version: u32,
+    /// Standard granule type A1…C3.
+    pub granule_type: String,
+    /// Number of granules, 1 ≤ N ≤ 100000.
+    pub granules: usize,
+    /// Granule diameter, mm.
+    pub diameter_mm: f64,
+    /// Mesh level `NxM`.
+    pub mesh: String,
+    /// Seed of the pour and of the mesh rotations.
+    pub seed: u64,
+    /// Die diameter, mm.
+    pub die_diameter_mm: f64,
+    /// Upper-punch speed, m/s (> 0).
+    pub punch_speed_m_s: f64,
+    /// Axial strain at which the run ends, 0 < C ≤ 0.9.
+    pub final_strain: f64,
+    /// Strain between output rows, > 0.
+    pub output_strain_interval: f64,
+    /// Damping ratio ξ, 0 ≤ ξ ≤ 2.
+    pub damping_ratio: f64,
+    /// Contact sweeps per step, 1..=10.
+    pub contact_sweeps: u32,
+    /// Material overrides.
+    #[serde(default)]
+    pub material: MaterialOverrides,
+}
+
+fn invalid(field: &str, value: impl core::fmt::Display, allowed: &str) -> anyhow::Error {
+    anyhow::Error::new(InputError(format!(
+        "scene field `{field}` = {value} is out of range (allowed: {allowed})"
+    )))
+}
+
+impl Scene {
+    /// The embedded published scene.
+    pub fn published() -> Self {
+        Self::from_toml(DEFAULT_SCENE).expect("the embedded scene parses")
+    }
+
+    /// Parses and validates a scene file's text.
+    pub fn from_toml(text: &str) -> anyhow::Result<Self> {
+        let scene: Scene = toml::from_str(text).map_err(|e| {
+            anyhow::Error::new(InputError(format!("invalid scene: {}", e.message())))
+                .context(e.to_string())
+        })?;
+        scene.validate()?;
+        Ok(scene)
+    }
+
+    /// The scene as TOML (for `summary.json` and `--print-scene` of an
+    /// overridden scene).
+    pub fn to_toml(&self) -> String {
+        toml::to_string(self).unwrap_or_default()
+    }
+
+    /// Checks every field; an error names the field and its allowed range.
+    pub fn validate(&self) -> anyhow::Result<()> {
+        if self.version != SCENE_VERSION {
+            bail!(invalid("version", self.version, "1"));
+        }
+        self.granule_type()?;
+        self.mesh_level()?;
+        let checks: [(bool, &str, f64, &str); 8] = [
+            (
+                (1..=100_000).contains(&self.granules),
+                "granules",
+                self.granules as f64,
+                "1..=100000",
+            ),
+            (
+                self.diameter_mm > 0.0 && self.diameter_mm < 2000.0,
+                "diameter_mm",
+                self.diameter_mm,
+                "0 < d < 2000",
+            ),
+            (
+                self.die_diameter_mm > 4.0 * self.diameter_mm && self.die_diameter_mm.is_finite(),
+                "die_diameter_mm",
+                self.die_diameter_mm,
+                "more than 4 granule diameters",
+            ),
+            (
+                self.punch_speed_m_s > 0.0 && self.punch_speed_m_s.is_finite(),
+                "punch_speed_m_s",
+                self.punch_speed_m_s,
+                "> 0",
+            ),
+            (
+                self.final_strain > 0.0 && self.final_strain <= 0.9,
+                "final_strain",
+                self.final_strain,
+                "0 < C <= 0.9",
+            ),
+            (
+                self.output_strain_interval > 0.0 && self.output_strain_interval.is_finite(),
+                "output_strain_interval",
+                self.output_strain_interval,
+                "> 0",
+            ),
+            (
+                (0.0..=2.0).contains(&self.damping_ratio),
+                "damping_ratio",
+                self.damping_ratio,
+                "0 <= xi <= 2",
+            ),
+            (
+                (1..=10).contains(&self.contact_sweeps),
+                "contact_sweeps",
+                f64::from(self.contact_sweeps),
+                "1..=10",
+            ),
+        ];
+        if let Some((_, field, value, allowed)) = checks.into_iter().find(|c| !c.0) {
+            bail!(invalid(field, value, allowed));
+        }
+        self.material()?;
+        Ok(())
+    }
+
+    /// The granule type.
+    pub fn granule_type(&self) -> anyhow::Result<GranuleType> {
+        self.granule_type
+            .parse()
+            .map_err(|_| invalid("granule_type", &self.granule_type, "A1, A2, A3, B1 ... C3"))
+    }
+
+    /// The mesh level.
+    pub fn mesh_level(&self) -> anyhow::Result<MeshLevel> {
+        self.mesh
+            .parse()
+            .map_err(|m: String| invalid("mesh", &self.mesh, &m))
+    }
+
+    /// The type's preset with the overrides (not validated).
+    pub fn material_params(&self) -> anyhow::Result<MaterialParams> {
+        let mut p = self.granule_type()?.params();
+        let o = &self.material;
+        for (field, value) in [
+            (&mut p.youngs_modulus_pa, o.youngs_modulus_pa),
+            (&mut p.poisson_ratio, o.poisson_ratio),
+            (&mut p.yield_stress_pa, o.yield_stress_pa),
+            (&mut p.eta0, o.eta0),
+            (&mut p.cp, o.cp),
+            (&mut p.eta_c, o.eta_c),
+            (&mut p.true_density_kg_m3, o.true_density_kg_m3),
+            (&mut p.friction, o.friction),
+        ] {
+            if let Some(v) = value {
+                *field = v;
+            }
+        }
+        Ok(p)
+    }
+
+    /// The validated material; a rejection names `material.<field>`.
+    pub fn material(&self) -> anyhow::Result<Material> {
+        let p = self.material_params()?;
+        p.validate().map_err(|e| {
+            anyhow::Error::new(InputError(format!(
+                "scene field `material.{}` = {} is out of range (allowed: {})",
+                e.field, e.value, e.allowed
+            )))
+        })
+    }
+
+    /// Reads a scene file.
+    pub fn read(path: &std::path::Path) -> anyhow::Result<Self> {
+        let text = std::fs::read_to_string(path)
+            .with_context(|| format!("cannot read scene `{}`", path.display()))?;
+        Self::from_toml(&text).with_context(|| format!("scene `{}`", path.display()))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_embedded_scene_is_the_published_one() {
+        let s = Scene::published();
+        assert_eq!(s.granules, 1000);
+        assert_eq!(s.granule_type().unwrap(), GranuleType::B2);
+        assert_eq!(s.mesh_level().unwrap(), MeshLevel::STANDARD);
+        assert_eq!(s.die_diameter_mm, 11.3);
+        assert_eq!(s.punch_speed_m_s, 0.05);
+        assert_eq!(s.final_strain, 0.3);
+        let m = s.material().unwrap();
+        assert_eq!(m.params.yield_stress_pa, 30e3);
+        assert_eq!(m.params.eta0, 0.8);
+        // The TOML written back parses to the same scene.
+        assert_eq!(Scene::from_toml(&s.to_toml()).unwrap(), s);
+    }
+
+    #[test]
+    fn bad_scenes_name_the_field() {
+        let bad = |from: &str, to: &str| {
+            let text = DEFAULT_SCENE.replace(from, to);
+            format!("{:#}", Scene::from_toml(&text).unwrap_err())
+        };
+        assert!(bad("granules = 1000", "granules = 0").contains("`granules`"));
+        assert!(bad("version = 1", "version = 2").contains("`version`"));
+        assert!(bad("mesh = \"8x2\"", "mesh = \"3x1\"").contains("`mesh`"));
+        assert!(bad("friction = 0.1", "friction = -1").contains("material.friction"));
+        assert!(bad("seed = 1", "seed = 1\ncolour = 3").contains("colour"));
+        assert!(bad("final_strain = 0.3", "final_strain = 1.5").contains("`final_strain`"));
+    }
+}
