@@ -134,10 +134,11 @@ impl BedArgs {
         let pool = rayon::ThreadPoolBuilder::new()
             .num_threads(self.threads)
             .build()?;
-        let progress = outputs::Progress::new(self.quiet, scene.final_strain);
-        let result =
-            pool.install(|| run::run_bed(&scene, &mut |s, elapsed| progress.update(s, elapsed)))?;
-        progress.finish();
+        let mut observer = Observer {
+            progress: outputs::Progress::new(self.quiet, scene.final_strain),
+        };
+        let result = pool.install(|| run::run_bed(&scene, &mut observer))?;
+        observer.progress.finish();
         outputs::write_all(&self.out, &scene, &result)?;
         if !self.quiet {
             writeln!(streams.stderr, "{}", outputs::summary_line(&scene, &result))?;
@@ -148,6 +149,26 @@ impl BedArgs {
                 self.out.display()
             )));
         }
+        Ok(())
+    }
+}
+
+/// What the command does with the run as it goes.
+struct Observer {
+    progress: outputs::Progress,
+}
+
+impl run::BedObserver for Observer {
+    fn sample(&mut self, sample: &run::BedSample, elapsed_s: f64) {
+        self.progress.update(sample, elapsed_s);
+    }
+
+    fn snapshot(
+        &mut self,
+        _strain: f64,
+        _assembly: &crate::assembly::Assembly<'_>,
+        _mesh: &crate::model::OwnedReference,
+    ) -> anyhow::Result<()> {
         Ok(())
     }
 }

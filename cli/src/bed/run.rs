@@ -122,14 +122,26 @@ fn geometry(asm: &Assembly<'_>, mesh: &OwnedReference, eta0: Real, d: Real) -> [
     ]
 }
 
-/// Runs `scene`. `on_sample` sees every sample with the wall time since
-/// the start of the compression (for progress). Errors before the first
+/// Sees the run as it goes: every sample (with the wall time since the
+/// start of the compression), and the assembly at each snapshot strain.
+pub trait BedObserver {
+    /// A new output row.
+    fn sample(&mut self, sample: &BedSample, elapsed_s: f64);
+    /// The state when the strain first reaches `strain`, one of the
+    /// scene's `snapshot_strains` (and at t = 0 for a strain of 0). An
+    /// error stops the run.
+    fn snapshot(
+        &mut self,
+        strain: Real,
+        assembly: &Assembly<'_>,
+        mesh: &OwnedReference,
+    ) -> anyhow::Result<()>;
+}
+
+/// Runs `scene`, reporting to `observer`. Errors before the first
 /// step (pour failed, bad setup) are returned; an error while stepping
 /// ends the run and is kept in [`BedRun::error`].
-pub fn run_bed(
-    scene: &Scene,
-    on_sample: &mut dyn FnMut(&BedSample, f64),
-) -> anyhow::Result<BedRun> {
+pub fn run_bed(scene: &Scene, observer: &mut dyn BedObserver) -> anyhow::Result<BedRun> {
     let material = scene.material()?;
     let radius = 0.5e-3 * scene.diameter_mm;
     let mut pour = PourParams::standard(material.density0, scene.seed);
@@ -202,7 +214,14 @@ pub fn run_bed(
         }
     };
     let first = sample(&mut asm, &Window::default());
-    on_sample(&first, 0.0);
+    observer.sample(&first, 0.0);
+    let mut snapshots: Vec<Real> = scene.snapshot_strains.clone();
+    snapshots.sort_by(Real::total_cmp);
+    snapshots.dedup();
+    let mut snapshots = snapshots.into_iter().peekable();
+    while snapshots.next_if(|&c| c <= 0.0).is_some() {
+        observer.snapshot(0.0, &asm, &mesh)?;
+    }
     let mut samples = vec![first];
     let mut window = Window {
         min_j: Real::INFINITY,
@@ -226,9 +245,12 @@ pub fn run_bed(
         window.walls += last.wall_contacts as Real * dt;
         window.min_j = window.min_j.min(last.min_j);
         let strain = die.strain_at(asm.time());
+        while let Some(c) = snapshots.next_if(|&c| strain + 1e-12 >= c) {
+            observer.snapshot(c, &asm, &mesh)?;
+        }
         if strain + 1e-12 >= next || asm.time() >= end {
             let s = sample(&mut asm, &window);
-            on_sample(&s, start.elapsed().as_secs_f64());
+            observer.sample(&s, start.elapsed().as_secs_f64());
             samples.push(s);
             window = Window {
                 min_j: Real::INFINITY,

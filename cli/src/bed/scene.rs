@@ -35,6 +35,8 @@ punch_speed_m_s = 0.05
 final_strain = 0.3
 # Output rows (time averages) every this much strain.
 output_strain_interval = 0.005
+# VTU snapshots of the granules at these strains (vtk/ in the output).
+snapshot_strains = [0.0, 0.1, 0.2, 0.3]
 
 # Selective damping of the non-rigid modes, fraction of critical.
 damping_ratio = 0.5
@@ -100,6 +102,9 @@ pub struct Scene {
     pub final_strain: f64,
     /// Strain between output rows, > 0.
     pub output_strain_interval: f64,
+    /// Strains at which VTU snapshots are written (each in [0, 0.9]).
+    #[serde(default)]
+    pub snapshot_strains: Vec<f64>,
     /// Damping ratio ξ, 0 ≤ ξ ≤ 2.
     pub damping_ratio: f64,
     /// Contact sweeps per step, 1..=10.
@@ -196,6 +201,13 @@ impl Scene {
         ];
         if let Some((_, field, value, allowed)) = checks.into_iter().find(|c| !c.0) {
             bail!(invalid(field, value, allowed));
+        }
+        if let Some(c) = self
+            .snapshot_strains
+            .iter()
+            .find(|c| !(0.0..=0.9).contains(*c))
+        {
+            bail!(invalid("snapshot_strains", c, "each 0 <= C <= 0.9"));
         }
         self.material()?;
         Ok(())
