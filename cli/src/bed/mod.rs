@@ -5,7 +5,9 @@
 //!
 //! * [`scene`]: the TOML scene format and the embedded published scene;
 //! * [`run`](mod@run): the run itself, sampled every output interval;
-//! * [`outputs`]: `compression.csv` and `summary.json`.
+//! * [`outputs`]: `compression.csv` and `summary.json`;
+//! * [`snapshots`]: the VTU snapshots (`vtk/`), [`plots`]: the SVG plots
+//!   (`plots/`), [`report`]: `report.html`.
 
 use std::path::PathBuf;
 
@@ -16,8 +18,11 @@ use crate::model::MeshLevel;
 use crate::output::Streams;
 
 pub mod outputs;
+pub mod plots;
+pub mod report;
 pub mod run;
 pub mod scene;
+pub mod snapshots;
 
 pub use scene::{DEFAULT_SCENE, Scene};
 
@@ -34,6 +39,13 @@ Output, in --out DIR (created if missing):
                    final strain, max pressure, initial bed height, counts, wall
                    time, ns per element-step, threads, min Jacobian, energy
                    residual, peak memory, version
+  vtk/bed_<k>.vtu  VTU snapshots at the scene's snapshot_strains: every granule's
+                   surface quads (all hexes with --vtk-full-mesh), cell data
+                   granule id, relative density eta0 V0/V, Heywood d_V S/V and d S/V
+  vtk/bed.pvd      ParaView collection of the snapshots (timestep = strain)
+  plots/*.svg      pressure, coordination number, relative density and Heywood
+                   coefficient against strain; Kawakita plot P/C vs P with the fit
+  report.html      one page: the summary table, the plots and the scene
 
 Without --scene the embedded published scene runs (print it with
 --print-scene); the flags below override the scene's fields.
@@ -84,6 +96,11 @@ pub struct BedArgs {
     /// Worker threads (0 = all cores). Results do not depend on it.
     #[arg(short = 'j', long, value_name = "N", default_value_t = 0)]
     pub threads: usize,
+
+    /// VTU snapshots with every hex of every granule instead of the
+    /// granule surfaces.
+    #[arg(long)]
+    pub vtk_full_mesh: bool,
 
     /// No progress line and no summary line on stderr.
     #[arg(short, long)]
@@ -136,6 +153,16 @@ impl BedArgs {
             .build()?;
         let mut observer = Observer {
             progress: outputs::Progress::new(self.quiet, scene.final_strain),
+            snapshots: snapshots::SnapshotWriter::new(
+                &self.out,
+                if self.vtk_full_mesh {
+                    snapshots::SnapshotContent::Hexes
+                } else {
+                    snapshots::SnapshotContent::Surfaces
+                },
+                &scene.snapshot_strains,
+                1e-3 * scene.diameter_mm,
+            ),
         };
         let result = pool.install(|| run::run_bed(&scene, &mut observer))?;
         observer.progress.finish();
@@ -156,6 +183,7 @@ impl BedArgs {
 /// What the command does with the run as it goes.
 struct Observer {
     progress: outputs::Progress,
+    snapshots: snapshots::SnapshotWriter,
 }
 
 impl run::BedObserver for Observer {
@@ -165,10 +193,10 @@ impl run::BedObserver for Observer {
 
     fn snapshot(
         &mut self,
-        _strain: f64,
-        _assembly: &crate::assembly::Assembly<'_>,
-        _mesh: &crate::model::OwnedReference,
+        strain: f64,
+        assembly: &crate::assembly::Assembly<'_>,
+        mesh: &crate::model::OwnedReference,
     ) -> anyhow::Result<()> {
-        Ok(())
+        self.snapshots.write(strain, assembly, mesh)
     }
 }

@@ -1,5 +1,6 @@
-//! What `granbed-cli bed` writes: `compression.csv`, `summary.json`, the
-//! one-line summary, and the progress bar on stderr.
+//! What `granbed-cli bed` writes: `compression.csv`, `summary.json` (then
+//! the plots and `report.html`), the one-line summary, and the progress bar
+//! on stderr.
 
 use std::path::Path;
 
@@ -201,7 +202,8 @@ pub fn summary<'a>(scene: &'a Scene, run: &BedRun) -> Summary<'a> {
     }
 }
 
-/// Writes `compression.csv` and `summary.json` into `dir` (created).
+/// Writes `compression.csv`, `summary.json`, the plots and `report.html`
+/// into `dir` (created).
 pub fn write_all(dir: &Path, scene: &Scene, run: &BedRun) -> anyhow::Result<()> {
     std::fs::create_dir_all(dir)
         .with_context(|| format!("cannot create output directory `{}`", dir.display()))?;
@@ -213,7 +215,10 @@ pub fn write_all(dir: &Path, scene: &Scene, run: &BedRun) -> anyhow::Result<()> 
             .with_context(|| format!("cannot write to `{}`", path.display()))?;
     }
     finish_file(csv.into_inner(), &path)?;
-    write_json(&dir.join("summary.json"), &summary(scene, run))
+    let summary = summary(scene, run);
+    write_json(&dir.join("summary.json"), &summary)?;
+    let svgs = super::plots::write_plots(dir, &run.samples, &summary.kawakita)?;
+    super::report::write_report(dir, scene, &summary, &svgs)
 }
 
 /// One line for stderr at the end.

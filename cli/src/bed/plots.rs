@@ -1,0 +1,364 @@
+//! The plots of a bed run as SVG (`plots/` in the output), drawn with
+//! plotters' SVG backend like `granule`'s plots: no system fonts, text is
+//! written as SVG `<text>` and laid out by the viewer.
+//!
+//! * `pressure_strain.svg`: upper- and lower-punch pressure against the
+//!   axial strain C;
+//! * `kawakita.svg`: P/C against P with the Kawakita fit line (points with
+//!   C ≥ 0.25 are the fitted ones);
+//! * `coordination_strain.svg`: coordination number Z, without and with
+//!   the walls;
+//! * `relative_density_strain.svg`: mean granule relative density and
+//!   Σsolid/ΣV;
+//! * `heywood_strain.svg`: mean Heywood coefficient α_SV with d_V and with
+//!   the nominal diameter.
+
+use std::io::Write as _;
+use std::path::Path;
+
+use anyhow::Context as _;
+use granbed_kernel::Real;
+use granbed_kernel::analysis::bed::KAWAKITA_MIN_STRAIN;
+use plotters::prelude::*;
+
+use super::outputs::KawakitaSummary;
+use super::run::BedSample;
+use crate::output::{create_file, finish_file};
+
+/// Sub-directory of the output directory holding the plots.
+pub const PLOTS_DIR: &str = "plots";
+
+/// The plot files, in the order [`write_plots`] writes them.
+pub const PLOT_FILES: [&str; 5] = [
+    "pressure_strain.svg",
+    "kawakita.svg",
+    "coordination_strain.svg",
+    "relative_density_strain.svg",
+    "heywood_strain.svg",
+];
+
+/// Plot size, pixels.
+const SIZE: (u32, u32) = (900, 600);
+
+/// Curve colours: the first of matplotlib's `tab10` (as `granule`'s plots).
+const COLOURS: [RGBColor; 4] = [
+    RGBColor(0x1f, 0x77, 0xb4),
+    RGBColor(0xff, 0x7f, 0x0e),
+    RGBColor(0x2c, 0xa0, 0x2c),
+    RGBColor(0xd6, 0x27, 0x28),
+];
+
+/// How a series is drawn.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Mark {
+    /// A solid line.
+    Line,
+    /// Filled circles.
+    Dots,
+    /// Open circles.
+    Rings,
+    /// A dashed black line (a fit).
+    Dashed,
+}
+
+/// One series of a plot.
+struct Series {
+    label: String,
+    points: Vec<(f64, f64)>,
+    mark: Mark,
+}
+
+impl Series {
+    fn new(label: impl Into<String>, mark: Mark, points: impl Iterator<Item = (f64, f64)>) -> Self {
+        Self {
+            label: label.into(),
+            // Non-finite values (a degenerate granule, an empty window)
+            // are left out rather than breaking the axes.
+            points: points
+                .filter(|(x, y)| x.is_finite() && y.is_finite())
+                .collect(),
+            mark,
+        }
+    }
+}
+
+/// A padded axis range over `values`, 0 included when `from_zero`; a
+/// degenerate range still gets a unit-width axis.
+fn range(values: impl Iterator<Item = f64>, from_zero: bool) -> core::ops::Range<f64> {
+    let (lo, hi) = values.fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), v| {
+        (lo.min(v), hi.max(v))
+    });
+    let (lo, hi) = if lo <= hi { (lo, hi) } else { (0.0, 1.0) };
+    let (lo, hi) = if from_zero {
+        (lo.min(0.0), hi.max(0.0))
+    } else {
+        (lo, hi)
+    };
+    let span = hi - lo;
+    if span > 0.0 {
+        (lo - 0.03 * span)..(hi + 0.05 * span)
+    } else {
+        let pad = if lo.abs() > 0.0 { 0.05 * lo.abs() } else { 1.0 };
+        (lo - pad)..(hi + pad)
+    }
+}
+
+/// The SVG text of `series` under `title`, with axis labels.
+fn xy_svg(
+    title: &str,
+    x_desc: &str,
+    y_desc: &str,
+    series: &[Series],
+    y_from_zero: bool,
+) -> anyhow::Result<String> {
+    let all = || series.iter().flat_map(|s| s.points.iter());
+    let x_range = range(all().map(|p| p.0), true);
+    let y_range = range(all().map(|p| p.1), y_from_zero);
+    let mut svg = String::new();
+    {
+        let root = SVGBackend::with_string(&mut svg, SIZE).into_drawing_area();
+        root.fill(&WHITE)?;
+        let mut chart = ChartBuilder::on(&root)
+            .caption(title, ("sans-serif", 20))
+            .margin(20)
+            .x_label_area_size(50)
+            .y_label_area_size(80)
+            .build_cartesian_2d(x_range, y_range)?;
+        chart
+            .configure_mesh()
+            .x_desc(x_desc)
+            .y_desc(y_desc)
+            .draw()?;
+        let mut colour = COLOURS.iter().cycle();
+        for s in series {
+            let pts = s.points.iter().copied();
+            let label = s.label.as_str();
+            match s.mark {
+                Mark::Line => {
+                    let style = colour.next().unwrap_or(&BLACK).stroke_width(2);
+                    chart
+                        .draw_series(LineSeries::new(pts, style))?
+                        .label(label)
+                        .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], style));
+                }
+                Mark::Dots | Mark::Rings => {
+                    let c = colour.next().unwrap_or(&BLACK);
+                    let style = if s.mark == Mark::Dots {
+                        c.filled()
+                    } else {
+                        c.stroke_width(1)
+                    };
+                    chart
+                        .draw_series(pts.map(move |p| Circle::new(p, 3, style)))?
+                        .label(label)
+                        .legend(move |(x, y)| Circle::new((x + 10, y), 3, style));
+                }
+                Mark::Dashed => {
+                    let style = BLACK.stroke_width(1);
+                    chart
+                        .draw_series(DashedLineSeries::new(pts, 6, 4, style))?
+                        .label(label)
+                        .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], style));
+                }
+            }
+        }
+        chart
+            .configure_series_labels()
+            .position(SeriesLabelPosition::UpperLeft)
+            .background_style(WHITE.mix(0.85))
+            .border_style(BLACK)
+            .draw()?;
+        root.present()?;
+    }
+    Ok(svg)
+}
+
+/// The value of a sample a curve shows.
+type Quantity = fn(&BedSample) -> Real;
+
+/// Two curves (label, value) of the samples against the strain.
+fn against_strain(samples: &[BedSample], curves: [(&str, Quantity); 2]) -> [Series; 2] {
+    curves
+        .map(|(label, y)| Series::new(label, Mark::Line, samples.iter().map(|s| (s.strain, y(s)))))
+}
+
+/// The Kawakita plot: P/C against P (kPa) of the samples with C > 0, the
+/// fitted ones (C ≥ 0.25) filled, and the line P/C = P/a + (1/b)/a over the
+/// fitted pressures.
+pub fn kawakita_svg(samples: &[BedSample], fit: &KawakitaSummary) -> anyhow::Result<String> {
+    let point = |s: &BedSample| {
+        (
+            s.upper_pressure_pa * 1e-3,
+            s.upper_pressure_pa / s.strain * 1e-3,
+        )
+    };
+    let used = |s: &&BedSample| s.strain >= KAWAKITA_MIN_STRAIN;
+    let early = |s: &&BedSample| s.strain > 0.0 && s.strain < KAWAKITA_MIN_STRAIN;
+    let mut series = vec![
+        Series::new(
+            format!("C < {KAWAKITA_MIN_STRAIN}"),
+            Mark::Rings,
+            samples.iter().filter(early).map(point),
+        ),
+        Series::new(
+            format!("C ≥ {KAWAKITA_MIN_STRAIN} (fitted)"),
+            Mark::Dots,
+            samples.iter().filter(used).map(point),
+        ),
+    ];
+    if let (Some(a), Some(inv_b)) = (fit.a, fit.inv_b_pa) {
+        let (lo, hi) = series[1]
+            .points
+            .iter()
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), p| {
+                (lo.min(p.0), hi.max(p.0))
+            });
+        if lo <= hi {
+            // In kPa: P/C = P/a + (1/b)/a.
+            let line = |p: f64| (p, p / a + inv_b * 1e-3 / a);
+            let r2 = fit.r_squared.map_or("n/a".into(), |r| format!("{r:.4}"));
+            series.push(Series::new(
+                format!("fit: a = {a:.4}, 1/b = {:.4} kPa, R² = {r2}", inv_b * 1e-3),
+                Mark::Dashed,
+                [line(lo), line(hi)].into_iter(),
+            ));
+        }
+    }
+    xy_svg(
+        "Kawakita plot",
+        "upper-punch pressure P, kPa",
+        "P/C, kPa",
+        &series,
+        true,
+    )
+}
+
+/// The SVG text of every plot, named as in [`PLOT_FILES`].
+pub fn plots(
+    samples: &[BedSample],
+    fit: &KawakitaSummary,
+) -> anyhow::Result<[(&'static str, String); 5]> {
+    const C: &str = "axial strain C = (H0 - H)/H0";
+    let pressure = against_strain(
+        samples,
+        [
+            ("upper punch", |s| s.upper_pressure_pa * 1e-3),
+            ("lower punch", |s| s.lower_pressure_pa * 1e-3),
+        ],
+    );
+    let coordination = against_strain(
+        samples,
+        [
+            ("granule pairs", |s| s.coordination),
+            ("with walls", |s| s.coordination_with_walls),
+        ],
+    );
+    let density = against_strain(
+        samples,
+        [
+            ("mean of η0 V0/V", |s| s.relative_density_mean),
+            ("Σ solid / Σ V", |s| s.relative_density_solid),
+        ],
+    );
+    let heywood = against_strain(
+        samples,
+        [
+            ("d_V S/V", |s| s.heywood_dv),
+            ("d S/V (nominal d)", |s| s.heywood_d),
+        ],
+    );
+    let [f0, f1, f2, f3, f4] = PLOT_FILES;
+    Ok([
+        (
+            f0,
+            xy_svg("Punch pressure", C, "pressure P, kPa", &pressure, true)?,
+        ),
+        (f1, kawakita_svg(samples, fit)?),
+        (
+            f2,
+            xy_svg("Coordination number", C, "Z", &coordination, true)?,
+        ),
+        (
+            f3,
+            xy_svg(
+                "Granule relative density",
+                C,
+                "relative density η",
+                &density,
+                false,
+            )?,
+        ),
+        (
+            f4,
+            xy_svg(
+                "Heywood coefficient (mean over granules)",
+                C,
+                "α_SV",
+                &heywood,
+                false,
+            )?,
+        ),
+    ])
+}
+
+/// Writes the plots of `samples` into `dir`/[`PLOTS_DIR`] (created) and
+/// returns them (file name, SVG text) for the report.
+pub fn write_plots(
+    dir: &Path,
+    samples: &[BedSample],
+    fit: &KawakitaSummary,
+) -> anyhow::Result<[(&'static str, String); 5]> {
+    let dir = dir.join(PLOTS_DIR);
+    std::fs::create_dir_all(&dir)
+        .with_context(|| format!("cannot create directory `{}`", dir.display()))?;
+    let svgs = plots(samples, fit)?;
+    for (name, svg) in &svgs {
+        let path = dir.join(name);
+        let mut file = create_file(&path)?;
+        file.write_all(svg.as_bytes())
+            .with_context(|| format!("cannot write to `{}`", path.display()))?;
+        finish_file(file, &path)?;
+    }
+    Ok(svgs)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn ranges_pad_and_survive_degenerate_data() {
+        assert_eq!(range([].into_iter(), false), -0.03..1.05);
+        let r = range([2.0, 2.0].into_iter(), false);
+        assert!(r.start < 2.0 && r.end > 2.0);
+        let r = range([1.0, 3.0].into_iter(), true);
+        assert!(r.start < 0.0 && r.end > 3.0);
+    }
+
+    #[test]
+    fn the_kawakita_plot_has_the_fit_line() {
+        // C = abP/(1 + bP) with a = 0.5, 1/b = 100 kPa.
+        let samples: Vec<BedSample> = (0..40)
+            .map(|i| {
+                let p = 5e3 * f64::from(i);
+                BedSample {
+                    strain: 0.5 * p / (1e5 + p),
+                    upper_pressure_pa: p,
+                    ..BedSample::default()
+                }
+            })
+            .collect();
+        let points = samples.iter().map(|s| (s.upper_pressure_pa, s.strain));
+        let fit = granbed_kernel::analysis::bed::kawakita_fit(points, 0.25).unwrap();
+        let summary = KawakitaSummary {
+            a: Some(fit.a),
+            inv_b_pa: Some(fit.inv_b_pa),
+            r_squared: Some(fit.r_squared),
+            points: fit.points,
+        };
+        let svg = kawakita_svg(&samples, &summary).unwrap();
+        assert!(svg.starts_with("<svg"), "{}", &svg[..100]);
+        assert!(svg.contains("fit: a = 0.5000, 1/b = 100.0000 kPa"), "{svg}");
+        assert!(svg.contains("C &lt; 0.25"));
+    }
+}

@@ -1,0 +1,220 @@
+//! `report.html`: one self-contained page of a bed run: the summary table
+//! (the fields of `summary.json`, values as written there), the plots
+//! inline as SVG, and the scene as TOML. All text is HTML-escaped.
+
+use core::fmt::Write as _;
+use std::io::Write as _;
+use std::path::Path;
+
+use anyhow::Context as _;
+use serde_json::Value;
+
+use super::outputs::Summary;
+use super::scene::{DEFAULT_SCENE, Scene};
+use super::snapshots::{PVD_FILE, VTK_DIR};
+use crate::output::{create_file, finish_file};
+
+/// File name of the report in the output directory.
+pub const REPORT_FILE: &str = "report.html";
+
+/// The fields of `summary.json` shown first, in this order, with their
+/// meaning; any other field follows (the nested `kawakita` object is
+/// flattened to `kawakita.<field>`, the scene is shown as TOML instead).
+const FIELDS: [(&str, &str); 24] = [
+    ("kawakita_a", "Kawakita a (limiting strain)"),
+    ("kawakita_inv_b_pa", "Kawakita 1/b, Pa"),
+    (
+        "kawakita.r_squared",
+        "R² of the Kawakita line P/C against P",
+    ),
+    ("kawakita.points", "samples with C ≥ 0.25 in the fit"),
+    ("final_strain", "axial strain reached"),
+    ("max_pressure_pa", "largest upper-punch pressure, Pa"),
+    ("initial_bed_height_m", "initial bed height H0, m"),
+    ("granules", "granules"),
+    ("elements", "hexes in the bed"),
+    ("steps", "time steps"),
+    ("element_steps", "element evaluations"),
+    ("wall_time_s", "wall time of the compression, s"),
+    ("pour_wall_time_s", "wall time of the pour, s"),
+    (
+        "ns_per_element_step",
+        "compression wall time per element evaluation, ns",
+    ),
+    (
+        "contact_share",
+        "share of the contact phase in the wall time",
+    ),
+    ("threads", "threads"),
+    ("min_jacobian", "smallest element Jacobian ratio"),
+    (
+        "energy_residual_rel",
+        "|energy ledger residual| / punch work",
+    ),
+    ("contact_loss_rel", "contact losses / punch work"),
+    ("peak_memory_bytes", "peak resident memory, bytes"),
+    ("error", "error that stopped the run early"),
+    ("version", "granbed version"),
+    // Shown in the fields above already.
+    ("kawakita.a", ""),
+    ("kawakita.inv_b_pa", ""),
+];
+
+/// `text` with the HTML special characters escaped (for element content
+/// and attribute values alike).
+pub fn html_escape(text: &str) -> String {
+    let mut out = String::with_capacity(text.len());
+    for c in text.chars() {
+        match c {
+            '&' => out.push_str("&amp;"),
+            '<' => out.push_str("&lt;"),
+            '>' => out.push_str("&gt;"),
+            '"' => out.push_str("&quot;"),
+            '\'' => out.push_str("&#39;"),
+            c => out.push(c),
+        }
+    }
+    out
+}
+
+/// A JSON value as the table shows it: numbers as in `summary.json`,
+/// strings without quotes, `null` as "n/a".
+fn show(value: &Value) -> String {
+    match value {
+        Value::Null => "n/a".to_string(),
+        Value::String(s) => s.clone(),
+        v => v.to_string(),
+    }
+}
+
+/// The summary's fields as (key, meaning, value) rows.
+fn rows(summary: &Summary<'_>) -> anyhow::Result<Vec<(String, &'static str, String)>> {
+    let Value::Object(map) = serde_json::to_value(summary)? else {
+        anyhow::bail!("the summary is not a JSON object");
+    };
+    let mut flat: Vec<(String, &Value)> = Vec::new();
+    for (key, value) in &map {
+        match value {
+            Value::Object(inner) => {
+                flat.extend(inner.iter().map(|(k, v)| (format!("{key}.{k}"), v)))
+            }
+            v => flat.push((key.clone(), v)),
+        }
+    }
+    let known = |k: &str| FIELDS.iter().position(|f| f.0 == k);
+    let mut out: Vec<(String, &'static str, String)> = FIELDS
+        .iter()
+        .filter(|f| !f.1.is_empty())
+        .filter_map(|&(key, meaning)| {
+            let v = flat.iter().find(|(k, _)| k == key)?.1;
+            Some((key.to_string(), meaning, show(v)))
+        })
+        .collect();
+    out.extend(
+        flat.iter()
+            .filter(|(k, _)| known(k).is_none() && !k.starts_with("scene."))
+            .map(|(k, v)| (k.clone(), "", show(v))),
+    );
+    Ok(out)
+}
+
+/// The report page of a run of `scene` with `summary` and the plots
+/// `svgs` (file name in `plots/`, SVG text).
+pub fn report_html(
+    scene: &Scene,
+    summary: &Summary<'_>,
+    svgs: &[(&str, String)],
+) -> anyhow::Result<String> {
+    let toml = if *scene == Scene::published() {
+        DEFAULT_SCENE.to_string()
+    } else {
+        scene.to_toml()
+    };
+    let title = format!(
+        "granbed bed: {} × {} granules, mesh {}",
+        scene.granules, scene.granule_type, scene.mesh
+    );
+    let mut h = String::new();
+    writeln!(
+        h,
+        "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n<title>{}</title>\n\
+         <style>\nbody {{ font-family: sans-serif; max-width: 960px; margin: 1em auto; padding: 0 1em; }}\n\
+         table {{ border-collapse: collapse; }}\n\
+         td, th {{ border: 1px solid #ccc; padding: 0.2em 0.6em; text-align: left; }}\n\
+         td.value {{ font-family: monospace; }}\n\
+         figure {{ margin: 1em 0; }}\nfigure svg {{ max-width: 100%; height: auto; }}\n\
+         pre {{ background: #f4f4f4; padding: 0.8em; overflow-x: auto; }}\n</style>\n</head>\n<body>",
+        html_escape(&title)
+    )?;
+    writeln!(h, "<h1>{}</h1>", html_escape(&title))?;
+    if let Some(e) = &summary.error {
+        writeln!(
+            h,
+            "<p><strong>The run stopped early:</strong> {}</p>",
+            html_escape(e)
+        )?;
+    }
+    writeln!(
+        h,
+        "<p>Files: <a href=\"compression.csv\">compression.csv</a>, \
+         <a href=\"summary.json\">summary.json</a>, \
+         <a href=\"{VTK_DIR}/{PVD_FILE}\">{VTK_DIR}/{PVD_FILE}</a> (VTU snapshots for ParaView).</p>"
+    )?;
+    writeln!(
+        h,
+        "<h2>Summary</h2>\n<table>\n<tr><th>field</th><th>value</th><th>meaning</th></tr>"
+    )?;
+    for (key, meaning, value) in rows(summary)? {
+        writeln!(
+            h,
+            "<tr><td>{}</td><td class=\"value\">{}</td><td>{}</td></tr>",
+            html_escape(&key),
+            html_escape(&value),
+            html_escape(meaning)
+        )?;
+    }
+    writeln!(h, "</table>\n<h2>Plots</h2>")?;
+    for (name, svg) in svgs {
+        // The SVG is plotters' output: well-formed XML with its text
+        // already escaped, so it is embedded as it is.
+        let name = html_escape(name);
+        writeln!(
+            h,
+            "<figure>\n{svg}\n<figcaption><a href=\"plots/{name}\">plots/{name}</a></figcaption>\n</figure>"
+        )?;
+    }
+    writeln!(
+        h,
+        "<h2>Scene</h2>\n<pre>{}</pre>\n</body>\n</html>",
+        html_escape(&toml)
+    )?;
+    Ok(h)
+}
+
+/// Writes [`REPORT_FILE`] into `dir`.
+pub fn write_report(
+    dir: &Path,
+    scene: &Scene,
+    summary: &Summary<'_>,
+    svgs: &[(&str, String)],
+) -> anyhow::Result<()> {
+    let path = dir.join(REPORT_FILE);
+    let html = report_html(scene, summary, svgs)?;
+    let mut file = create_file(&path)?;
+    file.write_all(html.as_bytes())
+        .with_context(|| format!("cannot write to `{}`", path.display()))?;
+    finish_file(file, &path)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn escaping() {
+        assert_eq!(
+            html_escape("a<b & \"c\" 'd'>"),
+            "a&lt;b &amp; &quot;c&quot; &#39;d&#39;&gt;"
+        );
+    }
+}

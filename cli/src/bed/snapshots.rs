@@ -1,0 +1,284 @@
+//! VTU snapshots of a bed (`vtk/` in the output): at each of the scene's
+//! `snapshot_strains`, `bed_<k>.vtu` holds every granule's outer surface
+//! quads (or, on request, all its hexes) in the current configuration,
+//! with cell data per granule: `granule` (id), `relative_density`
+//! (η_g = η0 V0/V), `heywood_dv` (α_SV with d_V) and `heywood_d` (α_SV with
+//! the nominal diameter). `bed.pvd` lists the snapshots with the strain as
+//! the timestep and is rewritten after each one, so a run that stops
+//! early leaves a valid collection. k is the index of the strain among the
+//! scene's sorted snapshot strains, and the collection lists every
+//! snapshot up to the current one whose file is there, so a resumed run
+//! continues the collection of the run it resumes.
+//!
+//! The `.vtu` files are written with the `vtkio` crate (VTK XML, binary
+//! data arrays base64-encoded inline); `vtkio` has no `.pvd` collection
+//! type, so that short index is written here.
+
+use std::io::Write as _;
+use std::path::{Path, PathBuf};
+
+use anyhow::{Context as _, bail};
+use granbed_kernel::Real;
+use granbed_kernel::analysis::bed::{granule_shape, surface_geometry};
+use vtkio::model::{
+    Attribute, Attributes, ByteOrder, CellType, Cells, DataSet, IOBuffer, UnstructuredGridPiece,
+    Version, VertexNumbers, Vtk,
+};
+
+use crate::assembly::Assembly;
+use crate::model::OwnedReference;
+use crate::output::{create_file, finish_file};
+
+/// Sub-directory of the output directory holding the snapshots.
+pub const VTK_DIR: &str = "vtk";
+
+/// File name of the snapshot collection in [`VTK_DIR`].
+pub const PVD_FILE: &str = "bed.pvd";
+
+/// What a snapshot holds of each granule.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum SnapshotContent {
+    /// The outer surface quads (`VTK_QUAD`), on the surface nodes only.
+    #[default]
+    Surfaces,
+    /// Every hex (`VTK_HEXAHEDRON`, hex8 order = VTK's), on all nodes.
+    Hexes,
+}
+
+/// The per-granule cell data of a snapshot, one value per granule.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct GranuleFields {
+    /// η_g = η0 V0/V (NaN for a degenerate surface).
+    pub relative_density: Vec<Real>,
+    /// α_SV = d_V S/V.
+    pub heywood_dv: Vec<Real>,
+    /// α_SV = d S/V with the nominal diameter d.
+    pub heywood_d: Vec<Real>,
+}
+
+/// The per-granule fields of `asm` (granule meshes `mesh`), with the
+/// nominal diameter `d_fixed_m` for `heywood_d`. A granule whose surface
+/// is degenerate gets NaN (shown, not an error).
+pub fn granule_fields(asm: &Assembly<'_>, mesh: &OwnedReference, d_fixed_m: Real) -> GranuleFields {
+    let eta0 = asm.params().material.params.eta0;
+    let v0 = surface_geometry(&mesh.positions, &mesh.quads).map_or(Real::NAN, |(_, v)| v);
+    let mut f = GranuleFields::default();
+    for g in asm.granules() {
+        let s = granule_shape(&g.x, &mesh.quads, eta0, v0, d_fixed_m).ok();
+        f.relative_density
+            .push(s.map_or(Real::NAN, |s| s.relative_density));
+        f.heywood_dv.push(s.map_or(Real::NAN, |s| s.heywood_dv));
+        f.heywood_d.push(s.map_or(Real::NAN, |s| s.heywood_fixed));
+    }
+    f
+}
+
+/// The snapshot of `asm` as a VTK unstructured grid: the granules one
+/// after the other (points, then cells, in granule order).
+pub fn snapshot_vtk(
+    asm: &Assembly<'_>,
+    mesh: &OwnedReference,
+    content: SnapshotContent,
+    d_fixed_m: Real,
+) -> anyhow::Result<Vtk> {
+    let nodes = mesh.positions.len();
+    // Nodes written per granule and the first of them; surfaces use the
+    // last `surface_nodes` nodes, which carry every surface quad.
+    let (first, count) = match content {
+        SnapshotContent::Surfaces => (nodes - mesh.surface_nodes.min(nodes), mesh.surface_nodes),
+        SnapshotContent::Hexes => (0, nodes),
+    };
+    let local: Vec<u64> = match content {
+        SnapshotContent::Surfaces => mesh
+            .quads
+            .iter()
+            .flatten()
+            .map(|&n| (n as usize).checked_sub(first).filter(|&i| i < count))
+            .collect::<Option<Vec<usize>>>()
+            .context("a surface quad uses a node outside the surface nodes")?
+            .into_iter()
+            .map(|i| i as u64)
+            .collect(),
+        SnapshotContent::Hexes => mesh.hexes.iter().flatten().map(|&n| u64::from(n)).collect(),
+    };
+    let (cell_type, per_cell) = match content {
+        SnapshotContent::Surfaces => (CellType::Quad, 4),
+        SnapshotContent::Hexes => (CellType::Hexahedron, 8),
+    };
+    let cells_per_granule = local.len() / per_cell;
+    let granules = asm.granules();
+    let mut points = Vec::with_capacity(3 * count * granules.len());
+    let mut connectivity = Vec::with_capacity(local.len() * granules.len());
+    for (g, store) in granules.iter().enumerate() {
+        if store.x.len() != nodes {
+            bail!("granule {g} has {} nodes, the mesh {nodes}", store.x.len());
+        }
+        points.extend(store.x[first..first + count].iter().flatten());
+        let base = (g * count) as u64;
+        connectivity.extend(local.iter().map(|i| base + i));
+    }
+    let cells = cells_per_granule * granules.len();
+    let offsets = (1..=cells).map(|c| (c * per_cell) as u64).collect();
+    let fields = granule_fields(asm, mesh, d_fixed_m);
+    let per_cell_values = |v: &[Real]| -> Vec<Real> {
+        v.iter()
+            .flat_map(|&x| core::iter::repeat_n(x, cells_per_granule))
+            .collect()
+    };
+    let ids: Vec<i64> = (0..granules.len() as i64)
+        .flat_map(|g| core::iter::repeat_n(g, cells_per_granule))
+        .collect();
+    let cell_data = vec![
+        Attribute::generic("granule", 1).with_data(ids),
+        // The active scalars: what a viewer colours by at first.
+        Attribute::scalars("relative_density", 1)
+            .with_data(per_cell_values(&fields.relative_density)),
+        Attribute::generic("heywood_dv", 1).with_data(per_cell_values(&fields.heywood_dv)),
+        Attribute::generic("heywood_d", 1).with_data(per_cell_values(&fields.heywood_d)),
+    ];
+    Ok(Vtk {
+        version: Version::new_xml(1, 0),
+        title: String::new(),
+        byte_order: ByteOrder::LittleEndian,
+        file_path: None,
+        data: DataSet::inline(UnstructuredGridPiece {
+            points: IOBuffer::F64(points),
+            cells: Cells {
+                cell_verts: VertexNumbers::XML {
+                    connectivity,
+                    offsets,
+                },
+                types: vec![cell_type; cells],
+            },
+            data: Attributes {
+                point: Vec::new(),
+                cell: cell_data,
+            },
+        }),
+    })
+}
+
+/// `text` with the XML special characters escaped.
+fn xml_escape(text: &str) -> String {
+    let mut out = String::with_capacity(text.len());
+    for c in text.chars() {
+        match c {
+            '&' => out.push_str("&amp;"),
+            '<' => out.push_str("&lt;"),
+            '>' => out.push_str("&gt;"),
+            '"' => out.push_str("&quot;"),
+            '\'' => out.push_str("&apos;"),
+            c => out.push(c),
+        }
+    }
+    out
+}
+
+/// The text of a ParaView collection (`.pvd`) of `(timestep, file)`
+/// entries, the files relative to the collection.
+pub fn pvd_text(entries: &[(Real, String)]) -> String {
+    let mut s = String::from(
+        "<?xml version=\"1.0\"?>\n\
+         <VTKFile type=\"Collection\" version=\"1.0\" byte_order=\"LittleEndian\">\n  <Collection>\n",
+    );
+    for (t, file) in entries {
+        s.push_str(&format!(
+            "    <DataSet timestep=\"{t:?}\" group=\"\" part=\"0\" file=\"{}\"/>\n",
+            xml_escape(file)
+        ));
+    }
+    s.push_str("  </Collection>\n</VTKFile>\n");
+    s
+}
+
+/// File name of snapshot `k`.
+pub fn snapshot_file(k: usize) -> String {
+    format!("bed_{k}.vtu")
+}
+
+/// Writes the snapshots of one run into `<out>/vtk/`.
+#[derive(Debug)]
+pub struct SnapshotWriter {
+    dir: PathBuf,
+    content: SnapshotContent,
+    d_fixed_m: Real,
+    strains: Vec<Real>,
+}
+
+impl SnapshotWriter {
+    /// A writer into `out`/[`VTK_DIR`] (created at the first snapshot) for
+    /// the scene's `snapshot_strains`; `d_fixed_m` is the nominal granule
+    /// diameter for `heywood_d`.
+    pub fn new(
+        out: &Path,
+        content: SnapshotContent,
+        snapshot_strains: &[Real],
+        d_fixed_m: Real,
+    ) -> Self {
+        let mut strains = snapshot_strains.to_vec();
+        strains.sort_by(Real::total_cmp);
+        strains.dedup();
+        Self {
+            dir: out.join(VTK_DIR),
+            content,
+            d_fixed_m,
+            strains,
+        }
+    }
+
+    /// Index k of the snapshot at `strain` (a strain not in the scene's
+    /// list is added to it).
+    fn index(&mut self, strain: Real) -> usize {
+        match self.strains.iter().position(|&c| c == strain) {
+            Some(k) => k,
+            None => {
+                let k = self.strains.partition_point(|&c| c < strain);
+                self.strains.insert(k, strain);
+                k
+            }
+        }
+    }
+
+    /// Writes `bed_<k>.vtu` of `asm` at `strain` and rewrites `bed.pvd`.
+    pub fn write(
+        &mut self,
+        strain: Real,
+        asm: &Assembly<'_>,
+        mesh: &OwnedReference,
+    ) -> anyhow::Result<()> {
+        std::fs::create_dir_all(&self.dir)
+            .with_context(|| format!("cannot create directory `{}`", self.dir.display()))?;
+        let k = self.index(strain);
+        let path = self.dir.join(snapshot_file(k));
+        let vtk = snapshot_vtk(asm, mesh, self.content, self.d_fixed_m)?;
+        let mut file = create_file(&path)?;
+        vtk.write_xml(&mut file)
+            .map_err(|e| anyhow::anyhow!("{e}"))
+            .with_context(|| format!("cannot write `{}`", path.display()))?;
+        finish_file(file, &path)?;
+        let entries: Vec<(Real, String)> = self.strains[..=k]
+            .iter()
+            .enumerate()
+            .map(|(j, &c)| (c, snapshot_file(j)))
+            .filter(|(_, name)| self.dir.join(name).is_file())
+            .collect();
+        let pvd = self.dir.join(PVD_FILE);
+        let mut file = create_file(&pvd)?;
+        file.write_all(pvd_text(&entries).as_bytes())
+            .with_context(|| format!("cannot write `{}`", pvd.display()))?;
+        finish_file(file, &pvd)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_collection_escapes_and_keeps_the_strains() {
+        let text = pvd_text(&[(0.0, "bed_0.vtu".into()), (0.1, "a&b.vtu".into())]);
+        assert!(text.contains("timestep=\"0.0\""), "{text}");
+        assert!(text.contains("timestep=\"0.1\" group=\"\" part=\"0\" file=\"a&amp;b.vtu\""));
+        assert!(text.ends_with("</VTKFile>\n"));
+    }
+}

@@ -1,0 +1,426 @@
+//! The viewing outputs of `granbed-cli bed` on a tiny bed (20 coarse 4x1
+//! granules in a 5 mm die, to 12 % strain, snapshots at 0, 5 and 10 %):
+//! the VTU snapshots and their `.pvd` collection parse as XML, have one
+//! cell per surface quad (or hex) of every granule and the per-granule cell
+//! data, and read back in meshio (Python; skipped with a notice only when
+//! python3 or meshio is missing outside CI); the SVG plots exist; the
+//! report holds the summary values and the scene.
+
+mod common;
+
+use std::collections::HashMap;
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+use common::{cli, summary};
+use granbed_cli::bed::DEFAULT_SCENE;
+use granbed_cli::model::{MeshLevel, OwnedReference};
+
+fn out_dir(name: &str) -> PathBuf {
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("cli_bed_outputs-{name}"));
+    let _ = std::fs::remove_dir_all(&dir);
+    dir
+}
+
+const GRANULES: usize = 20;
+const SNAPSHOTS: [f64; 3] = [0.0, 0.05, 0.1];
+const CELL_ARRAYS: [&str; 4] = ["granule", "relative_density", "heywood_dv", "heywood_d"];
+
+/// Runs the tiny bed into `dir` with `extra` flags; the scene file (the
+/// published scene with three snapshot strains) is written beside `dir`.
+fn tiny_bed(dir: &Path, strain: &str, extra: &[&str]) {
+    let scene = dir.with_extension("toml");
+    std::fs::write(
+        &scene,
+        DEFAULT_SCENE.replace(
+            "snapshot_strains = [0.0, 0.1, 0.2, 0.3]",
+            "snapshot_strains = [0.1, 0.0, 0.05]",
+        ),
+    )
+    .unwrap();
+    let mut argv = vec![
+        "bed",
+        "--quiet",
+        "--scene",
+        scene.to_str().unwrap(),
+        "--out",
+        dir.to_str().unwrap(),
+        "--granules",
+        "20",
+        "--mesh",
+        "4x1",
+        "--die-diameter-mm",
+        "5",
+        "--strain",
+        strain,
+    ];
+    argv.extend_from_slice(extra);
+    let run = cli(&argv);
+    assert_eq!(run.code, 0, "bed failed:\n{}", run.stderr);
+}
+
+/// The coarse granule mesh of the tiny bed.
+fn mesh() -> OwnedReference {
+    OwnedReference::sphere(0.5e-3, "4x1".parse::<MeshLevel>().unwrap(), false).unwrap()
+}
+
+/// One XML element: its name, attributes and text.
+struct Element {
+    name: String,
+    attrs: HashMap<String, String>,
+    text: String,
+}
+
+/// A minimal XML reader (as in cli_pack.rs): skips the `<?xml ?>`
+/// declaration, checks that every tag is closed in order, and returns the
+/// elements in the order they close.
+fn parse_xml(xml: &str) -> Vec<Element> {
+    let mut open: Vec<Element> = Vec::new();
+    let mut done = Vec::new();
+    let mut rest = xml;
+    while let Some(lt) = rest.find('<') {
+        if let Some(top) = open.last_mut() {
+            top.text.push_str(&rest[..lt]);
+        } else {
+            assert!(rest[..lt].trim().is_empty(), "text outside the root");
+        }
+        let gt = rest[lt..].find('>').expect("unclosed tag") + lt;
+        let tag = &rest[lt + 1..gt];
+        rest = &rest[gt + 1..];
+        if tag.starts_with('?') {
+            assert!(tag.ends_with('?'), "bad declaration <{tag}>");
+            continue;
+        }
+        if let Some(name) = tag.strip_prefix('/') {
+            let e = open
+                .pop()
+                .unwrap_or_else(|| panic!("</{name}> closes nothing"));
+            assert_eq!(e.name, name, "<{}> closed by </{name}>", e.name);
+            done.push(e);
+            continue;
+        }
+        let empty = tag.ends_with('/');
+        let tag = tag.trim_end_matches('/');
+        let (name, mut attrs_text) = tag.split_once(' ').unwrap_or((tag, ""));
+        let mut attrs = HashMap::new();
+        while let Some((key, value)) = attrs_text.split_once("=\"") {
+            let (value, after) = value.split_once('"').expect("unterminated attribute");
+            attrs.insert(key.trim().to_owned(), value.to_owned());
+            attrs_text = after;
+        }
+        assert!(attrs_text.trim().is_empty(), "bad attributes in <{tag}>");
+        let e = Element {
+            name: name.to_owned(),
+            attrs,
+            text: String::new(),
+        };
+        if empty {
+            done.push(e);
+        } else {
+            open.push(e);
+        }
+    }
+    assert!(rest.trim().is_empty(), "text after the root");
+    assert!(open.is_empty(), "unclosed <{}>", open[0].name);
+    done
+}
+
+/// Standard base64 (with padding), for the binary VTK data arrays.
+fn base64_decode(text: &str) -> Vec<u8> {
+    let value = |c: u8| -> u32 {
+        match c {
+            b'A'..=b'Z' => u32::from(c - b'A'),
+            b'a'..=b'z' => u32::from(c - b'a') + 26,
+            b'0'..=b'9' => u32::from(c - b'0') + 52,
+            b'+' => 62,
+            b'/' => 63,
+            _ => panic!("bad base64 character {c:?}"),
+        }
+    };
+    let bytes: Vec<u8> = text.bytes().filter(|c| !c.is_ascii_whitespace()).collect();
+    assert_eq!(bytes.len() % 4, 0, "base64 length");
+    let mut out = Vec::new();
+    for chunk in bytes.chunks(4) {
+        let pad = chunk.iter().filter(|&&c| c == b'=').count();
+        let n = chunk
+            .iter()
+            .map(|&c| if c == b'=' { 0 } else { value(c) })
+            .fold(0u32, |n, v| (n << 6) | v);
+        out.extend_from_slice(&n.to_be_bytes()[1..4 - pad]);
+    }
+    out
+}
+
+/// The values of a binary (inline base64, UInt64 header) little-endian
+/// `DataArray` of 8-byte numbers, as `f64` (Float64) or `i64` (Int64).
+fn binary_values(e: &Element) -> Vec<f64> {
+    assert_eq!(e.attrs["format"], "binary", "{}", e.attrs["Name"]);
+    let bytes = base64_decode(&e.text);
+    let (header, data) = bytes.split_at(8);
+    let len = u64::from_le_bytes(header.try_into().unwrap()) as usize;
+    assert_eq!(len, data.len(), "header of {}", e.attrs["Name"]);
+    data.chunks(8)
+        .map(|b| {
+            let b: [u8; 8] = b.try_into().unwrap();
+            match e.attrs["type"].as_str() {
+                "Float64" => f64::from_le_bytes(b),
+                "Int64" => i64::from_le_bytes(b) as f64,
+                t => panic!("unexpected type {t}"),
+            }
+        })
+        .collect()
+}
+
+/// What a snapshot file holds, as this test reads it.
+struct Snapshot {
+    points: usize,
+    cells: usize,
+    cell_data: HashMap<String, Vec<f64>>,
+    types: Vec<u8>,
+}
+
+fn read_vtu(path: &Path) -> Snapshot {
+    let xml = std::fs::read_to_string(path)
+        .unwrap_or_else(|e| panic!("cannot read {}: {e}", path.display()));
+    let elements = parse_xml(&xml);
+    let root = elements.last().unwrap();
+    assert_eq!(root.name, "VTKFile");
+    assert_eq!(root.attrs["type"], "UnstructuredGrid");
+    let piece = elements.iter().find(|e| e.name == "Piece").unwrap();
+    let count = |k: &str| piece.attrs[k].parse::<usize>().unwrap();
+    let array = |name: &str| {
+        elements
+            .iter()
+            .find(|e| {
+                e.name == "DataArray" && e.attrs.get("Name").map(String::as_str) == Some(name)
+            })
+            .unwrap_or_else(|| panic!("no DataArray {name} in {}", path.display()))
+    };
+    let types = base64_decode(&array("types").text)[8..].to_vec();
+    let cell_data = CELL_ARRAYS
+        .iter()
+        .map(|&n| (n.to_string(), binary_values(array(n))))
+        .collect();
+    Snapshot {
+        points: count("NumberOfPoints"),
+        cells: count("NumberOfCells"),
+        cell_data,
+        types,
+    }
+}
+
+/// The `(timestep, file)` entries of a `.pvd` collection.
+fn read_pvd(path: &Path) -> Vec<(f64, String)> {
+    let xml = std::fs::read_to_string(path).unwrap();
+    let elements = parse_xml(&xml);
+    assert_eq!(elements.last().unwrap().attrs["type"], "Collection");
+    elements
+        .iter()
+        .filter(|e| e.name == "DataSet")
+        .map(|e| {
+            (
+                e.attrs["timestep"].parse().unwrap(),
+                e.attrs["file"].clone(),
+            )
+        })
+        .collect()
+}
+
+/// The per-file summary meshio gives of `files`: one line per file,
+/// `cells <type> <n> <array>=<min>,<max> ...`; `None` (with a notice) when
+/// python3 or meshio is missing outside CI. In CI (`CI` set) they must be
+/// there: `.ci/setup` installs meshio.
+fn meshio_summary(files: &[PathBuf]) -> Option<Vec<String>> {
+    const SCRIPT: &str = r#"
+import sys
+import meshio
+for path in sys.argv[1:]:
+    m = meshio.read(path)
+    parts = []
+    for block in m.cells:
+        parts.append("cells %s %d" % (block.type, len(block.data)))
+    for name in sorted(m.cell_data):
+        v = m.cell_data[name][0]
+        parts.append("%s=%r,%r" % (name, float(v.min()), float(v.max())))
+    parts.append("points %d" % len(m.points))
+    print(" ".join(parts))
+"#;
+    let has_meshio = Command::new("python3")
+        .args(["-c", "import meshio"])
+        .output()
+        .is_ok_and(|o| o.status.success());
+    if !has_meshio {
+        assert!(
+            std::env::var_os("CI").is_none(),
+            "python3 with meshio is missing in CI (.ci/setup installs it)"
+        );
+        eprintln!("NOTICE: python3 or meshio missing: the meshio read-back is skipped");
+        return None;
+    }
+    let out = Command::new("python3")
+        .arg("-c")
+        .arg(SCRIPT)
+        .args(files)
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "meshio failed:\n{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    Some(
+        String::from_utf8(out.stdout)
+            .unwrap()
+            .lines()
+            .map(str::to_owned)
+            .collect(),
+    )
+}
+
+#[test]
+fn snapshots_plots_and_report() {
+    let dir = out_dir("surfaces");
+    tiny_bed(&dir, "0.12", &[]);
+    let mesh = mesh();
+    let quads = mesh.quads.len();
+    assert_eq!(quads, 96);
+
+    // The collection lists the three snapshots in strain order.
+    let pvd = read_pvd(&dir.join("vtk/bed.pvd"));
+    let files: Vec<String> = (0..3).map(|k| format!("bed_{k}.vtu")).collect();
+    assert_eq!(
+        pvd,
+        SNAPSHOTS
+            .iter()
+            .copied()
+            .zip(files.iter().cloned())
+            .collect::<Vec<_>>()
+    );
+
+    let mut mean_density = Vec::new();
+    for file in &files {
+        let s = read_vtu(&dir.join("vtk").join(file));
+        assert_eq!(s.cells, GRANULES * quads, "{file}");
+        assert_eq!(s.points, GRANULES * mesh.surface_nodes, "{file}");
+        assert!(s.types.len() == s.cells && s.types.iter().all(|&t| t == 9));
+        let ids = &s.cell_data["granule"];
+        assert_eq!(ids.len(), s.cells);
+        for (g, chunk) in ids.chunks(quads).enumerate() {
+            assert!(chunk.iter().all(|&i| i == g as f64), "{file}: ids");
+        }
+        for name in CELL_ARRAYS {
+            let v = &s.cell_data[name];
+            assert_eq!(v.len(), s.cells, "{file}: {name}");
+            assert!(v.iter().all(|x| x.is_finite()), "{file}: {name}");
+            // One value per granule.
+            assert!(v.chunks(quads).all(|c| c.iter().all(|x| *x == c[0])));
+        }
+        let rho = &s.cell_data["relative_density"];
+        mean_density.push(rho.iter().sum::<f64>() / rho.len() as f64);
+        let a = &s.cell_data["heywood_dv"];
+        assert!(a.iter().all(|&x| (5.9..7.5).contains(&x)), "{file}: α_SV");
+    }
+    // Undeformed granules hold η0 = 0.8; pressed, they densify.
+    assert!((mean_density[0] - 0.8).abs() < 1e-9, "{mean_density:?}");
+    assert!(mean_density[2] > mean_density[0], "{mean_density:?}");
+
+    // meshio reads the same cells and arrays.
+    let paths: Vec<PathBuf> = files.iter().map(|f| dir.join("vtk").join(f)).collect();
+    if let Some(lines) = meshio_summary(&paths) {
+        assert_eq!(lines.len(), 3);
+        for line in &lines {
+            assert!(
+                line.starts_with(&format!("cells quad {}", GRANULES * quads)),
+                "{line}"
+            );
+            for name in CELL_ARRAYS {
+                assert!(line.contains(&format!(" {name}=")), "{line}");
+            }
+            assert!(
+                line.contains(&format!("granule=0.0,{}.0", GRANULES - 1)),
+                "{line}"
+            );
+            assert!(
+                line.ends_with(&format!("points {}", GRANULES * mesh.surface_nodes)),
+                "{line}"
+            );
+        }
+    }
+
+    // The plots.
+    for name in [
+        "pressure_strain.svg",
+        "kawakita.svg",
+        "coordination_strain.svg",
+        "relative_density_strain.svg",
+        "heywood_strain.svg",
+    ] {
+        let svg = std::fs::read_to_string(dir.join("plots").join(name))
+            .unwrap_or_else(|e| panic!("{name}: {e}"));
+        assert!(svg.contains("<svg"), "{name}");
+        assert!(svg.contains("</svg>"), "{name}");
+    }
+
+    // The report: the summary's values (as written in summary.json), the
+    // plots inline and the scene.
+    let html = std::fs::read_to_string(dir.join("report.html")).unwrap();
+    assert!(html.starts_with("<!DOCTYPE html>"));
+    assert!(html.trim_end().ends_with("</html>"));
+    assert_eq!(html.matches("<svg").count(), 5);
+    let s = summary(&dir);
+    for key in [
+        "final_strain",
+        "max_pressure_pa",
+        "initial_bed_height_m",
+        "granules",
+        "elements",
+        "steps",
+        "element_steps",
+        "min_jacobian",
+        "energy_residual_rel",
+    ] {
+        let value = s[key].to_string();
+        assert!(
+            html.contains(&format!("<td class=\"value\">{value}</td>")),
+            "report lacks {key} = {value}"
+        );
+    }
+    assert!(html.contains(&format!(
+        "<td>version</td><td class=\"value\">{}</td>",
+        s["version"].as_str().unwrap()
+    )));
+    for line in [
+        "granules = 20",
+        "mesh = &quot;4x1&quot;",
+        "final_strain = 0.12",
+    ] {
+        assert!(html.contains(line), "report lacks the scene line {line}");
+    }
+    assert!(html.contains("snapshot_strains = ["), "no snapshot strains");
+}
+
+#[test]
+fn full_mesh_snapshots_hold_every_hex() {
+    let dir = out_dir("hexes");
+    tiny_bed(&dir, "0.01", &["--vtk-full-mesh"]);
+    let mesh = mesh();
+    // Only the snapshot at C = 0 is reached.
+    assert_eq!(
+        read_pvd(&dir.join("vtk/bed.pvd")),
+        [(0.0, "bed_0.vtu".to_string())]
+    );
+    let s = read_vtu(&dir.join("vtk/bed_0.vtu"));
+    assert_eq!(s.cells, GRANULES * mesh.hexes.len());
+    assert_eq!(s.points, GRANULES * mesh.positions.len());
+    assert!(s.types.iter().all(|&t| t == 12));
+    let rho = &s.cell_data["relative_density"];
+    assert!(rho.iter().all(|x| (x - 0.8).abs() < 1e-9));
+    let path = dir.join("vtk/bed_0.vtu");
+    if let Some(lines) = meshio_summary(&[path]) {
+        assert!(
+            lines[0].starts_with(&format!("cells hexahedron {}", GRANULES * mesh.hexes.len())),
+            "{}",
+            lines[0]
+        );
+    }
+}
