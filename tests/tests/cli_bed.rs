@@ -139,3 +139,49 @@ fn bad_input_is_a_usage_error_naming_the_field() {
     assert_eq!(run.code, 2, "{}", run.stderr);
     assert!(run.stderr.contains("sped"), "{}", run.stderr);
 }
+
+#[test]
+fn a_stopped_run_resumes_to_the_same_bits() {
+    let args = [
+        "--quiet",
+        "--granules",
+        "20",
+        "--mesh",
+        "4x1",
+        "--die-diameter-mm",
+        "5",
+        "--strain",
+        "0.12",
+    ];
+    let (whole, parts) = (out_dir("whole"), out_dir("parts"));
+    let run = |extra: &[&str]| {
+        let mut argv = vec!["bed"];
+        argv.extend_from_slice(extra);
+        let r = cli(&argv);
+        assert_eq!(r.code, 0, "bed {extra:?} failed:\n{}", r.stderr);
+    };
+    let whole_s = whole.to_str().unwrap();
+    let parts_s = parts.to_str().unwrap();
+    run(&[&["--out", whole_s][..], &args].concat());
+    run(&[&["--out", parts_s, "--stop-at-strain", "0.05"][..], &args].concat());
+    let partial = Table::read(&parts.join("compression.csv")).num("strain");
+    assert!(
+        *partial.last().unwrap() < 0.06,
+        "the first part ran to {partial:?}"
+    );
+    run(&["--resume", parts_s, "--quiet"]);
+    assert_eq!(
+        std::fs::read(whole.join("compression.csv")).unwrap(),
+        std::fs::read(parts.join("compression.csv")).unwrap(),
+        "stop + resume differs from the uninterrupted run"
+    );
+    // A damaged checkpoint is refused with a reason, not used.
+    let ckpt = parts.join("checkpoint.bin");
+    let mut bytes = std::fs::read(&ckpt).unwrap();
+    let k = bytes.len() / 2;
+    bytes[k] ^= 0x40;
+    std::fs::write(&ckpt, &bytes).unwrap();
+    let r = cli(&["bed", "--resume", parts_s, "--quiet"]);
+    assert_ne!(r.code, 0);
+    assert!(r.stderr.contains("checksum"), "{}", r.stderr);
+}

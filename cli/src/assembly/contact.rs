@@ -137,6 +137,30 @@ impl ContactPhase {
         missed
     }
 
+    /// The candidate pairs and the bounding spheres of their build.
+    pub(super) fn broad_state(&self) -> (Vec<GranulePair>, Vec<Bound>) {
+        (self.pairs.clone(), self.built.clone())
+    }
+
+    /// Continues with `pairs` built from `built` (from [`Self::broad_state`]).
+    pub(super) fn restore_broad(&mut self, pairs: &[GranulePair], built: &[Bound]) {
+        self.pairs = pairs.to_vec();
+        self.built = built.to_vec();
+        self.work = vec![PairWork::default(); pairs.len()];
+        self.index_pairs();
+    }
+
+    /// Rebuilds each granule's list of (pair, side) from the pair list.
+    fn index_pairs(&mut self) {
+        for list in &mut self.by_granule {
+            list.clear();
+        }
+        for (k, p) in self.pairs.iter().enumerate() {
+            self.by_granule[p.a as usize].push((k as u32, Side::A));
+            self.by_granule[p.b as usize].push((k as u32, Side::B));
+        }
+    }
+
     /// Bounding sphere of granule `g` on the last x̃.
     pub fn bound(&self, g: usize) -> Bound {
         self.bounds[g]
@@ -209,13 +233,7 @@ impl ContactPhase {
         out.truncate(count);
         self.pairs = out;
         self.work.resize_with(count, PairWork::default);
-        for list in &mut self.by_granule {
-            list.clear();
-        }
-        for (k, p) in self.pairs.iter().enumerate() {
-            self.by_granule[p.a as usize].push((k as u32, Side::A));
-            self.by_granule[p.b as usize].push((k as u32, Side::B));
-        }
+        self.index_pairs();
         self.built.clone_from(&self.bounds);
         self.rebuilds += 1;
         Ok(())

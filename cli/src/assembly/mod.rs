@@ -25,6 +25,7 @@ pub mod die;
 mod step;
 
 use granbed_kernel::Real;
+use granbed_kernel::contact::broad::{Bound, GranulePair};
 use granbed_kernel::contact::pair::PairSettings;
 use granbed_kernel::contact::wall::Wall;
 use granbed_kernel::granule::damping::damping_coefficient;
@@ -157,6 +158,38 @@ impl WallSpec {
     }
 }
 
+/// Everything that carries the run from one step to the next (for
+/// checkpoints): restoring it continues the run bit for bit. Scratch
+/// buffers (v*, x̃, forces, contact lists) are rebuilt by the next step.
+#[derive(Clone, Debug, PartialEq)]
+pub struct AssemblyState {
+    /// Simulated time, s.
+    pub time: Real,
+    /// Steps taken.
+    pub steps: u64,
+    /// Δt_{n+½} and Δt_{n−½}, s.
+    pub dt: [Real; 2],
+    /// The energy ledger.
+    pub energies: Energies,
+    /// Per granule: positions, velocities, C_p⁻¹.
+    pub granules: Vec<GranuleState>,
+    /// The candidate pairs and the bounding spheres they were built from.
+    pub pairs: Vec<GranulePair>,
+    /// Bounding spheres at the last broad-phase build.
+    pub built: Vec<Bound>,
+}
+
+/// One granule's state in an [`AssemblyState`].
+#[derive(Clone, Debug, PartialEq)]
+pub struct GranuleState {
+    /// Positions x_n, m.
+    pub x: Vec<[Real; 3]>,
+    /// Velocities v_{n−½}, m/s.
+    pub v: Vec<[Real; 3]>,
+    /// C_p⁻¹ per integration point.
+    pub cp_inv: Vec<[Real; 6]>,
+}
+
 /// The running assembly.
 pub struct Assembly<'m> {
     params: AssemblyParams,
@@ -236,6 +269,64 @@ impl<'m> Assembly<'m> {
         assembly.dt = assembly.stable_step()?;
         assembly.dt_prev = assembly.dt;
         Ok(assembly)
+    }
+
+    /// The state a checkpoint keeps.
+    pub fn state(&self) -> AssemblyState {
+        let (pairs, built) = self.contact.broad_state();
+        AssemblyState {
+            time: self.time,
+            steps: self.steps,
+            dt: [self.dt, self.dt_prev],
+            energies: self.energies,
+            granules: self
+                .granules
+                .iter()
+                .map(|g| GranuleState {
+                    x: g.x.clone(),
+                    v: g.v.clone(),
+                    cp_inv: g.cp_inv.clone(),
+                })
+                .collect(),
+            pairs,
+            built,
+        }
+    }
+
+    /// Continues from `state` (taken from an assembly with the same
+    /// parameters, mesh, granule count and walls). Fails if the buffer
+    /// sizes do not match.
+    pub fn restore(&mut self, state: &AssemblyState) -> Result<(), AssemblyError> {
+        let mismatch = AssemblyError::InvalidParameter {
+            field: "checkpoint",
+            value: state.granules.len() as Real,
+            allowed: "a state of the same scene (granule count, mesh)",
+        };
+        if state.granules.len() != self.granules.len() || state.built.len() != self.granules.len() {
+            return Err(mismatch);
+        }
+        for (g, s) in self.granules.iter_mut().zip(&state.granules) {
+            if s.x.len() != g.x.len() || s.v.len() != g.v.len() || s.cp_inv.len() != g.cp_inv.len()
+            {
+                return Err(mismatch);
+            }
+            g.x.clone_from(&s.x);
+            g.v.clone_from(&s.v);
+            g.cp_inv.clone_from(&s.cp_inv);
+        }
+        if state
+            .pairs
+            .iter()
+            .any(|p| p.a >= p.b || p.b as usize >= self.granules.len())
+        {
+            return Err(mismatch);
+        }
+        self.contact.restore_broad(&state.pairs, &state.built);
+        self.time = state.time;
+        self.steps = state.steps;
+        [self.dt, self.dt_prev] = state.dt;
+        self.energies = state.energies;
+        Ok(())
     }
 
     /// The parameters.

@@ -11,12 +11,14 @@
 
 use std::path::PathBuf;
 
+use anyhow::Context as _;
 use clap::Args;
 use granbed_kernel::material::GranuleType;
 
 use crate::model::MeshLevel;
 use crate::output::Streams;
 
+pub mod checkpoint;
 pub mod outputs;
 pub mod plots;
 pub mod report;
@@ -93,6 +95,17 @@ pub struct BedArgs {
     #[arg(long, value_name = "MM")]
     pub die_diameter_mm: Option<f64>,
 
+    /// Continue the run whose checkpoint is in DIR (its `checkpoint.bin`);
+    /// the outputs go to DIR. Only --strain, --stop-at-strain, -j and
+    /// --quiet may be given with it.
+    #[arg(long, value_name = "DIR", conflicts_with_all = ["scene", "out", "granule_type", "granules", "mesh", "seed", "die_diameter_mm"])]
+    pub resume: Option<PathBuf>,
+
+    /// Write a checkpoint and stop once the strain reaches C (continue
+    /// later with --resume).
+    #[arg(long, value_name = "C")]
+    pub stop_at_strain: Option<f64>,
+
     /// Worker threads (0 = all cores). Results do not depend on it.
     #[arg(short = 'j', long, value_name = "N", default_value_t = 0)]
     pub threads: usize,
@@ -108,11 +121,15 @@ pub struct BedArgs {
 }
 
 impl BedArgs {
-    /// The scene: the file or the published one, with the overrides, validated.
-    pub fn scene(&self) -> anyhow::Result<Scene> {
-        let mut scene = match &self.scene {
-            Some(path) => Scene::read(path)?,
-            None => Scene::published(),
+    /// The scene: the checkpoint's, the file or the published one, with
+    /// the overrides, validated.
+    pub fn scene(&self, resume: Option<&checkpoint::Checkpoint>) -> anyhow::Result<Scene> {
+        let mut scene = match (&self.scene, resume) {
+            (_, Some(c)) => {
+                Scene::from_toml(&c.progress.scene_toml).context("the checkpoint's scene")?
+            }
+            (Some(path), None) => Scene::read(path)?,
+            (None, None) => Scene::published(),
         };
         if let Some(t) = self.granule_type {
             scene.granule_type = t.name().to_string();
@@ -138,7 +155,20 @@ impl BedArgs {
 
     /// Runs the command.
     pub fn run(&self, streams: &mut Streams<'_>) -> anyhow::Result<()> {
-        let scene = self.scene()?;
+        let resume = match &self.resume {
+            Some(dir) => Some(checkpoint::Checkpoint::read(dir)?),
+            None => None,
+        };
+        let scene = self.scene(resume.as_ref())?;
+        let out = self.resume.clone().unwrap_or_else(|| self.out.clone());
+        if let Some(c) = self.stop_at_strain
+            && !(c > 0.0 && c <= scene.final_strain)
+        {
+            return Err(anyhow::Error::new(crate::error::InputError(format!(
+                "`--stop-at-strain {c}` is out of range (allowed: 0 < C <= the final strain {})",
+                scene.final_strain
+            ))));
+        }
         if self.print_scene {
             let text = if self.scene.is_none() && scene == Scene::published() {
                 DEFAULT_SCENE.to_string()
@@ -154,7 +184,7 @@ impl BedArgs {
         let mut observer = Observer {
             progress: outputs::Progress::new(self.quiet, scene.final_strain),
             snapshots: snapshots::SnapshotWriter::new(
-                &self.out,
+                &out,
                 if self.vtk_full_mesh {
                     snapshots::SnapshotContent::Hexes
                 } else {
@@ -164,16 +194,33 @@ impl BedArgs {
                 1e-3 * scene.diameter_mm,
             ),
         };
-        let result = pool.install(|| run::run_bed(&scene, &mut observer))?;
+        std::fs::create_dir_all(&out)
+            .with_context(|| format!("cannot create output directory `{}`", out.display()))?;
+        let control = run::RunControl {
+            resume,
+            checkpoint_dir: Some(out.clone()),
+            stop_at_strain: self.stop_at_strain,
+        };
+        let result = pool.install(|| run::run_bed(&scene, &control, &mut observer))?;
         observer.progress.finish();
-        outputs::write_all(&self.out, &scene, &result)?;
+        outputs::write_all(&out, &scene, &result)?;
         if !self.quiet {
             writeln!(streams.stderr, "{}", outputs::summary_line(&scene, &result))?;
         }
+        if result.stopped && !self.quiet {
+            writeln!(
+                streams.stderr,
+                "stopped at C = {:.4}; continue with: granbed-cli bed --resume {}",
+                result.samples.last().map_or(0.0, |s| s.strain),
+                out.display()
+            )?;
+        }
         if let Some(e) = result.error {
+            let strain = result.samples.last().map_or(0.0, |s| s.strain);
             return Err(anyhow::Error::new(e).context(format!(
-                "the bed compression stopped early (outputs so far in `{}`)",
-                self.out.display()
+                "the bed compression stopped early after C = {strain:.4} (outputs so far and \
+                 the last checkpoint in `{}`)",
+                out.display()
             )));
         }
         Ok(())

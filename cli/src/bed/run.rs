@@ -3,6 +3,7 @@
 //! time-averaged state every output interval. Nothing here depends on
 //! clap, so the tests drive exactly this code.
 
+use std::path::PathBuf;
 use std::time::Instant;
 
 use anyhow::Context as _;
@@ -14,6 +15,7 @@ use granbed_kernel::analysis::bed::{
 use granbed_kernel::dem::pour::PourParams;
 use granbed_kernel::granule::forces::{ElementKind, ElementSettings};
 
+use super::checkpoint::{self, Checkpoint};
 use super::scene::Scene;
 use crate::assembly::die::{DieScene, placements, wall_index};
 use crate::assembly::{Assembly, AssemblyError, AssemblyParams, Energies};
@@ -85,18 +87,26 @@ pub struct BedRun {
     pub phase_times: crate::assembly::PhaseTimes,
     /// Threads of the pool the run used.
     pub threads: usize,
+    /// True if the run stopped at `RunControl::stop_at_strain`.
+    pub stopped: bool,
     /// The error that stopped the run, if any.
     pub error: Option<AssemblyError>,
 }
 
-/// The time-averaging window of the samples.
-#[derive(Default)]
-struct Window {
-    time: Real,
-    impulse: [Real; 3],
-    pairs: Real,
-    walls: Real,
-    min_j: Real,
+/// The time-averaging window of the samples (integrals over the open
+/// output interval).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Window {
+    /// Length, s.
+    pub time: Real,
+    /// ∫ upper, lower punch force and die friction z dt, N s.
+    pub impulse: [Real; 3],
+    /// ∫ pairs in contact dt, s.
+    pub pairs: Real,
+    /// ∫ (granule, wall) contacts dt, s.
+    pub walls: Real,
+    /// Smallest Jacobian ratio.
+    pub min_j: Real,
 }
 
 /// Bed geometry from every granule's current surface (physics.md §7.5–6):
@@ -138,11 +148,19 @@ pub trait BedObserver {
     ) -> anyhow::Result<()>;
 }
 
-/// Runs `scene`, reporting to `observer`. Errors before the first
-/// step (pour failed, bad setup) are returned; an error while stepping
-/// ends the run and is kept in [`BedRun::error`].
-pub fn run_bed(scene: &Scene, observer: &mut dyn BedObserver) -> anyhow::Result<BedRun> {
-    let material = scene.material()?;
+/// How a run starts and when it writes checkpoints or stops early.
+#[derive(Clone, Debug, Default)]
+pub struct RunControl {
+    /// Continue from this checkpoint instead of pouring.
+    pub resume: Option<Checkpoint>,
+    /// Directory for checkpoints (none: no checkpoints).
+    pub checkpoint_dir: Option<PathBuf>,
+    /// Stop (after a checkpoint) once the strain reaches this.
+    pub stop_at_strain: Option<Real>,
+}
+
+/// The pour's parameters for `scene`.
+fn pour_params(scene: &Scene, material: &granbed_kernel::material::Material) -> PourParams {
     let radius = 0.5e-3 * scene.diameter_mm;
     let mut pour = PourParams::standard(material.density0, scene.seed);
     let scale = radius / pour.radius;
@@ -154,20 +172,20 @@ pub fn run_bed(scene: &Scene, observer: &mut dyn BedObserver) -> anyhow::Result<
     pour.die_radius = 0.5e-3 * scene.die_diameter_mm;
     pour.friction_particle = material.params.friction;
     pour.friction_wall = material.params.friction;
-    let pour_start = Instant::now();
-    let poured = run_pour(pour, &mut |_, _| {}).map_err(anyhow::Error::new)?;
-    if let Some(e) = poured.error {
-        return Err(anyhow::Error::new(e).context("the pour did not come to rest"));
-    }
-    let pour_wall_time_s = pour_start.elapsed().as_secs_f64();
+    pour
+}
 
+/// Runs `scene`, reporting to `observer`. Errors before the first
+/// step (pour failed, bad setup, unusable checkpoint) are returned; an
+/// error while stepping ends the run and is kept in [`BedRun::error`].
+pub fn run_bed(
+    scene: &Scene,
+    control: &RunControl,
+    observer: &mut dyn BedObserver,
+) -> anyhow::Result<BedRun> {
+    let material = scene.material()?;
+    let radius = 0.5e-3 * scene.diameter_mm;
     let mesh = OwnedReference::sphere(radius, scene.mesh_level()?, false)?;
-    let die = DieScene::new(
-        &poured.positions,
-        radius,
-        pour.die_radius,
-        scene.punch_speed_m_s,
-    );
     let elements = ElementSettings {
         kind: ElementKind::OnePoint,
         update: Default::default(),
@@ -176,11 +194,39 @@ pub fn run_bed(scene: &Scene, observer: &mut dyn BedObserver) -> anyhow::Result<
     let mut params = AssemblyParams::standard(material, elements);
     params.damping_ratio = scene.damping_ratio;
     params.contact_sweeps = scene.contact_sweeps;
-    let placed = placements(&poured.positions, scene.seed);
+    // Where the run starts: a fresh pour, or a checkpoint's state.
+    let (die, placed, resumed, pour_wall_time_s) = match &control.resume {
+        Some(c) => {
+            // Any placement: the checkpoint's state replaces it.
+            let placed = vec![crate::assembly::Placement::at([0.0; 3]); scene.granules];
+            (c.progress.die, placed, Some(c), c.progress.pour_wall_time_s)
+        }
+        None => {
+            let pour = pour_params(scene, &material);
+            let pour_start = Instant::now();
+            let poured = run_pour(pour, &mut |_, _| {}).map_err(anyhow::Error::new)?;
+            if let Some(e) = poured.error {
+                return Err(anyhow::Error::new(e).context("the pour did not come to rest"));
+            }
+            let die = DieScene::new(
+                &poured.positions,
+                radius,
+                pour.die_radius,
+                scene.punch_speed_m_s,
+            );
+            let placed = placements(&poured.positions, scene.seed);
+            (die, placed, None, pour_start.elapsed().as_secs_f64())
+        }
+    };
     let mut asm = Assembly::new(params, &mesh, &placed, die.walls())
         .map_err(anyhow::Error::new)
         .context("cannot set up the bed")?;
-    let area = core::f64::consts::PI * pour.die_radius * pour.die_radius;
+    if let Some(c) = resumed {
+        asm.restore(&c.state)
+            .map_err(anyhow::Error::new)
+            .context("the checkpoint does not fit the scene")?;
+    }
+    let area = core::f64::consts::PI * die.die_radius_m * die.die_radius_m;
     let granules = scene.granules;
     let eta0 = material.params.eta0;
     let d = 2.0 * radius;
@@ -213,23 +259,57 @@ pub fn run_bed(scene: &Scene, observer: &mut dyn BedObserver) -> anyhow::Result<
             energies: *asm.energies(),
         }
     };
-    let first = sample(&mut asm, &Window::default());
-    observer.sample(&first, 0.0);
     let mut snapshots: Vec<Real> = scene.snapshot_strains.clone();
     snapshots.sort_by(Real::total_cmp);
     snapshots.dedup();
-    let mut snapshots = snapshots.into_iter().peekable();
-    while snapshots.next_if(|&c| c <= 0.0).is_some() {
-        observer.snapshot(0.0, &asm, &mesh)?;
-    }
-    let mut samples = vec![first];
-    let mut window = Window {
-        min_j: Real::INFINITY,
-        ..Window::default()
+    let (mut samples, mut window, mut next, mut snapshots_done) = match resumed {
+        Some(c) => {
+            let p = &c.progress;
+            for s in &p.samples {
+                observer.sample(s, 0.0);
+            }
+            (p.samples.clone(), p.window, p.next_output, p.snapshots_done)
+        }
+        None => {
+            let first = sample(&mut asm, &Window::default());
+            observer.sample(&first, 0.0);
+            let window = Window {
+                min_j: Real::INFINITY,
+                ..Window::default()
+            };
+            (vec![first], window, scene.output_strain_interval, 0)
+        }
     };
-    let mut next = scene.output_strain_interval;
+    while snapshots.get(snapshots_done).is_some_and(|&c| c <= 0.0) {
+        observer.snapshot(0.0, &asm, &mesh)?;
+        snapshots_done += 1;
+    }
+    let checkpoint =
+        |asm: &Assembly<'_>, samples: &[BedSample], window: &Window, next: Real, done: usize| {
+            let Some(dir) = &control.checkpoint_dir else {
+                return Ok(());
+            };
+            Checkpoint {
+                progress: checkpoint::Progress {
+                    scene_toml: scene.to_toml(),
+                    die,
+                    pour_wall_time_s,
+                    samples: samples.to_vec(),
+                    window: *window,
+                    next_output: next,
+                    snapshots_done: done,
+                },
+                state: asm.state(),
+            }
+            .write(dir)
+            .map(drop)
+        };
     let end = die.time_of_strain(scene.final_strain);
+    let every_s = 60.0 * scene.checkpoint_interval_minutes;
+    let mut last_checkpoint = Instant::now();
+    let mut next_checkpoint_strain = die.strain_at(asm.time()) + scene.checkpoint_strain_interval;
     let mut error = None;
+    let mut stopped = false;
     while asm.time() < end {
         if let Err(e) = asm.step() {
             error = Some(e);
@@ -245,8 +325,12 @@ pub fn run_bed(scene: &Scene, observer: &mut dyn BedObserver) -> anyhow::Result<
         window.walls += last.wall_contacts as Real * dt;
         window.min_j = window.min_j.min(last.min_j);
         let strain = die.strain_at(asm.time());
-        while let Some(c) = snapshots.next_if(|&c| strain + 1e-12 >= c) {
-            observer.snapshot(c, &asm, &mesh)?;
+        while snapshots
+            .get(snapshots_done)
+            .is_some_and(|&c| strain + 1e-12 >= c)
+        {
+            observer.snapshot(snapshots[snapshots_done], &asm, &mesh)?;
+            snapshots_done += 1;
         }
         if strain + 1e-12 >= next || asm.time() >= end {
             let s = sample(&mut asm, &window);
@@ -260,12 +344,27 @@ pub fn run_bed(scene: &Scene, observer: &mut dyn BedObserver) -> anyhow::Result<
                 next += scene.output_strain_interval;
             }
         }
+        let stop = control.stop_at_strain.is_some_and(|c| strain + 1e-12 >= c);
+        if stop
+            || strain >= next_checkpoint_strain
+            || last_checkpoint.elapsed().as_secs_f64() >= every_s
+        {
+            checkpoint(&asm, &samples, &window, next, snapshots_done)?;
+            last_checkpoint = Instant::now();
+            while next_checkpoint_strain <= strain {
+                next_checkpoint_strain += scene.checkpoint_strain_interval;
+            }
+        }
+        if stop {
+            stopped = true;
+            break;
+        }
     }
     let steps = asm.steps();
     Ok(BedRun {
         samples,
         bed_height_m: die.bed_height_m,
-        die_radius_m: pour.die_radius,
+        die_radius_m: die.die_radius_m,
         granules: scene.granules,
         hexes_per_granule: mesh.hexes.len(),
         steps,
@@ -274,6 +373,7 @@ pub fn run_bed(scene: &Scene, observer: &mut dyn BedObserver) -> anyhow::Result<
         wall_time_s: start.elapsed().as_secs_f64(),
         phase_times: *asm.times(),
         threads: rayon::current_num_threads(),
+        stopped,
         error,
     })
 }

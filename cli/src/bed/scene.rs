@@ -38,6 +38,11 @@ output_strain_interval = 0.005
 # VTU snapshots of the granules at these strains (vtk/ in the output).
 snapshot_strains = [0.0, 0.1, 0.2, 0.3]
 
+# Checkpoints (checkpoint.bin in the output) every this many minutes of wall
+# time and every this much strain; resume with granbed-cli bed --resume DIR.
+checkpoint_interval_minutes = 10.0
+checkpoint_strain_interval = 0.05
+
 # Selective damping of the non-rigid modes, fraction of critical.
 damping_ratio = 0.5
 # Contact sweeps per step (physics.md 5.3).
@@ -105,6 +110,10 @@ pub struct Scene {
     /// Strains at which VTU snapshots are written (each in [0, 0.9]).
     #[serde(default)]
     pub snapshot_strains: Vec<f64>,
+    /// Wall time between checkpoints, minutes (> 0).
+    pub checkpoint_interval_minutes: f64,
+    /// Strain between checkpoints (> 0).
+    pub checkpoint_strain_interval: f64,
     /// Damping ratio ξ, 0 ≤ ξ ≤ 2.
     pub damping_ratio: f64,
     /// Contact sweeps per step, 1..=10.
@@ -149,7 +158,19 @@ impl Scene {
         }
         self.granule_type()?;
         self.mesh_level()?;
-        let checks: [(bool, &str, f64, &str); 8] = [
+        let checks: [(bool, &str, f64, &str); 10] = [
+            (
+                self.checkpoint_interval_minutes > 0.0,
+                "checkpoint_interval_minutes",
+                self.checkpoint_interval_minutes,
+                "> 0",
+            ),
+            (
+                self.checkpoint_strain_interval > 0.0,
+                "checkpoint_strain_interval",
+                self.checkpoint_strain_interval,
+                "> 0",
+            ),
             (
                 (1..=100_000).contains(&self.granules),
                 "granules",

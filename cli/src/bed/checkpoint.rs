@@ -1,0 +1,389 @@
+//! Checkpoints of a bed run: everything needed to continue bit for bit,
+//! in one binary file written atomically (temporary file, flush, rename).
+//!
+//! Layout (little endian): the 16-byte magic `GRANBED-CKPT\0\0\0\0`, the
+//! format version (u32), the payload length (u64), the FNV-1a 64 checksum
+//! of the payload (u64), then the payload: the scene TOML, the run's
+//! progress ([`Progress`]) and the assembly state. Floats are stored as
+//! their bits, so nothing is rounded.
+
+use std::io::Write as _;
+use std::path::{Path, PathBuf};
+
+use anyhow::{Context as _, bail};
+use granbed_kernel::Real;
+use granbed_kernel::contact::broad::{Bound, GranulePair};
+
+use super::run::{BedSample, Window};
+use crate::assembly::die::DieScene;
+use crate::assembly::{AssemblyState, Energies, GranuleState};
+
+/// File name of the checkpoint in the output directory.
+pub const FILE_NAME: &str = "checkpoint.bin";
+/// Format version written and read.
+pub const VERSION: u32 = 1;
+const MAGIC: &[u8; 16] = b"GRANBED-CKPT\0\0\0\0";
+
+/// A bed run's progress besides the assembly state.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Progress {
+    /// The scene as run (TOML).
+    pub scene_toml: String,
+    /// The die and the bed height.
+    pub die: DieScene,
+    /// Wall time of the pour, s.
+    pub pour_wall_time_s: f64,
+    /// Samples written so far.
+    pub samples: Vec<BedSample>,
+    /// The open averaging window.
+    pub window: Window,
+    /// Strain of the next output row.
+    pub next_output: Real,
+    /// Snapshot strains already written (of the sorted list).
+    pub snapshots_done: usize,
+}
+
+/// A checkpoint: progress and assembly state.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Checkpoint {
+    /// The run's progress.
+    pub progress: Progress,
+    /// The assembly.
+    pub state: AssemblyState,
+}
+
+/// FNV-1a, 64 bits.
+fn fnv1a(bytes: &[u8]) -> u64 {
+    bytes.iter().fold(0xcbf2_9ce4_8422_2325, |h, &b| {
+        (h ^ u64::from(b)).wrapping_mul(0x0000_0100_0000_01b3)
+    })
+}
+
+#[derive(Default)]
+struct Enc(Vec<u8>);
+
+impl Enc {
+    fn u64(&mut self, v: u64) {
+        self.0.extend_from_slice(&v.to_le_bytes());
+    }
+    fn f64(&mut self, v: f64) {
+        self.u64(v.to_bits());
+    }
+    fn f64s(&mut self, v: &[f64]) {
+        self.u64(v.len() as u64);
+        for x in v {
+            self.f64(*x);
+        }
+    }
+    fn vecs<const N: usize>(&mut self, v: &[[f64; N]]) {
+        self.u64(v.len() as u64);
+        for x in v {
+            for c in x {
+                self.f64(*c);
+            }
+        }
+    }
+    fn bytes(&mut self, b: &[u8]) {
+        self.u64(b.len() as u64);
+        self.0.extend_from_slice(b);
+    }
+}
+
+struct Dec<'a>(&'a [u8]);
+
+impl Dec<'_> {
+    fn u64(&mut self) -> anyhow::Result<u64> {
+        let Some((head, rest)) = self.0.split_first_chunk::<8>() else {
+            bail!("checkpoint payload ends early");
+        };
+        self.0 = rest;
+        Ok(u64::from_le_bytes(*head))
+    }
+    fn f64(&mut self) -> anyhow::Result<f64> {
+        Ok(f64::from_bits(self.u64()?))
+    }
+    fn len(&mut self, item_bytes: usize) -> anyhow::Result<usize> {
+        let n = self.u64()?;
+        match usize::try_from(n) {
+            Ok(n) if n.checked_mul(item_bytes).is_some_and(|b| b <= self.0.len()) => Ok(n),
+            _ => bail!("checkpoint holds an impossible length {n}"),
+        }
+    }
+    fn f64s(&mut self) -> anyhow::Result<Vec<f64>> {
+        let n = self.len(8)?;
+        (0..n).map(|_| self.f64()).collect()
+    }
+    fn vecs<const N: usize>(&mut self) -> anyhow::Result<Vec<[f64; N]>> {
+        let n = self.len(8 * N)?;
+        (0..n)
+            .map(|_| {
+                let mut x = [0.0; N];
+                for c in &mut x {
+                    *c = self.f64()?;
+                }
+                Ok(x)
+            })
+            .collect()
+    }
+    fn bytes(&mut self) -> anyhow::Result<&[u8]> {
+        let n = self.len(1)?;
+        let (head, rest) = self.0.split_at(n);
+        self.0 = rest;
+        Ok(head)
+    }
+}
+
+fn energies_to(e: &Energies) -> [f64; 10] {
+    [
+        e.internal_work,
+        e.contact_work,
+        e.punch_work,
+        e.damping,
+        e.gravity_work,
+        e.kinetic,
+        e.initial_kinetic,
+        e.plastic,
+        e.hourglass,
+        e.elastic,
+    ]
+}
+
+fn energies_from(v: [f64; 10]) -> Energies {
+    Energies {
+        internal_work: v[0],
+        contact_work: v[1],
+        punch_work: v[2],
+        damping: v[3],
+        gravity_work: v[4],
+        kinetic: v[5],
+        initial_kinetic: v[6],
+        plastic: v[7],
+        hourglass: v[8],
+        elastic: v[9],
+    }
+}
+
+fn sample_to(s: &BedSample) -> [f64; 26] {
+    let e = energies_to(&s.energies);
+    let head = [
+        s.time_s,
+        s.strain,
+        s.upper_force_n,
+        s.lower_force_n,
+        s.die_friction_z_n,
+        s.upper_pressure_pa,
+        s.lower_pressure_pa,
+        s.coordination,
+        s.coordination_with_walls,
+        s.relative_density_mean,
+        s.relative_density_solid,
+        s.heywood_dv,
+        s.heywood_d,
+        s.min_jacobian,
+        f64::from_bits(s.steps),
+        0.0,
+    ];
+    core::array::from_fn(|i| if i < 16 { head[i] } else { e[i - 16] })
+}
+
+fn sample_from(v: [f64; 26]) -> BedSample {
+    BedSample {
+        time_s: v[0],
+        strain: v[1],
+        upper_force_n: v[2],
+        lower_force_n: v[3],
+        die_friction_z_n: v[4],
+        upper_pressure_pa: v[5],
+        lower_pressure_pa: v[6],
+        coordination: v[7],
+        coordination_with_walls: v[8],
+        relative_density_mean: v[9],
+        relative_density_solid: v[10],
+        heywood_dv: v[11],
+        heywood_d: v[12],
+        min_jacobian: v[13],
+        steps: v[14].to_bits(),
+        energies: energies_from(core::array::from_fn(|i| v[16 + i])),
+    }
+}
+
+impl Checkpoint {
+    fn payload(&self) -> Vec<u8> {
+        let (p, s) = (&self.progress, &self.state);
+        let mut e = Enc::default();
+        e.bytes(p.scene_toml.as_bytes());
+        e.f64s(&[
+            p.die.die_radius_m,
+            p.die.bed_height_m,
+            p.die.punch_speed_m_s,
+            p.pour_wall_time_s,
+            p.next_output,
+        ]);
+        e.u64(p.snapshots_done as u64);
+        let w = &p.window;
+        e.f64s(&[
+            w.time,
+            w.impulse[0],
+            w.impulse[1],
+            w.impulse[2],
+            w.pairs,
+            w.walls,
+            w.min_j,
+        ]);
+        e.vecs(&p.samples.iter().map(sample_to).collect::<Vec<_>>());
+        e.f64s(&[s.time, f64::from_bits(s.steps), s.dt[0], s.dt[1]]);
+        e.f64s(&energies_to(&s.energies));
+        e.u64(s.granules.len() as u64);
+        for g in &s.granules {
+            e.vecs(&g.x);
+            e.vecs(&g.v);
+            e.vecs(&g.cp_inv);
+        }
+        e.u64(s.pairs.len() as u64);
+        for pair in &s.pairs {
+            e.u64(u64::from(pair.a) << 32 | u64::from(pair.b));
+        }
+        e.vecs(
+            &s.built
+                .iter()
+                .map(|b| [b.centre[0], b.centre[1], b.centre[2], b.radius])
+                .collect::<Vec<_>>(),
+        );
+        e.0
+    }
+
+    fn from_payload(bytes: &[u8]) -> anyhow::Result<Self> {
+        let mut d = Dec(bytes);
+        let scene_toml = String::from_utf8(d.bytes()?.to_vec()).context("scene text")?;
+        let head = d.f64s()?;
+        let [
+            die_radius_m,
+            bed_height_m,
+            punch_speed_m_s,
+            pour_wall_time_s,
+            next_output,
+        ] = <[f64; 5]>::try_from(head).map_err(|_| anyhow::anyhow!("bad run header"))?;
+        let snapshots_done = d.u64()? as usize;
+        let w = <[f64; 7]>::try_from(d.f64s()?).map_err(|_| anyhow::anyhow!("bad window"))?;
+        let samples = d.vecs::<26>()?.into_iter().map(sample_from).collect();
+        let t = <[f64; 4]>::try_from(d.f64s()?).map_err(|_| anyhow::anyhow!("bad time"))?;
+        let energies = energies_from(
+            <[f64; 10]>::try_from(d.f64s()?).map_err(|_| anyhow::anyhow!("bad energies"))?,
+        );
+        let n = d.len(24)?;
+        let granules = (0..n)
+            .map(|_| {
+                Ok(GranuleState {
+                    x: d.vecs()?,
+                    v: d.vecs()?,
+                    cp_inv: d.vecs()?,
+                })
+            })
+            .collect::<anyhow::Result<Vec<_>>>()?;
+        let np = d.len(8)?;
+        let pairs = (0..np)
+            .map(|_| {
+                let v = d.u64()?;
+                Ok(GranulePair {
+                    a: (v >> 32) as u32,
+                    b: v as u32,
+                })
+            })
+            .collect::<anyhow::Result<Vec<_>>>()?;
+        let built = d
+            .vecs::<4>()?
+            .into_iter()
+            .map(|b| Bound {
+                centre: [b[0], b[1], b[2]],
+                radius: b[3],
+            })
+            .collect();
+        if !d.0.is_empty() {
+            bail!("checkpoint has {} bytes after its end", d.0.len());
+        }
+        Ok(Self {
+            progress: Progress {
+                scene_toml,
+                die: DieScene {
+                    die_radius_m,
+                    bed_height_m,
+                    punch_speed_m_s,
+                },
+                pour_wall_time_s,
+                samples,
+                window: Window {
+                    time: w[0],
+                    impulse: [w[1], w[2], w[3]],
+                    pairs: w[4],
+                    walls: w[5],
+                    min_j: w[6],
+                },
+                next_output,
+                snapshots_done,
+            },
+            state: AssemblyState {
+                time: t[0],
+                steps: t[1].to_bits(),
+                dt: [t[2], t[3]],
+                energies,
+                granules,
+                pairs,
+                built,
+            },
+        })
+    }
+
+    /// Writes the checkpoint to `dir/checkpoint.bin` atomically: a
+    /// temporary file in the same directory, flushed and synced, then
+    /// renamed over the old one (a crash leaves the old or the new file,
+    /// never a torn one).
+    pub fn write(&self, dir: &Path) -> anyhow::Result<PathBuf> {
+        let payload = self.payload();
+        let path = dir.join(FILE_NAME);
+        let tmp = dir.join(format!("{FILE_NAME}.tmp"));
+        let mut file = std::fs::File::create(&tmp)
+            .with_context(|| format!("cannot create `{}`", tmp.display()))?;
+        let mut head = Vec::with_capacity(36);
+        head.extend_from_slice(MAGIC);
+        head.extend_from_slice(&VERSION.to_le_bytes());
+        head.extend_from_slice(&(payload.len() as u64).to_le_bytes());
+        head.extend_from_slice(&fnv1a(&payload).to_le_bytes());
+        file.write_all(&head)
+            .and_then(|()| file.write_all(&payload))
+            .and_then(|()| file.sync_all())
+            .with_context(|| format!("cannot write `{}`", tmp.display()))?;
+        drop(file);
+        std::fs::rename(&tmp, &path)
+            .with_context(|| format!("cannot move the checkpoint to `{}`", path.display()))?;
+        Ok(path)
+    }
+
+    /// Reads `dir/checkpoint.bin`, checking the magic, the version and the
+    /// checksum.
+    pub fn read(dir: &Path) -> anyhow::Result<Self> {
+        let path = dir.join(FILE_NAME);
+        let bytes = std::fs::read(&path)
+            .with_context(|| format!("cannot read checkpoint `{}`", path.display()))?;
+        let bad =
+            |why: &str| anyhow::anyhow!("`{}` is not a usable checkpoint: {why}", path.display());
+        if bytes.len() < 36 || &bytes[..16] != MAGIC {
+            return Err(bad("no granbed checkpoint header"));
+        }
+        let version = u32::from_le_bytes(bytes[16..20].try_into().unwrap_or_default());
+        if version != VERSION {
+            return Err(bad(&format!(
+                "format version {version}, this build reads {VERSION}"
+            )));
+        }
+        let len = u64::from_le_bytes(bytes[20..28].try_into().unwrap_or_default());
+        let sum = u64::from_le_bytes(bytes[28..36].try_into().unwrap_or_default());
+        let payload = &bytes[36..];
+        if payload.len() as u64 != len {
+            return Err(bad("truncated"));
+        }
+        if fnv1a(payload) != sum {
+            return Err(bad("checksum mismatch"));
+        }
+        Self::from_payload(payload).map_err(|e| bad(&format!("{e:#}")))
+    }
+}
