@@ -30,6 +30,9 @@ use granbed_kernel::contact::pair::PairSettings;
 use granbed_kernel::contact::wall::Wall;
 use granbed_kernel::granule::damping::damping_coefficient;
 use granbed_kernel::granule::forces::ElementSettings;
+use granbed_kernel::granule::timestep::{
+    TimeStepControl, TimeStepMemory, TimeStepMethod, power_start,
+};
 use granbed_kernel::material::Material;
 
 use crate::model::{GranuleStore, OwnedReference};
@@ -57,8 +60,11 @@ pub struct AssemblyParams {
     /// Contact sweeps per step (≥ 1): each further sweep moves x̃ by the
     /// forces found so far and corrects the gaps that are left.
     pub contact_sweeps: u32,
-    /// Safety factor C on the element estimate of the stable step; (0, 1].
+    /// Safety factor C on the estimate of the stable step; (0, 1].
     pub time_step_safety: Real,
+    /// Element estimate, or the global 2/ω_max by power iteration per
+    /// granule (warm-started; tracked by the element lengths in between).
+    pub time_step_method: TimeStepMethod,
     /// Steps between time-step re-estimates; ≥ 1.
     pub time_step_interval: u32,
 }
@@ -66,7 +72,9 @@ pub struct AssemblyParams {
 impl AssemblyParams {
     /// physics.md's choices for `material`: ξ = 0.5, gravity 9.81 m/s²,
     /// the material's friction on walls and between granules, symmetric
-    /// two-pass with mass sharing and three sweeps, C = 0.9, re-estimated every 100 steps.
+    /// two-pass with mass sharing and three sweeps, C = 0.9 on the global
+    /// estimate 2/ω_max (power iteration every 10 re-estimates), re-estimated
+    /// every 100 steps.
     pub fn standard(material: Material, elements: ElementSettings) -> Self {
         let mu = material.params.friction;
         Self {
@@ -79,6 +87,10 @@ impl AssemblyParams {
             mass_sharing: true,
             contact_sweeps: 3,
             time_step_safety: 0.9,
+            time_step_method: TimeStepMethod::Global {
+                power_interval: 10,
+                power_iterations: 30,
+            },
             time_step_interval: 100,
         }
     }
@@ -188,6 +200,10 @@ pub struct GranuleState {
     pub v: Vec<[Real; 3]>,
     /// C_p⁻¹ per integration point.
     pub cp_inv: Vec<[Real; 6]>,
+    /// The power iteration's mode (warm start), one per node.
+    pub mode: Vec<[Real; 3]>,
+    /// The time-step policy's memory.
+    pub time_step: TimeStepMemory,
 }
 
 /// The running assembly.
@@ -205,6 +221,10 @@ pub struct Assembly<'m> {
     energies: Energies,
     last: StepReport,
     times: PhaseTimes,
+    /// Per granule: the time-step policy and its memory.
+    time_steps: Vec<TimeStepControl>,
+    /// Per granule: the power iteration's mode (its warm start).
+    modes: Vec<Vec<[Real; 3]>>,
 }
 
 impl<'m> Assembly<'m> {
@@ -257,6 +277,17 @@ impl<'m> Assembly<'m> {
             energies: Energies::default(),
             last: StepReport::default(),
             times: PhaseTimes::default(),
+            time_steps: vec![
+                TimeStepControl::new(params.time_step_method, params.time_step_safety);
+                placements.len()
+            ],
+            modes: (0..placements.len())
+                .map(|_| {
+                    let mut mode = vec![[0.0; 3]; mesh.positions.len()];
+                    power_start(&mut mode);
+                    mode
+                })
+                .collect(),
         };
         let kinetic: Real = assembly
             .granules
@@ -282,10 +313,14 @@ impl<'m> Assembly<'m> {
             granules: self
                 .granules
                 .iter()
-                .map(|g| GranuleState {
+                .zip(&self.modes)
+                .zip(&self.time_steps)
+                .map(|((g, mode), control)| GranuleState {
                     x: g.x.clone(),
                     v: g.v.clone(),
                     cp_inv: g.cp_inv.clone(),
+                    mode: mode.clone(),
+                    time_step: control.memory(),
                 })
                 .collect(),
             pairs,
@@ -305,14 +340,25 @@ impl<'m> Assembly<'m> {
         if state.granules.len() != self.granules.len() || state.built.len() != self.granules.len() {
             return Err(mismatch);
         }
-        for (g, s) in self.granules.iter_mut().zip(&state.granules) {
-            if s.x.len() != g.x.len() || s.v.len() != g.v.len() || s.cp_inv.len() != g.cp_inv.len()
+        for (((g, mode), control), s) in self
+            .granules
+            .iter_mut()
+            .zip(&mut self.modes)
+            .zip(&mut self.time_steps)
+            .zip(&state.granules)
+        {
+            if s.x.len() != g.x.len()
+                || s.v.len() != g.v.len()
+                || s.cp_inv.len() != g.cp_inv.len()
+                || s.mode.len() != mode.len()
             {
                 return Err(mismatch);
             }
             g.x.clone_from(&s.x);
             g.v.clone_from(&s.v);
             g.cp_inv.clone_from(&s.cp_inv);
+            mode.clone_from(&s.mode);
+            control.restore(s.time_step);
         }
         if state
             .pairs

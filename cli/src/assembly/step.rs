@@ -8,7 +8,7 @@ use granbed_kernel::contact::pair::ContactError;
 use granbed_kernel::contact::wall::{PredictedNodes, WallForce, count_wall_contacts, wall_contact};
 use granbed_kernel::granule::dynamics::{Loads, StepSizes, StepWork, correct, predict};
 use granbed_kernel::granule::forces::{ElementFailure, ForceSummary, elastic_energy};
-use granbed_kernel::granule::timestep::element_time_step;
+use granbed_kernel::granule::timestep::{Linearisation, PowerIterationBuffers};
 use rayon::prelude::*;
 
 use super::{Assembly, AssemblyParams};
@@ -242,15 +242,38 @@ fn add_wall(total: &mut WallForce, w: &WallForce, sum_contacts: bool) {
 }
 
 impl Assembly<'_> {
-    /// The stable step: `time_step_safety` × the smallest element estimate
-    /// over all granules, reduced for the damping.
-    pub(super) fn stable_step(&self) -> Result<Real, AssemblyError> {
+    /// The stable step: the smallest of the granules' estimates
+    /// (`time_step_method` × `time_step_safety`), reduced for the damping.
+    pub(super) fn stable_step(&mut self) -> Result<Real, AssemblyError> {
         let view = self.mesh.view();
-        let (mat, c) = (self.params.material, self.params.time_step_safety);
+        let p = self.params;
+        let (nodes, states) = (
+            self.mesh.positions.len(),
+            self.mesh.hexes.len() * p.elements.points_per_element(),
+        );
         let per: Vec<Option<Real>> = self
             .granules
             .par_iter()
-            .map(|g| element_time_step(&view, &mat, &g.x, c))
+            .zip(self.time_steps.par_iter_mut())
+            .zip(self.modes.par_iter_mut())
+            .map_init(
+                || PowerScratch::new(nodes, states),
+                |scratch, ((g, control), mode)| {
+                    let at = Linearisation {
+                        mass: &g.mass,
+                        x: &g.x,
+                        cp_inv: &g.cp_inv,
+                    };
+                    let mut buffers = PowerIterationBuffers {
+                        mode,
+                        x_pert: &mut scratch.x_pert,
+                        f_plus: &mut scratch.f_plus,
+                        f_minus: &mut scratch.f_minus,
+                        cp_scratch: &mut scratch.cp_scratch,
+                    };
+                    control.estimate(&view, &p.material, &p.elements, &at, &mut buffers)
+                },
+            )
             .collect();
         let mut dt = Real::INFINITY;
         for (g, d) in per.into_iter().enumerate() {
@@ -521,5 +544,25 @@ impl Assembly<'_> {
         self.steps += 1;
         self.dt_prev = sizes.dt;
         Ok(())
+    }
+}
+
+/// Per-thread scratch of the power iteration (the mode itself is kept
+/// per granule as the warm start).
+struct PowerScratch {
+    x_pert: Vec<[Real; 3]>,
+    f_plus: Vec<[Real; 3]>,
+    f_minus: Vec<[Real; 3]>,
+    cp_scratch: Vec<[Real; 6]>,
+}
+
+impl PowerScratch {
+    fn new(nodes: usize, states: usize) -> Self {
+        Self {
+            x_pert: vec![[0.0; 3]; nodes],
+            f_plus: vec![[0.0; 3]; nodes],
+            f_minus: vec![[0.0; 3]; nodes],
+            cp_scratch: vec![[0.0; 6]; states],
+        }
     }
 }

@@ -238,6 +238,11 @@ impl Checkpoint {
             e.vecs(&g.x);
             e.vecs(&g.v);
             e.vecs(&g.cp_inv);
+            e.vecs(&g.mode);
+            let (since, dt, length) = g.time_step;
+            e.u64(u64::from(since));
+            e.f64(dt);
+            e.f64(length);
         }
         e.u64(s.pairs.len() as u64);
         for pair in &s.pairs {
@@ -277,6 +282,12 @@ impl Checkpoint {
                     x: d.vecs()?,
                     v: d.vecs()?,
                     cp_inv: d.vecs()?,
+                    mode: d.vecs()?,
+                    time_step: (
+                        u32::try_from(d.u64()?).context("time-step memory")?,
+                        d.f64()?,
+                        d.f64()?,
+                    ),
                 })
             })
             .collect::<anyhow::Result<Vec<_>>>()?;

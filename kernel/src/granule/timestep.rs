@@ -164,7 +164,35 @@ pub struct TimeStepControl {
     global_length: Real,
 }
 
+/// Fills `mode` with the fixed, non-symmetric start field of the power
+/// iteration (the same everywhere, so runs are reproducible).
+pub fn power_start(mode: &mut [[Real; 3]]) {
+    for (i, u) in mode.iter_mut().enumerate() {
+        let k = i as Real;
+        *u = [
+            crate::math::sin(1.7 * k + 0.3),
+            crate::math::cos(2.3 * k),
+            crate::math::sin(0.7 * k + 1.1),
+        ];
+    }
+}
+
+/// What a [`TimeStepControl`] remembers between re-estimates, for
+/// checkpoints: (re-estimates since the last power iteration, 2/ω_max then
+/// in s, min L_e then in m).
+pub type TimeStepMemory = (u32, Real, Real);
+
 impl TimeStepControl {
+    /// What the policy remembers (see [`TimeStepMemory`]).
+    pub fn memory(&self) -> TimeStepMemory {
+        (self.since_power, self.global_dt, self.global_length)
+    }
+
+    /// Continues with `memory` from [`Self::memory`].
+    pub fn restore(&mut self, memory: TimeStepMemory) {
+        (self.since_power, self.global_dt, self.global_length) = memory;
+    }
+
     /// A policy with safety factor `safety` (0 < C ≤ 1).
     pub fn new(method: TimeStepMethod, safety: Real) -> Self {
         Self {

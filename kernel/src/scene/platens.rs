@@ -26,7 +26,7 @@ use crate::granule::damping::damping_coefficient;
 use crate::granule::dynamics::{GranuleBuffers, Loads, StepSizes, correct, predict};
 use crate::granule::forces::{ElementFailure, ElementKind, ElementSettings, elastic_energy};
 use crate::granule::timestep::{
-    Linearisation, PowerIterationBuffers, TimeStepControl, TimeStepMethod,
+    Linearisation, PowerIterationBuffers, TimeStepControl, TimeStepMethod, power_start,
 };
 use crate::material::Material;
 use crate::mesh::reference::ReferenceMesh;
@@ -430,14 +430,7 @@ impl<'a> PlatenScene<'a> {
             .fold(Real::NEG_INFINITY, |m, x| crate::math::max(m, x[2]));
         let radius = z_top0;
         // Warm start of the power iteration: a fixed, non-symmetric field.
-        for (i, u) in power.mode.iter_mut().enumerate() {
-            let k = i as Real;
-            *u = [
-                crate::math::sin(1.7 * k + 0.3),
-                crate::math::cos(2.3 * k),
-                crate::math::sin(0.7 * k + 1.1),
-            ];
-        }
+        power_start(power.mode);
         let mut time_step = TimeStepControl::new(params.time_step_method, params.time_step_safety);
         let at = Linearisation {
             mass: buf.mass,
