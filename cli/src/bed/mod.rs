@@ -7,7 +7,8 @@
 //! * [`run`](mod@run): the run itself, sampled every output interval;
 //! * [`outputs`]: `compression.csv` and `summary.json`;
 //! * [`snapshots`]: the VTU snapshots (`vtk/`), [`plots`]: the SVG plots
-//!   (`plots/`), [`report`]: `report.html`.
+//!   (`plots/`), [`report`]: `report.html`;
+//! * [`compare`]: `--types`, several granule types from one pour.
 
 use std::path::PathBuf;
 
@@ -15,10 +16,12 @@ use anyhow::Context as _;
 use clap::Args;
 use granbed_kernel::material::GranuleType;
 
+use crate::granule::TypeList;
 use crate::model::MeshLevel;
 use crate::output::Streams;
 
 pub mod checkpoint;
+pub mod compare;
 pub mod outputs;
 pub mod plots;
 pub mod report;
@@ -48,6 +51,22 @@ Output, in --out DIR (created if missing):
   plots/*.svg      pressure, coordination number, relative density and Heywood
                    coefficient against strain; Kawakita plot P/C vs P with the fit
   report.html      one page: the summary table, the plots and the scene
+  checkpoint.bin   the state to continue from with --resume
+
+With --types, the files above go to DIR/<TYPE>/ per type (each resumable
+alone with --resume DIR/<TYPE>), and DIR holds the comparison:
+  comparison.csv   one row per type, in the order given: type, yield stress,
+                   eta0, Kawakita a, 1/b (Pa), R^2, points, max pressure,
+                   final strain, final pressure, final mean relative density,
+                   final coordination number, wall time
+  comparison.json  the same rows, the errors, and the type of the pour
+  comparison_pressure.svg, comparison_density.svg
+                   upper-punch pressure and mean relative density against
+                   strain, one curve per type
+All types start from ONE pour (as the published study compares the nine
+types on one bed): the pour uses the sphere density of the scene's type if
+it is listed, else of the first listed type; types with another eta0 (digit)
+reuse that packing.
 
 Without --scene the embedded published scene runs (print it with
 --print-scene); the flags below override the scene's fields.
@@ -74,6 +93,14 @@ pub struct BedArgs {
     /// Override: standard granule type A1…C3.
     #[arg(long = "type", value_name = "TYPE")]
     pub granule_type: Option<GranuleType>,
+
+    /// Compress several granule types, one after the other (each on all
+    /// the -j threads), from ONE pour: `all` (A1…C3) or a comma list such as
+    /// `A2,B2,C2`. The pour uses the sphere density of the scene's type if
+    /// listed, else of the first listed type. Writes `DIR/<TYPE>/` per type
+    /// plus `DIR/comparison.csv`, `.json` and the `comparison_*.svg` plots.
+    #[arg(long, value_name = "LIST", conflicts_with_all = ["granule_type", "resume", "stop_at_strain"])]
+    pub types: Option<TypeList>,
 
     /// Override: number of granules (1 ≤ N ≤ 100000).
     #[arg(long, value_name = "N")]
@@ -181,32 +208,16 @@ impl BedArgs {
         let pool = rayon::ThreadPoolBuilder::new()
             .num_threads(self.threads)
             .build()?;
-        let mut observer = Observer {
-            progress: outputs::Progress::new(self.quiet, scene.final_strain),
-            snapshots: snapshots::SnapshotWriter::new(
-                &out,
-                if self.vtk_full_mesh {
-                    snapshots::SnapshotContent::Hexes
-                } else {
-                    snapshots::SnapshotContent::Surfaces
-                },
-                &scene.snapshot_strains,
-                1e-3 * scene.diameter_mm,
-            ),
-        };
-        std::fs::create_dir_all(&out)
-            .with_context(|| format!("cannot create output directory `{}`", out.display()))?;
+        if let Some(types) = &self.types {
+            return self.run_types(&scene, &types.0, &pool, streams);
+        }
         let control = run::RunControl {
             resume,
+            packing: None,
             checkpoint_dir: Some(out.clone()),
             stop_at_strain: self.stop_at_strain,
         };
-        let result = pool.install(|| run::run_bed(&scene, &control, &mut observer))?;
-        observer.progress.finish();
-        outputs::write_all(&out, &scene, &result)?;
-        if !self.quiet {
-            writeln!(streams.stderr, "{}", outputs::summary_line(&scene, &result))?;
-        }
+        let result = self.compress(&pool, &scene, control, &out, "bed", streams)?;
         if result.stopped && !self.quiet {
             writeln!(
                 streams.stderr,
@@ -224,6 +235,147 @@ impl BedArgs {
             )));
         }
         Ok(())
+    }
+
+    /// One compression of `scene` on `pool` as `control` says, with its
+    /// outputs in `out` (created) and the summary line on stderr; the
+    /// progress bar starts with `label`.
+    fn compress(
+        &self,
+        pool: &rayon::ThreadPool,
+        scene: &Scene,
+        control: run::RunControl,
+        out: &std::path::Path,
+        label: &str,
+        streams: &mut Streams<'_>,
+    ) -> anyhow::Result<run::BedRun> {
+        let mut observer = Observer {
+            progress: outputs::Progress::new(self.quiet, scene.final_strain, label),
+            snapshots: snapshots::SnapshotWriter::new(
+                out,
+                if self.vtk_full_mesh {
+                    snapshots::SnapshotContent::Hexes
+                } else {
+                    snapshots::SnapshotContent::Surfaces
+                },
+                &scene.snapshot_strains,
+                1e-3 * scene.diameter_mm,
+            ),
+        };
+        std::fs::create_dir_all(out)
+            .with_context(|| format!("cannot create output directory `{}`", out.display()))?;
+        let result = pool.install(|| run::run_bed(scene, &control, &mut observer));
+        observer.progress.finish();
+        let result = result?;
+        outputs::write_all(out, scene, &result)?;
+        if !self.quiet {
+            writeln!(streams.stderr, "{}", outputs::summary_line(scene, &result))?;
+        }
+        Ok(result)
+    }
+
+    /// `--types`: pour once, compress every type in `types` from that
+    /// packing into `DIR/<TYPE>/`, then write the comparison into `DIR`.
+    fn run_types(
+        &self,
+        base: &Scene,
+        types: &[GranuleType],
+        pool: &rayon::ThreadPool,
+        streams: &mut Streams<'_>,
+    ) -> anyhow::Result<()> {
+        // Every type's scene is validated (the material overrides apply to
+        // each) before anything runs.
+        let scenes: Vec<Scene> = types
+            .iter()
+            .map(|t| {
+                let scene = Scene {
+                    granule_type: t.name().to_string(),
+                    ..base.clone()
+                };
+                scene
+                    .validate()
+                    .with_context(|| format!("granule type {t}"))?;
+                Ok(scene)
+            })
+            .collect::<anyhow::Result<_>>()?;
+        // One pour for all types, as the published study compares the nine
+        // types on one bed. The pour depends on the type only through the
+        // sphere density (η0, the type's digit): it uses the scene's own
+        // type if listed, else the first listed, and the types with another
+        // η0 reuse that packing as it is.
+        let pour_index = types
+            .iter()
+            .position(|t| t.name() == base.granule_type)
+            .unwrap_or(0);
+        let pour_type = types[pour_index];
+        std::fs::create_dir_all(&self.out)
+            .with_context(|| format!("cannot create output directory `{}`", self.out.display()))?;
+        let packing = pool
+            .install(|| run::pour(&scenes[pour_index]))
+            .with_context(|| format!("the pour (sphere density of type {pour_type})"))?;
+        if !self.quiet {
+            writeln!(
+                streams.stderr,
+                "poured {} spheres (density of {pour_type}) in {:.1} s; compressing {} types",
+                packing.centres.len(),
+                packing.wall_time_s,
+                types.len()
+            )?;
+        }
+        let mut runs = Vec::with_capacity(types.len());
+        for (t, scene) in types.iter().zip(&scenes) {
+            let dir = self.out.join(t.name());
+            let control = run::RunControl {
+                resume: None,
+                packing: Some(packing.clone()),
+                checkpoint_dir: Some(dir.clone()),
+                stop_at_strain: None,
+            };
+            let label = format!("bed {t}");
+            let result = self
+                .compress(pool, scene, control, &dir, &label, streams)
+                .with_context(|| format!("granule type {t}"))?;
+            runs.push(result);
+        }
+        let rows: Vec<compare::ComparisonRow> = types
+            .iter()
+            .zip(&scenes)
+            .zip(&runs)
+            .map(|((t, scene), r)| compare::ComparisonRow::new(*t, &outputs::summary(scene, r)))
+            .collect();
+        let samples: Vec<&[run::BedSample]> = runs.iter().map(|r| r.samples.as_slice()).collect();
+        let comparison = compare::Comparison {
+            version: env!("CARGO_PKG_VERSION"),
+            pour_granule_type: pour_type.name(),
+            pour_wall_time_s: packing.wall_time_s,
+            types: &rows,
+        };
+        compare::write_comparison(&self.out, &comparison, &samples)?;
+        // Runs the kernel stopped: the others ran on; report them all.
+        let mut failed = types.iter().zip(runs).filter_map(|(t, r)| {
+            let strain = r.samples.last().map_or(0.0, |s| s.strain);
+            let dir = self.out.join(t.name());
+            r.error.map(|e| {
+                anyhow::Error::new(e).context(format!(
+                    "granule type {t}: the bed compression stopped early after C = {strain:.4} \
+                     (outputs so far and the last checkpoint in `{}`)",
+                    dir.display()
+                ))
+            })
+        });
+        let Some(first) = failed.next() else {
+            return Ok(());
+        };
+        let others: Vec<String> = failed.map(|e| format!("{e:#}")).collect();
+        if others.is_empty() {
+            Err(first)
+        } else {
+            Err(first.context(format!(
+                "{} granule types stopped early; also: {}",
+                others.len() + 1,
+                others.join("; ")
+            )))
+        }
     }
 }
 

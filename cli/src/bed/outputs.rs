@@ -98,8 +98,19 @@ pub struct Summary<'a> {
     pub kawakita_inv_b_pa: Option<Real>,
     /// The fit in full.
     pub kawakita: KawakitaSummary,
+    /// Yield stress of the granules as run (the type's, or the scene's
+    /// override), Pa.
+    pub yield_stress_pa: Real,
+    /// Initial relative density η0 of the granules as run.
+    pub eta0: Real,
     /// Strain reached.
     pub final_strain: Real,
+    /// Upper-punch pressure of the last sample, Pa.
+    pub final_pressure_pa: Real,
+    /// Mean granule relative density η0 V0/V of the last sample.
+    pub final_relative_density: Real,
+    /// Coordination number (granule pairs) of the last sample.
+    pub final_coordination: Real,
     /// Largest upper-punch pressure of the samples, Pa.
     pub max_pressure_pa: Real,
     /// H0, m.
@@ -172,13 +183,19 @@ pub fn summary<'a>(scene: &'a Scene, run: &BedRun) -> Summary<'a> {
         .map(|s| s.min_jacobian)
         .fold(Real::INFINITY, Real::min);
     let e = last.energies;
+    let material = scene.material_params().ok();
     Summary {
         version: env!("CARGO_PKG_VERSION"),
         scene,
         kawakita_a: k.a,
         kawakita_inv_b_pa: k.inv_b_pa,
         kawakita: k,
+        yield_stress_pa: material.map_or(Real::NAN, |m| m.yield_stress_pa),
+        eta0: material.map_or(Real::NAN, |m| m.eta0),
         final_strain: last.strain,
+        final_pressure_pa: last.upper_pressure_pa,
+        final_relative_density: last.relative_density_mean,
+        final_coordination: last.coordination,
         max_pressure_pa: run
             .samples
             .iter()
@@ -254,18 +271,20 @@ pub struct Progress {
 const TICKS: f64 = 10_000.0;
 
 impl Progress {
-    /// A bar up to `final_strain`.
-    pub fn new(quiet: bool, final_strain: Real) -> Self {
+    /// A bar up to `final_strain`, its line starting with `label`.
+    pub fn new(quiet: bool, final_strain: Real, label: &str) -> Self {
         let target = if quiet {
             ProgressDrawTarget::hidden()
         } else {
             ProgressDrawTarget::stderr()
         };
-        let style =
-            ProgressStyle::with_template("bed [{elapsed_precise}] {bar:30} C {msg} (ETA {eta})")
-                .unwrap_or_else(|_| ProgressStyle::default_bar());
+        let style = ProgressStyle::with_template(
+            "{prefix} [{elapsed_precise}] {bar:30} C {msg} (ETA {eta})",
+        )
+        .unwrap_or_else(|_| ProgressStyle::default_bar());
         let bar = ProgressBar::with_draw_target(Some((final_strain * TICKS) as u64), target)
-            .with_style(style);
+            .with_style(style)
+            .with_prefix(label.to_string());
         Self { bar }
     }
 

@@ -40,12 +40,19 @@ pub const PLOT_FILES: [&str; 5] = [
 /// Plot size, pixels.
 const SIZE: (u32, u32) = (900, 600);
 
-/// Curve colours: the first of matplotlib's `tab10` (as `granule`'s plots).
-const COLOURS: [RGBColor; 4] = [
+/// Curve colours: matplotlib's `tab10` (as `granule`'s plots), enough for
+/// the nine types of a `--types all` comparison.
+const COLOURS: [RGBColor; 10] = [
     RGBColor(0x1f, 0x77, 0xb4),
     RGBColor(0xff, 0x7f, 0x0e),
     RGBColor(0x2c, 0xa0, 0x2c),
     RGBColor(0xd6, 0x27, 0x28),
+    RGBColor(0x94, 0x67, 0xbd),
+    RGBColor(0x8c, 0x56, 0x4b),
+    RGBColor(0xe3, 0x77, 0xc2),
+    RGBColor(0x7f, 0x7f, 0x7f),
+    RGBColor(0xbc, 0xbd, 0x22),
+    RGBColor(0x17, 0xbe, 0xcf),
 ];
 
 /// How a series is drawn.
@@ -174,7 +181,31 @@ fn xy_svg(
 }
 
 /// The value of a sample a curve shows.
-type Quantity = fn(&BedSample) -> Real;
+pub type Quantity = fn(&BedSample) -> Real;
+
+/// One line per (label, samples) of `y` against the strain, overlaid with
+/// a legend (the `--types` comparison plots).
+pub fn overlay_svg(
+    title: &str,
+    y_desc: &str,
+    curves: &[(&str, &[BedSample])],
+    y: Quantity,
+    y_from_zero: bool,
+) -> anyhow::Result<String> {
+    let series: Vec<Series> = curves
+        .iter()
+        .map(|(label, samples)| {
+            Series::new(*label, Mark::Line, samples.iter().map(|s| (s.strain, y(s))))
+        })
+        .collect();
+    xy_svg(
+        title,
+        "axial strain C = (H0 - H)/H0",
+        y_desc,
+        &series,
+        y_from_zero,
+    )
+}
 
 /// Two curves (label, value) of the samples against the strain.
 fn against_strain(samples: &[BedSample], curves: [(&str, Quantity); 2]) -> [Series; 2] {

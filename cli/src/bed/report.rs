@@ -20,7 +20,7 @@ pub const REPORT_FILE: &str = "report.html";
 /// The fields of `summary.json` shown first, in this order, with their
 /// meaning; any other field follows (the nested `kawakita` object is
 /// flattened to `kawakita.<field>`, the scene is shown as TOML instead).
-const FIELDS: [(&str, &str); 24] = [
+const FIELDS: [(&str, &str); 29] = [
     ("kawakita_a", "Kawakita a (limiting strain)"),
     ("kawakita_inv_b_pa", "Kawakita 1/b, Pa"),
     (
@@ -28,7 +28,15 @@ const FIELDS: [(&str, &str); 24] = [
         "R² of the Kawakita line P/C against P",
     ),
     ("kawakita.points", "samples with C ≥ 0.25 in the fit"),
+    ("yield_stress_pa", "granule yield stress, Pa"),
+    ("eta0", "granule initial relative density η0"),
     ("final_strain", "axial strain reached"),
+    ("final_pressure_pa", "upper-punch pressure at the end, Pa"),
+    (
+        "final_relative_density",
+        "mean granule relative density at the end",
+    ),
+    ("final_coordination", "coordination number Z at the end"),
     ("max_pressure_pa", "largest upper-punch pressure, Pa"),
     ("initial_bed_height_m", "initial bed height H0, m"),
     ("granules", "granules"),

@@ -1,5 +1,5 @@
-//! The bed compression run: pour the spheres, put a granule mesh at every
-//! centre, press the upper punch to the final strain and sample the
+//! The bed compression run: pour the spheres ([`pour`], or take a
+//! [`Packing`] poured before), put a granule mesh at every centre, press the upper punch to the final strain and sample the
 //! time-averaged state every output interval. Nothing here depends on
 //! clap, so the tests drive exactly this code.
 
@@ -148,11 +148,46 @@ pub trait BedObserver {
     ) -> anyhow::Result<()>;
 }
 
+/// A poured bed: the hand-over from the pour to the compression, made
+/// once by [`pour`] and usable by several runs (`bed --types`).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Packing {
+    /// Sphere centres, m.
+    pub centres: Vec<[Real; 3]>,
+    /// Sphere radius, m.
+    pub radius_m: Real,
+    /// Die radius, m.
+    pub die_radius_m: Real,
+    /// Wall time of the pour, s.
+    pub wall_time_s: f64,
+}
+
+/// Pours the bed of `scene` (its granule type sets the sphere density).
+/// An error names why the pour failed.
+pub fn pour(scene: &Scene) -> anyhow::Result<Packing> {
+    let material = scene.material()?;
+    let pour = pour_params(scene, &material);
+    let start = Instant::now();
+    let poured = run_pour(pour, &mut |_, _| {}).map_err(anyhow::Error::new)?;
+    if let Some(e) = poured.error {
+        return Err(anyhow::Error::new(e).context("the pour did not come to rest"));
+    }
+    Ok(Packing {
+        centres: poured.positions,
+        radius_m: pour.radius,
+        die_radius_m: pour.die_radius,
+        wall_time_s: start.elapsed().as_secs_f64(),
+    })
+}
+
 /// How a run starts and when it writes checkpoints or stops early.
 #[derive(Clone, Debug, Default)]
 pub struct RunControl {
     /// Continue from this checkpoint instead of pouring.
     pub resume: Option<Checkpoint>,
+    /// Compress this packing instead of pouring (ignored with `resume`);
+    /// it must have the scene's granule count, granule and die diameter.
+    pub packing: Option<Packing>,
     /// Directory for checkpoints (none: no checkpoints).
     pub checkpoint_dir: Option<PathBuf>,
     /// Stop (after a checkpoint) once the strain reaches this.
@@ -175,8 +210,9 @@ fn pour_params(scene: &Scene, material: &granbed_kernel::material::Material) -> 
     pour
 }
 
-/// Runs `scene`, reporting to `observer`. Errors before the first
-/// step (pour failed, bad setup, unusable checkpoint) are returned; an
+/// Runs `scene` from `control`'s checkpoint, else its packing, else a
+/// fresh pour, reporting to `observer`. Errors before the first step
+/// (pour failed, bad setup, packing or checkpoint unfit) are returned; an
 /// error while stepping ends the run and is kept in [`BedRun::error`].
 pub fn run_bed(
     scene: &Scene,
@@ -202,20 +238,31 @@ pub fn run_bed(
             (c.progress.die, placed, Some(c), c.progress.pour_wall_time_s)
         }
         None => {
-            let pour = pour_params(scene, &material);
-            let pour_start = Instant::now();
-            let poured = run_pour(pour, &mut |_, _| {}).map_err(anyhow::Error::new)?;
-            if let Some(e) = poured.error {
-                return Err(anyhow::Error::new(e).context("the pour did not come to rest"));
+            let poured;
+            let packing = match &control.packing {
+                Some(p) => p,
+                None => {
+                    poured = pour(scene)?;
+                    &poured
+                }
+            };
+            let die_radius = 0.5e-3 * scene.die_diameter_mm;
+            if packing.centres.len() != scene.granules
+                || packing.radius_m != radius
+                || packing.die_radius_m != die_radius
+            {
+                anyhow::bail!(
+                    "the packing ({} spheres of radius {} m in a die of radius {} m) does not fit \
+                     the scene ({} granules of radius {radius} m, die radius {die_radius} m)",
+                    packing.centres.len(),
+                    packing.radius_m,
+                    packing.die_radius_m,
+                    scene.granules
+                );
             }
-            let die = DieScene::new(
-                &poured.positions,
-                radius,
-                pour.die_radius,
-                scene.punch_speed_m_s,
-            );
-            let placed = placements(&poured.positions, scene.seed);
-            (die, placed, None, pour_start.elapsed().as_secs_f64())
+            let die = DieScene::new(&packing.centres, radius, die_radius, scene.punch_speed_m_s);
+            let placed = placements(&packing.centres, scene.seed);
+            (die, placed, None, packing.wall_time_s)
         }
     };
     let mut asm = Assembly::new(params, &mesh, &placed, die.walls())

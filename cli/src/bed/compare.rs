@@ -1,0 +1,186 @@
+//! The comparison of `granbed-cli bed --types`: several granule types
+//! compressed from the same poured bed, one row per type in
+//! `comparison.csv` and `comparison.json`, and the overlaid plots
+//! `comparison_pressure.svg` (P against C) and `comparison_density.svg`
+//! (mean granule relative density against C).
+
+use std::io::Write as _;
+use std::path::Path;
+
+use anyhow::Context as _;
+use granbed_kernel::Real;
+use granbed_kernel::material::GranuleType;
+use serde::Serialize;
+
+use super::outputs::Summary;
+use super::plots::overlay_svg;
+use super::run::BedSample;
+use crate::csv::{CsvWriter, Field};
+use crate::output::{create_file, finish_file, write_json};
+
+/// File name of the comparison table.
+pub const COMPARISON_CSV: &str = "comparison.csv";
+/// File name of the comparison as JSON.
+pub const COMPARISON_JSON: &str = "comparison.json";
+/// File name of the overlaid pressure plot.
+pub const PRESSURE_SVG: &str = "comparison_pressure.svg";
+/// File name of the overlaid relative-density plot.
+pub const DENSITY_SVG: &str = "comparison_density.svg";
+
+/// Columns of [`COMPARISON_CSV`], in order (`NaN` where the summary has
+/// `null`, e.g. no Kawakita fit below C = 0.25).
+pub const COMPARISON_COLUMNS: [&str; 13] = [
+    "type",
+    "yield_stress_pa",
+    "eta0",
+    "kawakita_a",
+    "kawakita_inv_b_pa",
+    "kawakita_r_squared",
+    "kawakita_points",
+    "max_pressure_pa",
+    "final_strain",
+    "final_pressure_pa",
+    "final_relative_density",
+    "final_coordination",
+    "wall_time_s",
+];
+
+/// One type's row: the values of its `summary.json`.
+#[derive(Clone, Debug, Serialize)]
+pub struct ComparisonRow {
+    /// Granule type.
+    #[serde(rename = "type")]
+    pub granule_type: &'static str,
+    /// Yield stress, Pa.
+    pub yield_stress_pa: Real,
+    /// Initial relative density η0.
+    pub eta0: Real,
+    /// Kawakita a.
+    pub kawakita_a: Option<Real>,
+    /// Kawakita 1/b, Pa.
+    pub kawakita_inv_b_pa: Option<Real>,
+    /// R² of the Kawakita fit.
+    pub kawakita_r_squared: Option<Real>,
+    /// Samples in the fit (C ≥ 0.25).
+    pub kawakita_points: usize,
+    /// Largest upper-punch pressure, Pa.
+    pub max_pressure_pa: Real,
+    /// Strain reached.
+    pub final_strain: Real,
+    /// Upper-punch pressure at the end, Pa.
+    pub final_pressure_pa: Real,
+    /// Mean granule relative density at the end.
+    pub final_relative_density: Real,
+    /// Coordination number Z at the end.
+    pub final_coordination: Real,
+    /// Wall time of the compression, s.
+    pub wall_time_s: f64,
+    /// The error that stopped the run early, if any.
+    pub error: Option<String>,
+}
+
+impl ComparisonRow {
+    /// The row of type `t` from its run's summary.
+    pub fn new(t: GranuleType, s: &Summary<'_>) -> Self {
+        Self {
+            granule_type: t.name(),
+            yield_stress_pa: s.yield_stress_pa,
+            eta0: s.eta0,
+            kawakita_a: s.kawakita.a,
+            kawakita_inv_b_pa: s.kawakita.inv_b_pa,
+            kawakita_r_squared: s.kawakita.r_squared,
+            kawakita_points: s.kawakita.points,
+            max_pressure_pa: s.max_pressure_pa,
+            final_strain: s.final_strain,
+            final_pressure_pa: s.final_pressure_pa,
+            final_relative_density: s.final_relative_density,
+            final_coordination: s.final_coordination,
+            wall_time_s: s.wall_time_s,
+            error: s.error.clone(),
+        }
+    }
+
+    fn fields(&self) -> [Field; COMPARISON_COLUMNS.len()] {
+        let opt = |x: Option<Real>| Field::Real(x.unwrap_or(Real::NAN));
+        [
+            Field::Text(self.granule_type),
+            self.yield_stress_pa.into(),
+            self.eta0.into(),
+            opt(self.kawakita_a),
+            opt(self.kawakita_inv_b_pa),
+            opt(self.kawakita_r_squared),
+            Field::Int(self.kawakita_points as u64),
+            self.max_pressure_pa.into(),
+            self.final_strain.into(),
+            self.final_pressure_pa.into(),
+            self.final_relative_density.into(),
+            self.final_coordination.into(),
+            self.wall_time_s.into(),
+        ]
+    }
+}
+
+/// The fields of [`COMPARISON_JSON`].
+#[derive(Debug, Serialize)]
+pub struct Comparison<'a> {
+    /// granbed version.
+    pub version: &'static str,
+    /// The type whose sphere density the one shared pour used.
+    pub pour_granule_type: &'static str,
+    /// Wall time of the shared pour, s.
+    pub pour_wall_time_s: f64,
+    /// One row per type, in the order given.
+    pub types: &'a [ComparisonRow],
+}
+
+/// Writes [`COMPARISON_CSV`], [`COMPARISON_JSON`], [`PRESSURE_SVG`] and
+/// [`DENSITY_SVG`] into `dir`: `rows` and `samples` are per type, in the
+/// same order.
+pub fn write_comparison(
+    dir: &Path,
+    comparison: &Comparison<'_>,
+    samples: &[&[BedSample]],
+) -> anyhow::Result<()> {
+    let path = dir.join(COMPARISON_CSV);
+    let ctx = || format!("cannot write to `{}`", path.display());
+    let mut csv = CsvWriter::new(create_file(&path)?, &COMPARISON_COLUMNS).with_context(ctx)?;
+    for row in comparison.types {
+        csv.write_row(&row.fields()).with_context(ctx)?;
+    }
+    finish_file(csv.into_inner(), &path)?;
+    write_json(&dir.join(COMPARISON_JSON), comparison)?;
+    let curves: Vec<(&str, &[BedSample])> = comparison
+        .types
+        .iter()
+        .zip(samples)
+        .map(|(row, s)| (row.granule_type, *s))
+        .collect();
+    let title = |what: &str| {
+        format!(
+            "{what} by granule type (one pour, sphere density of {})",
+            comparison.pour_granule_type
+        )
+    };
+    let pressure = overlay_svg(
+        &title("Upper-punch pressure"),
+        "pressure P, kPa",
+        &curves,
+        |s| s.upper_pressure_pa * 1e-3,
+        true,
+    )?;
+    let density = overlay_svg(
+        &title("Granule relative density"),
+        "mean relative density η0 V0/V",
+        &curves,
+        |s| s.relative_density_mean,
+        false,
+    )?;
+    for (name, svg) in [(PRESSURE_SVG, pressure), (DENSITY_SVG, density)] {
+        let path = dir.join(name);
+        let mut file = create_file(&path)?;
+        file.write_all(svg.as_bytes())
+            .with_context(|| format!("cannot write to `{}`", path.display()))?;
+        finish_file(file, &path)?;
+    }
+    Ok(())
+}

@@ -1,0 +1,164 @@
+//! `granbed-cli bed --types`: several granule types compressed from ONE
+//! pour. A CI-sized bed (30 coarse 4x1 granules in a 5 mm die, to 15 %
+//! strain) with A2, B2, C2 — one η0, so the pour is the same for all and
+//! only the yield stress differs (10, 30, 100 kPa): the punch pressure at
+//! the final strain is ordered A2 < B2 < C2 (a harder granule makes a
+//! stiffer bed; measured 1.39, 3.10, 4.99 kPa). Every type has its own
+//! outputs, and `comparison.csv` holds their summary values in the order
+//! given. Usage errors name the flag.
+
+mod common;
+
+use std::path::{Path, PathBuf};
+
+use common::{Table, cli, number, summary};
+
+fn out_dir(name: &str) -> PathBuf {
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("cli_bed_types-{name}"));
+    let _ = std::fs::remove_dir_all(&dir);
+    dir
+}
+
+const TYPES: [&str; 3] = ["A2", "B2", "C2"];
+
+/// `comparison.csv` column → `summary.json` field.
+const SAME_AS_SUMMARY: [(&str, &str); 7] = [
+    ("max_pressure_pa", "max_pressure_pa"),
+    ("final_strain", "final_strain"),
+    ("final_pressure_pa", "final_pressure_pa"),
+    ("final_relative_density", "final_relative_density"),
+    ("final_coordination", "final_coordination"),
+    ("yield_stress_pa", "yield_stress_pa"),
+    ("eta0", "eta0"),
+];
+
+#[test]
+fn three_types_from_one_pour_are_ordered_by_yield_stress() {
+    let dir = out_dir("a2b2c2");
+    let run = cli(&[
+        "bed",
+        "--quiet",
+        "--out",
+        dir.to_str().unwrap(),
+        "--types",
+        "A2,b2,C2",
+        "--granules",
+        "30",
+        "--mesh",
+        "4x1",
+        "--die-diameter-mm",
+        "5",
+        "--strain",
+        "0.15",
+    ]);
+    assert_eq!(run.code, 0, "bed --types failed:\n{}", run.stderr);
+
+    let table = Table::read(&dir.join("comparison.csv"));
+    assert_eq!(table.text("type"), TYPES, "rows in the order given");
+    let summaries: Vec<_> = TYPES
+        .iter()
+        .map(|t| {
+            let sub = dir.join(t);
+            assert!(
+                sub.join("compression.csv").is_file(),
+                "{t}: no compression.csv"
+            );
+            let s = summary(&sub);
+            assert_eq!(s["scene"]["granule_type"], *t);
+            assert!(s["error"].is_null(), "{t}: {}", s["error"]);
+            s
+        })
+        .collect();
+    // The table's numbers are the summaries' values, bit for bit.
+    for (column, field) in SAME_AS_SUMMARY {
+        let values = table.num(column);
+        for ((t, s), v) in TYPES.iter().zip(&summaries).zip(values) {
+            assert_eq!(v, number(s, field), "{t}: {column}");
+        }
+    }
+    for ((t, s), v) in TYPES
+        .iter()
+        .zip(&summaries)
+        .zip(table.num("kawakita_points"))
+    {
+        assert_eq!(v, s["kawakita"]["points"].as_f64().unwrap(), "{t}");
+    }
+    assert_eq!(table.num("yield_stress_pa"), [10e3, 30e3, 100e3]);
+    assert_eq!(table.num("eta0"), [0.8; 3]);
+
+    // One pour: the same bed height for every type.
+    let h0: Vec<f64> = summaries
+        .iter()
+        .map(|s| number(s, "initial_bed_height_m"))
+        .collect();
+    assert!(h0.iter().all(|&h| h == h0[0]), "bed heights {h0:?}");
+
+    // Each type's final pressure is the last row of its compression.csv,
+    // reached at the final strain, and they rise with the yield stress.
+    let finals: Vec<f64> = TYPES
+        .iter()
+        .map(|t| {
+            let c = Table::read(&dir.join(t).join("compression.csv"));
+            assert!(*c.num("strain").last().unwrap() >= 0.15 - 1e-9, "{t}");
+            *c.num("upper_pressure_pa").last().unwrap()
+        })
+        .collect();
+    assert_eq!(finals, table.num("final_pressure_pa"));
+    assert!(
+        finals[0] > 0.0 && finals[0] < finals[1] && finals[1] < finals[2],
+        "final pressures A2, B2, C2 not increasing: {finals:?}"
+    );
+
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("comparison.json")).unwrap())
+            .unwrap();
+    assert_eq!(
+        json["pour_granule_type"], "B2",
+        "the scene's type is listed"
+    );
+    assert_eq!(json["types"].as_array().unwrap().len(), 3);
+    for name in ["comparison_pressure.svg", "comparison_density.svg"] {
+        let svg = std::fs::read_to_string(dir.join(name)).unwrap();
+        assert!(svg.starts_with("<svg"), "{name}");
+        for t in TYPES {
+            assert!(
+                svg.contains(&format!(">\n{t}\n</text>")),
+                "{name} lacks the legend {t}"
+            );
+        }
+    }
+}
+
+#[test]
+fn bad_type_lists_and_conflicts_are_usage_errors() {
+    let dir = out_dir("bad");
+    let out = dir.to_str().unwrap();
+    let run = cli(&["bed", "--out", out, "--types", "A2,D7"]);
+    assert_eq!(run.code, 2, "{}", run.stderr);
+    assert!(
+        run.stderr.contains("--types")
+            && run.stderr.contains("A1, A2")
+            && run.stderr.contains("all"),
+        "{}",
+        run.stderr
+    );
+    let run = cli(&["bed", "--out", out, "--types", "A2,a2"]);
+    assert_eq!(run.code, 2, "{}", run.stderr);
+    assert!(run.stderr.contains("twice"), "{}", run.stderr);
+    for extra in [
+        &["--stop-at-strain", "0.1"][..],
+        &["--resume", out][..],
+        &["--type", "B2"][..],
+    ] {
+        let mut argv = vec!["bed", "--types", "all"];
+        argv.extend_from_slice(extra);
+        let run = cli(&argv);
+        assert_eq!(run.code, 2, "{extra:?}: {}", run.stderr);
+        assert!(
+            run.stderr.contains("--types") && run.stderr.contains(extra[0]),
+            "{extra:?}: {}",
+            run.stderr
+        );
+    }
+    assert!(!dir.exists(), "a usage error wrote {}", dir.display());
+}
