@@ -3,7 +3,7 @@
 //! strain) with A2, B2, C2 — one η0, so the pour is the same for all and
 //! only the yield stress differs (10, 30, 100 kPa): the punch pressure at
 //! the final strain is ordered A2 < B2 < C2 (a harder granule makes a
-//! stiffer bed; measured 1.39, 3.10, 4.99 kPa). Every type has its own
+//! stiffer bed; measured about 1.4, 3.1, 5.0 kPa). Every type has its own
 //! outputs, and `comparison.csv` holds their summary values in the order
 //! given. Usage errors name the flag.
 
