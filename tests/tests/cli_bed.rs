@@ -106,6 +106,8 @@ fn a_small_bed_runs_end_to_end_and_is_thread_independent() {
     assert!(number(&s, "peak_memory_bytes") > 0.0);
     assert!(s["error"].is_null());
     assert_eq!(s["scene"]["mesh"], "4x1");
+    // Physical masses at 50 mm/s: quasi-static by the certificate.
+    assert_eq!(s["quasi_static"]["passed"], true, "{}", s["quasi_static"]);
 }
 
 #[test]
@@ -184,4 +186,28 @@ fn a_stopped_run_resumes_to_the_same_bits() {
     let r = cli(&["bed", "--resume", parts_s, "--quiet"]);
     assert_ne!(r.code, 0);
     assert!(r.stderr.contains("checksum"), "{}", r.stderr);
+}
+
+#[test]
+fn heavy_mass_scaling_fails_the_quasi_static_certificate() {
+    let dir = out_dir("mass100");
+    let mut argv = vec![
+        "bed",
+        "-j",
+        "2",
+        "--out",
+        dir.to_str().unwrap(),
+        "--mass-scaling",
+        "100",
+    ];
+    argv.extend_from_slice(&SMALL);
+    let run = cli(&argv);
+    assert_eq!(run.code, 0, "{}", run.stderr);
+    let s = summary(&dir);
+    assert_eq!(s["scene"]["mass_scaling"], 100.0);
+    assert_eq!(s["quasi_static"]["passed"], false, "{}", s["quasi_static"]);
+    assert!(run.stderr.contains("NOT quasi-static"), "{}", run.stderr);
+    let run = cli(&["bed", "--print-scene", "--mass-scaling", "0.5"]);
+    assert_eq!(run.code, 2);
+    assert!(run.stderr.contains("mass_scaling"), "{}", run.stderr);
 }

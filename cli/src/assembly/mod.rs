@@ -60,6 +60,11 @@ pub struct AssemblyParams {
     /// Contact sweeps per step (≥ 1): each further sweep moves x̃ by the
     /// forces found so far and corrects the gaps that are left.
     pub contact_sweeps: u32,
+    /// Uniform mass scaling F ≥ 1 for quasi-static runs: every nodal mass
+    /// (inertia) is multiplied by F, so the stable step grows by √F; the
+    /// weight is kept (gravity is divided by F) and the damping follows
+    /// the slower modes. 1 = physical masses.
+    pub mass_scaling: Real,
     /// Safety factor C on the estimate of the stable step; (0, 1].
     pub time_step_safety: Real,
     /// Element estimate, or the global 2/ω_max by power iteration per
@@ -86,6 +91,7 @@ impl AssemblyParams {
             contact: PairSettings::standard(mu),
             mass_sharing: true,
             contact_sweeps: 3,
+            mass_scaling: 1.0,
             time_step_safety: 0.9,
             time_step_method: TimeStepMethod::Global {
                 power_interval: 10,
@@ -248,6 +254,9 @@ impl<'m> Assembly<'m> {
             .map(|p| {
                 let mut g = GranuleStore::new(mesh, points);
                 g.buffers().reset(&view, &params.material);
+                for m in &mut g.mass {
+                    *m *= params.mass_scaling;
+                }
                 for (x, x0) in g.x.iter_mut().zip(&mesh.positions) {
                     let r = p.rotation;
                     *x = core::array::from_fn(|a| {
@@ -262,7 +271,7 @@ impl<'m> Assembly<'m> {
             damping_c: damping_coefficient(
                 params.damping_ratio,
                 params.material.mu,
-                params.material.density0,
+                params.material.density0 * params.mass_scaling,
                 radius,
             ),
             contact: ContactPhase::new(&granules, mesh),
@@ -318,6 +327,9 @@ impl<'m> Assembly<'m> {
         let view = self.mesh.view();
         let mut reference = GranuleStore::new(self.mesh, p.elements.points_per_element());
         reference.buffers().reset(&view, &p.material);
+        for m in &mut reference.mass {
+            *m *= p.mass_scaling;
+        }
         let mut control = TimeStepControl::new(p.time_step_method, p.time_step_safety);
         let mut mode = vec![[0.0; 3]; self.mesh.positions.len()];
         power_start(&mut mode);
@@ -491,7 +503,8 @@ impl<'m> Assembly<'m> {
         &self.contact
     }
 
-    /// Total mass of granule `g`, kg.
+    /// Total (scaled) mass of granule `g`, kg: the physical mass times
+    /// `mass_scaling`.
     pub fn granule_mass(&self, g: usize) -> Real {
         self.granules[g].mass.iter().sum()
     }

@@ -78,7 +78,13 @@ impl fmt::Display for AssemblyError {
 impl core::error::Error for AssemblyError {}
 
 pub(super) fn validate(p: &AssemblyParams) -> Result<(), AssemblyError> {
-    let checks: [(bool, &'static str, Real, &'static str); 8] = [
+    let checks: [(bool, &'static str, Real, &'static str); 9] = [
+        (
+            (1.0..=1e6).contains(&p.mass_scaling),
+            "mass_scaling",
+            p.mass_scaling,
+            "1 <= F <= 1e6",
+        ),
         (
             (1..=10).contains(&p.contact_sweeps),
             "contact_sweeps",
@@ -416,7 +422,7 @@ impl Assembly<'_> {
         };
         let p = self.params;
         let loads = Loads {
-            gravity_m_s2: p.gravity_m_s2,
+            gravity_m_s2: p.gravity_m_s2 / p.mass_scaling,
             damping_c: self.damping_c,
             rigid_modes: true,
         };
@@ -491,7 +497,7 @@ impl Assembly<'_> {
         let per: Vec<StepWork> = self
             .granules
             .par_iter_mut()
-            .map(|g| correct(&mut g.buffers(), sizes, p.gravity_m_s2))
+            .map(|g| correct(&mut g.buffers(), sizes, p.gravity_m_s2 / p.mass_scaling))
             .collect();
 
         let mut report = StepReport {

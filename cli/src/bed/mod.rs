@@ -133,6 +133,12 @@ pub struct BedArgs {
     #[arg(long, value_name = "C")]
     pub stop_at_strain: Option<f64>,
 
+    /// Override: uniform mass scaling F ≥ 1 for quasi-static runs (the
+    /// stable step grows by √F; check the quasi-static certificate in
+    /// summary.json).
+    #[arg(long, value_name = "F")]
+    pub mass_scaling: Option<f64>,
+
     /// Worker threads (0 = all cores). Results do not depend on it.
     #[arg(short = 'j', long, value_name = "N", default_value_t = 0)]
     pub threads: usize,
@@ -175,6 +181,9 @@ impl BedArgs {
         }
         if let Some(d) = self.die_diameter_mm {
             scene.die_diameter_mm = d;
+        }
+        if let Some(f) = self.mass_scaling {
+            scene.mass_scaling = f;
         }
         scene.validate()?;
         Ok(scene)

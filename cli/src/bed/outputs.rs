@@ -85,6 +85,45 @@ pub struct KawakitaSummary {
     pub points: usize,
 }
 
+/// Whether a run stayed quasi-static (issue #8's certificate, needed once
+/// masses are scaled), judged over the second half of the run, where the
+/// bed carries load (the first half holds the rearrangement, whose impacts
+/// are dynamic at any mass). **Choices:** kinetic energy below 1 % of the
+/// internal work at every sample, and the punch-force imbalance
+/// |F_up − F_low − F_wall,z| below 5 % of F_up on average.
+#[derive(Clone, Copy, Debug, Serialize)]
+pub struct QuasiStatic {
+    /// Largest kinetic / internal work ratio over the second half.
+    pub max_kinetic_to_internal: Option<Real>,
+    /// Mean |F_up − F_low − F_wall,z| / F_up over the second half.
+    pub force_imbalance_rel: Option<Real>,
+    /// Both below their limits.
+    pub passed: bool,
+}
+
+/// The quasi-static certificate of `samples`.
+pub fn quasi_static(samples: &[BedSample]) -> QuasiStatic {
+    let half = &samples[samples.len() / 2..];
+    let max_kinetic_to_internal = half
+        .iter()
+        .filter(|s| s.energies.internal_work > 0.0)
+        .map(|s| s.energies.kinetic / s.energies.internal_work)
+        .fold(None, |m: Option<Real>, r| Some(m.map_or(r, |m| m.max(r))));
+    let loaded: Vec<Real> = half
+        .iter()
+        .filter(|s| s.upper_force_n > 0.0)
+        .map(|s| (s.upper_force_n - s.lower_force_n - s.die_friction_z_n).abs() / s.upper_force_n)
+        .collect();
+    let force_imbalance_rel =
+        (!loaded.is_empty()).then(|| loaded.iter().sum::<Real>() / loaded.len() as Real);
+    QuasiStatic {
+        max_kinetic_to_internal,
+        force_imbalance_rel,
+        passed: max_kinetic_to_internal.is_some_and(|r| r < 0.01)
+            && force_imbalance_rel.is_some_and(|r| r < 0.05),
+    }
+}
+
 /// The fields of `summary.json`.
 #[derive(Debug, Serialize)]
 pub struct Summary<'a> {
@@ -141,6 +180,8 @@ pub struct Summary<'a> {
     pub contact_loss_rel: Option<Real>,
     /// Peak resident memory of the process, bytes (Linux VmHWM).
     pub peak_memory_bytes: Option<u64>,
+    /// The quasi-static certificate.
+    pub quasi_static: QuasiStatic,
     /// The error that stopped the run early, if any.
     pub error: Option<String>,
 }
@@ -215,6 +256,7 @@ pub fn summary<'a>(scene: &'a Scene, run: &BedRun) -> Summary<'a> {
         energy_residual_rel: finite_ratio(e.residual().abs(), e.punch_work),
         contact_loss_rel: finite_ratio(e.contact_loss(), e.punch_work),
         peak_memory_bytes: peak_memory_bytes(),
+        quasi_static: quasi_static(&run.samples),
         error: run.error.as_ref().map(|e| e.to_string()),
     }
 }
@@ -243,9 +285,19 @@ pub fn summary_line(scene: &Scene, run: &BedRun) -> String {
     let s = summary(scene, run);
     let fmt =
         |x: Option<Real>, scale: Real| x.map_or("n/a".to_string(), |v| format!("{:.4}", v * scale));
+    let q = s.quasi_static;
+    let certificate = if q.passed {
+        String::new()
+    } else {
+        format!(
+            "; NOT quasi-static (kinetic/internal up to {}, force imbalance {})",
+            fmt(q.max_kinetic_to_internal, 1.0),
+            fmt(q.force_imbalance_rel, 1.0)
+        )
+    };
     format!(
         "bed {} x {}: C = {:.3} after {} steps in {:.1} s ({} threads, {:.0} ns/element-step); \
-         max pressure {:.1} kPa; Kawakita a = {}, 1/b = {} kPa ({} points)",
+         max pressure {:.1} kPa; Kawakita a = {}, 1/b = {} kPa ({} points){}",
         scene.granules,
         scene.granule_type,
         s.final_strain,
@@ -257,6 +309,7 @@ pub fn summary_line(scene: &Scene, run: &BedRun) -> String {
         fmt(s.kawakita_a, 1.0),
         fmt(s.kawakita_inv_b_pa, 1e-3),
         s.kawakita.points,
+        certificate,
     )
 }
 

@@ -230,6 +230,7 @@ pub fn run_bed(
     let mut params = AssemblyParams::standard(material, elements);
     params.damping_ratio = scene.damping_ratio;
     params.contact_sweeps = scene.contact_sweeps;
+    params.mass_scaling = scene.mass_scaling;
     // Where the run starts: a fresh pour, or a checkpoint's state.
     let (die, placed, resumed, pour_wall_time_s) = match &control.resume {
         Some(c) => {

@@ -47,6 +47,9 @@ checkpoint_strain_interval = 0.05
 damping_ratio = 0.5
 # Contact sweeps per step (physics.md 5.3).
 contact_sweeps = 3
+# Uniform mass scaling F >= 1 for quasi-static runs (1 = physical inertia;
+# the summary's quasi-static certificate says whether a run stayed quasi-static).
+mass_scaling = 1.0
 
 # Overrides of the type's preset (SI units), e.g. yield_stress_pa = 30e3.
 [material]
@@ -118,9 +121,16 @@ pub struct Scene {
     pub damping_ratio: f64,
     /// Contact sweeps per step, 1..=10.
     pub contact_sweeps: u32,
+    /// Uniform mass scaling F, 1 ≤ F ≤ 1e6 (absent: 1).
+    #[serde(default = "unit_scaling")]
+    pub mass_scaling: f64,
     /// Material overrides.
     #[serde(default)]
     pub material: MaterialOverrides,
+}
+
+fn unit_scaling() -> f64 {
+    1.0
 }
 
 fn invalid(field: &str, value: impl core::fmt::Display, allowed: &str) -> anyhow::Error {
@@ -158,7 +168,13 @@ impl Scene {
         }
         self.granule_type()?;
         self.mesh_level()?;
-        let checks: [(bool, &str, f64, &str); 10] = [
+        let checks: [(bool, &str, f64, &str); 11] = [
+            (
+                (1.0..=1e6).contains(&self.mass_scaling),
+                "mass_scaling",
+                self.mass_scaling,
+                "1 <= F <= 1e6",
+            ),
             (
                 self.checkpoint_interval_minutes > 0.0,
                 "checkpoint_interval_minutes",
