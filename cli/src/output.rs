@@ -101,3 +101,42 @@ pub fn finite_ratio(num: f64, den: f64) -> Option<f64> {
     let r = num / den;
     r.is_finite().then_some(r)
 }
+
+/// `text` with the five markup special characters escaped, for XML (VTK
+/// files) and HTML alike (the apostrophe as `&#39;`, which both read).
+pub fn escape_markup(text: &str) -> String {
+    let mut out = String::with_capacity(text.len());
+    for c in text.chars() {
+        match c {
+            '&' => out.push_str("&amp;"),
+            '<' => out.push_str("&lt;"),
+            '>' => out.push_str("&gt;"),
+            '"' => out.push_str("&quot;"),
+            '\'' => out.push_str("&#39;"),
+            c => out.push(c),
+        }
+    }
+    out
+}
+
+/// `Ok` if `failures` is empty, else the first failure with the others
+/// listed in its context ("N granule types <verb>; also: …"), so a batch
+/// of runs reports every failure, not just one.
+pub fn all_failures(
+    mut failures: impl Iterator<Item = anyhow::Error>,
+    verb: &str,
+) -> anyhow::Result<()> {
+    let Some(first) = failures.next() else {
+        return Ok(());
+    };
+    let others: Vec<String> = failures.map(|e| format!("{e:#}")).collect();
+    if others.is_empty() {
+        Err(first)
+    } else {
+        Err(first.context(format!(
+            "{} granule types {verb}; also: {}",
+            others.len() + 1,
+            others.join("; ")
+        )))
+    }
+}

@@ -132,22 +132,6 @@ fn invalid(message: String) -> io::Error {
     io::Error::new(io::ErrorKind::InvalidInput, message)
 }
 
-/// `text` with the five XML special characters escaped.
-fn escape(text: &str) -> String {
-    let mut out = String::with_capacity(text.len());
-    for c in text.chars() {
-        match c {
-            '&' => out.push_str("&amp;"),
-            '<' => out.push_str("&lt;"),
-            '>' => out.push_str("&gt;"),
-            '"' => out.push_str("&quot;"),
-            '\'' => out.push_str("&apos;"),
-            c => out.push(c),
-        }
-    }
-    out
-}
-
 /// Writes `items` `per_line` to a line, each with `item`, indented.
 fn write_lines<T>(
     out: &mut dyn Write,
@@ -169,7 +153,7 @@ fn write_lines<T>(
 }
 
 fn write_array(out: &mut dyn Write, array: &DataArray<'_>) -> io::Result<()> {
-    let name = escape(array.name);
+    let name = crate::output::escape_markup(array.name);
     let (kind, components) = match array.values {
         Values::Float64(_) => ("Float64", 1),
         Values::Vector64(_) => ("Float64", 3),

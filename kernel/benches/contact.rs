@@ -8,7 +8,7 @@ use core::hint::black_box;
 use criterion::{Criterion, criterion_group, criterion_main};
 use granbed_kernel::contact::broad::bounding_sphere;
 use granbed_kernel::contact::pair::{
-    CandidateFace, Constraint, NodeForce, PairSettings, Side, detect, forces,
+    CandidateFace, Constraint, NodeForce, PairSettings, detect, forces,
 };
 use granbed_kernel::contact::quad::project;
 use granbed_kernel::contact::surface::{Aabb, SurfaceBody, quad_bounds};
@@ -99,25 +99,10 @@ fn benches(c: &mut Criterion) {
     let b = body(&m, &b_x, &mass, &b_boxes);
     let settings = PairSettings::standard(0.1);
     let mut scratch = vec![CandidateFace::default(); m.quads.len()];
-    let empty = Constraint {
-        side: Side::A,
-        slave: 0,
-        quad: 0,
-        weights: [0.0; 4],
-        normal: [0.0; 3],
-        gap: 0.0,
-    };
-    let mut constraints = vec![empty; 1024];
+    let mut constraints = vec![Constraint::default(); 1024];
     let n = detect(&a, &b, &settings, &mut scratch, &mut constraints).unwrap();
     eprintln!("dense pair: {n} constraints (both passes)");
-    let mut out = vec![
-        NodeForce {
-            side: Side::A,
-            node: 0,
-            force: [0.0; 3],
-        };
-        5 * 1024
-    ];
+    let mut out = vec![NodeForce::default(); 5 * 1024];
     c.bench_function("contact pass on a dense pair (detect + forces)", |bench| {
         bench.iter(|| {
             let n = detect(&a, &b, &settings, &mut scratch, &mut constraints).unwrap();

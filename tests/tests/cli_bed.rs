@@ -12,9 +12,7 @@ use common::{Table, cli, number, summary};
 use granbed_cli::bed::{DEFAULT_SCENE, Scene};
 
 fn out_dir(name: &str) -> PathBuf {
-    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("cli_bed-{name}"));
-    let _ = std::fs::remove_dir_all(&dir);
-    dir
+    common::fresh_dir("cli_bed", name)
 }
 
 const SMALL: [&str; 8] = [

@@ -17,9 +17,7 @@ use granbed_cli::bed::DEFAULT_SCENE;
 use granbed_cli::model::{MeshLevel, OwnedReference};
 
 fn out_dir(name: &str) -> PathBuf {
-    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("cli_bed_outputs-{name}"));
-    let _ = std::fs::remove_dir_all(&dir);
-    dir
+    common::fresh_dir("cli_bed_outputs", name)
 }
 
 const GRANULES: usize = 20;

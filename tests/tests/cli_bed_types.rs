@@ -9,14 +9,12 @@
 
 mod common;
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 use common::{Table, cli, number, summary};
 
 fn out_dir(name: &str) -> PathBuf {
-    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("cli_bed_types-{name}"));
-    let _ = std::fs::remove_dir_all(&dir);
-    dir
+    common::fresh_dir("cli_bed_types", name)
 }
 
 const TYPES: [&str; 3] = ["A2", "B2", "C2"];

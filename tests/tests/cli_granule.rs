@@ -16,9 +16,7 @@ use serde_json::Value;
 
 /// A fresh (emptied) output directory named `name`.
 fn out_dir(name: &str) -> PathBuf {
-    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("cli_granule-{name}"));
-    let _ = std::fs::remove_dir_all(&dir);
-    dir
+    common::fresh_dir("cli_granule", name)
 }
 
 /// Runs `granbed-cli granule ARGS --out DIR` and asserts success.

@@ -20,9 +20,7 @@ use serde_json::Value;
 
 /// A fresh (emptied, not created) output directory named `name`.
 fn out_dir(name: &str) -> PathBuf {
-    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("cli_pack-{name}"));
-    let _ = std::fs::remove_dir_all(&dir);
-    dir
+    common::fresh_dir("cli_pack", name)
 }
 
 /// Runs `granbed-cli pack --out DIR ARGS`.

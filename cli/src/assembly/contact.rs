@@ -339,14 +339,7 @@ impl ContactPhase {
                 };
                 let need = 5 * w.count;
                 if w.forces.len() < need {
-                    w.forces.resize(
-                        need,
-                        NodeForce {
-                            side: Side::A,
-                            node: 0,
-                            force: [0.0; 3],
-                        },
-                    );
+                    w.forces.resize(need, NodeForce::default());
                 }
                 let (k, result) = forces(
                     (&body_a, sa),
@@ -471,17 +464,7 @@ fn detect_growing(
         scratch.resize(need, CandidateFace::default());
     }
     if w.constraints.is_empty() {
-        w.constraints.resize(
-            64,
-            Constraint {
-                side: Side::A,
-                slave: 0,
-                quad: 0,
-                weights: [0.0; 4],
-                normal: [0.0; 3],
-                gap: 0.0,
-            },
-        );
+        w.constraints.resize(64, Constraint::default());
     }
     loop {
         match detect(a, b, settings, scratch, &mut w.constraints) {

@@ -361,7 +361,7 @@ impl BedArgs {
         };
         compare::write_comparison(&self.out, &comparison, &samples)?;
         // Runs the kernel stopped: the others ran on; report them all.
-        let mut failed = types.iter().zip(runs).filter_map(|(t, r)| {
+        let failed = types.iter().zip(runs).filter_map(|(t, r)| {
             let strain = r.samples.last().map_or(0.0, |s| s.strain);
             let dir = self.out.join(t.name());
             r.error.map(|e| {
@@ -372,19 +372,7 @@ impl BedArgs {
                 ))
             })
         });
-        let Some(first) = failed.next() else {
-            return Ok(());
-        };
-        let others: Vec<String> = failed.map(|e| format!("{e:#}")).collect();
-        if others.is_empty() {
-            Err(first)
-        } else {
-            Err(first.context(format!(
-                "{} granule types stopped early; also: {}",
-                others.len() + 1,
-                others.join("; ")
-            )))
-        }
+        crate::output::all_failures(failed, "stopped early")
     }
 }
 

@@ -71,18 +71,7 @@ const FIELDS: [(&str, &str); 29] = [
 /// `text` with the HTML special characters escaped (for element content
 /// and attribute values alike).
 pub fn html_escape(text: &str) -> String {
-    let mut out = String::with_capacity(text.len());
-    for c in text.chars() {
-        match c {
-            '&' => out.push_str("&amp;"),
-            '<' => out.push_str("&lt;"),
-            '>' => out.push_str("&gt;"),
-            '"' => out.push_str("&quot;"),
-            '\'' => out.push_str("&#39;"),
-            c => out.push(c),
-        }
-    }
-    out
+    crate::output::escape_markup(text)
 }
 
 /// A JSON value as the table shows it: numbers as in `summary.json`,

@@ -266,23 +266,19 @@ impl Scene {
 
     /// The type's preset with the overrides (not validated).
     pub fn material_params(&self) -> anyhow::Result<MaterialParams> {
-        let mut p = self.granule_type()?.params();
-        let o = &self.material;
-        for (field, value) in [
-            (&mut p.youngs_modulus_pa, o.youngs_modulus_pa),
-            (&mut p.poisson_ratio, o.poisson_ratio),
-            (&mut p.yield_stress_pa, o.yield_stress_pa),
-            (&mut p.eta0, o.eta0),
-            (&mut p.cp, o.cp),
-            (&mut p.eta_c, o.eta_c),
-            (&mut p.true_density_kg_m3, o.true_density_kg_m3),
-            (&mut p.friction, o.friction),
-        ] {
-            if let Some(v) = value {
-                *field = v;
-            }
+        let o = self.material;
+        Ok(crate::material_args::MaterialArgs {
+            granule_type: self.granule_type()?,
+            youngs_modulus_pa: o.youngs_modulus_pa,
+            poisson_ratio: o.poisson_ratio,
+            yield_stress_pa: o.yield_stress_pa,
+            eta0: o.eta0,
+            cp: o.cp,
+            eta_c: o.eta_c,
+            true_density_kg_m3: o.true_density_kg_m3,
+            friction: o.friction,
         }
-        Ok(p)
+        .params())
     }
 
     /// The validated material; a rejection names `material.<field>`.

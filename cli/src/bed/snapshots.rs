@@ -158,22 +158,6 @@ pub fn snapshot_vtk(
     })
 }
 
-/// `text` with the XML special characters escaped.
-fn xml_escape(text: &str) -> String {
-    let mut out = String::with_capacity(text.len());
-    for c in text.chars() {
-        match c {
-            '&' => out.push_str("&amp;"),
-            '<' => out.push_str("&lt;"),
-            '>' => out.push_str("&gt;"),
-            '"' => out.push_str("&quot;"),
-            '\'' => out.push_str("&apos;"),
-            c => out.push(c),
-        }
-    }
-    out
-}
-
 /// The text of a ParaView collection (`.pvd`) of `(timestep, file)`
 /// entries, the files relative to the collection.
 pub fn pvd_text(entries: &[(Real, String)]) -> String {
@@ -184,7 +168,7 @@ pub fn pvd_text(entries: &[(Real, String)]) -> String {
     for (t, file) in entries {
         s.push_str(&format!(
             "    <DataSet timestep=\"{t:?}\" group=\"\" part=\"0\" file=\"{}\"/>\n",
-            xml_escape(file)
+            crate::output::escape_markup(file)
         ));
     }
     s.push_str("  </Collection>\n</VTKFile>\n");

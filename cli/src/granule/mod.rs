@@ -503,7 +503,7 @@ fn write_type_outputs(
 /// The error of the runs the kernel stopped (naming type, step, strain,
 /// element and where the partial results are), or `Ok` if none.
 fn kernel_failures(outcomes: &[Outcome]) -> anyhow::Result<()> {
-    let mut failed = outcomes.iter().filter_map(|o| {
+    let failed = outcomes.iter().filter_map(|o| {
         let err = o.result.error?;
         let context = format!(
             "granule {}: the kernel stopped the run; the {} samples before it are in `{}` and \
@@ -515,19 +515,7 @@ fn kernel_failures(outcomes: &[Outcome]) -> anyhow::Result<()> {
         );
         Some(anyhow::Error::new(err).context(context))
     });
-    let Some(first) = failed.next() else {
-        return Ok(());
-    };
-    let others: Vec<String> = failed.map(|e| format!("{e:#}")).collect();
-    if others.is_empty() {
-        Err(first)
-    } else {
-        Err(first.context(format!(
-            "{} granule types failed; also: {}",
-            others.len() + 1,
-            others.join("; ")
-        )))
-    }
+    crate::output::all_failures(failed, "failed")
 }
 
 #[cfg(test)]

@@ -114,6 +114,31 @@ pub struct Constraint {
     pub gap: Real,
 }
 
+impl Default for Constraint {
+    /// A placeholder (zero weights and gap) for sizing caller lists.
+    fn default() -> Self {
+        Self {
+            side: Side::A,
+            slave: 0,
+            quad: 0,
+            weights: [0.0; 4],
+            normal: [0.0; 3],
+            gap: 0.0,
+        }
+    }
+}
+
+impl Default for NodeForce {
+    /// A zero force on node 0 of A, for sizing caller lists.
+    fn default() -> Self {
+        Self {
+            side: Side::A,
+            node: 0,
+            force: [0.0; 3],
+        }
+    }
+}
+
 /// A force on one node, as a pair writes it for the driver to sum.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct NodeForce {

@@ -5,6 +5,14 @@
 use std::collections::HashMap;
 use std::path::Path;
 
+/// A fresh (emptied, not created) output directory `<suite>-<name>` under
+/// Cargo's per-target temporary directory.
+pub fn fresh_dir(suite: &str, name: &str) -> std::path::PathBuf {
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("{suite}-{name}"));
+    let _ = std::fs::remove_dir_all(&dir);
+    dir
+}
+
 /// What a run of the CLI produced.
 pub struct Run {
     /// Exit status the binary would return.
