@@ -12,7 +12,7 @@ use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
-use common::{cli, summary};
+use common::{Element, cli, parse_xml, summary};
 use granbed_cli::bed::DEFAULT_SCENE;
 use granbed_cli::model::{MeshLevel, OwnedReference};
 
@@ -60,67 +60,6 @@ fn tiny_bed(dir: &Path, strain: &str, extra: &[&str]) {
 /// The coarse granule mesh of the tiny bed.
 fn mesh() -> OwnedReference {
     OwnedReference::sphere(0.5e-3, "4x1".parse::<MeshLevel>().unwrap(), false).unwrap()
-}
-
-/// One XML element: its name, attributes and text.
-struct Element {
-    name: String,
-    attrs: HashMap<String, String>,
-    text: String,
-}
-
-/// A minimal XML reader (as in cli_pack.rs): skips the `<?xml ?>`
-/// declaration, checks that every tag is closed in order, and returns the
-/// elements in the order they close.
-fn parse_xml(xml: &str) -> Vec<Element> {
-    let mut open: Vec<Element> = Vec::new();
-    let mut done = Vec::new();
-    let mut rest = xml;
-    while let Some(lt) = rest.find('<') {
-        if let Some(top) = open.last_mut() {
-            top.text.push_str(&rest[..lt]);
-        } else {
-            assert!(rest[..lt].trim().is_empty(), "text outside the root");
-        }
-        let gt = rest[lt..].find('>').expect("unclosed tag") + lt;
-        let tag = &rest[lt + 1..gt];
-        rest = &rest[gt + 1..];
-        if tag.starts_with('?') {
-            assert!(tag.ends_with('?'), "bad declaration <{tag}>");
-            continue;
-        }
-        if let Some(name) = tag.strip_prefix('/') {
-            let e = open
-                .pop()
-                .unwrap_or_else(|| panic!("</{name}> closes nothing"));
-            assert_eq!(e.name, name, "<{}> closed by </{name}>", e.name);
-            done.push(e);
-            continue;
-        }
-        let empty = tag.ends_with('/');
-        let tag = tag.trim_end_matches('/');
-        let (name, mut attrs_text) = tag.split_once(' ').unwrap_or((tag, ""));
-        let mut attrs = HashMap::new();
-        while let Some((key, value)) = attrs_text.split_once("=\"") {
-            let (value, after) = value.split_once('"').expect("unterminated attribute");
-            attrs.insert(key.trim().to_owned(), value.to_owned());
-            attrs_text = after;
-        }
-        assert!(attrs_text.trim().is_empty(), "bad attributes in <{tag}>");
-        let e = Element {
-            name: name.to_owned(),
-            attrs,
-            text: String::new(),
-        };
-        if empty {
-            done.push(e);
-        } else {
-            open.push(e);
-        }
-    }
-    assert!(rest.trim().is_empty(), "text after the root");
-    assert!(open.is_empty(), "unclosed <{}>", open[0].name);
-    done
 }
 
 /// Standard base64 (with padding), for the binary VTK data arrays.

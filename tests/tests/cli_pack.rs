@@ -10,10 +10,9 @@
 
 mod common;
 
-use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 
-use common::{Run, Table, assert_close, cli, number, summary};
+use common::{Element, Run, Table, assert_close, cli, number, parse_xml, summary};
 use granbed_cli::pack::measures::{self, Region};
 use granbed_cli::pack::{outputs, read_packing};
 use serde_json::Value;
@@ -70,67 +69,6 @@ const SUMMARY_KEYS: [&str; 30] = [
     "wall_time_s",
     "force_balance_rel",
 ];
-
-/// One XML element: name, attributes and the text directly inside it.
-struct Element {
-    name: String,
-    attrs: HashMap<String, String>,
-    text: String,
-}
-
-/// A minimal XML reader, enough for the VTU files: skips the `<?xml ?>`
-/// declaration, checks that every tag is closed in order, and returns the
-/// elements in the order they close.
-fn parse_xml(xml: &str) -> Vec<Element> {
-    let mut open: Vec<Element> = Vec::new();
-    let mut done = Vec::new();
-    let mut rest = xml;
-    while let Some(lt) = rest.find('<') {
-        if let Some(top) = open.last_mut() {
-            top.text.push_str(&rest[..lt]);
-        } else {
-            assert!(rest[..lt].trim().is_empty(), "text outside the root");
-        }
-        let gt = rest[lt..].find('>').expect("unclosed tag") + lt;
-        let tag = &rest[lt + 1..gt];
-        rest = &rest[gt + 1..];
-        if tag.starts_with('?') {
-            assert!(tag.ends_with('?'), "bad declaration <{tag}>");
-            continue;
-        }
-        if let Some(name) = tag.strip_prefix('/') {
-            let e = open
-                .pop()
-                .unwrap_or_else(|| panic!("</{name}> closes nothing"));
-            assert_eq!(e.name, name, "<{}> closed by </{name}>", e.name);
-            done.push(e);
-            continue;
-        }
-        let empty = tag.ends_with('/');
-        let tag = tag.trim_end_matches('/');
-        let (name, mut attrs_text) = tag.split_once(' ').unwrap_or((tag, ""));
-        let mut attrs = HashMap::new();
-        while let Some((key, value)) = attrs_text.split_once("=\"") {
-            let (value, after) = value.split_once('"').expect("unterminated attribute");
-            attrs.insert(key.trim().to_owned(), value.to_owned());
-            attrs_text = after;
-        }
-        assert!(attrs_text.trim().is_empty(), "bad attributes in <{tag}>");
-        let e = Element {
-            name: name.to_owned(),
-            attrs,
-            text: String::new(),
-        };
-        if empty {
-            done.push(e);
-        } else {
-            open.push(e);
-        }
-    }
-    assert!(rest.trim().is_empty(), "text after the root");
-    assert!(open.is_empty(), "unclosed <{}>", open[0].name);
-    done
-}
 
 /// The values of the `DataArray` named `name`.
 fn data_array<'a>(elements: &'a [Element], name: &str) -> Vec<&'a str> {
