@@ -72,11 +72,12 @@ fn a_small_die_compresses_to_thirty_percent() {
     }
     let times = *asm.times();
     eprintln!(
-        "phases: predict {:.2} s, contact {:.2} s, correct {:.2} s: contact share {:.1} %",
+        "phases: predict {:.2} s, contact {:.2} s, correct {:.2} s: contact share {:.1} %, {:.2} sweeps per step",
         times.predict_s,
         times.contact_s,
         times.correct_s,
-        100.0 * times.contact_share()
+        100.0 * times.contact_share(),
+        times.sweeps as f64 / asm.steps() as f64
     );
     asm.elastic_energy();
     let e = *asm.energies();

@@ -60,6 +60,9 @@ pub struct AssemblyParams {
     /// Contact sweeps per step (≥ 1): each further sweep moves x̃ by the
     /// forces found so far and corrects the gaps that are left.
     pub contact_sweeps: u32,
+    /// A further sweep runs only while the last one found a granule–granule
+    /// gap deeper than this, m (0: always all `contact_sweeps`).
+    pub sweep_tolerance_m: Real,
     /// Uniform mass scaling F ≥ 1 for quasi-static runs: every nodal mass
     /// (inertia) is multiplied by F, so the stable step grows by √F; the
     /// weight is kept (gravity is divided by F) and the damping follows
@@ -77,7 +80,8 @@ pub struct AssemblyParams {
 impl AssemblyParams {
     /// physics.md's choices for `material`: ξ = 0.5, gravity 9.81 m/s²,
     /// the material's friction on walls and between granules, symmetric
-    /// two-pass with mass sharing and three sweeps, C = 0.9 on the global
+    /// two-pass with mass sharing and up to three sweeps (a further one
+    /// while a gap deeper than 0.05 µm is left), C = 0.9 on the global
     /// estimate 2/ω_max (power iteration every 10 re-estimates), re-estimated
     /// every 100 steps.
     pub fn standard(material: Material, elements: ElementSettings) -> Self {
@@ -91,6 +95,7 @@ impl AssemblyParams {
             contact: PairSettings::standard(mu),
             mass_sharing: true,
             contact_sweeps: 3,
+            sweep_tolerance_m: 0.05e-6,
             mass_scaling: 1.0,
             time_step_safety: 0.9,
             time_step_method: TimeStepMethod::Global {

@@ -205,6 +205,8 @@ pub struct PhaseTimes {
     pub contact_s: f64,
     /// The corrector and the energy sums.
     pub correct_s: f64,
+    /// Contact sweeps run (over all steps).
+    pub sweeps: u64,
 }
 
 impl PhaseTimes {
@@ -488,6 +490,18 @@ impl Assembly<'_> {
                 self.contact.f_before = self.granules.iter().map(|g| g.f_c.clone()).collect();
             }
             self.contact_sweep(step, &walls, dt2, sweep == 0, &mut wall_totals)?;
+            self.times.sweeps += 1;
+            // Another sweep only if this one still found a gap deeper than
+            // the tolerance (a minimum: the same for any thread count).
+            let deepest = self
+                .contact
+                .work()
+                .iter()
+                .map(|w| w.result.min_gap)
+                .fold(0.0, Real::min);
+            if deepest > -p.sweep_tolerance_m {
+                break;
+            }
         }
         for w in self.contact.work() {
             pair_normal += w.step.normal;
