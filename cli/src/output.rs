@@ -120,7 +120,7 @@ pub fn escape_markup(text: &str) -> String {
 }
 
 /// `Ok` if `failures` is empty, else the first failure with the others
-/// listed in its context ("N granule types <verb>; also: …"), so a batch
+/// listed in its context ("N granule types `verb`; also: …"), so a batch
 /// of runs reports every failure, not just one.
 pub fn all_failures(
     mut failures: impl Iterator<Item = anyhow::Error>,
