@@ -209,3 +209,40 @@ fn heavy_mass_scaling_fails_the_quasi_static_certificate() {
     assert_eq!(run.code, 2);
     assert!(run.stderr.contains("mass_scaling"), "{}", run.stderr);
 }
+
+#[test]
+fn a_failing_run_names_granule_element_step_and_strain_and_keeps_its_outputs() {
+    // A punch at 30 m/s crushes the coarse granules within a few steps.
+    let dir = out_dir("crushed");
+    let scene = dir.with_extension("toml");
+    let text = DEFAULT_SCENE
+        .replace("punch_speed_m_s = 0.05", "punch_speed_m_s = 30.0")
+        .replace("granules = 1000", "granules = 20")
+        .replace("mesh = \"8x2\"", "mesh = \"4x1\"")
+        .replace("die_diameter_mm = 11.3", "die_diameter_mm = 5.0")
+        .replace("final_strain = 0.3", "final_strain = 0.6");
+    std::fs::write(&scene, text).unwrap();
+    let run = cli(&[
+        "bed",
+        "--quiet",
+        "--scene",
+        scene.to_str().unwrap(),
+        "--out",
+        dir.to_str().unwrap(),
+    ]);
+    assert_eq!(run.code, 1, "{}", run.stderr);
+    for word in ["granule", "element", "step", "after C ="] {
+        assert!(
+            run.stderr.contains(word),
+            "`{word}` missing: {}",
+            run.stderr
+        );
+    }
+    let s = summary(&dir);
+    assert!(
+        s["error"].as_str().unwrap().contains("element"),
+        "{}",
+        s["error"]
+    );
+    assert!(dir.join("compression.csv").exists());
+}
