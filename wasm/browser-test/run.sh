@@ -15,8 +15,9 @@ bash "$ROOT/wasm/build.sh" || status=$?
 [[ $status == 0 ]] || exit $status
 
 command -v node >/dev/null || { echo "browser-test: SKIPPED: no node"; exit $SKIP; }
-if [[ ! -d node_modules/playwright-core ]] ||
-    ! cmp -s package-lock.json node_modules/.package-lock.json 2>/dev/null; then
+want=$(node -p 'require("./package.json").dependencies["playwright-core"]')
+have=$(node -p 'require("./node_modules/playwright-core/package.json").version' 2>/dev/null || true)
+if [[ $have != "$want" ]]; then
     echo "browser-test: npm ci"
     npm ci --no-audit --no-fund --loglevel=error
 fi

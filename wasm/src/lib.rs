@@ -1,6 +1,6 @@
 //! Browser front end of granbed: the kernel's single-granule platen
 //! experiment ([`granbed_kernel::scene::platens`], the same code as
-//! `granbed-cli granule`) behind a [`wasm_bindgen`] handle.
+//! `granbed-cli granule`) behind a `wasm_bindgen` handle.
 //!
 //! JavaScript constructs a [`Granule`] from an object of inputs, calls
 //! [`Granule::step`] in chunks (from a Web Worker or between animation
