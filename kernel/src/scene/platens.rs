@@ -522,6 +522,17 @@ impl<'a> PlatenScene<'a> {
         &self.params
     }
 
+    /// Ends the experiment and hands the caller's buffers back (in the
+    /// state the last step left them), so that a caller holding them for
+    /// the program's lifetime — the browser front end — can lend them to
+    /// the next run.
+    pub fn into_buffers(self) -> PlatenBuffers<'a> {
+        PlatenBuffers {
+            granule: self.buf,
+            power: self.power,
+        }
+    }
+
     /// The sample at the current instant, with the platen forces averaged
     /// over the window since the last sample (zero at t = 0). Updates the
     /// stored elastic energy.

@@ -1,0 +1,88 @@
+// The page in Debian's headless chromium: run B2, compare the shown σ_est
+// with granbed-cli's, download the CSV (the CLI's bytes), cancel a run, and
+// provoke a bad input (ν = 0.6). Screenshots go to out/.
+import { test, before, after } from 'node:test';
+import assert from 'node:assert/strict';
+import { mkdirSync, readFileSync } from 'node:fs';
+import { join } from 'node:path';
+import { chromium } from 'playwright-core';
+import { serve } from './server.js';
+import { OUT, WWW, native } from './common.js';
+import { formatStress, formatSlope } from '../www/format.js';
+
+const CHROMIUM = process.env.GRANBED_CHROMIUM ?? '/usr/bin/chromium';
+let server, browser, page;
+const problems = [];
+
+before(async () => {
+  mkdirSync(OUT, { recursive: true });
+  server = await serve(WWW);
+  browser = await chromium.launch({
+    executablePath: CHROMIUM,
+    args: ['--headless', '--no-sandbox', '--disable-gpu'],
+  });
+  const context = await browser.newContext({ acceptDownloads: true, viewport: { width: 1000, height: 1100 } });
+  page = await context.newPage();
+  page.on('pageerror', (e) => problems.push(`page error: ${e.message}`));
+  page.on('console', (m) => m.type() === 'error' && problems.push(`console error: ${m.text()}`));
+  await page.goto(server.url);
+  await page.waitForSelector('#run:not([disabled])', { timeout: 60_000 });
+});
+
+after(async () => {
+  await browser?.close();
+  await server?.close();
+});
+
+test('B2: the shown sigma_est is the native one; the CSV is the CLI\'s', async () => {
+  const ref = native('GRANBED_NATIVE_B2');
+  await page.selectOption('#type', 'B2');
+  await page.selectOption('#mesh', '8x2');
+  assert.equal(await page.inputValue('#poisson_ratio'), '0.3');
+  await page.click('#run');
+  await page.waitForSelector('#results[data-state="done"]', { timeout: 300_000 });
+
+  const shown = await page.textContent('#sigma-est');
+  const value = Number(await page.getAttribute('#sigma-est', 'data-value'));
+  assert.equal(shown, formatStress(ref.summary.sigma_est_pa));
+  assert.equal(value, ref.summary.sigma_est_pa);
+  assert.equal(await page.textContent('#sigma-eff0'), formatStress(ref.summary.sigma_eff0_pa));
+  assert.equal(await page.textContent('#slope'), formatSlope(ref.summary.slope_n_per_m));
+  const wall = Number(await page.getAttribute('#wall', 'data-value'));
+  console.log(
+    `browser B2 8x2: sigma_est shown "${shown}" (${value} Pa), native ${ref.summary.sigma_est_pa} Pa; ` +
+      `wall ${wall.toFixed(2)} s in chromium, native ${ref.summary.wall_time_s.toFixed(2)} s, ratio ${(wall / ref.summary.wall_time_s).toFixed(2)}`,
+  );
+
+  const [download] = await Promise.all([page.waitForEvent('download'), page.click('#download')]);
+  const file = join(OUT, download.suggestedFilename());
+  await download.saveAs(file);
+  assert.equal(readFileSync(file, 'utf8'), ref.csv);
+  await page.screenshot({ path: join(OUT, 'screenshot.png'), fullPage: true });
+  assert.deepEqual(problems, []);
+});
+
+test('Cancel stops a run and the page can run again', async () => {
+  await page.click('#run');
+  await page.waitForSelector('#cancel:not([disabled])');
+  await page.click('#cancel');
+  await page.waitForSelector('#results[data-state="cancelled"]');
+  await page.waitForSelector('#run:not([disabled])', { timeout: 60_000 });
+  assert.equal(await page.textContent('#sigma-est'), '–');
+  assert.deepEqual(problems, []);
+});
+
+test('nu = 0.6 gives a readable error naming the field and its range', async () => {
+  await page.check('#custom');
+  await page.fill('#poisson_ratio', '0.6');
+  await page.click('#run');
+  await page.waitForSelector('#error:not([hidden])', { timeout: 60_000 });
+  const text = await page.textContent('#error');
+  assert.match(text, /Poisson's ratio ν = 0\.6/);
+  assert.match(text, /-1 < nu < 0\.5/);
+  assert.match(text, /poisson_ratio/);
+  assert.equal(await page.getAttribute('#poisson_ratio', 'aria-invalid'), 'true');
+  assert.equal(await page.isEnabled('#run'), true);
+  await page.screenshot({ path: join(OUT, 'error.png') });
+  assert.deepEqual(problems, []);
+});

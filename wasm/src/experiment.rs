@@ -1,0 +1,428 @@
+//! The single-granule platen experiment behind the browser handle, in plain
+//! Rust (no JavaScript types), so that it is tested natively: inputs and
+//! their validation, stepping in chunks, the samples, σ_est / σ_y,eff0 (the
+//! kernel's `analysis::granule`, as `granbed-cli granule`'s summary) and
+//! the CSV (the CLI's `force_displacement.csv` format, byte for byte).
+
+use alloc::format;
+use alloc::string::String;
+use alloc::vec::Vec;
+use core::fmt::Write as _;
+
+use granbed_kernel::Real;
+use granbed_kernel::analysis::fit::LineFit;
+use granbed_kernel::analysis::granule::{initial_effective_yield_stress, yield_stress_estimate};
+use granbed_kernel::material::{GranuleType, MaterialParams, ParamError};
+use granbed_kernel::scene::platens::{PlatenParams, PlatenSample, PlatenScene, SceneError};
+
+use crate::mesh::{OctantMesh, give_back, octant_mesh, take_buffers};
+
+/// Strain range of the σ_est fit, x/d (as `granbed-cli granule`).
+pub const FIT_STRAIN_RANGE: [Real; 2] = [0.1, 0.4];
+
+/// The standard granule diameter, m (the CLI's 1 mm granule).
+pub const STANDARD_DIAMETER_M: Real = 1.0e-3;
+
+/// Allowed granule diameters, m.
+pub const DIAMETER_RANGE_M: [Real; 2] = [1.0e-6, 1.0];
+
+/// Header of the CSV (the CLI's `force_displacement.csv` columns).
+pub const CSV_COLUMNS: [&str; 18] = [
+    "time_s",
+    "displacement_m",
+    "strain",
+    "force_n",
+    "force_upper_n",
+    "force_lower_n",
+    "kinetic_j",
+    "internal_work_j",
+    "elastic_j",
+    "plastic_j",
+    "hourglass_j",
+    "damping_j",
+    "contact_work_j",
+    "gravity_work_j",
+    "platen_work_j",
+    "min_j",
+    "dt_s",
+    "steps",
+];
+
+/// The material fields a caller may override, in the names of
+/// [`MaterialParams`].
+pub const MATERIAL_FIELDS: [&str; 8] = [
+    "yield_stress_pa",
+    "eta0",
+    "youngs_modulus_pa",
+    "poisson_ratio",
+    "cp",
+    "eta_c",
+    "friction",
+    "true_density_kg_m3",
+];
+
+/// A human label of an input field, for error messages.
+pub fn field_label(field: &str) -> &'static str {
+    match field {
+        "yield_stress_pa" => "yield stress σy (Pa)",
+        "eta0" => "initial relative density η0",
+        "youngs_modulus_pa" => "Young's modulus E (Pa)",
+        "poisson_ratio" => "Poisson's ratio ν",
+        "cp" => "yield-surface constant cp",
+        "eta_c" => "critical relative density ηc",
+        "friction" => "friction coefficient μ",
+        "true_density_kg_m3" => "true density (kg/m³)",
+        "diameter_m" => "granule diameter d (m)",
+        "mesh" => "mesh level",
+        "type" => "granule type",
+        _ => "parameter",
+    }
+}
+
+/// What the caller asked for.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Inputs {
+    /// The preset the material starts from.
+    pub granule_type: GranuleType,
+    /// Overrides of [`MATERIAL_FIELDS`], in that order.
+    pub overrides: [Option<Real>; 8],
+    /// Granule diameter d, m.
+    pub diameter_m: Real,
+    /// Mesh level n×m of the full sphere (the octant is simulated).
+    pub mesh: (u32, u32),
+}
+
+impl Inputs {
+    /// The standard experiment of `granule_type`: the 1 mm granule, the
+    /// 8x2 (1280-hex) sphere, no overrides.
+    pub fn standard(granule_type: GranuleType) -> Self {
+        Self {
+            granule_type,
+            overrides: [None; 8],
+            diameter_m: STANDARD_DIAMETER_M,
+            mesh: (8, 2),
+        }
+    }
+
+    /// Sets the override of `field` (one of [`MATERIAL_FIELDS`]); false if
+    /// there is no such field.
+    pub fn set(&mut self, field: &str, value: Real) -> bool {
+        match MATERIAL_FIELDS.iter().position(|f| *f == field) {
+            Some(i) => {
+                self.overrides[i] = Some(value);
+                true
+            }
+            None => false,
+        }
+    }
+
+    /// The preset with the overrides applied (not validated).
+    pub fn material_params(&self) -> MaterialParams {
+        let mut p = self.granule_type.params();
+        let fields = [
+            &mut p.yield_stress_pa,
+            &mut p.eta0,
+            &mut p.youngs_modulus_pa,
+            &mut p.poisson_ratio,
+            &mut p.cp,
+            &mut p.eta_c,
+            &mut p.friction,
+            &mut p.true_density_kg_m3,
+        ];
+        for (field, value) in fields.into_iter().zip(self.overrides) {
+            if let Some(v) = value {
+                *field = v;
+            }
+        }
+        p
+    }
+}
+
+/// A rejected input or a failed run: a readable message and, for a rejected
+/// parameter, the field, the value and the allowed range.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Error {
+    /// The whole message.
+    pub message: String,
+    /// The input field (a [`MATERIAL_FIELDS`] name, `diameter_m`, `mesh`,
+    /// `type`, or a field of the experiment), if an input was rejected.
+    pub field: Option<&'static str>,
+    /// The rejected value, if numeric.
+    pub value: Option<Real>,
+    /// The allowed range.
+    pub allowed: Option<&'static str>,
+}
+
+impl Error {
+    /// A rejected input `field` = `value`, allowed `allowed`.
+    pub fn invalid(field: &'static str, value: Real, allowed: &'static str) -> Self {
+        Self {
+            message: format!(
+                "{} = {value} is not allowed: the allowed range is {allowed} (field `{field}`)",
+                field_label(field)
+            ),
+            field: Some(field),
+            value: Some(value),
+            allowed: Some(allowed),
+        }
+    }
+
+    /// A message without a field.
+    pub fn other(message: String) -> Self {
+        Self {
+            message,
+            field: None,
+            value: None,
+            allowed: None,
+        }
+    }
+}
+
+impl From<ParamError> for Error {
+    fn from(e: ParamError) -> Self {
+        Self::invalid(e.field, e.value, e.allowed)
+    }
+}
+
+impl From<SceneError> for Error {
+    fn from(e: SceneError) -> Self {
+        match e {
+            SceneError::InvalidParameter {
+                field,
+                value,
+                allowed,
+            } => Self::invalid(field, value, allowed),
+            other => Self::other(format!("the simulation stopped: {other}")),
+        }
+    }
+}
+
+/// σ_est and the fit behind it, σ_y,eff0.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Measures {
+    /// σ_est = 4/(πd)·dF/dx over [`FIT_STRAIN_RANGE`], Pa (`None` with
+    /// fewer than two samples there).
+    pub sigma_est_pa: Option<Real>,
+    /// The least-squares fit of F(x).
+    pub fit: Option<LineFit>,
+    /// σ_y,eff0 = √a2(η0)·σ_y, Pa.
+    pub sigma_eff0_pa: Real,
+}
+
+/// The platen force of a sample: the mean of both platens, N (the CLI's
+/// `force_n`).
+pub fn mean_force(s: &PlatenSample) -> Real {
+    0.5 * (s.force_upper_n + s.force_lower_n)
+}
+
+/// A running (or finished) experiment.
+pub struct Experiment {
+    scene: Option<PlatenScene<'static>>,
+    mesh: &'static OctantMesh,
+    inputs: Inputs,
+    params: PlatenParams,
+    diameter: Real,
+    samples: Vec<PlatenSample>,
+    error: Option<Error>,
+}
+
+impl Experiment {
+    /// Validates `inputs` and sets up the standard platen experiment
+    /// (octant, 5 mm/s, ξ = 0.5, to 40 % strain: `PlatenParams::standard`,
+    /// exactly what `granbed-cli granule` runs by default).
+    pub fn new(inputs: Inputs) -> Result<Self, Error> {
+        let material = inputs.material_params().validate()?;
+        let d = inputs.diameter_m;
+        if !(DIAMETER_RANGE_M[0]..=DIAMETER_RANGE_M[1]).contains(&d) {
+            return Err(Error::invalid("diameter_m", d, "1e-6 <= d <= 1 m"));
+        }
+        let (n, m) = inputs.mesh;
+        let mesh = octant_mesh(0.5 * d, n, m).ok_or_else(|| {
+            Error::other(format!(
+                "mesh level {n}x{m} rejected: n must be even in 2..=64 and m in 1..=32 \
+                 (field `mesh`)"
+            ))
+        })?;
+        let params = PlatenParams::standard(material);
+        let points = params.elements.points_per_element();
+        let buffers = take_buffers(mesh.positions.len(), mesh.hexes.len() * points);
+        // On failure the scene has consumed the buffers: they are leaked,
+        // which happens only for an unstable initial step.
+        let mut scene = PlatenScene::new(params, mesh.view(), buffers)?;
+        let first = scene.sample();
+        Ok(Self {
+            diameter: scene.diameter(),
+            scene: Some(scene),
+            mesh,
+            inputs,
+            params,
+            samples: alloc::vec![first],
+            error: None,
+        })
+    }
+
+    /// Advances up to `max_steps` steps (fewer at the end or on an error).
+    /// Returns the error that stopped the run, once; afterwards the run is
+    /// finished and keeps its samples.
+    pub fn step(&mut self, max_steps: u32) -> Result<(), Error> {
+        let Some(scene) = self.scene.as_mut() else {
+            return Ok(());
+        };
+        for _ in 0..max_steps {
+            if scene.finished() {
+                break;
+            }
+            match scene.step() {
+                Ok(Some(sample)) => self.samples.push(sample),
+                Ok(None) => {}
+                Err(e) => {
+                    let e = Error::from(e);
+                    self.error = Some(e.clone());
+                    self.release();
+                    return Err(e);
+                }
+            }
+        }
+        Ok(())
+    }
+
+    fn release(&mut self) {
+        if let Some(scene) = self.scene.take() {
+            give_back(scene.into_buffers());
+        }
+    }
+
+    /// True once the final strain is reached or an error stopped the run.
+    pub fn finished(&self) -> bool {
+        self.scene.as_ref().is_none_or(PlatenScene::finished)
+    }
+
+    /// The error that stopped the run, if any.
+    pub fn error(&self) -> Option<&Error> {
+        self.error.as_ref()
+    }
+
+    /// Current strain x/d (that of the last sample once stopped).
+    pub fn strain(&self) -> Real {
+        match &self.scene {
+            Some(s) => s.strain(),
+            None => self.samples.last().map_or(0.0, |s| s.strain),
+        }
+    }
+
+    /// Fraction of the final strain reached, 0…1.
+    pub fn progress(&self) -> Real {
+        if self.finished() {
+            return 1.0;
+        }
+        (self.strain() / self.params.final_strain).clamp(0.0, 1.0)
+    }
+
+    /// Steps taken.
+    pub fn steps(&self) -> u64 {
+        match &self.scene {
+            Some(s) => s.steps(),
+            None => self.samples.last().map_or(0, |s| s.steps),
+        }
+    }
+
+    /// The samples so far: t = 0, then one per 0.5 % strain.
+    pub fn samples(&self) -> &[PlatenSample] {
+        &self.samples
+    }
+
+    /// The inputs.
+    pub fn inputs(&self) -> &Inputs {
+        &self.inputs
+    }
+
+    /// The experiment's parameters.
+    pub fn params(&self) -> &PlatenParams {
+        &self.params
+    }
+
+    /// The simulated octant mesh.
+    pub fn mesh(&self) -> &'static OctantMesh {
+        self.mesh
+    }
+
+    /// Current node positions (the reference positions once stopped), m.
+    pub fn positions(&self) -> &[[Real; 3]] {
+        match &self.scene {
+            Some(s) => s.positions(),
+            None => &self.mesh.positions,
+        }
+    }
+
+    /// The granule diameter d that strains are measured against (the
+    /// scene's: twice the mesh's top height), m.
+    pub fn diameter(&self) -> Real {
+        self.diameter
+    }
+
+    /// σ_est (fitted over the samples so far), σ_y,eff0 — what
+    /// `granbed-cli granule` writes to `summary.json` as `sigma_est_pa`,
+    /// `slope_n_per_m`, … and `sigma_eff0_pa`.
+    pub fn measures(&self) -> Measures {
+        let [lo, hi] = FIT_STRAIN_RANGE;
+        let points = self.samples.iter().map(|s| (s.approach_m, mean_force(s)));
+        let fit = yield_stress_estimate(points, self.diameter(), lo, hi);
+        Measures {
+            sigma_est_pa: fit.map(|(s, _)| s),
+            fit: fit.map(|(_, f)| f),
+            sigma_eff0_pa: initial_effective_yield_stress(&self.params.material.params),
+        }
+    }
+
+    /// The samples as CSV, the CLI's `force_displacement.csv` byte for byte.
+    pub fn csv(&self) -> String {
+        let mut out = String::new();
+        out.push_str(&CSV_COLUMNS.join(","));
+        out.push('\n');
+        for s in &self.samples {
+            let e = &s.energy;
+            let reals = [
+                s.time_s,
+                s.approach_m,
+                s.strain,
+                mean_force(s),
+                s.force_upper_n,
+                s.force_lower_n,
+                e.kinetic,
+                e.internal_work,
+                e.elastic,
+                e.plastic,
+                e.hourglass,
+                e.damping,
+                e.contact_work,
+                e.gravity_work,
+                e.platen_work,
+                s.min_j,
+                s.dt_s,
+            ];
+            for x in reals {
+                write_real(&mut out, x);
+                out.push(',');
+            }
+            let _ = writeln!(out, "{}", s.steps);
+        }
+        out
+    }
+}
+
+impl Drop for Experiment {
+    fn drop(&mut self) {
+        self.release();
+    }
+}
+
+/// Writes `x` as the CLI's CSV does: the shortest round-trip decimal,
+/// exponent form outside [1e-4, 1e15).
+fn write_real(out: &mut String, x: Real) {
+    let a = x.abs();
+    let _ = if a == 0.0 || !a.is_finite() || (1.0e-4..1.0e15).contains(&a) {
+        write!(out, "{x}")
+    } else {
+        write!(out, "{x:e}")
+    };
+}

@@ -1,0 +1,122 @@
+//! The browser front end's experiment, run natively, against
+//! `granbed-cli granule`'s code path: the same samples bit for bit, the
+//! same σ_est and σ_y,eff0, the same CSV bytes; and the input errors.
+
+use granbed_cli::granule::outputs::write_force_csv;
+use granbed_cli::granule::run::run_platens;
+use granbed_cli::granule::summary::{RunSetup, Summary};
+use granbed_cli::model::{MeshLevel, OwnedReference};
+use granbed_kernel::material::GranuleType;
+use granbed_kernel::scene::platens::PlatenParams;
+use granbed_wasm::experiment::{Experiment, Inputs};
+
+fn coarse(t: GranuleType) -> Inputs {
+    Inputs {
+        mesh: (4, 1),
+        ..Inputs::standard(t)
+    }
+}
+
+fn run_to_end(inputs: Inputs) -> Experiment {
+    let mut run = Experiment::new(inputs).expect("valid inputs");
+    let mut chunks = 0;
+    while !run.finished() {
+        run.step(97).expect("the run completes");
+        chunks += 1;
+        assert!(chunks < 1_000_000);
+    }
+    run
+}
+
+#[test]
+fn coarse_b2_matches_the_cli_bit_for_bit() {
+    let run = run_to_end(coarse(GranuleType::B2));
+
+    let level = MeshLevel::new(4, 1);
+    let mesh = OwnedReference::sphere(0.5e-3, level, true).unwrap();
+    let material = GranuleType::B2.params().validate().unwrap();
+    let params = PlatenParams::standard(material);
+    let cli = run_platens(params, &mesh, &mut |_, _| {}).unwrap();
+    assert!(cli.error.is_none());
+    assert_eq!(run.samples(), cli.samples.as_slice());
+
+    let setup = RunSetup {
+        granule_type: "B2",
+        mesh: level,
+        nodes: mesh.positions.len(),
+        hexes: mesh.hexes.len(),
+        params: &params,
+    };
+    let summary = Summary::new(&setup, &cli);
+    let m = run.measures();
+    assert_eq!(m.sigma_est_pa, summary.sigma_est_pa);
+    assert_eq!(m.sigma_eff0_pa, summary.sigma_eff0_pa);
+    assert_eq!(m.fit.map(|f| f.slope), summary.slope_n_per_m);
+    assert!(m.sigma_est_pa.unwrap() > 0.0);
+
+    let dir = std::env::temp_dir().join(format!("granbed-wasm-native-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join("force_displacement.csv");
+    write_force_csv(&path, &cli.samples).unwrap();
+    let expected = std::fs::read_to_string(&path).unwrap();
+    std::fs::remove_dir_all(&dir).unwrap();
+    assert_eq!(run.csv(), expected);
+}
+
+#[test]
+fn pooled_buffers_give_the_same_run() {
+    // The second run reuses the first one's buffers (returned on drop).
+    let inputs = Inputs {
+        mesh: (2, 1),
+        ..Inputs::standard(GranuleType::C3)
+    };
+    let first = run_to_end(inputs).samples().to_vec();
+    let second = run_to_end(inputs).samples().to_vec();
+    assert_eq!(first, second);
+    assert!(first.len() > 10);
+}
+
+#[test]
+fn bad_inputs_name_the_field_and_range() {
+    let mut inputs = Inputs::standard(GranuleType::B2);
+    assert!(inputs.set("poisson_ratio", 0.6));
+    let Err(e) = Experiment::new(inputs) else {
+        panic!("nu = 0.6 accepted")
+    };
+    assert_eq!(e.field, Some("poisson_ratio"));
+    assert_eq!(e.value, Some(0.6));
+    assert!(e.message.contains("Poisson's ratio"), "{}", e.message);
+    assert!(e.message.contains("-1 < nu < 0.5"), "{}", e.message);
+
+    let mut inputs = Inputs::standard(GranuleType::B2);
+    inputs.diameter_m = -1.0;
+    let Err(e) = Experiment::new(inputs) else {
+        panic!("negative diameter accepted")
+    };
+    assert_eq!(e.field, Some("diameter_m"));
+
+    let inputs = Inputs {
+        mesh: (3, 1),
+        ..Inputs::standard(GranuleType::B2)
+    };
+    let Err(e) = Experiment::new(inputs) else {
+        panic!("odd mesh level accepted")
+    };
+    assert!(e.message.contains("3x1"), "{}", e.message);
+
+    assert!(!Inputs::standard(GranuleType::B2).set("nonsense", 1.0));
+}
+
+#[test]
+fn custom_diameter_scales_the_strain() {
+    let inputs = Inputs {
+        diameter_m: 2.0e-3,
+        mesh: (2, 1),
+        ..Inputs::standard(GranuleType::B2)
+    };
+    let mut run = Experiment::new(inputs).unwrap();
+    assert_eq!(run.diameter(), 2.0e-3);
+    run.step(50).unwrap();
+    let last = run.samples().last().unwrap();
+    assert_eq!(last.strain, last.approach_m / 2.0e-3);
+}

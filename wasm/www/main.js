@@ -1,0 +1,306 @@
+// The page: the form, the worker that runs the simulation, the live plot,
+// the granule view, the results table and the CSV download.
+import { formatStress, formatSlope } from './format.js';
+
+const $ = (id) => document.getElementById(id);
+const FIELDS = ['yield_stress_pa', 'eta0', 'youngs_modulus_pa', 'poisson_ratio', 'cp', 'eta_c', 'friction'];
+const LABELS = {
+  yield_stress_pa: 'σy', eta0: 'η0', youngs_modulus_pa: 'E', poisson_ratio: 'ν', cp: 'cp',
+  eta_c: 'ηc', friction: 'μ', diameter_mm: 'd',
+};
+
+let worker = null;
+let running = false;
+let view = null; // { quads, positions, diameter, x, f, fit }
+let csvUrl = null;
+
+function setStatus(text) { $('status').textContent = text; }
+
+function showError(message, field) {
+  const box = $('error');
+  box.textContent = message;
+  box.hidden = false;
+  for (const input of document.querySelectorAll('#params input')) input.removeAttribute('aria-invalid');
+  const id = field === 'diameter_m' ? 'diameter_mm' : field;
+  if (id && $(id)) $(id).setAttribute('aria-invalid', 'true');
+}
+
+function clearError() {
+  $('error').hidden = true;
+  $('error').textContent = '';
+  for (const input of document.querySelectorAll('#params input')) input.removeAttribute('aria-invalid');
+}
+
+function setRunning(on) {
+  running = on;
+  $('run').disabled = on;
+  $('cancel').disabled = !on;
+}
+
+function startWorker() {
+  worker = new Worker(new URL('./worker.js', import.meta.url), { type: 'module' });
+  worker.onmessage = (ev) => onWorker(ev.data);
+  worker.onerror = (ev) => {
+    setRunning(false);
+    showError(`the simulation worker failed: ${ev.message || 'unknown error'}`);
+  };
+  worker.postMessage({ cmd: 'hello' });
+}
+
+function onWorker(msg) {
+  switch (msg.kind) {
+    case 'ready':
+      $('run').disabled = running;
+      setStatus('ready');
+      requestPreset();
+      break;
+    case 'preset':
+      if (!$('custom').checked) fillParams(msg.values);
+      break;
+    case 'error':
+      setRunning(false);
+      setStatus('stopped');
+      showError(msg.message, msg.field);
+      break;
+    case 'start':
+      view = { quads: msg.quads, positions: msg.positions, diameter: msg.diameter, x: [], f: [], fit: null };
+      drawAll();
+      break;
+    case 'progress':
+      $('progress').value = msg.progress;
+      setStatus(`strain ${(100 * msg.strain).toFixed(1)} %, ${msg.steps} steps`);
+      Object.assign(view, { positions: msg.positions, x: msg.x, f: msg.f });
+      drawAll();
+      break;
+    case 'done':
+      finish(msg);
+      break;
+    default:
+      break;
+  }
+}
+
+function fillParams(values) {
+  for (const k of FIELDS) $(k).value = values[k];
+  $('diameter_mm').value = values.diameter_m * 1e3;
+}
+
+function requestPreset() {
+  worker.postMessage({ cmd: 'preset', type: $('type').value });
+}
+
+// The inputs object of granbed-wasm's Granule: the type and mesh, and with
+// "custom" every parameter field.
+function readInputs() {
+  const inputs = { type: $('type').value, mesh: $('mesh').value };
+  if (!$('custom').checked) return inputs;
+  for (const k of [...FIELDS, 'diameter_mm']) {
+    const text = $(k).value.trim();
+    const v = Number(text);
+    if (text === '' || !Number.isFinite(v)) {
+      const field = k === 'diameter_mm' ? 'diameter_m' : k;
+      throw Object.assign(new Error(`${LABELS[k]}: “${text}” is not a number (field \`${field}\`)`), { field });
+    }
+    if (k === 'diameter_mm') inputs.diameter_m = v * 1e-3; else inputs[k] = v;
+  }
+  return inputs;
+}
+
+function resetResults() {
+  for (const id of ['sigma-est', 'sigma-eff0', 'slope', 'r2', 'steps', 'wall']) {
+    $(id).textContent = '–';
+    delete $(id).dataset.value;
+  }
+  $('download').hidden = true;
+  if (csvUrl) URL.revokeObjectURL(csvUrl);
+  csvUrl = null;
+  $('progress').value = 0;
+}
+
+function run(ev) {
+  ev.preventDefault();
+  if (running) return;
+  clearError();
+  let inputs;
+  try {
+    inputs = readInputs();
+  } catch (e) {
+    showError(e.message, e.field);
+    return;
+  }
+  resetResults();
+  setRunning(true);
+  setStatus('starting…');
+  $('results').dataset.state = 'running';
+  worker.postMessage({ cmd: 'run', inputs });
+}
+
+function finish(msg) {
+  setRunning(false);
+  Object.assign(view, { positions: msg.positions, x: msg.x, f: msg.f });
+  if (msg.slope !== null) {
+    view.fit = { slope: msg.slope, intercept: msg.intercept, x0: 0.1 * msg.diameter, x1: Math.min(0.4, msg.strain) * msg.diameter };
+  }
+  drawAll();
+  const set = (id, text, value) => {
+    $(id).textContent = text;
+    if (value !== undefined && value !== null) $(id).dataset.value = String(value);
+  };
+  set('sigma-est', formatStress(msg.sigmaEst), msg.sigmaEst);
+  set('sigma-eff0', formatStress(msg.sigmaEff0), msg.sigmaEff0);
+  set('slope', formatSlope(msg.slope), msg.slope);
+  set('r2', msg.r2 === null ? 'n/a' : msg.r2.toFixed(5), msg.r2);
+  set('steps', String(msg.steps), msg.steps);
+  set('wall', `${(msg.wallMs / 1e3).toFixed(2)} s`, msg.wallMs / 1e3);
+  csvUrl = URL.createObjectURL(new Blob([msg.csv], { type: 'text/csv' }));
+  const a = $('download');
+  a.href = csvUrl;
+  a.download = `granule_${$('type').value}${$('custom').checked ? '_custom' : ''}_force_displacement.csv`;
+  a.hidden = false;
+  $('progress').value = msg.failure ? $('progress').value : 1;
+  if (msg.failure) {
+    setStatus('stopped by an error');
+    showError(`${msg.failure.message}\nThe curve up to that point is shown and in the CSV.`, msg.failure.field);
+    $('results').dataset.state = 'failed';
+  } else {
+    setStatus(`done: strain ${(100 * msg.strain).toFixed(1)} % in ${(msg.wallMs / 1e3).toFixed(2)} s`);
+    $('results').dataset.state = 'done';
+  }
+}
+
+function cancel() {
+  if (!running) return;
+  worker.terminate();
+  setRunning(false);
+  $('run').disabled = true;
+  setStatus('cancelled; restarting the worker…');
+  $('results').dataset.state = 'cancelled';
+  startWorker();
+}
+
+// ---- drawing -------------------------------------------------------------
+
+function niceStep(range, count) {
+  const raw = range / count;
+  const p = 10 ** Math.floor(Math.log10(raw));
+  const m = raw / p;
+  return (m < 1.5 ? 1 : m < 3 ? 2 : m < 7 ? 5 : 10) * p;
+}
+
+function drawPlot() {
+  const c = $('plot');
+  const g = c.getContext('2d');
+  const W = c.width, H = c.height, L = 64, R = 16, T = 16, B = 44;
+  g.clearRect(0, 0, W, H);
+  const x = view ? Array.from(view.x, (v) => v * 1e3) : [];
+  const f = view ? Array.from(view.f) : [];
+  const d = view ? view.diameter * 1e3 : 1;
+  const xMax = 0.4 * d * 1.02;
+  const fMax = Math.max(1e-12, ...f) * 1.08;
+  const px = (v) => L + (v / xMax) * (W - L - R);
+  const py = (v) => H - B - (v / fMax) * (H - T - B);
+  g.strokeStyle = '#999'; g.fillStyle = '#333'; g.lineWidth = 1; g.font = '12px system-ui, sans-serif';
+  g.beginPath(); g.moveTo(L, T); g.lineTo(L, H - B); g.lineTo(W - R, H - B); g.stroke();
+  g.textAlign = 'center'; g.textBaseline = 'top';
+  const xs = niceStep(xMax, 6);
+  for (let v = 0; v <= xMax + 1e-12; v += xs) {
+    g.fillText(+v.toPrecision(6) + '', px(v), H - B + 6);
+    g.beginPath(); g.moveTo(px(v), H - B); g.lineTo(px(v), H - B + 4); g.stroke();
+  }
+  g.fillText('platen approach x, mm', (L + W - R) / 2, H - 18);
+  g.textAlign = 'right'; g.textBaseline = 'middle';
+  if (f.length) {
+    const fs = niceStep(fMax, 6);
+    for (let v = 0; v <= fMax + 1e-15; v += fs) {
+      g.fillText(+v.toPrecision(4) + '', L - 6, py(v));
+      g.strokeStyle = '#eee'; g.beginPath(); g.moveTo(L + 1, py(v)); g.lineTo(W - R, py(v)); g.stroke();
+    }
+  }
+  g.save(); g.translate(14, (T + H - B) / 2); g.rotate(-Math.PI / 2); g.textAlign = 'center';
+  g.fillStyle = '#333'; g.fillText('platen force F, N', 0, 0); g.restore();
+  if (x.length > 1) {
+    g.strokeStyle = '#1f5fbf'; g.lineWidth = 2; g.beginPath();
+    x.forEach((v, i) => (i ? g.lineTo(px(v), py(f[i])) : g.moveTo(px(v), py(f[i]))));
+    g.stroke();
+  }
+  if (view && view.fit) {
+    const { slope, intercept, x0, x1 } = view.fit;
+    g.strokeStyle = '#c33'; g.lineWidth = 1.5; g.setLineDash([6, 4]); g.beginPath();
+    g.moveTo(px(x0 * 1e3), py(slope * x0 + intercept)); g.lineTo(px(x1 * 1e3), py(slope * x1 + intercept));
+    g.stroke(); g.setLineDash([]);
+  }
+}
+
+// The octant's surface mirrored into all eight octants, seen from the front
+// and a little above; painter's order, back faces culled, Lambert shading.
+function drawGranule() {
+  const c = $('granule');
+  const g = c.getContext('2d');
+  const W = c.width, H = c.height;
+  g.clearRect(0, 0, W, H);
+  if (!view) return;
+  const p = view.positions, q = view.quads, d = view.diameter;
+  const phi = 0.5, theta = 0.35, cp = Math.cos(phi), sp = Math.sin(phi), ct = Math.cos(theta), st = Math.sin(theta);
+  const scale = (0.45 * W) / d;
+  const cam = [0, -ct, st];
+  const light = [-0.4, -0.7, 0.6];
+  const ln = Math.hypot(...light);
+  const faces = [];
+  for (const sx of [-1, 1]) for (const sy of [-1, 1]) for (const sz of [-1, 1]) {
+    for (let k = 0; k < q.length; k += 4) {
+      const v = [];
+      for (let j = 0; j < 4; j++) {
+        const n = q[k + j] * 3;
+        const X = sx * p[n], Y = sy * p[n + 1], Z = sz * p[n + 2];
+        v.push([X * cp - Y * sp, X * sp + Y * cp, Z]);
+      }
+      const a = v[2].map((t, i) => t - v[0][i]), b = v[3].map((t, i) => t - v[1][i]);
+      let nrm = [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]];
+      const cen = [0, 1, 2].map((i) => (v[0][i] + v[1][i] + v[2][i] + v[3][i]) / 4);
+      if (nrm[0] * cen[0] + nrm[1] * cen[1] + nrm[2] * cen[2] < 0) nrm = nrm.map((t) => -t);
+      const nl = Math.hypot(...nrm) || 1;
+      if ((nrm[0] * cam[0] + nrm[1] * cam[1] + nrm[2] * cam[2]) / nl < -0.05) continue;
+      const shade = 0.3 + 0.7 * Math.max(0, (nrm[0] * light[0] + nrm[1] * light[1] + nrm[2] * light[2]) / (nl * ln));
+      faces.push({ v, depth: cen[0] * cam[0] + cen[1] * cam[1] + cen[2] * cam[2], shade });
+    }
+  }
+  faces.sort((a, b) => a.depth - b.depth);
+  const sx = (v) => W / 2 + scale * v[0];
+  const sy = (v) => H / 2 - scale * (v[1] * st + v[2] * ct);
+  // The platens: squares of side 1.5 d at the granule's top and bottom.
+  let top = 0;
+  for (let n = 2; n < p.length; n += 3) top = Math.max(top, p[n]);
+  const plate = (z) => {
+    const a = 0.75 * d;
+    const corners = [[-a, -a], [a, -a], [a, a], [-a, a]].map(([X, Y]) => [X * cp - Y * sp, X * sp + Y * cp, z]);
+    g.fillStyle = 'rgba(110,110,110,0.35)';
+    g.strokeStyle = 'rgba(60,60,60,0.8)';
+    g.beginPath();
+    corners.forEach((v, i) => (i ? g.lineTo(sx(v), sy(v)) : g.moveTo(sx(v), sy(v))));
+    g.closePath(); g.fill(); g.stroke();
+  };
+  plate(-top);
+  for (const face of faces) {
+    const s = Math.round(90 + 150 * face.shade);
+    g.fillStyle = `rgb(${Math.round(s * 0.75)},${Math.round(s * 0.85)},${s})`;
+    g.strokeStyle = 'rgba(20,30,60,0.35)';
+    g.beginPath();
+    face.v.forEach((v, i) => (i ? g.lineTo(sx(v), sy(v)) : g.moveTo(sx(v), sy(v))));
+    g.closePath(); g.fill(); g.stroke();
+  }
+  plate(top);
+}
+
+function drawAll() { drawPlot(); drawGranule(); }
+
+// ---- wiring --------------------------------------------------------------
+
+$('inputs').addEventListener('submit', run);
+$('cancel').addEventListener('click', cancel);
+$('type').addEventListener('change', () => { if (!$('custom').checked) requestPreset(); });
+$('custom').addEventListener('change', () => {
+  $('params').disabled = !$('custom').checked;
+  if (!$('custom').checked) requestPreset();
+});
+drawAll();
+startWorker();

@@ -1,0 +1,93 @@
+// The simulation's Web Worker: loads the WebAssembly module, runs one
+// experiment at a time in chunks of time steps and posts the growing curve
+// and the node positions after each chunk. The page cancels a run by
+// terminating this worker.
+import init, { Granule, preset } from './pkg/granbed_wasm.js';
+
+// Time steps per chunk: about 0.1 s of work on the standard mesh.
+const CHUNK = 1500;
+
+const ready = init();
+
+function errorMessage(e) {
+  return {
+    message: e instanceof Error ? e.message : String(e),
+    field: e && e.field !== undefined ? e.field : null,
+  };
+}
+
+function curve(g) {
+  return { x: g.displacements_m(), f: g.forces_n() };
+}
+
+function run(inputs) {
+  const t0 = performance.now();
+  let g;
+  try {
+    g = new Granule(inputs);
+  } catch (e) {
+    postMessage({ kind: 'error', ...errorMessage(e) });
+    return;
+  }
+  postMessage({
+    kind: 'start',
+    quads: g.surface_quads(),
+    positions: g.positions(),
+    diameter: g.diameter_m(),
+  });
+  let failure = null;
+  try {
+    while (!g.finished()) {
+      const progress = g.step(CHUNK);
+      postMessage({
+        kind: 'progress',
+        progress,
+        strain: g.strain(),
+        steps: g.steps(),
+        positions: g.positions(),
+        ...curve(g),
+      });
+    }
+  } catch (e) {
+    failure = errorMessage(e);
+  }
+  const slope = g.slope_n_per_m();
+  postMessage({
+    kind: 'done',
+    wallMs: performance.now() - t0,
+    sigmaEst: g.sigma_est_pa() ?? null,
+    sigmaEff0: g.sigma_eff0_pa(),
+    slope: slope ?? null,
+    intercept: g.intercept_n() ?? null,
+    r2: g.fit_r_squared() ?? null,
+    steps: g.steps(),
+    strain: g.strain(),
+    diameter: g.diameter_m(),
+    positions: g.positions(),
+    csv: g.csv(),
+    failure,
+    ...curve(g),
+  });
+  g.free();
+}
+
+onmessage = async (ev) => {
+  const msg = ev.data;
+  try {
+    await ready;
+  } catch (e) {
+    postMessage({ kind: 'error', message: `cannot load the WebAssembly module: ${errorMessage(e).message}` });
+    return;
+  }
+  if (msg.cmd === 'hello') {
+    postMessage({ kind: 'ready' });
+  } else if (msg.cmd === 'preset') {
+    try {
+      postMessage({ kind: 'preset', type: msg.type, values: preset(msg.type) });
+    } catch (e) {
+      postMessage({ kind: 'error', ...errorMessage(e) });
+    }
+  } else if (msg.cmd === 'run') {
+    run(msg.inputs);
+  }
+};
