@@ -231,8 +231,12 @@ function drawPlot() {
   }
 }
 
-// The octant's surface mirrored into all eight octants, seen from the front
-// and a little above; painter's order, back faces culled, Lambert shading.
+// The view angles of the granule picture (drag on it to turn it): azimuth
+// about the platen axis and elevation above the equator, radians.
+const viewAngles = { phi: 0.5, theta: 0.35 };
+
+// The octant's surface mirrored into all eight octants, seen from the view
+// angles; painter's order, back faces culled, Lambert shading.
 function drawGranule() {
   const c = $('granule');
   const g = c.getContext('2d');
@@ -240,7 +244,8 @@ function drawGranule() {
   g.clearRect(0, 0, W, H);
   if (!view) return;
   const p = view.positions, q = view.quads, d = view.diameter;
-  const phi = 0.5, theta = 0.35, cp = Math.cos(phi), sp = Math.sin(phi), ct = Math.cos(theta), st = Math.sin(theta);
+  const { phi, theta } = viewAngles;
+  const cp = Math.cos(phi), sp = Math.sin(phi), ct = Math.cos(theta), st = Math.sin(theta);
   const scale = (0.45 * W) / d;
   const cam = [0, -ct, st];
   const light = [-0.4, -0.7, 0.6];
@@ -302,5 +307,19 @@ $('custom').addEventListener('change', () => {
   $('params').disabled = !$('custom').checked;
   if (!$('custom').checked) requestPreset();
 });
+// Drag on the picture to turn the granule.
+{
+  const c = $('granule');
+  let last = null;
+  c.addEventListener('pointerdown', (e) => { last = [e.clientX, e.clientY]; c.setPointerCapture(e.pointerId); });
+  c.addEventListener('pointerup', () => { last = null; });
+  c.addEventListener('pointermove', (e) => {
+    if (!last) return;
+    viewAngles.phi += 0.01 * (e.clientX - last[0]);
+    viewAngles.theta = Math.max(-1.5, Math.min(1.5, viewAngles.theta + 0.01 * (e.clientY - last[1])));
+    last = [e.clientX, e.clientY];
+    drawGranule();
+  });
+}
 drawAll();
 startWorker();
