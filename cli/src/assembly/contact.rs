@@ -48,7 +48,8 @@ pub struct ContactPhase {
     /// Per granule: (pair index, side of the granule in it), pair order.
     by_granule: Vec<Vec<(u32, Side)>>,
     built: Vec<Bound>,
-    bounds: Vec<Bound>,
+    /// Per granule, the bounding sphere of its surface on the last x̃.
+    pub(super) bounds: Vec<Bound>,
     boxes: Vec<Aabb>,
     /// Per granule, the box of every surface quad on x̃.
     quad_boxes: Vec<Vec<Aabb>>,
@@ -161,11 +162,6 @@ impl ContactPhase {
         }
     }
 
-    /// Bounding sphere of granule `g` on the last x̃.
-    pub fn bound(&self, g: usize) -> Bound {
-        self.bounds[g]
-    }
-
     /// Broad-phase rebuilds so far.
     pub fn rebuilds(&self) -> u64 {
         self.rebuilds
@@ -197,15 +193,17 @@ impl ContactPhase {
         margin: Real,
     ) -> Result<(), ContactError> {
         let first = mesh.positions.len() - mesh.surface_nodes;
-        (self.bounds, self.boxes) = granules
-            .par_iter()
-            .map(|g| {
-                (
-                    bounding_sphere(&g.x_pred, first),
-                    Aabb::of_surface(&g.x_pred, first),
-                )
-            })
-            .unzip();
+        // In place: this runs every sweep of every step.
+        self.bounds.resize(granules.len(), Bound::default());
+        self.boxes.resize(granules.len(), Aabb::EMPTY);
+        self.bounds
+            .par_iter_mut()
+            .zip(self.boxes.par_iter_mut())
+            .zip(granules.par_iter())
+            .for_each(|((b, a), g)| {
+                *b = bounding_sphere(&g.x_pred, first);
+                *a = Aabb::of_surface(&g.x_pred, first);
+            });
         self.quad_boxes
             .resize(granules.len(), vec![Aabb::EMPTY; mesh.quads.len()]);
         self.quad_boxes

@@ -340,16 +340,13 @@ impl Assembly<'_> {
             .detect(&self.granules, mesh, &p.contact, first)
             .map_err(contact_error)?;
         let surface = mesh.positions.len() - mesh.surface_nodes..mesh.positions.len();
-        let bounds: Vec<_> = (0..self.granules.len())
-            .map(|g| self.contact.bound(g))
-            .collect();
         if p.mass_sharing {
             self.contact.count_pairs(&self.granules, mesh);
             self.contact
                 .share
                 .par_iter_mut()
                 .zip(self.granules.par_iter())
-                .zip(bounds.par_iter())
+                .zip(self.contact.bounds.par_iter())
                 .for_each(|((share, g), b)| {
                     for w in walls.iter().filter(|w| w.may_touch(&b.centre, b.radius)) {
                         count_wall_contacts(w, surface.clone(), &g.x_pred, share);
@@ -378,7 +375,7 @@ impl Assembly<'_> {
                     x_n: &g.x,
                     x_pred: &g.x_pred,
                 };
-                let b = bounds[gi];
+                let b = contact.bounds[gi];
                 for (k, (w, total)) in walls.iter().zip(totals.iter_mut()).enumerate() {
                     if !w.may_touch(&b.centre, b.radius) {
                         continue;
@@ -487,7 +484,12 @@ impl Assembly<'_> {
                     });
             }
             if sweep + 1 < p.contact_sweeps {
-                self.contact.f_before = self.granules.iter().map(|g| g.f_c.clone()).collect();
+                // Reuse the buffers: this runs every sweep of every step.
+                let before = &mut self.contact.f_before;
+                before.resize_with(self.granules.len(), Vec::new);
+                for (b, g) in before.iter_mut().zip(&self.granules) {
+                    b.clone_from(&g.f_c);
+                }
             }
             self.contact_sweep(step, &walls, dt2, sweep == 0, &mut wall_totals)?;
             self.times.sweeps += 1;
