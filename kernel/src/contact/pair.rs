@@ -519,6 +519,96 @@ fn mark_constraint(
     }
 }
 
+/// One node-to-face constraint as [`node_face_force`] needs it: the slave
+/// node and the four master corners (start and predicted end of the step)
+/// with their (shared) masses, and where the node meets the face.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct NodeFace {
+    /// Slave node mass m_s (after mass sharing), kg.
+    pub slave_mass: Real,
+    /// Slave node position at the start of the step x_n, m.
+    pub slave_x_n: Vec3,
+    /// Slave node predicted position x̃ (end of the step without contact), m.
+    pub slave_x_pred: Vec3,
+    /// Master corner masses mᵢ (after mass sharing), kg.
+    pub master_mass: [Real; 4],
+    /// Master corner positions at the start of the step, m.
+    pub master_x_n: [Vec3; 4],
+    /// Master corner predicted positions, m.
+    pub master_x_pred: [Vec3; 4],
+    /// Bilinear weights Nᵢ of the corners at the contact point (Σ = 1).
+    pub weights: [Real; 4],
+    /// The master face's outward unit normal at the contact point.
+    pub normal: Vec3,
+    /// Signed predicted gap n·(x̃_s − x_c), m; only a negative gap pushes.
+    pub gap: Real,
+}
+
+/// The kinematic force of one constraint (physics.md §5.3–§5.4).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct NodeFaceForce {
+    /// Force on the slave node (normal + friction), N. Corner i of the
+    /// master face gets −Nᵢ times it.
+    pub force: Vec3,
+    /// Its friction part, N.
+    pub friction: Vec3,
+    /// Normal force magnitude F_n = w (−g) m_eff / Δt², N.
+    pub normal: Real,
+    /// The friction force sits on the Coulomb cap μ F_n (slip).
+    pub slipping: bool,
+}
+
+/// The force that closes the predicted gap of one node-to-face constraint
+/// in one step, shared by effective mass m_eff = m_s / (1 + m_s Σ Nᵢ²/mᵢ),
+/// with the partition weight `weight` (½ or 1, see [`forces`]), Coulomb
+/// friction `friction` (μ ≥ 0; 0 skips it) from the relative tangential
+/// motion of the step, and `dt_squared` = Δt_{n+½}·Δt_n (s²). A positive
+/// gap gives a pull (the caller only passes penetrating constraints).
+pub fn node_face_force(
+    c: &NodeFace,
+    weight: Real,
+    friction: Real,
+    dt_squared: Real,
+) -> NodeFaceForce {
+    let m_s = c.slave_mass;
+    let inv_md: Real = (0..4)
+        .map(|i| c.weights[i] * c.weights[i] / c.master_mass[i])
+        .sum();
+    let m_eff = m_s / (1.0 + m_s * inv_md);
+    let n = c.normal;
+    let f_n = weight * (-c.gap) * m_eff / dt_squared;
+    let mut f = n.map(|v| f_n * v);
+    let mut f_t = [0.0; 3];
+    let mut slipping = false;
+    if friction > 0.0 {
+        let mut du = sub(&c.slave_x_pred, &c.slave_x_n);
+        for i in 0..4 {
+            let dm = sub(&c.master_x_pred[i], &c.master_x_n[i]);
+            for (d, m) in du.iter_mut().zip(dm) {
+                *d -= c.weights[i] * m;
+            }
+        }
+        let dn = dot(&du, &n);
+        f_t = core::array::from_fn(|a| -weight * m_eff * (du[a] - dn * n[a]) / dt_squared);
+        let mag = sqrt(dot(&f_t, &f_t));
+        let cap = friction * f_n;
+        if mag > cap {
+            let scale = cap / mag;
+            f_t = f_t.map(|v| v * scale);
+            slipping = true;
+        }
+        for a in 0..3 {
+            f[a] += f_t[a];
+        }
+    }
+    NodeFaceForce {
+        force: f,
+        friction: f_t,
+        normal: f_n,
+        slipping,
+    }
+}
+
 /// Shared mass m/max(1, n) of node `i` (`share` empty: no sharing).
 fn shared_mass(body: &SurfaceBody<'_>, share: &[u16], i: usize) -> Real {
     let n = share.get(i).copied().unwrap_or(1).max(1);
@@ -561,36 +651,24 @@ pub fn forces(
         };
         let s = c.slave as usize;
         let ids = master.quads[c.quad as usize].map(|i| i as usize);
-        let m_s = shared_mass(slave, s_share, s);
-        let inv_md: Real = (0..4)
-            .map(|i| c.weights[i] * c.weights[i] / shared_mass(master, m_share, ids[i]))
-            .sum();
-        let m_eff = m_s / (1.0 + m_s * inv_md);
-        let n = c.normal;
-        let f_n = w * (-c.gap) * m_eff / dt_squared;
-        let mut f = n.map(|v| f_n * v);
-        let mut f_t = [0.0; 3];
-        if mu > 0.0 {
-            let mut du = sub(&slave.x_pred[s], &slave.x_n[s]);
-            for (i, &id) in ids.iter().enumerate() {
-                let dm = sub(&master.x_pred[id], &master.x_n[id]);
-                for (d, m) in du.iter_mut().zip(dm) {
-                    *d -= c.weights[i] * m;
-                }
-            }
-            let dn = dot(&du, &n);
-            f_t = core::array::from_fn(|a| -w * m_eff * (du[a] - dn * n[a]) / dt_squared);
-            let mag = sqrt(dot(&f_t, &f_t));
-            let cap = mu * f_n;
-            if mag > cap {
-                let scale = cap / mag;
-                f_t = f_t.map(|v| v * scale);
-                total.slipping += 1;
-            }
-            for a in 0..3 {
-                f[a] += f_t[a];
-            }
-        }
+        let node = NodeFace {
+            slave_mass: shared_mass(slave, s_share, s),
+            slave_x_n: slave.x_n[s],
+            slave_x_pred: slave.x_pred[s],
+            master_mass: ids.map(|id| shared_mass(master, m_share, id)),
+            master_x_n: ids.map(|id| master.x_n[id]),
+            master_x_pred: ids.map(|id| master.x_pred[id]),
+            weights: c.weights,
+            normal: c.normal,
+            gap: c.gap,
+        };
+        let NodeFaceForce {
+            force: f,
+            friction: f_t,
+            normal: f_n,
+            slipping,
+        } = node_face_force(&node, w, mu, dt_squared);
+        total.slipping += usize::from(slipping);
         out[k] = NodeForce {
             side: c.side,
             node: c.slave,

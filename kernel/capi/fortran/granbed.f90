@@ -1,0 +1,137 @@
+!> granbed: Fortran interface to the C ABI of the granbed kernel
+!> (kernel/capi/include/granbed.h), by iso_c_binding.
+!>
+!> The routine FE users call is granbed_vumat_block: a block of nblock
+!> material points in the calling convention of explicit user materials
+!> (Abaqus/Explicit VUMAT style): arrays dimensioned (nblock, ncomp), the
+!> deformation gradient in, the Cauchy stress and the state variables out.
+!>
+!>   props(8)                   E [Pa], nu, sigma_y [Pa], eta0, c_p, eta_c,
+!>                              true density [kg/m^3], friction
+!>   defgradNew(nblock, 9)      F11 F22 F33 F12 F23 F31 F21 F32 F13
+!>   stateOld/New(nblock, nstatev)  1-6: Cp^-1 (11 22 33 12 23 31; all zero
+!>                              = virgin state), 7: eta, 8: plastic flag
+!>   stressNew(nblock, 6)       Cauchy stress [Pa], 11 22 33 12 23 31, in the
+!>                              global basis (Abaqus expects the co-rotational
+!>                              one: rotate by R of F = RU in a VUMAT wrapper)
+!>   status(nblock)             GRANBED_OK or the point's error code
+!>
+!> Link with the static library: gfortran ... libgranbed.a -lm
+module granbed
+  use, intrinsic :: iso_c_binding, only: c_int32_t, c_size_t, c_double, c_char, c_ptr, &
+       c_null_char, c_f_pointer
+  implicit none
+  private
+  public :: granbed_vumat_block, granbed_preset_props, granbed_check_props, granbed_message
+
+  integer(c_int32_t), parameter, public :: GRANBED_OK = 0
+  integer(c_int32_t), parameter, public :: GRANBED_ERR_INVALID_PARAMETER = 2
+  integer(c_int32_t), parameter, public :: GRANBED_ERR_POINT_FAILED = 9
+  integer, parameter, public :: GRANBED_VUMAT_NPROPS = 8, GRANBED_VUMAT_NSTATEV = 8
+
+  !> struct GranbedMaterialParams (8 doubles) and GranbedParamError.
+  type, bind(c), public :: granbed_material_params
+     real(c_double) :: youngs_modulus_pa, poisson_ratio, yield_stress_pa, eta0, cp, eta_c, &
+          true_density_kg_m3, friction
+  end type granbed_material_params
+
+  type, bind(c), public :: granbed_param_error
+     character(kind=c_char) :: field(40)
+     character(kind=c_char) :: allowed(80)
+     real(c_double) :: value
+  end type granbed_param_error
+
+  interface
+     integer(c_int32_t) function c_granbed_vumat(nblock, nstatev, nprops, props, defgrad_new, &
+          state_old, state_new, stress_new, point_status) bind(c, name='granbed_vumat')
+       import :: c_int32_t, c_size_t, c_double
+       integer(c_size_t), value :: nblock, nstatev, nprops
+       real(c_double), intent(in) :: props(*), defgrad_new(*), state_old(*)
+       real(c_double), intent(out) :: state_new(*), stress_new(*)
+       integer(c_int32_t), intent(out) :: point_status(*)
+     end function c_granbed_vumat
+
+     integer(c_int32_t) function c_granbed_material_check(params, error) &
+          bind(c, name='granbed_material_check')
+       import :: c_int32_t, granbed_material_params, granbed_param_error
+       type(granbed_material_params), intent(in) :: params
+       type(granbed_param_error), intent(out) :: error
+     end function c_granbed_material_check
+
+     integer(c_int32_t) function c_granbed_material_preset(name, params) &
+          bind(c, name='granbed_material_preset')
+       import :: c_int32_t, c_char, granbed_material_params
+       character(kind=c_char), intent(in) :: name(*)
+       type(granbed_material_params), intent(out) :: params
+     end function c_granbed_material_preset
+
+     type(c_ptr) function c_granbed_status_message(code) bind(c, name='granbed_status_message')
+       import :: c_ptr, c_int32_t
+       integer(c_int32_t), value :: code
+     end function c_granbed_status_message
+  end interface
+
+contains
+
+  !> Updates a block of nblock points (layout in the module header). Returns
+  !> in ierr GRANBED_OK, GRANBED_ERR_POINT_FAILED (see status) or an
+  !> argument error code (see granbed_message).
+  subroutine granbed_vumat_block(nblock, nstatev, nprops, props, defgradNew, stateOld, stateNew, &
+       stressNew, status, ierr)
+    integer, intent(in) :: nblock, nstatev, nprops
+    real(c_double), intent(in) :: props(nprops), defgradNew(nblock, 9), stateOld(nblock, nstatev)
+    real(c_double), intent(out) :: stateNew(nblock, nstatev), stressNew(nblock, 6)
+    integer(c_int32_t), intent(out) :: status(nblock)
+    integer(c_int32_t), intent(out) :: ierr
+    ierr = c_granbed_vumat(int(nblock, c_size_t), int(nstatev, c_size_t), int(nprops, c_size_t), &
+         props, defgradNew, stateOld, stateNew, stressNew, status)
+  end subroutine granbed_vumat_block
+
+  !> props(1:8) of the standard granule type name ('A1' ... 'C3').
+  subroutine granbed_preset_props(name, props, ierr)
+    character(len=*), intent(in) :: name
+    real(c_double), intent(out) :: props(GRANBED_VUMAT_NPROPS)
+    integer(c_int32_t), intent(out) :: ierr
+    type(granbed_material_params) :: p
+    ierr = c_granbed_material_preset(trim(name)//c_null_char, p)
+    props = [p%youngs_modulus_pa, p%poisson_ratio, p%yield_stress_pa, p%eta0, p%cp, p%eta_c, &
+         p%true_density_kg_m3, p%friction]
+  end subroutine granbed_preset_props
+
+  !> Checks props(1:8); on failure message names the field, value and range.
+  subroutine granbed_check_props(props, ierr, message)
+    real(c_double), intent(in) :: props(GRANBED_VUMAT_NPROPS)
+    integer(c_int32_t), intent(out) :: ierr
+    character(len=*), intent(out) :: message
+    type(granbed_material_params) :: p
+    type(granbed_param_error) :: e
+    p = granbed_material_params(props(1), props(2), props(3), props(4), props(5), props(6), &
+         props(7), props(8))
+    ierr = c_granbed_material_check(p, e)
+    message = ''
+    if (ierr == GRANBED_ERR_INVALID_PARAMETER) then
+       write (message, '(3a,g0,2a)') 'invalid material parameter ', trim(c_string(e%field)), &
+            ' = ', e%value, ': allowed range is ', trim(c_string(e%allowed))
+    end if
+  end subroutine granbed_check_props
+
+  !> The message of status code code.
+  function granbed_message(code) result(message)
+    integer(c_int32_t), intent(in) :: code
+    character(len=96) :: message
+    character(kind=c_char), pointer :: chars(:)
+    call c_f_pointer(c_granbed_status_message(code), chars, [96])
+    message = c_string(chars)
+  end function granbed_message
+
+  function c_string(chars) result(text)
+    character(kind=c_char), intent(in) :: chars(:)
+    character(len=size(chars)) :: text
+    integer :: i
+    text = ''
+    do i = 1, size(chars)
+       if (chars(i) == c_null_char) exit
+       text(i:i) = chars(i)
+    end do
+  end function c_string
+end module granbed

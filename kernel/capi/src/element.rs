@@ -1,0 +1,210 @@
+//! The one-point hex element for a batch of elements: reference data once,
+//! then nodal forces per step.
+
+use granbed_kernel::element::force::hex_forces;
+use granbed_kernel::element::reference::{HexReference, hex_reference};
+
+use crate::buffers::{input, one, optional_output, output, status};
+use crate::material::{GranbedMaterialParams, validated};
+use crate::status::{
+    GRANBED_ERR_DEGENERATE, GRANBED_ERR_INVALID_ARGUMENT, GRANBED_ERR_NON_FINITE,
+    GRANBED_ERR_POINT_FAILED, GRANBED_OK, update_status,
+};
+use crate::update::{GranbedPointInfo, options};
+
+/// Doubles per element in the reference array of [`granbed_hex_reference`]:
+/// V0 (1), B0 (8 nodes × xyz = 24), γ0 (4 modes × 8 nodes = 32), the
+/// hourglass geometry factor V0 Σ|B0_I|²/3 (1), the lumped node volumes (8).
+pub const GRANBED_HEX_REFERENCE_LEN: usize = 66;
+
+/// Default hourglass coefficient κ of the kernel.
+pub const GRANBED_DEFAULT_HOURGLASS_KAPPA: f64 = 0.05;
+const _: () = assert!(
+    GRANBED_DEFAULT_HOURGLASS_KAPPA == granbed_kernel::element::force::DEFAULT_HOURGLASS_KAPPA
+);
+
+fn encode(r: &HexReference, out: &mut [f64; GRANBED_HEX_REFERENCE_LEN]) {
+    let values = core::iter::once(r.volume)
+        .chain(r.b0.iter().flatten().copied())
+        .chain(r.gamma0.iter().flatten().copied())
+        .chain(core::iter::once(r.hourglass_geometry))
+        .chain(r.node_volume.iter().copied());
+    for (o, v) in out.iter_mut().zip(values) {
+        *o = v;
+    }
+}
+
+fn decode(v: &[f64; GRANBED_HEX_REFERENCE_LEN]) -> HexReference {
+    let mut it = v.iter().copied();
+    let mut next = || it.next().unwrap_or(0.0);
+    let volume = next();
+    let b0 = core::array::from_fn(|_| core::array::from_fn(|_| next()));
+    let gamma0 = core::array::from_fn(|_| core::array::from_fn(|_| next()));
+    let hourglass_geometry = next();
+    let node_volume = core::array::from_fn(|_| next());
+    HexReference {
+        volume,
+        b0,
+        gamma0,
+        hourglass_geometry,
+        node_volume,
+    }
+}
+
+/// Node coordinates of one hex, `[node][xyz]`, from 24 doubles.
+fn coords(x: &[f64; 24]) -> [[f64; 3]; 8] {
+    core::array::from_fn(|i| core::array::from_fn(|a| x.get(3 * i + a).copied().unwrap_or(0.0)))
+}
+
+/// Computes the reference data of `n` hexes.
+///
+/// * `x_ref`: in, n×24, reference node coordinates (m), node-major
+///   `[element][node][xyz]`, nodes in the usual trilinear order (0 at
+///   (−,−,−), 1 (+,−,−), 2 (+,+,−), 3 (−,+,−), then 4–7 the same at +ζ).
+/// * `reference`: out, n×[`GRANBED_HEX_REFERENCE_LEN`].
+/// * `element_status`: out, n codes (`GRANBED_ERR_DEGENERATE` for a hex
+///   with a non-positive Gauss-point Jacobian, `GRANBED_ERR_NON_FINITE`).
+///
+/// # Safety
+/// Pointers to arrays of the documented lengths, outputs not overlapping.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn granbed_hex_reference(
+    n: usize,
+    x_ref: *const f64,
+    reference: *mut f64,
+    element_status: *mut i32,
+) -> i32 {
+    status((|| {
+        // SAFETY (all three): the caller's contract.
+        let x = unsafe { input(x_ref, n, 24) }?;
+        let out = unsafe { output(reference, n, GRANBED_HEX_REFERENCE_LEN) }?;
+        let codes = unsafe { output(element_status, n, 1) }?;
+        let (x, _) = x.as_chunks::<24>();
+        let (out, _) = out.as_chunks_mut::<GRANBED_HEX_REFERENCE_LEN>();
+        let mut failed = false;
+        for ((x, o), code) in x.iter().zip(out.iter_mut()).zip(codes.iter_mut()) {
+            *code = if !x.iter().all(|v| v.is_finite()) {
+                GRANBED_ERR_NON_FINITE
+            } else if let Some(r) = hex_reference(&coords(x)) {
+                encode(&r, o);
+                GRANBED_OK
+            } else {
+                GRANBED_ERR_DEGENERATE
+            };
+            if *code != GRANBED_OK {
+                *o = [0.0; GRANBED_HEX_REFERENCE_LEN];
+                failed = true;
+            }
+        }
+        Ok(if failed {
+            GRANBED_ERR_POINT_FAILED
+        } else {
+            GRANBED_OK
+        })
+    })())
+}
+
+/// Internal plus hourglass nodal forces of `n` one-point hexes
+/// (physics.md §2.1–§2.2): F̄ = Σ x_I ⊗ B0_I, the constitutive update,
+/// f_I = V0 τ F̄⁻ᵀ B0_I plus the Flanagan–Belytschko hourglass force with
+/// k = κ (λ + 2μ) × the geometry factor. The nodal equation of motion
+/// subtracts `f` (m a = f_ext − f).
+///
+/// * `kappa`: hourglass coefficient κ, 0 ≤ κ ≤ 1
+///   ([`GRANBED_DEFAULT_HOURGLASS_KAPPA`] = 0.05).
+/// * `reference`: in, n×66 from [`granbed_hex_reference`].
+/// * `x`: in, n×24, current node coordinates, `[element][node][xyz]`, m.
+/// * `cp_inv`: in/out, n×6, the element's C_p⁻¹ (kept on failure).
+/// * `f`: out, n×24, nodal forces `[element][node][xyz]`, N (zero on
+///   failure).
+/// * `tau`: out, n×6 Kirchhoff stress, Pa, or NULL.
+/// * `info`: out, n records, or NULL.
+/// * `element_status`: out, n codes.
+///
+/// Returns `GRANBED_OK`, `GRANBED_ERR_POINT_FAILED` or an argument error.
+///
+/// # Safety
+/// Pointers to arrays of the documented lengths, outputs not overlapping.
+#[unsafe(no_mangle)]
+#[allow(clippy::too_many_arguments)]
+pub unsafe extern "C" fn granbed_hex_forces(
+    params: *const GranbedMaterialParams,
+    volume_fix: i32,
+    kappa: f64,
+    n: usize,
+    reference: *const f64,
+    x: *const f64,
+    cp_inv: *mut f64,
+    f: *mut f64,
+    tau: *mut f64,
+    info: *mut GranbedPointInfo,
+    element_status: *mut i32,
+) -> i32 {
+    status((|| {
+        // SAFETY (all): the caller's contract on lengths and aliasing.
+        let mat = validated(unsafe { one(params) }?, None)?;
+        let opts = options(volume_fix)?;
+        if !(0.0..=1.0).contains(&kappa) {
+            return Err(GRANBED_ERR_INVALID_ARGUMENT);
+        }
+        let reference = unsafe { input(reference, n, GRANBED_HEX_REFERENCE_LEN) }?;
+        let x = unsafe { input(x, n, 24) }?;
+        let cp = unsafe { output(cp_inv, n, 6) }?;
+        let f = unsafe { output(f, n, 24) }?;
+        let mut tau = unsafe { optional_output(tau, n, 6) }?;
+        let mut info = unsafe { optional_output(info, n, 1) }?;
+        let codes = unsafe { output(element_status, n, 1) }?;
+        let (reference, _) = reference.as_chunks::<GRANBED_HEX_REFERENCE_LEN>();
+        let (x, _) = x.as_chunks::<24>();
+        let (cp, _) = cp.as_chunks_mut::<6>();
+        let (f, _) = f.as_chunks_mut::<24>();
+        let mut failed = false;
+        for (k, ((((r, x), c), fe), code)) in reference
+            .iter()
+            .zip(x.iter())
+            .zip(cp.iter_mut())
+            .zip(f.iter_mut())
+            .zip(codes.iter_mut())
+            .enumerate()
+        {
+            let t = tau.as_deref_mut().and_then(|t| t.get_mut(6 * k..6 * k + 6));
+            let record = info.as_deref_mut().and_then(|i| i.get_mut(k));
+            match hex_forces(&mat, &opts, kappa, &decode(r), &coords(x), c) {
+                Ok(out) => {
+                    for (dst, v) in fe.iter_mut().zip(out.f.iter().flatten()) {
+                        *dst = *v;
+                    }
+                    if let Some(t) = t {
+                        t.copy_from_slice(&out.tau);
+                    }
+                    if let Some(rec) = record {
+                        *rec = GranbedPointInfo {
+                            j: out.j,
+                            eta: out.info.eta,
+                            dissipation_density: out.plastic_dissipation / r[0],
+                            plastic: i32::from(out.info.plastic),
+                            iterations: i32::try_from(out.info.iterations).unwrap_or(i32::MAX),
+                        };
+                    }
+                    *code = GRANBED_OK;
+                }
+                Err(e) => {
+                    *fe = [0.0; 24];
+                    if let Some(t) = t {
+                        t.fill(0.0);
+                    }
+                    if let Some(rec) = record {
+                        *rec = GranbedPointInfo::default();
+                    }
+                    *code = update_status(&e);
+                    failed = true;
+                }
+            }
+        }
+        Ok(if failed {
+            GRANBED_ERR_POINT_FAILED
+        } else {
+            GRANBED_OK
+        })
+    })())
+}

@@ -1,0 +1,73 @@
+#![cfg_attr(not(test), no_std)]
+//! # granbed-capi
+//!
+//! The C ABI of `granbed-kernel`, for finite-element codes in C, C++ and
+//! Fortran: material validation, state initialisation, the porous
+//! elastoplastic update for a batch of points, the one-point hex element
+//! for a batch of elements, and the node-to-quad projection and kinematic
+//! contact force. The header is `include/granbed.h` (cbindgen); the
+//! Fortran interface module is `fortran/granbed.f90`.
+//!
+//! Conventions of every function:
+//! * Only C types cross the boundary: `double`, `int32_t`, `size_t`,
+//!   `char`, plain `#[repr(C)]` structs of those, and pointers to arrays.
+//! * Units are SI (m, Pa, kg, s).
+//! * Arrays are flat and row-major (C order) unless the function says
+//!   otherwise; a "n×9" array holds point i's nine values at 9i..9i+9.
+//! * Symmetric tensors are 6 values in the kernel's Voigt order
+//!   xx, yy, zz, yz, xz, xy (no factor 2 on the shear terms).
+//! * The return value is a status code ([`GRANBED_OK`] = 0, or one of the
+//!   `GRANBED_ERR_*` constants); [`granbed_status_message`] names it.
+//!   Batch functions also write one status per point or element and carry
+//!   on past a failing one; a failed point's state is left unchanged.
+//! * No function panics, allocates, keeps global state or is unsafe to
+//!   call from several threads on separate buffers. `.ci/capi-check` proves
+//!   the first: the shared library is built with `panic = "abort"` and LTO,
+//!   and it must contain no panic handler (it would be linked in if any
+//!   exported function could reach a panic).
+
+mod buffers;
+mod contact;
+mod element;
+mod material;
+mod status;
+mod update;
+mod vumat;
+
+pub use contact::*;
+pub use element::*;
+pub use material::*;
+pub use status::*;
+pub use update::*;
+pub use vumat::*;
+
+/// The library version, NUL-terminated (static storage).
+#[unsafe(no_mangle)]
+pub extern "C" fn granbed_version() -> *const core::ffi::c_char {
+    const VERSION: &core::ffi::CStr = match core::ffi::CStr::from_bytes_with_nul(
+        concat!(env!("CARGO_PKG_VERSION"), "\0").as_bytes(),
+    ) {
+        Ok(v) => v,
+        Err(_) => c"unknown",
+    };
+    VERSION.as_ptr()
+}
+
+// Unreachable: .ci/capi-check fails if this handler is linked into the
+// shared library, i.e. if any exported function can reach a panic.
+#[cfg(not(test))]
+#[panic_handler]
+fn panic(_: &core::panic::PanicInfo) -> ! {
+    loop {}
+}
+
+/// Only with the `panic-probe` feature: an exported function that can
+/// panic (a checked slice index), so that `.ci/capi-check` can show its
+/// panic-handler test would catch one.
+#[cfg(feature = "panic-probe")]
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn granbed_panic_probe(p: *const f64, n: usize, i: usize) -> f64 {
+    // SAFETY: test-only; the caller passes n readable doubles.
+    let s = unsafe { core::slice::from_raw_parts(p, n) };
+    s[i]
+}

@@ -1,0 +1,205 @@
+//! Material parameters: presets, validation with a named error, and the
+//! state initialisation.
+
+use core::ffi::c_char;
+
+use granbed_kernel::material::{GranuleType, Material, MaterialParams, ParamError};
+use granbed_kernel::tensor::VOIGT_IDENTITY;
+
+use crate::buffers::{one, one_mut, output, status};
+use crate::status::{GRANBED_ERR_INVALID_ARGUMENT, GRANBED_ERR_INVALID_PARAMETER, GRANBED_OK};
+
+/// Material parameters of a porous granule, SI units (the kernel's
+/// `MaterialParams`, field for field; 8 doubles in this order, so a
+/// Fortran `props(8)` array maps onto it).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct GranbedMaterialParams {
+    /// Young's modulus E of the skeleton, Pa. Range: finite, > 0.
+    pub youngs_modulus_pa: f64,
+    /// Poisson's ratio ν. Range: −1 < ν < 0.5.
+    pub poisson_ratio: f64,
+    /// Yield stress σ_y, Pa. Range: > 0 (+inf: purely elastic).
+    pub yield_stress_pa: f64,
+    /// Initial relative density η0. Range: η_c < η0 ≤ 1.
+    pub eta0: f64,
+    /// Yield-surface constant c_p. Range: finite, ≥ 0.
+    pub cp: f64,
+    /// Critical relative density η_c. Range: 0 ≤ η_c < 1.
+    pub eta_c: f64,
+    /// True (solid) density, kg/m³. Range: finite, > 0.
+    pub true_density_kg_m3: f64,
+    /// Coulomb friction coefficient. Range: finite, ≥ 0.
+    pub friction: f64,
+}
+
+impl From<&GranbedMaterialParams> for MaterialParams {
+    fn from(p: &GranbedMaterialParams) -> Self {
+        Self {
+            youngs_modulus_pa: p.youngs_modulus_pa,
+            poisson_ratio: p.poisson_ratio,
+            yield_stress_pa: p.yield_stress_pa,
+            eta0: p.eta0,
+            cp: p.cp,
+            eta_c: p.eta_c,
+            true_density_kg_m3: p.true_density_kg_m3,
+            friction: p.friction,
+        }
+    }
+}
+
+impl From<MaterialParams> for GranbedMaterialParams {
+    fn from(p: MaterialParams) -> Self {
+        Self {
+            youngs_modulus_pa: p.youngs_modulus_pa,
+            poisson_ratio: p.poisson_ratio,
+            yield_stress_pa: p.yield_stress_pa,
+            eta0: p.eta0,
+            cp: p.cp,
+            eta_c: p.eta_c,
+            true_density_kg_m3: p.true_density_kg_m3,
+            friction: p.friction,
+        }
+    }
+}
+
+/// Bytes of [`GranbedParamError::field`], NUL included.
+pub const GRANBED_FIELD_LEN: usize = 40;
+/// Bytes of [`GranbedParamError::allowed`], NUL included.
+pub const GRANBED_ALLOWED_LEN: usize = 80;
+
+/// Which material parameter was rejected, its value and the allowed range.
+#[repr(C)]
+#[derive(Clone, Copy, Debug)]
+pub struct GranbedParamError {
+    /// Field name as in [`GranbedMaterialParams`], NUL-terminated.
+    pub field: [c_char; GRANBED_FIELD_LEN],
+    /// The allowed range, human readable, NUL-terminated.
+    pub allowed: [c_char; GRANBED_ALLOWED_LEN],
+    /// The rejected value.
+    pub value: f64,
+}
+
+/// Copies `text` into `dst` as a NUL-terminated C string (truncated to fit).
+fn copy_c_string(dst: &mut [c_char], text: &str) {
+    let room = dst.len().saturating_sub(1);
+    let mut end = 0;
+    for (d, b) in dst.iter_mut().zip(text.bytes().take(room)) {
+        *d = b as c_char;
+        end += 1;
+    }
+    if let Some(d) = dst.get_mut(end) {
+        *d = 0;
+    }
+}
+
+/// The validated kernel material of `params`, the rejection written to
+/// `error` when it is not NULL.
+pub(crate) fn validated(
+    params: &GranbedMaterialParams,
+    error: Option<&mut GranbedParamError>,
+) -> Result<Material, i32> {
+    MaterialParams::from(params)
+        .validate()
+        .map_err(|e: ParamError| {
+            if let Some(out) = error {
+                copy_c_string(&mut out.field, e.field);
+                copy_c_string(&mut out.allowed, e.allowed);
+                out.value = e.value;
+            }
+            GRANBED_ERR_INVALID_PARAMETER
+        })
+}
+
+/// Writes the parameters of the standard granule type `name` ("A1" … "C3",
+/// case-insensitive, NUL-terminated) to `out`.
+///
+/// Returns [`GRANBED_OK`], `GRANBED_ERR_NULL_POINTER`, or
+/// `GRANBED_ERR_INVALID_ARGUMENT` for an unknown name.
+///
+/// # Safety
+/// `name` is NULL or a NUL-terminated string; `out` is NULL or points to a
+/// writable [`GranbedMaterialParams`].
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn granbed_material_preset(
+    name: *const c_char,
+    out: *mut GranbedMaterialParams,
+) -> i32 {
+    status((|| {
+        if name.is_null() {
+            return Err(crate::status::GRANBED_ERR_NULL_POINTER);
+        }
+        // A type name has two characters; read at most four bytes.
+        let mut text = [0u8; 4];
+        let mut len = 0;
+        for slot in text.iter_mut() {
+            // SAFETY: the string is NUL-terminated and we stop at the NUL.
+            let b = unsafe { *name.add(len) } as u8;
+            if b == 0 {
+                break;
+            }
+            *slot = b;
+            len += 1;
+        }
+        let name = text
+            .get(..len)
+            .and_then(|t| core::str::from_utf8(t).ok())
+            .and_then(|t| t.parse::<GranuleType>().ok())
+            .ok_or(GRANBED_ERR_INVALID_ARGUMENT)?;
+        // SAFETY: the caller's contract.
+        let out = unsafe { one_mut(out) }?;
+        *out = name.params().into();
+        Ok(GRANBED_OK)
+    })())
+}
+
+/// Checks every field of `params` against its range (NaN always fails).
+/// On failure returns `GRANBED_ERR_INVALID_PARAMETER` and, if `error` is
+/// not NULL, writes the first rejected field, its value and the allowed
+/// range there.
+///
+/// # Safety
+/// `params` is NULL or points to a [`GranbedMaterialParams`]; `error` is
+/// NULL or points to a writable [`GranbedParamError`].
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn granbed_material_check(
+    params: *const GranbedMaterialParams,
+    error: *mut GranbedParamError,
+) -> i32 {
+    status((|| {
+        // SAFETY: the caller's contract.
+        let params = unsafe { one(params) }?;
+        // SAFETY: the caller's contract.
+        let error = unsafe { error.as_mut() };
+        validated(params, error).map(|_| GRANBED_OK)
+    })())
+}
+
+/// Writes the initial plastic state C_p⁻¹ = identity of `n` points to
+/// `cp_inv` (n×6, Voigt xx yy zz yz xz xy).
+///
+/// # Safety
+/// `cp_inv` points to 6n writable doubles (may be NULL if n = 0).
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn granbed_state_init(n: usize, cp_inv: *mut f64) -> i32 {
+    status((|| {
+        // SAFETY: the caller's contract.
+        let cp = unsafe { output(cp_inv, n, 6) }?;
+        for point in cp.chunks_exact_mut(6) {
+            point.copy_from_slice(&VOIGT_IDENTITY);
+        }
+        Ok(GRANBED_OK)
+    })())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_long_field_name_is_truncated_and_terminated() {
+        let mut dst = [1 as c_char; 4];
+        copy_c_string(&mut dst, "abcdef");
+        assert_eq!(dst, [b'a' as c_char, b'b' as c_char, b'c' as c_char, 0]);
+    }
+}
