@@ -1,0 +1,100 @@
+/* The one-point hex through the C ABI, checked against mechanics:
+ *  1. a unit cube under a homogeneous F: the element's Kirchhoff stress is
+ *     the material point's (granbed_update_points with the same F) to
+ *     round-off, the nodal forces sum to zero and are V0 τ F^-T B0_I, and a
+ *     homogeneous field excites no hourglass force;
+ *  2. a rigid rotation of the deformed cube rotates the forces with it
+ *     (objectivity);
+ *  3. two elements in one batch, one inverted: per-element status codes,
+ *     the good one still computed.
+ * Exit status 0 if all hold. */
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+
+#include "granbed.h"
+
+static int failures = 0;
+static void check(const char *what, int ok) {
+    if (!ok) { fprintf(stderr, "FAIL %s\n", what); failures++; }
+}
+
+/* Node I of the unit cube in the trilinear order. */
+static const double CUBE[8][3] = {{0, 0, 0}, {1e-3, 0, 0}, {1e-3, 1e-3, 0}, {0, 1e-3, 0},
+                                  {0, 0, 1e-3}, {1e-3, 0, 1e-3}, {1e-3, 1e-3, 1e-3}, {0, 1e-3, 1e-3}};
+
+static void apply(const double f[9], const double x[24], double out[24]) {
+    for (int i = 0; i < 8; i++)
+        for (int a = 0; a < 3; a++)
+            out[3 * i + a] = f[3 * a] * x[3 * i] + f[3 * a + 1] * x[3 * i + 1] + f[3 * a + 2] * x[3 * i + 2];
+}
+
+int main(void) {
+    GranbedMaterialParams p;
+    granbed_material_preset("B2", &p);
+    double xref[24];
+    memcpy(xref, CUBE, sizeof xref);
+    double ref[GRANBED_HEX_REFERENCE_LEN];
+    int32_t st[2];
+    check("reference", granbed_hex_reference(1, xref, ref, st) == GRANBED_OK && st[0] == GRANBED_OK);
+    check("volume", fabs(ref[0] - 1e-9) < 1e-24);
+
+    /* 1. Homogeneous compression with shear (plastic for B2). */
+    const double F[9] = {1.01, 0.02, 0, 0, 0.99, 0.01, 0, 0, 0.9};
+    double x[24], cp[6], cp_point[6], f[24], tau[6], tau_point[6];
+    apply(F, xref, x);
+    granbed_state_init(1, cp);
+    granbed_state_init(1, cp_point);
+    GranbedPointInfo info, info_point;
+    check("forces", granbed_hex_forces(&p, 1, GRANBED_DEFAULT_HOURGLASS_KAPPA, 1, ref, x, cp, f, tau, &info, st) == GRANBED_OK);
+    check("point", granbed_update_points(&p, 1, 1, F, cp_point, GRANBED_STRESS_KIRCHHOFF, tau_point, &info_point, st) == GRANBED_OK);
+    double dtau = 0, tau_scale = 0;
+    for (int c = 0; c < 6; c++) {
+        dtau = fmax(dtau, fabs(tau[c] - tau_point[c]));
+        tau_scale = fmax(tau_scale, fabs(tau_point[c]));
+    }
+    printf("hex_element: tau_zz element %.12g Pa, point %.12g Pa, plastic %d/%d\n", tau[2], tau_point[2],
+           info.plastic, info_point.plastic);
+    check("element stress = point stress", dtau <= 1e-9 * tau_scale && info.plastic == 1);
+    double sum[3] = {0, 0, 0}, fmax_abs = 0;
+    for (int i = 0; i < 8; i++)
+        for (int a = 0; a < 3; a++) { sum[a] += f[3 * i + a]; fmax_abs = fmax(fmax_abs, fabs(f[3 * i + a])); }
+    check("forces balance", fabs(sum[0]) + fabs(sum[1]) + fabs(sum[2]) <= 1e-12 * fmax_abs);
+    /* The top face (nodes 4-7) carries P_zz times the reference area A0 = 1e-6 m² (f_I = V0 P B0_I with
+     * B0_I,z = 1/(4L) on the top; no hourglass force in a homogeneous field). With P = τ F^-T and F
+     * upper triangular, row z of F^-1 is (0, 0, 1/F33), so P_zz = τ_zz / F33. */
+    double top = f[3 * 4 + 2] + f[3 * 5 + 2] + f[3 * 6 + 2] + f[3 * 7 + 2];
+    double expect_top = tau[2] / F[8] * 1e-6;
+    printf("hex_element: top-face axial force %.12g N, P_zz A0 %.12g N\n", top, expect_top);
+    check("top face force = P A0", fabs(top - expect_top) <= 1e-9 * fabs(expect_top));
+
+    /* 2. Objectivity: rotate the deformed element by 30° about z. */
+    const double pi = acos(-1.0), c30 = cos(pi / 6), s30 = sin(pi / 6);
+    const double R[9] = {c30, -s30, 0, s30, c30, 0, 0, 0, 1};
+    double xr[24], fr[24], cpr[6];
+    apply(R, x, xr);
+    granbed_state_init(1, cpr);
+    check("rotated", granbed_hex_forces(&p, 1, GRANBED_DEFAULT_HOURGLASS_KAPPA, 1, ref, xr, cpr, fr, NULL, NULL, st) == GRANBED_OK);
+    double err = 0;
+    for (int i = 0; i < 8; i++) {
+        double rf[3];
+        for (int a = 0; a < 3; a++) rf[a] = R[3 * a] * f[3 * i] + R[3 * a + 1] * f[3 * i + 1] + R[3 * a + 2] * f[3 * i + 2];
+        for (int a = 0; a < 3; a++) err = fmax(err, fabs(rf[a] - fr[3 * i + a]));
+    }
+    printf("hex_element: objectivity error %.3g N of %.3g N\n", err, fmax_abs);
+    check("objective", err <= 1e-9 * fmax_abs);
+
+    /* 3. A batch of two, the second inverted (top face pushed below the bottom). */
+    double refs[2 * GRANBED_HEX_REFERENCE_LEN], xs[48], cps[12], fs[48];
+    memcpy(refs, ref, sizeof ref);
+    memcpy(refs + GRANBED_HEX_REFERENCE_LEN, ref, sizeof ref);
+    memcpy(xs, x, sizeof x);
+    memcpy(xs + 24, xref, sizeof xref);
+    for (int i = 4; i < 8; i++) xs[24 + 3 * i + 2] = -1e-3;
+    granbed_state_init(2, cps);
+    check("batch", granbed_hex_forces(&p, 1, 0.05, 2, refs, xs, cps, fs, NULL, NULL, st) == GRANBED_ERR_POINT_FAILED);
+    check("batch codes", st[0] == GRANBED_OK && st[1] == GRANBED_ERR_INVERTED);
+    check("good element computed", memcmp(fs, f, sizeof f) == 0);
+    printf("hex_element: %s\n", failures ? "FAILED" : "all checks hold");
+    return failures ? 1 : 0;
+}
