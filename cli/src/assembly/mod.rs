@@ -68,8 +68,14 @@ pub struct AssemblyParams {
     /// weight is kept (gravity is divided by F) and the damping follows
     /// the slower modes. 1 = physical masses.
     pub mass_scaling: Real,
-    /// Safety factor C on the estimate of the stable step; (0, 1].
+    /// Safety factor C on the estimate of the stable step; (0, 2]. Above
+    /// 1 the step exceeds the estimated stability limit: only for testing
+    /// how a run fails (the watchdog stops it).
     pub time_step_safety: Real,
+    /// Watchdog: a node faster than this (m/s) stops the step with
+    /// [`AssemblyError::Runaway`] before the motion turns into garbage
+    /// (∞: off).
+    pub max_node_speed_m_s: Real,
     /// Element estimate, or the global 2/ω_max by power iteration per
     /// granule (warm-started; tracked by the element lengths in between).
     pub time_step_method: TimeStepMethod,
@@ -81,7 +87,7 @@ impl AssemblyParams {
     /// physics.md's choices for `material`: ξ = 0.5, gravity 9.81 m/s²,
     /// the material's friction on walls and between granules, symmetric
     /// two-pass with mass sharing and up to three sweeps (a further one
-    /// while a gap deeper than 0.05 µm is left), C = 0.9 on the global
+    /// while a gap deeper than 0.05 µm is left), no speed watchdog, C = 0.9 on the global
     /// estimate 2/ω_max (power iteration every 10 re-estimates), re-estimated
     /// every 100 steps.
     pub fn standard(material: Material, elements: ElementSettings) -> Self {
@@ -98,6 +104,7 @@ impl AssemblyParams {
             sweep_tolerance_m: 0.05e-6,
             mass_scaling: 1.0,
             time_step_safety: 0.9,
+            max_node_speed_m_s: Real::INFINITY,
             time_step_method: TimeStepMethod::Global {
                 power_interval: 10,
                 power_iterations: 30,
@@ -415,7 +422,9 @@ impl<'m> Assembly<'m> {
             value: state.granules.len() as Real,
             allowed: "a state of the same scene (granule count, mesh)",
         };
-        if state.granules.len() != self.granules.len() || state.built.len() != self.granules.len() {
+        // An empty `built` is a state from before the first broad phase.
+        let built_ok = state.built.is_empty() || state.built.len() == self.granules.len();
+        if state.granules.len() != self.granules.len() || !built_ok {
             return Err(mismatch);
         }
         for (((g, mode), control), s) in self
@@ -451,6 +460,15 @@ impl<'m> Assembly<'m> {
         [self.dt, self.dt_prev] = state.dt;
         self.energies = state.energies;
         Ok(())
+    }
+
+    /// Multiplies the current step Δt by `factor` (> 0) until the next
+    /// re-estimate: for a resumed run whose time-step safety factor was
+    /// changed (the restored Δt carries the old one).
+    pub fn rescale_time_step(&mut self, factor: Real) {
+        if factor > 0.0 && factor.is_finite() {
+            self.dt *= factor;
+        }
     }
 
     /// The parameters.

@@ -41,6 +41,18 @@ pub enum AssemblyError {
         /// What went wrong.
         error: ContactError,
     },
+    /// The watchdog: a node moved faster than
+    /// [`AssemblyParams::max_node_speed_m_s`] — the run is going unstable.
+    Runaway {
+        /// Step.
+        step: u64,
+        /// The first granule over the limit (in granule order).
+        granule: usize,
+        /// Its fastest node's speed, m/s.
+        speed_m_s: Real,
+        /// The limit, m/s.
+        limit_m_s: Real,
+    },
     /// The stable step could not be estimated or the motion blew up.
     Unstable {
         /// Step.
@@ -64,6 +76,17 @@ impl fmt::Display for AssemblyError {
                 failure,
             } => write!(f, "granule {granule}, step {step}: {failure}"),
             Self::Contact { step, error } => write!(f, "step {step}: {error}"),
+            Self::Runaway {
+                step,
+                granule,
+                speed_m_s,
+                limit_m_s,
+            } => write!(
+                f,
+                "step {step}: granule {granule} has a node moving at {speed_m_s:.4e} m/s, over \
+                 the watchdog limit of {limit_m_s:.4e} m/s: the motion is going unstable (is the \
+                 time-step safety factor too large?)"
+            ),
             Self::Unstable { step, granule } => match granule {
                 Some(g) => write!(
                     f,
@@ -78,7 +101,7 @@ impl fmt::Display for AssemblyError {
 impl core::error::Error for AssemblyError {}
 
 pub(super) fn validate(p: &AssemblyParams) -> Result<(), AssemblyError> {
-    let checks: [(bool, &'static str, Real, &'static str); 9] = [
+    let checks: [(bool, &'static str, Real, &'static str); 10] = [
         (
             (1.0..=1e6).contains(&p.mass_scaling),
             "mass_scaling",
@@ -128,10 +151,16 @@ pub(super) fn validate(p: &AssemblyParams) -> Result<(), AssemblyError> {
             "> 0 m",
         ),
         (
-            p.time_step_safety > 0.0 && p.time_step_safety <= 1.0 && p.time_step_interval >= 1,
+            p.time_step_safety > 0.0 && p.time_step_safety <= 2.0 && p.time_step_interval >= 1,
             "time_step_safety",
             p.time_step_safety,
-            "0 < C <= 1 (and an interval >= 1)",
+            "0 < C <= 2 (and an interval >= 1)",
+        ),
+        (
+            p.max_node_speed_m_s > 0.0,
+            "max_node_speed_m_s",
+            p.max_node_speed_m_s,
+            "> 0 m/s (inf: no watchdog)",
         ),
     ];
     match checks.into_iter().find(|c| !c.0) {
@@ -529,6 +558,14 @@ impl Assembly<'_> {
                 return Err(AssemblyError::Unstable {
                     step,
                     granule: Some(granule),
+                });
+            }
+            if w.max_speed_squared > p.max_node_speed_m_s * p.max_node_speed_m_s {
+                return Err(AssemblyError::Runaway {
+                    step,
+                    granule,
+                    speed_m_s: w.max_speed_squared.sqrt(),
+                    limit_m_s: p.max_node_speed_m_s,
                 });
             }
             e.internal_work += w.internal;

@@ -123,8 +123,9 @@ pub struct BedArgs {
     pub die_diameter_mm: Option<f64>,
 
     /// Continue the run whose checkpoint is in DIR (its `checkpoint.bin`);
-    /// the outputs go to DIR. Only --strain, --stop-at-strain, -j and
-    /// --quiet may be given with it.
+    /// the outputs go to DIR. Only --strain, --stop-at-strain,
+    /// --time-step-safety, --mass-scaling, -j and --quiet may be given with
+    /// it.
     #[arg(long, value_name = "DIR", conflicts_with_all = ["scene", "out", "granule_type", "granules", "mesh", "seed", "die_diameter_mm"])]
     pub resume: Option<PathBuf>,
 
@@ -138,6 +139,12 @@ pub struct BedArgs {
     /// summary.json).
     #[arg(long, value_name = "F")]
     pub mass_scaling: Option<f64>,
+
+    /// Override: safety factor on the stable time step 2/ω_max
+    /// (0 < C ≤ 2; default 0.9; above 1 the run is unstable). Allowed with
+    /// --resume, e.g. to continue a run that failed with a smaller step.
+    #[arg(long, value_name = "C")]
+    pub time_step_safety: Option<f64>,
 
     /// Worker threads (0 = all cores). Results do not depend on it.
     #[arg(short = 'j', long, value_name = "N", default_value_t = 0)]
@@ -184,6 +191,9 @@ impl BedArgs {
         }
         if let Some(f) = self.mass_scaling {
             scene.mass_scaling = f;
+        }
+        if let Some(c) = self.time_step_safety {
+            scene.time_step_safety = c;
         }
         scene.validate()?;
         Ok(scene)
@@ -237,9 +247,17 @@ impl BedArgs {
         }
         if let Some(e) = result.error {
             let strain = result.samples.last().map_or(0.0, |s| s.strain);
+            let checkpoint = match result.checkpoint_strain {
+                Some(c) => format!(
+                    "a checkpoint from before the failure, at C = {c:.4}, continues with \
+                     `granbed-cli bed --resume {}`",
+                    out.display()
+                ),
+                None => "no checkpoint was written".to_owned(),
+            };
             return Err(anyhow::Error::new(e).context(format!(
-                "the bed compression stopped early after C = {strain:.4} (outputs so far and \
-                 the last checkpoint in `{}`)",
+                "the bed compression stopped early after C = {strain:.4}; the outputs so far are \
+                 in `{}`, {checkpoint}",
                 out.display()
             )));
         }

@@ -91,6 +91,10 @@ pub struct BedRun {
     pub stopped: bool,
     /// The error that stopped the run, if any.
     pub error: Option<AssemblyError>,
+    /// With an error: the strain of the newest checkpoint on disk (the
+    /// state at the last output row before the failure, or a later
+    /// periodic checkpoint), if checkpoints are written.
+    pub checkpoint_strain: Option<Real>,
 }
 
 /// The time-averaging window of the samples (integrals over the open
@@ -231,6 +235,8 @@ pub fn run_bed(
     params.damping_ratio = scene.damping_ratio;
     params.contact_sweeps = scene.contact_sweeps;
     params.mass_scaling = scene.mass_scaling;
+    params.time_step_safety = scene.time_step_safety;
+    params.max_node_speed_m_s = scene.watchdog_speed_ratio * scene.punch_speed_m_s;
     // Where the run starts: a fresh pour, or a checkpoint's state.
     let (die, placed, resumed, pour_wall_time_s) = match &control.resume {
         Some(c) => {
@@ -273,6 +279,14 @@ pub fn run_bed(
         asm.restore(&c.state)
             .map_err(anyhow::Error::new)
             .context("the checkpoint does not fit the scene")?;
+        // A changed safety factor (--time-step-safety with --resume) applies
+        // at once, not only from the next re-estimate.
+        let before = Scene::from_toml(&c.progress.scene_toml)
+            .context("the checkpoint's scene")?
+            .time_step_safety;
+        if before != scene.time_step_safety {
+            asm.rescale_time_step(scene.time_step_safety / before);
+        }
     }
     let area = core::f64::consts::PI * die.die_radius_m * die.die_radius_m;
     let granules = scene.granules;
@@ -332,11 +346,9 @@ pub fn run_bed(
         observer.snapshot(0.0, &asm, &mesh)?;
         snapshots_done += 1;
     }
-    let checkpoint =
+    let dir = control.checkpoint_dir.as_deref();
+    let make =
         |asm: &Assembly<'_>, samples: &[BedSample], window: &Window, next: Real, done: usize| {
-            let Some(dir) = &control.checkpoint_dir else {
-                return Ok(());
-            };
             Checkpoint {
                 progress: checkpoint::Progress {
                     scene_toml: scene.to_toml(),
@@ -349,9 +361,13 @@ pub fn run_bed(
                 },
                 state: asm.state(),
             }
-            .write(dir)
-            .map(drop)
         };
+    // The state at the last output row, kept in memory so that a failed
+    // step (which has already changed some granules) still leaves a
+    // checkpoint from before it; and the steps and strain of the newest
+    // checkpoint on disk.
+    let mut last_good = dir.map(|_| make(&asm, &samples, &window, next, snapshots_done));
+    let mut on_disk: Option<(u64, Real)> = None;
     let end = die.time_of_strain(scene.final_strain);
     let every_s = 60.0 * scene.checkpoint_interval_minutes;
     let mut last_checkpoint = Instant::now();
@@ -391,13 +407,19 @@ pub fn run_bed(
             while next <= strain + 1e-12 {
                 next += scene.output_strain_interval;
             }
+            if dir.is_some() {
+                last_good = Some(make(&asm, &samples, &window, next, snapshots_done));
+            }
         }
         let stop = control.stop_at_strain.is_some_and(|c| strain + 1e-12 >= c);
         if stop
             || strain >= next_checkpoint_strain
             || last_checkpoint.elapsed().as_secs_f64() >= every_s
         {
-            checkpoint(&asm, &samples, &window, next, snapshots_done)?;
+            if let Some(dir) = dir {
+                make(&asm, &samples, &window, next, snapshots_done).write(dir)?;
+                on_disk = Some((asm.steps(), strain));
+            }
             last_checkpoint = Instant::now();
             while next_checkpoint_strain <= strain {
                 next_checkpoint_strain += scene.checkpoint_strain_interval;
@@ -406,6 +428,14 @@ pub fn run_bed(
         if stop {
             stopped = true;
             break;
+        }
+    }
+    let mut checkpoint_strain = on_disk.map(|(_, c)| c);
+    if let (Some(_), Some(dir), Some(good)) = (&error, dir, &last_good) {
+        let newer = on_disk.is_none_or(|(steps, _)| good.state.steps > steps);
+        if newer {
+            good.write(dir)?;
+            checkpoint_strain = Some(die.strain_at(good.state.time));
         }
     }
     let steps = asm.steps();
@@ -423,5 +453,6 @@ pub fn run_bed(
         threads: rayon::current_num_threads(),
         stopped,
         error,
+        checkpoint_strain,
     })
 }

@@ -50,6 +50,12 @@ contact_sweeps = 3
 # Uniform mass scaling F >= 1 for quasi-static runs (1 = physical inertia;
 # the summary's quasi-static certificate says whether a run stayed quasi-static).
 mass_scaling = 1.0
+# Safety factor on the stable time step 2/omega_max (0 < C <= 2; above 1 the
+# run is unstable, which only tests the failure handling).
+time_step_safety = 0.9
+# Watchdog: stop (with a checkpoint from before) when a node moves faster than
+# this multiple of the punch speed: the motion is going unstable.
+watchdog_speed_ratio = 200.0
 
 # Overrides of the type's preset (SI units), e.g. yield_stress_pa = 30e3.
 [material]
@@ -124,6 +130,14 @@ pub struct Scene {
     /// Uniform mass scaling F, 1 ≤ F ≤ 1e6 (absent: 1).
     #[serde(default = "unit_scaling")]
     pub mass_scaling: f64,
+    /// Safety factor on the stable step, 0 < C ≤ 2 (absent: 0.9; above 1
+    /// unstable, for testing the failure handling).
+    #[serde(default = "default_time_step_safety")]
+    pub time_step_safety: f64,
+    /// Watchdog limit on any node's speed as a multiple of the punch
+    /// speed, 1 ≤ r ≤ 1e9 (absent: 200).
+    #[serde(default = "default_watchdog_speed_ratio")]
+    pub watchdog_speed_ratio: f64,
     /// Material overrides.
     #[serde(default)]
     pub material: MaterialOverrides,
@@ -131,6 +145,14 @@ pub struct Scene {
 
 fn unit_scaling() -> f64 {
     1.0
+}
+
+fn default_time_step_safety() -> f64 {
+    0.9
+}
+
+fn default_watchdog_speed_ratio() -> f64 {
+    200.0
 }
 
 fn invalid(field: &str, value: impl core::fmt::Display, allowed: &str) -> anyhow::Error {
@@ -168,7 +190,19 @@ impl Scene {
         }
         self.granule_type()?;
         self.mesh_level()?;
-        let checks: [(bool, &str, f64, &str); 11] = [
+        let checks: [(bool, &str, f64, &str); 13] = [
+            (
+                self.time_step_safety > 0.0 && self.time_step_safety <= 2.0,
+                "time_step_safety",
+                self.time_step_safety,
+                "0 < C <= 2",
+            ),
+            (
+                (1.0..=1e9).contains(&self.watchdog_speed_ratio),
+                "watchdog_speed_ratio",
+                self.watchdog_speed_ratio,
+                "1 <= r <= 1e9",
+            ),
             (
                 (1.0..=1e6).contains(&self.mass_scaling),
                 "mass_scaling",

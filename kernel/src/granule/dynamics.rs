@@ -127,6 +127,8 @@ pub struct StepWork {
     pub gravity: Real,
     /// Kinetic energy ½ Σ m v_{n+½}².
     pub kinetic: Real,
+    /// Largest nodal |v_{n+½}|², m²/s² (for a driver's runaway watchdog).
+    pub max_speed_squared: Real,
 }
 
 /// First half of a step: forces at x_n, damping, v*, x̃; clears `f_c`.
@@ -183,6 +185,9 @@ pub fn correct(b: &mut GranuleBuffers<'_>, sizes: StepSizes, gravity_m_s2: Real)
             b.x[i][a] += dt * v_new;
             w.kinetic += 0.5 * m * v_new * v_new;
         }
+        let v = b.v[i];
+        w.max_speed_squared =
+            crate::math::max(w.max_speed_squared, v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
     }
     w
 }

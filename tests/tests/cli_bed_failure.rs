@@ -1,0 +1,149 @@
+//! How `granbed-cli bed` fails (issue #9: a run made to fail on purpose
+//! stops cleanly with a message and a usable checkpoint). A time-step
+//! safety factor of 1.9 — the explicit step almost twice its stability
+//! limit — makes a small bed blow up within a few dozen steps:
+//! * the speed watchdog stops it before an element fails, naming the
+//!   granule, the step and the speed; a checkpoint from before the failure
+//!   is on disk and `--resume DIR --time-step-safety 0.9` finishes the run;
+//! * with the watchdog off, the kernel's failure (granule, element, step)
+//!   stops it, again with a readable, finite checkpoint;
+//! * out-of-range factors are rejected by name.
+
+mod common;
+
+use std::path::Path;
+
+use common::{cli, number, summary};
+use granbed_cli::bed::DEFAULT_SCENE;
+use granbed_cli::bed::checkpoint::Checkpoint;
+
+/// A 20-granule coarse bed to 1 % strain, with the given safety factor and
+/// watchdog ratio, written as a scene file in `dir`.
+fn scene_file(dir: &Path, safety: f64, watchdog: f64) -> std::path::PathBuf {
+    std::fs::create_dir_all(dir).unwrap();
+    let text = DEFAULT_SCENE
+        .replace("granules = 1000", "granules = 20")
+        .replace("mesh = \"8x2\"", "mesh = \"4x1\"")
+        .replace("die_diameter_mm = 11.3", "die_diameter_mm = 4.5")
+        .replace("final_strain = 0.3", "final_strain = 0.01")
+        .replace(
+            "time_step_safety = 0.9",
+            &format!("time_step_safety = {safety}"),
+        )
+        .replace(
+            "watchdog_speed_ratio = 200.0",
+            &format!("watchdog_speed_ratio = {watchdog}"),
+        );
+    assert!(text.contains(&format!("time_step_safety = {safety}")));
+    let path = dir.join("scene.toml");
+    std::fs::write(&path, text).unwrap();
+    path
+}
+
+fn run(scene: &Path, out: &Path) -> common::Run {
+    cli(&[
+        "bed",
+        "--quiet",
+        "--scene",
+        scene.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+    ])
+}
+
+/// The checkpoint in `out` reads back and holds a finite state.
+fn usable_checkpoint(out: &Path) -> Checkpoint {
+    let c = Checkpoint::read(out).expect("the checkpoint reads back");
+    for g in &c.state.granules {
+        assert!(
+            g.x.iter().chain(&g.v).flatten().all(|v| v.is_finite()),
+            "the checkpoint holds a non-finite state"
+        );
+    }
+    c
+}
+
+#[test]
+fn the_watchdog_stops_a_runaway_bed_and_its_checkpoint_resumes() {
+    let dir = common::fresh_dir("cli_bed_failure", "watchdog");
+    let scene = scene_file(&dir, 1.9, 200.0);
+    let out = dir.join("out");
+    let r = run(&scene, &out);
+    assert_eq!(r.code, 1, "the unstable run must fail:\n{}", r.stderr);
+    for needle in [
+        "watchdog limit",
+        "granule ",
+        "step ",
+        "a checkpoint from before the failure, at C = ",
+        "--resume",
+    ] {
+        assert!(r.stderr.contains(needle), "no `{needle}` in:\n{}", r.stderr);
+    }
+    assert!(
+        !r.stderr.contains("element"),
+        "the watchdog must stop the run before an element fails:\n{}",
+        r.stderr
+    );
+    let failed_at: u64 = r
+        .stderr
+        .split("step ")
+        .nth(1)
+        .and_then(|s| s.split(':').next())
+        .and_then(|s| s.parse().ok())
+        .expect("the message names the step");
+    let c = usable_checkpoint(&out);
+    assert!(
+        c.state.steps < failed_at,
+        "the checkpoint (step {}) must come from before the failure (step {failed_at})",
+        c.state.steps
+    );
+    // The outputs so far exist.
+    assert!(out.join("compression.csv").exists() && out.join("summary.json").exists());
+
+    // Continue from it with a sane step: the run completes.
+    let resumed = cli(&[
+        "bed",
+        "--quiet",
+        "--resume",
+        out.to_str().unwrap(),
+        "--time-step-safety",
+        "0.9",
+    ]);
+    assert_eq!(resumed.code, 0, "resume failed:\n{}", resumed.stderr);
+    let s = summary(&out);
+    assert!(number(&s, "final_strain") >= 0.01 - 1e-9);
+    assert!(number(&s, "min_jacobian") > 0.5);
+}
+
+#[test]
+fn without_the_watchdog_the_kernel_failure_is_named_and_a_checkpoint_kept() {
+    let dir = common::fresh_dir("cli_bed_failure", "kernel");
+    let scene = scene_file(&dir, 1.9, 1e9);
+    let out = dir.join("out");
+    let r = run(&scene, &out);
+    assert_eq!(r.code, 1, "the unstable run must fail:\n{}", r.stderr);
+    assert!(
+        r.stderr.contains("granule ")
+            && r.stderr.contains("step ")
+            && (r.stderr.contains("element ") || r.stderr.contains("unstable")),
+        "the failure must name granule, step and element:\n{}",
+        r.stderr
+    );
+    assert!(r.stderr.contains("a checkpoint from before the failure"));
+    usable_checkpoint(&out);
+}
+
+#[test]
+fn out_of_range_factors_are_rejected_by_name() {
+    let dir = common::fresh_dir("cli_bed_failure", "ranges");
+    for (safety, watchdog, field) in [
+        (3.0, 200.0, "time_step_safety"),
+        (0.0, 200.0, "time_step_safety"),
+        (0.9, 0.5, "watchdog_speed_ratio"),
+    ] {
+        let scene = scene_file(&dir, safety, watchdog);
+        let r = run(&scene, &dir.join("out"));
+        assert_eq!(r.code, 2, "{field}: {}", r.stderr);
+        assert!(r.stderr.contains(field), "{field} not named:\n{}", r.stderr);
+    }
+}
