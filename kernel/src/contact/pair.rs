@@ -570,17 +570,7 @@ pub fn node_face_force(
     friction: Real,
     dt_squared: Real,
 ) -> NodeFaceForce {
-    let m_s = c.slave_mass;
-    let inv_md: Real = (0..4)
-        .map(|i| c.weights[i] * c.weights[i] / c.master_mass[i])
-        .sum();
-    let m_eff = m_s / (1.0 + m_s * inv_md);
-    let n = c.normal;
-    let f_n = weight * (-c.gap) * m_eff / dt_squared;
-    let mut f = n.map(|v| f_n * v);
-    let mut f_t = [0.0; 3];
-    let mut slipping = false;
-    if friction > 0.0 {
+    let increment = || {
         let mut du = sub(&c.slave_x_pred, &c.slave_x_n);
         for i in 0..4 {
             let dm = sub(&c.master_x_pred[i], &c.master_x_n[i]);
@@ -588,6 +578,51 @@ pub fn node_face_force(
                 *d -= c.weights[i] * m;
             }
         }
+        du
+    };
+    let spot = Spot {
+        slave_mass: c.slave_mass,
+        master_mass: c.master_mass,
+        weights: &c.weights,
+        normal: &c.normal,
+        gap: c.gap,
+    };
+    kinematic_force(&spot, increment, weight, friction, dt_squared)
+}
+
+/// What [`kinematic_force`] needs besides the motion of the step.
+struct Spot<'a> {
+    slave_mass: Real,
+    master_mass: [Real; 4],
+    weights: &'a [Real; 4],
+    normal: &'a Vec3,
+    gap: Real,
+}
+
+/// The arithmetic of [`node_face_force`], shared with [`forces`] (which
+/// reads the positions from its bodies): `increment` gives the relative
+/// motion of the step Δu = (x̃_s − x_s) − Σ Nᵢ (x̃ᵢ − xᵢ), asked for only
+/// when there is friction.
+#[inline]
+fn kinematic_force(
+    c: &Spot<'_>,
+    increment: impl FnOnce() -> Vec3,
+    weight: Real,
+    friction: Real,
+    dt_squared: Real,
+) -> NodeFaceForce {
+    let m_s = c.slave_mass;
+    let inv_md: Real = (0..4)
+        .map(|i| c.weights[i] * c.weights[i] / c.master_mass[i])
+        .sum();
+    let m_eff = m_s / (1.0 + m_s * inv_md);
+    let n = *c.normal;
+    let f_n = weight * (-c.gap) * m_eff / dt_squared;
+    let mut f = n.map(|v| f_n * v);
+    let mut f_t = [0.0; 3];
+    let mut slipping = false;
+    if friction > 0.0 {
+        let du = increment();
         let dn = dot(&du, &n);
         f_t = core::array::from_fn(|a| -weight * m_eff * (du[a] - dn * n[a]) / dt_squared);
         let mag = sqrt(dot(&f_t, &f_t));
@@ -651,15 +686,21 @@ pub fn forces(
         };
         let s = c.slave as usize;
         let ids = master.quads[c.quad as usize].map(|i| i as usize);
-        let node = NodeFace {
+        let increment = || {
+            let mut du = sub(&slave.x_pred[s], &slave.x_n[s]);
+            for (i, &id) in ids.iter().enumerate() {
+                let dm = sub(&master.x_pred[id], &master.x_n[id]);
+                for (d, m) in du.iter_mut().zip(dm) {
+                    *d -= c.weights[i] * m;
+                }
+            }
+            du
+        };
+        let spot = Spot {
             slave_mass: shared_mass(slave, s_share, s),
-            slave_x_n: slave.x_n[s],
-            slave_x_pred: slave.x_pred[s],
             master_mass: ids.map(|id| shared_mass(master, m_share, id)),
-            master_x_n: ids.map(|id| master.x_n[id]),
-            master_x_pred: ids.map(|id| master.x_pred[id]),
-            weights: c.weights,
-            normal: c.normal,
+            weights: &c.weights,
+            normal: &c.normal,
             gap: c.gap,
         };
         let NodeFaceForce {
@@ -667,7 +708,7 @@ pub fn forces(
             friction: f_t,
             normal: f_n,
             slipping,
-        } = node_face_force(&node, w, mu, dt_squared);
+        } = kinematic_force(&spot, increment, w, mu, dt_squared);
         total.slipping += usize::from(slipping);
         out[k] = NodeForce {
             side: c.side,

@@ -47,6 +47,16 @@ pub fn mean_deformation_gradient(r: &HexReference, x: &HexCoords) -> Mat3 {
     f
 }
 
+/// V0 τ F⁻ᵀ from τ, F⁻¹ and V0: (τ F⁻ᵀ)_ab = Σ_k τ_ak (F⁻¹)_bk, summed
+/// k = 0, 1, 2, then scaled by V0.
+#[inline(always)]
+fn kirchhoff_to_first_pk(tau: &Mat3, f_inv: &Mat3, volume: Real) -> Mat3 {
+    Mat3::from_fn(|a, b| {
+        (tau[(a, 0)] * f_inv[(b, 0)] + tau[(a, 1)] * f_inv[(b, 1)] + tau[(a, 2)] * f_inv[(b, 2)])
+            * volume
+    })
+}
+
 /// Forces of one element at current node positions `x` (m).
 ///
 /// * `cp_inv`: in/out, the element's C_p⁻¹ (start → end of step); untouched
@@ -64,8 +74,11 @@ pub fn hex_forces(
     let F = mean_deformation_gradient(r, x);
     let up = update_point(mat, opts, &F, cp_inv)?;
     let j = crate::tensor::det_mat(&F);
-    // P = τ F⁻ᵀ; f_I = V0 P B0_I.
-    let P = mat_from_voigt(&up.tau) * inverse_with_det(&F, j).transpose() * r.volume;
+    // P = τ F⁻ᵀ; f_I = V0 P B0_I. The products are written out: left to
+    // nalgebra's generic `Mul`, whether they were inlined depended on how
+    // rustc partitioned the crate (out of line they cost 5 % of a bed run).
+    // Same summation order as nalgebra's, so the same bits.
+    let P = kirchhoff_to_first_pk(&mat_from_voigt(&up.tau), &inverse_with_det(&F, j), r.volume);
     let mut f = [[0.0; 3]; 8];
     for (fi, bi) in f.iter_mut().zip(r.b0.iter()) {
         for a in 0..3 {
