@@ -133,3 +133,93 @@ fn broad_phase_finds_exactly_the_brute_force_pairs() {
     moved[17].centre[0] += 0.5 * margin;
     assert!(needs_rebuild(&bounds, &moved, margin));
 }
+
+// Regressions found by `fuzz_inputs.rs` (issue #9).
+
+/// A strongly warped, skewed face and a point 1.3 face sizes away: the
+/// plain Newton iteration stopped at a point that was no minimum and
+/// reported the node inside the face and 0.07 behind it (a false contact).
+/// With the line search the projection descends: whatever it reports, a
+/// point it calls inside is no farther than the true closest point of the
+/// face (brute force on a 801² grid) allows.
+#[test]
+fn a_warped_skewed_face_reports_no_false_contact() {
+    let q = [
+        [0.7424753412673608, 0.07232429699752399, 0.7165678238745629],
+        [
+            -0.36059079505813646,
+            -0.13149883626287498,
+            0.7711372490669683,
+        ],
+        [-0.4108391457767893, -0.4457946524203274, 0.9745595219141283],
+        [0.5951760674884068, 0.296419139561023, 0.8463376149920782],
+    ];
+    let p = [-0.34858909461025595, 0.6203624597902218, 1.91214975116203];
+    let mut best = f64::INFINITY;
+    for i in 0..=800 {
+        for j in 0..=800 {
+            let x = bilinear(&q, -1.0 + i as f64 / 400.0, -1.0 + j as f64 / 400.0);
+            best = best.min(dist(&x, &p));
+        }
+    }
+    let r = project(&p, &q).expect("a regular face");
+    if r.inside(0.0) {
+        assert!(
+            dist(&r.point, &p) <= best * (1.0 + 1e-9),
+            "inside at distance {} but the face's closest point is {best}",
+            dist(&r.point, &p)
+        );
+    }
+    // The closest point of the face is on its edge, 1.30 away: no contact.
+    assert!(best > 1.29 && !(r.inside(0.0) && r.gap < 0.0 && r.gap > -0.3));
+}
+
+/// A face beyond f64's range gave a zero "unit" normal (|n|² overflowed);
+/// now it is reported as unusable.
+#[test]
+fn a_face_too_large_for_f64_is_refused() {
+    let q = [
+        [0.0, 0.0, 0.0],
+        [0.0, 0.0, 0.0],
+        [0.0, 0.0, 5.158992707029342e19],
+        [4.525196648703604e146, 0.0, 0.0],
+    ];
+    let p = [0.9557169300612098 * 4.525196648703604e146, 0.0, 0.0];
+    if let Some(r) = project(&p, &q) {
+        let n2: f64 = r.normal.iter().map(|v| v * v).sum();
+        assert!((n2 - 1.0).abs() < 1e-9, "normal {:?}", r.normal);
+    }
+}
+
+/// The sieve on a skewed face (the kind fuzzing found): a planar
+/// parallelogram with e1 = (1, 0, 0), e2 = (0.95, 0.1, 0) and a node at
+/// (ξ, η) = (0.9, 0.9), 0.01 behind it. The old parallelogram coordinate
+/// (p − c)·e1/|e1|² = 0.9 + 0.9·0.95 = 1.755 exceeded the old limit 1.5 and
+/// rejected this contact; the oblique coordinates give ξ = 0.9 exactly.
+#[test]
+fn the_sieve_passes_contacts_on_skewed_faces() {
+    use granbed_kernel::contact::quad::QuadSieve;
+    let (e1, e2) = ([1.0, 0.0, 0.0], [0.95, 0.1, 0.0]);
+    let corner = |s1: f64, s2: f64| -> V { core::array::from_fn(|a| s1 * e1[a] + s2 * e2[a]) };
+    let q = [
+        corner(-1.0, -1.0),
+        corner(1.0, -1.0),
+        corner(1.0, 1.0),
+        corner(-1.0, 1.0),
+    ];
+    let p = [0.9 * 1.95, 0.09, -0.01];
+    let r = project(&p, &q).unwrap();
+    assert!(
+        (r.xi - 0.9).abs() < 1e-12 && (r.eta - 0.9).abs() < 1e-12,
+        "{r:?}"
+    );
+    assert!((r.gap + 0.01).abs() < 1e-12, "gap {}", r.gap);
+    let sieve = QuadSieve::new(&q).unwrap();
+    assert!(
+        sieve.may_touch(&p, 0.02, 0.0),
+        "the sieve rejected a contact"
+    );
+    // And it still rejects what is plainly out of reach.
+    assert!(!sieve.may_touch(&[10.0, 10.0, -0.01], 0.02, 0.0));
+    assert!(!sieve.may_touch(&[0.0, 0.0, -1.0], 0.02, 0.0));
+}

@@ -1,0 +1,247 @@
+//! Fuzzing of what `granbed-cli bed` reads from disk (issue #9): scene
+//! TOML and checkpoints, mutated at random. Every read must return — no
+//! panic — with a clear error or a valid value:
+//! * scenes: the published scene with bytes flipped, inserted, deleted or
+//!   the text cut short; a scene that parses must also validate;
+//! * checkpoints: a real small-bed checkpoint truncated, with bytes
+//!   flipped (caught by the checksum), with its version changed, and with
+//!   its payload mutated *and the checksum recomputed*, which drives the
+//!   payload decoder itself with hostile lengths and values. A checkpoint
+//!   that decodes is also restored into the bed (`--resume`), which must
+//!   accept it or refuse it with an error.
+//!
+//! `PROPTEST_CASES` sets the cases per property (default below).
+
+mod common;
+
+use std::path::{Path, PathBuf};
+use std::sync::OnceLock;
+
+use granbed_cli::bed::checkpoint::{Checkpoint, FILE_NAME};
+use granbed_cli::bed::{DEFAULT_SCENE, Scene};
+use proptest::prelude::*;
+
+fn cases(default: u32) -> u32 {
+    std::env::var("PROPTEST_CASES")
+        .ok()
+        .and_then(|v| v.parse().ok())
+        .unwrap_or(default)
+}
+
+/// One edit of a byte string.
+#[derive(Clone, Debug)]
+enum Edit {
+    Flip(usize, u8),
+    Insert(usize, u8),
+    Delete(usize),
+    Truncate(usize),
+}
+
+fn edit() -> impl Strategy<Value = Edit> {
+    prop_oneof![
+        (any::<usize>(), any::<u8>()).prop_map(|(i, b)| Edit::Flip(i, b)),
+        (any::<usize>(), any::<u8>()).prop_map(|(i, b)| Edit::Insert(i, b)),
+        any::<usize>().prop_map(Edit::Delete),
+        any::<usize>().prop_map(Edit::Truncate),
+    ]
+}
+
+fn apply(bytes: &mut Vec<u8>, edits: &[Edit]) {
+    for e in edits {
+        let n = bytes.len().max(1);
+        match *e {
+            Edit::Flip(i, b) => {
+                if let Some(x) = bytes.get_mut(i % n) {
+                    *x ^= b.max(1);
+                }
+            }
+            Edit::Insert(i, b) => bytes.insert(i % (bytes.len() + 1), b),
+            Edit::Delete(i) => {
+                if !bytes.is_empty() {
+                    bytes.remove(i % n);
+                }
+            }
+            Edit::Truncate(i) => bytes.truncate(i % n),
+        }
+    }
+}
+
+/// Scene values that stress the validation, spliced into the text.
+fn hostile_value() -> impl Strategy<Value = String> {
+    prop_oneof![
+        Just("nan".to_owned()),
+        Just("inf".to_owned()),
+        Just("-inf".to_owned()),
+        Just("-1".to_owned()),
+        Just("0".to_owned()),
+        Just("1e308".to_owned()),
+        Just("18446744073709551616".to_owned()),
+        Just("\"x\"".to_owned()),
+        Just("[]".to_owned()),
+        any::<f64>().prop_map(|v| format!("{v:?}")),
+        any::<i64>().prop_map(|v| v.to_string()),
+    ]
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(cases(2000)))]
+
+    #[test]
+    fn mutated_scenes_parse_or_fail_cleanly(edits in proptest::collection::vec(edit(), 1..8)) {
+        let mut bytes = DEFAULT_SCENE.as_bytes().to_vec();
+        apply(&mut bytes, &edits);
+        if let Ok(text) = core::str::from_utf8(&bytes)
+            && let Ok(scene) = Scene::from_toml(text)
+        {
+            prop_assert!(scene.validate().is_ok());
+        }
+    }
+
+    #[test]
+    fn hostile_scene_values_are_rejected_or_valid(
+        line in 0usize..64,
+        value in hostile_value(),
+    ) {
+        // Replace the value of one `key = value` line of the scene.
+        let lines: Vec<&str> = DEFAULT_SCENE.lines().collect();
+        let assignments: Vec<usize> = (0..lines.len())
+            .filter(|&i| lines[i].contains(" = ") && !lines[i].starts_with('#'))
+            .collect();
+        let target = assignments[line % assignments.len()];
+        let key = lines[target].split(" = ").next().unwrap();
+        let text: String = lines
+            .iter()
+            .enumerate()
+            .map(|(i, l)| if i == target { format!("{key} = {value}\n") } else { format!("{l}\n") })
+            .collect();
+        match Scene::from_toml(&text) {
+            Ok(scene) => prop_assert!(scene.validate().is_ok()),
+            Err(e) => {
+                let message = format!("{e:#}");
+                prop_assert!(!message.is_empty());
+            }
+        }
+    }
+}
+
+/// A small bed's checkpoint (4 coarse granules stopped at 0.5 % strain),
+/// made once per test binary: its directory and bytes.
+fn base_checkpoint() -> &'static (PathBuf, Vec<u8>) {
+    static BASE: OnceLock<(PathBuf, Vec<u8>)> = OnceLock::new();
+    BASE.get_or_init(|| {
+        let dir = common::fresh_dir("fuzz_files", "base");
+        let run = common::cli(&[
+            "bed",
+            "--quiet",
+            "--granules",
+            "4",
+            "--mesh",
+            "4x1",
+            "--die-diameter-mm",
+            "4.5",
+            "--strain",
+            "0.01",
+            "--stop-at-strain",
+            "0.005",
+            "--out",
+            dir.to_str().unwrap(),
+        ]);
+        assert_eq!(run.code, 0, "{}", run.stderr);
+        let bytes = std::fs::read(dir.join(FILE_NAME)).unwrap();
+        (dir, bytes)
+    })
+}
+
+/// FNV-1a 64, the checkpoint's checksum (as documented in checkpoint.rs).
+fn fnv1a(bytes: &[u8]) -> u64 {
+    bytes.iter().fold(0xcbf2_9ce4_8422_2325, |h, &b| {
+        (h ^ u64::from(b)).wrapping_mul(0x0000_0100_0000_01b3)
+    })
+}
+
+/// Writes `bytes` as the checkpoint of a fresh directory `name`.
+fn write_checkpoint(name: &str, bytes: &[u8]) -> PathBuf {
+    let dir = common::fresh_dir("fuzz_files", name);
+    std::fs::create_dir_all(&dir).unwrap();
+    std::fs::write(dir.join(FILE_NAME), bytes).unwrap();
+    dir
+}
+
+fn read(dir: &Path) -> Result<Checkpoint, String> {
+    Checkpoint::read(dir).map_err(|e| format!("{e:#}"))
+}
+
+#[test]
+fn the_base_checkpoint_reads_back() {
+    let (dir, _) = base_checkpoint();
+    read(dir).expect("an intact checkpoint reads");
+}
+
+#[test]
+fn truncated_checkpoints_are_refused_with_a_reason() {
+    let (_, bytes) = base_checkpoint();
+    // Every cut in the header, then cuts spread over the payload.
+    let cuts = (0..64).chain((64..bytes.len()).step_by(bytes.len() / 200 + 1));
+    for cut in cuts {
+        let dir = write_checkpoint("truncated", &bytes[..cut]);
+        let e = read(&dir).expect_err("a truncated checkpoint must be refused");
+        assert!(
+            e.contains("not a usable checkpoint"),
+            "cut at {cut}: unclear error: {e}"
+        );
+    }
+}
+
+#[test]
+fn a_wrong_version_is_named() {
+    let (_, bytes) = base_checkpoint();
+    let mut b = bytes.clone();
+    b[16..20].copy_from_slice(&99u32.to_le_bytes());
+    let e = read(&write_checkpoint("version", &b)).unwrap_err();
+    assert!(e.contains("format version 99"), "{e}");
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(cases(300)))]
+
+    #[test]
+    fn corrupted_checkpoints_are_refused(edits in proptest::collection::vec(edit(), 1..4)) {
+        let (_, bytes) = base_checkpoint();
+        let mut b = bytes.clone();
+        apply(&mut b, &edits);
+        prop_assume!(&b != bytes);
+        let dir = write_checkpoint("corrupted", &b);
+        // The checksum (or the header) catches every change.
+        prop_assert!(read(&dir).is_err());
+    }
+
+    #[test]
+    fn mutated_payloads_with_a_valid_checksum_decode_or_fail_cleanly(
+        edits in proptest::collection::vec(edit(), 1..6),
+    ) {
+        let (_, bytes) = base_checkpoint();
+        let mut payload = bytes[36..].to_vec();
+        apply(&mut payload, &edits);
+        let mut b = bytes[..20].to_vec();
+        b.extend_from_slice(&(payload.len() as u64).to_le_bytes());
+        b.extend_from_slice(&fnv1a(&payload).to_le_bytes());
+        b.extend_from_slice(&payload);
+        let dir = write_checkpoint("payload", &b);
+        if read(&dir).is_ok() {
+            // It decoded: resuming must accept it or refuse it with an
+            // error (exit status 1 or 2), never panic. The run stops just
+            // past the checkpoint's strain (0.005).
+            let run = common::cli(&[
+                "bed",
+                "--quiet",
+                "--resume",
+                dir.to_str().unwrap(),
+                "--strain",
+                "0.01",
+                "--stop-at-strain",
+                "0.0051",
+            ]);
+            prop_assert!(run.code <= 2, "exit {}: {}", run.code, run.stderr);
+        }
+    }
+}
