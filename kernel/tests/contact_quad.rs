@@ -223,3 +223,23 @@ fn the_sieve_passes_contacts_on_skewed_faces() {
     assert!(!sieve.may_touch(&[10.0, 10.0, -0.01], 0.02, 0.0));
     assert!(!sieve.may_touch(&[0.0, 0.0, -1.0], 0.02, 0.0));
 }
+
+/// A point 3e304 away from a face with one corner at 4e139: the line
+/// search found no descent at the start, whose coordinates were so large
+/// that the bilinear weights cancelled to a sum of 0. The reported
+/// coordinates now stay in the iterates' box [−4, 4]².
+#[test]
+fn a_far_point_gets_bounded_coordinates_and_weights_that_sum_to_one() {
+    let q = [
+        [0.0, -0.9477576316510261, 0.0],
+        [0.0, -0.6205348357968942, -0.16378925119772084],
+        [0.0, 0.4276509334102136, -0.0946795611330926],
+        [4.4579037026861536e139, 0.0, 0.0],
+    ];
+    let p = [0.0, -7.527417871229974e164 * 4.4579037026861536e139, 0.0];
+    if let Some(r) = project(&p, &q) {
+        assert!(r.xi.abs() <= 4.0 && r.eta.abs() <= 4.0, "{r:?}");
+        let w: f64 = r.weights.iter().sum();
+        assert!((w - 1.0).abs() < 1e-9, "weights sum to {w}");
+    }
+}

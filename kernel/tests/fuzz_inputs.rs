@@ -227,3 +227,30 @@ proptest! {
         }
     }
 }
+
+/// Found by the long campaign: det F = 2.8e-310 (positive but subnormal)
+/// made η = η0/J infinite and the update returned it as a success. A
+/// crushed point is now refused like an inverted one, state untouched.
+#[test]
+fn a_crushed_point_is_refused() {
+    use granbed_kernel::constitutive::UpdateError;
+    let material = GranuleType::B1.params().validate().unwrap();
+    let f = mat([
+        0.0,
+        0.06091301814140482,
+        0.0,
+        0.0,
+        -0.0,
+        5.079974356325416e-309,
+        0.9162218651876999,
+        0.0,
+        0.0,
+    ]);
+    let mut cp = VOIGT_IDENTITY;
+    let r = update_point(&material, &UpdateOptions::default(), &f, &mut cp);
+    assert!(
+        matches!(r, Err(UpdateError::InvertedDeformation { .. })),
+        "{r:?}"
+    );
+    assert_eq!(cp, VOIGT_IDENTITY);
+}

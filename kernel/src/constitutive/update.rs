@@ -66,7 +66,8 @@ pub struct UpdateInfo {
 pub enum UpdateError {
     /// A component of F is NaN or infinite.
     NonFinite,
-    /// J = det F ≤ 0: the element is inverted.
+    /// J = det F ≤ 0, or so small that η0/J overflows: the element is
+    /// inverted or crushed flat.
     InvertedDeformation {
         /// det F.
         j: Real,
@@ -164,6 +165,11 @@ pub fn update_point(
     let beta_tr = tensor::norm(&s_tr);
     let alpha_tr = theta_tr + elastic::h(mat, je_tr);
     let eta = mat.params.eta0 / J;
+    if !eta.is_finite() {
+        // J > 0 but so small (subnormal) that η = η0/J overflows: crushed
+        // flat, for the update as good as inverted (found by fuzzing).
+        return Err(UpdateError::InvertedDeformation { j: J });
+    }
     let coefficients = yield_surface::coefficients(&mat.params, eta);
     let sy = mat.params.yield_stress_pa;
     let scale = yield_surface::yield_scale(&coefficients, sy);

@@ -179,7 +179,10 @@ pub fn project(p: &Vec3, x: &[Vec3; 4]) -> Option<QuadProjection> {
     if !(xi.is_finite() && eta.is_finite()) {
         return None;
     }
-    finish(p, &q, xi, eta)
+    // A search that found no descent at its start returns the start,
+    // which may lie far out (the weights of ξ ≥ 2⁵³ cancel to a sum of 0;
+    // found by fuzzing): keep it in the same box as the iterates.
+    finish(p, &q, xi.clamp(-4.0, 4.0), eta.clamp(-4.0, 4.0))
 }
 
 /// The projection record at (ξ, η) (no minimisation).
