@@ -33,9 +33,12 @@ pub struct GranbedMaterialParams {
     pub friction: f64,
 }
 
-impl From<&GranbedMaterialParams> for MaterialParams {
-    fn from(p: &GranbedMaterialParams) -> Self {
-        Self {
+/// Builds a `$to` from `$from` with the same eight material fields (the two
+/// structs mirror each other; the list is written once).
+macro_rules! material_fields {
+    ($from:expr => $to:ident) => {{
+        let p = $from;
+        $to {
             youngs_modulus_pa: p.youngs_modulus_pa,
             poisson_ratio: p.poisson_ratio,
             yield_stress_pa: p.yield_stress_pa,
@@ -45,21 +48,18 @@ impl From<&GranbedMaterialParams> for MaterialParams {
             true_density_kg_m3: p.true_density_kg_m3,
             friction: p.friction,
         }
+    }};
+}
+
+impl From<&GranbedMaterialParams> for MaterialParams {
+    fn from(p: &GranbedMaterialParams) -> Self {
+        material_fields!(p => MaterialParams)
     }
 }
 
 impl From<MaterialParams> for GranbedMaterialParams {
     fn from(p: MaterialParams) -> Self {
-        Self {
-            youngs_modulus_pa: p.youngs_modulus_pa,
-            poisson_ratio: p.poisson_ratio,
-            yield_stress_pa: p.yield_stress_pa,
-            eta0: p.eta0,
-            cp: p.cp,
-            eta_c: p.eta_c,
-            true_density_kg_m3: p.true_density_kg_m3,
-            friction: p.friction,
-        }
+        material_fields!(p => GranbedMaterialParams)
     }
 }
 
