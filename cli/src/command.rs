@@ -12,6 +12,7 @@ use crate::granule::GranuleArgs;
 use crate::output::Streams;
 use crate::pack::PackArgs;
 use crate::point::PointArgs;
+use crate::study::StudyArgs;
 
 /// granbed: a combined finite/discrete element simulator of granule-bed die
 /// compaction.
@@ -48,6 +49,9 @@ pub enum Command {
     /// strain; write the compression profile and a summary with the
     /// Kawakita fit. Without arguments it runs the published scene.
     Bed(BedArgs),
+    /// Studies of the code itself: `work-precision` measures what each
+    /// numerical setting costs and how far it moves the answer.
+    Study(StudyArgs),
 }
 
 impl Command {
@@ -59,6 +63,7 @@ impl Command {
             Self::Granule(args) => args.run(streams),
             Self::Pack(args) => args.run(streams),
             Self::Bed(args) => args.run(streams),
+            Self::Study(args) => args.run(streams),
         }
     }
 }

@@ -41,6 +41,7 @@ pub mod model;
 pub mod output;
 pub mod pack;
 pub mod point;
+pub mod study;
 pub mod vtk;
 
 pub use command::{Cli, Command};
