@@ -408,6 +408,8 @@ pub fn run_bed(
                 next += scene.output_strain_interval;
             }
             if dir.is_some() {
+                // Drop the old copy first: one copy of the state at a time.
+                drop(last_good.take());
                 last_good = Some(make(&asm, &samples, &window, next, snapshots_done));
             }
         }
