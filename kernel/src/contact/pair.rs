@@ -223,6 +223,8 @@ pub struct CandidateFace {
     pub corners: [Vec3; 4],
     /// Gap window g_max of this face, m.
     pub window: Real,
+    /// The face's box.
+    pub bounds: Aabb,
     /// The face's box grown by `window`.
     pub reach: Aabb,
     /// The cheap pre-test of the projection (`None`: degenerate face).
@@ -235,6 +237,7 @@ impl Default for CandidateFace {
             quad: 0,
             corners: [[0.0; 3]; 4],
             window: 0.0,
+            bounds: Aabb::EMPTY,
             reach: Aabb::EMPTY,
             sieve: None,
         }
@@ -319,6 +322,7 @@ fn detect_pass(
                 quad: q as u32,
                 corners,
                 window,
+                bounds: *bounds,
                 reach: bounds.expanded(window),
                 sieve: QuadSieve::new(&corners),
             };
@@ -411,14 +415,35 @@ fn closest_face(
             best = Some(hit);
         }
     }
-    if best.is_some() {
-        return best;
-    }
-    if !near_outside {
+    if let Some(hit) = best {
+        // The nearest surface point decides, edges included: a face whose
+        // clamped closest point is nearer than the hit's depth means the
+        // node sits beside that face, and the deep hit is the far side of a
+        // folded surface (seen at 55 % strain in a dense bed: a node just
+        // off one face, 7 µm from it, "inside" a tilted neighbour 70 µm
+        // deep; the force that closed that gap shot the face's corner off
+        // at 200× the punch speed). A face sharing an edge with the hit's
+        // cannot be nearer (its closest point on that edge is a point of
+        // the hit's face too), so only other faces can.
+        let depth = abs(hit.projection.gap);
+        let nearer = candidates.iter().any(|face| {
+            face.quad != hit.quad
+                && face.bounds.distance_to(&p) < depth
+                && project_clamped(&p, &face.corners)
+                    .is_some_and(|pr| norm(&sub(&p, &pr.point)) < depth * (1.0 - NEARER_TOLERANCE))
+        });
+        if !nearer {
+            return best;
+        }
+    } else if !near_outside {
         return None;
     }
     concave_edge(&p, candidates).filter(|h| opposing(&h.projection.normal))
 }
+
+/// Relative margin by which another face's closest point must be nearer
+/// than a hit's depth to overrule it (round-off of the two projections).
+const NEARER_TOLERANCE: Real = 1e-9;
 
 /// The closest point of `p` on the candidate faces confined to their
 /// edges, when two or more faces share it (a concave edge or corner): the

@@ -1,0 +1,109 @@
+//! Node-to-surface detection between two bodies (`contact::pair::detect`)
+//! on hand-made surfaces: which face a node is held against.
+
+use granbed_kernel::Real;
+use granbed_kernel::contact::broad::bounding_sphere;
+use granbed_kernel::contact::pair::{CandidateFace, Constraint, PairSettings, detect};
+use granbed_kernel::contact::surface::{Aabb, SurfaceBody, quad_bounds};
+
+type Vec3 = [Real; 3];
+
+/// Detects `slave`'s nodes (one quad, facing −z) against `master`'s quads
+/// (single pass, a margin that covers the unit-sized scene: the master's
+/// faces must lie within it of the slave's box to be tried).
+fn constraints(slave: &[Vec3], master: &[Vec3], master_quads: &[[u32; 4]]) -> Vec<Constraint> {
+    let slave_quads = [[0u32, 1, 2, 3]];
+    let slave_node_quads = [[0u32, u32::MAX, u32::MAX, u32::MAX]; 4];
+    let master_node_quads = vec![[u32::MAX; 4]; master.len()];
+    let mut slave_boxes = [Aabb::EMPTY; 1];
+    quad_bounds(slave, &slave_quads, &mut slave_boxes);
+    let mut master_boxes = vec![Aabb::EMPTY; master_quads.len()];
+    quad_bounds(master, master_quads, &mut master_boxes);
+    let mass_s = [1.0; 4];
+    let mass_m = vec![1.0; master.len()];
+    let a = SurfaceBody {
+        x_n: slave,
+        x_pred: slave,
+        mass: &mass_s,
+        first_surface: 0,
+        quads: &slave_quads,
+        node_quads: &slave_node_quads,
+        bounds: Aabb::of_surface(slave, 0),
+        sphere: bounding_sphere(slave, 0),
+        quad_bounds: &slave_boxes,
+    };
+    let b = SurfaceBody {
+        x_n: master,
+        x_pred: master,
+        mass: &mass_m,
+        first_surface: 0,
+        quads: master_quads,
+        node_quads: &master_node_quads,
+        bounds: Aabb::of_surface(master, 0),
+        sphere: bounding_sphere(master, 0),
+        quad_bounds: &master_boxes,
+    };
+    let settings = PairSettings {
+        margin: 0.5,
+        symmetric: false,
+        ..PairSettings::standard(0.0)
+    };
+    let mut scratch = vec![CandidateFace::default(); master_quads.len()];
+    let mut out = vec![Constraint::default(); 16];
+    let n = detect(&a, &b, &settings, &mut scratch, &mut out).unwrap();
+    out.truncate(n);
+    out
+}
+
+/// A slave quad in the plane z = `z`, corner (x, 0.5), facing −z.
+fn slave_at(x: Real, z: Real) -> [Vec3; 4] {
+    [
+        [x, 0.5, z],
+        [x, 0.6, z],
+        [x + 0.1, 0.6, z],
+        [x + 0.1, 0.5, z],
+    ]
+}
+
+/// A master surface folded over itself: face 0 in z = 0 over x ∈ [0, 1],
+/// face 1 (not connected to it) in z = 0.3 over x ∈ [0.8, 1.6], both
+/// facing +z.
+fn folded_master() -> (Vec<Vec3>, Vec<[u32; 4]>) {
+    let x = vec![
+        [0.0, 0.0, 0.0],
+        [1.0, 0.0, 0.0],
+        [1.0, 1.0, 0.0],
+        [0.0, 1.0, 0.0],
+        [0.8, 0.0, 0.3],
+        [1.6, 0.0, 0.3],
+        [1.6, 1.0, 0.3],
+        [0.8, 1.0, 0.3],
+    ];
+    (x, vec![[0, 1, 2, 3], [4, 5, 6, 7]])
+}
+
+#[test]
+fn a_node_beside_a_near_face_is_not_held_against_a_far_side_face() {
+    let (master, quads) = folded_master();
+    // Just beyond face 0's edge, 5 µm-scale below its plane: 0.02 from
+    // face 0, but "inside" face 1, 0.305 behind it (within its window of
+    // 0.25 × diagonal = 0.32). The nearest surface is face 0's edge, which
+    // the node is beside, not behind: no contact.
+    let slave = slave_at(1.02, -0.005);
+    let found = constraints(&slave, &master, &quads);
+    assert!(found.is_empty(), "far-side contacts: {found:?}");
+}
+
+#[test]
+fn a_node_behind_a_face_far_from_other_faces_is_held_against_it() {
+    let (master, quads) = folded_master();
+    // 0.01 behind face 1, well away from face 0 (0.29 below is face 0's
+    // plane, but its edge is 0.3 away): a contact with face 1.
+    let slave = slave_at(1.4, 0.29);
+    let found = constraints(&slave, &master, &quads);
+    assert_eq!(found.len(), 4, "{found:?}");
+    for c in &found {
+        assert_eq!(c.quad, 1);
+        assert!((c.gap + 0.01).abs() < 1e-12, "gap {}", c.gap);
+    }
+}
