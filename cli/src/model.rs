@@ -161,6 +161,20 @@ impl OwnedReference {
         })
     }
 
+    /// The shortest edge of the surface quads, m: the element size that
+    /// contact tolerances are stated against (penetration < 1 % of it).
+    pub fn shortest_surface_edge(&self) -> Real {
+        self.quads
+            .iter()
+            .flat_map(|q| (0..4).map(move |k| (q[k], q[(k + 1) % 4])))
+            .map(|(a, b)| {
+                let (p, q) = (self.positions[a as usize], self.positions[b as usize]);
+                let d: [Real; 3] = core::array::from_fn(|i| p[i] - q[i]);
+                granbed_kernel::math::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2])
+            })
+            .fold(Real::INFINITY, Real::min)
+    }
+
     /// Generates the hex cube of side `side` (m) with `n` divisions per edge,
     /// centred at the origin, and computes the element data.
     pub fn cube(side: Real, n: u32) -> anyhow::Result<Self> {

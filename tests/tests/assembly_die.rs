@@ -42,16 +42,7 @@ fn a_small_die_compresses_to_thirty_percent() {
     let mesh = OwnedReference::sphere(R, MeshLevel::new(4, 1), false).unwrap();
     let placed = placements(&centres, 7);
     let mut asm = Assembly::new(params, &mesh, &placed, scene.walls()).unwrap();
-    // Element size: the shortest surface edge of the reference mesh.
-    let h = mesh
-        .quads
-        .iter()
-        .flat_map(|q| (0..4).map(move |k| (q[k], q[(k + 1) % 4])))
-        .map(|(a, b)| {
-            let (p, q) = (mesh.positions[a as usize], mesh.positions[b as usize]);
-            ((p[0] - q[0]).powi(2) + (p[1] - q[1]).powi(2) + (p[2] - q[2]).powi(2)).sqrt()
-        })
-        .fold(Real::INFINITY, Real::min);
+    let h = mesh.shortest_surface_edge();
     let end = scene.time_of_strain(0.3);
     let mut worst_gap: Real = 0.0;
     let mut min_j = Real::INFINITY;

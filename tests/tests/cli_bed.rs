@@ -103,6 +103,21 @@ fn a_small_bed_runs_end_to_end_and_is_thread_independent() {
     assert!(fit.points >= 10);
     assert!(number(&s, "energy_residual_rel") < 0.01);
     assert!(number(&s, "min_jacobian") > 0.0);
+    // Issue #9's contact criterion: granules overlap by less than 1 % of
+    // the element size at every output row; the summary's figure is the
+    // table's largest overlap.
+    let overlap = table.num("penetration_m");
+    assert!(overlap.iter().all(|p| p.is_finite() && *p >= 0.0));
+    let deepest = overlap.iter().copied().fold(0.0, f64::max);
+    assert_eq!(number(&s, "max_penetration_m"), deepest);
+    assert!(
+        number(&s, "max_penetration_rel_element") < 0.01,
+        "overlap {deepest:e} m"
+    );
+    // Nodes touching the punch move with it: the fastest node is at least
+    // as fast once the punch carries load.
+    let speed = table.num("max_node_speed_m_s");
+    assert!(speed[n / 2..].iter().all(|v| *v >= 0.9 * 0.05), "{speed:?}");
     assert_eq!(number(&s, "granules"), 30.0);
     assert_eq!(number(&s, "elements"), 30.0 * 160.0);
     assert!(number(&s, "peak_memory_bytes") > 0.0);

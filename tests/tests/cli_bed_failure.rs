@@ -2,11 +2,13 @@
 //! stops cleanly with a message and a usable checkpoint). A time-step
 //! safety factor of 1.9 — the explicit step almost twice its stability
 //! limit — makes a small bed blow up within a few dozen steps:
-//! * the speed watchdog stops it before an element fails, naming the
-//!   granule, the step and the speed; a checkpoint from before the failure
-//!   is on disk and `--resume DIR --time-step-safety 0.9` finishes the run;
-//! * with the watchdog off, the kernel's failure (granule, element, step)
-//!   stops it, again with a readable, finite checkpoint;
+//! * the energy watchdog (on by default) stops it within a few steps,
+//!   before an element fails, naming the granule, the step and the
+//!   energies; a checkpoint from before the failure is on disk and
+//!   `--resume DIR --time-step-safety 0.9` finishes the run;
+//! * the speed watchdog, set tight on a sane run, stops it by name;
+//! * with both watchdogs off, the kernel's failure (granule, element,
+//!   step) stops it, again with a readable, finite checkpoint;
 //! * out-of-range factors are rejected by name.
 
 mod common;
@@ -18,8 +20,8 @@ use granbed_cli::bed::DEFAULT_SCENE;
 use granbed_cli::bed::checkpoint::Checkpoint;
 
 /// A 20-granule coarse bed to 1 % strain, with the given safety factor and
-/// watchdog ratio, written as a scene file in `dir`.
-fn scene_file(dir: &Path, safety: f64, watchdog: f64) -> std::path::PathBuf {
+/// watchdog ratios (energy, speed), written as a scene file in `dir`.
+fn scene_file(dir: &Path, safety: f64, watchdog: [f64; 2]) -> std::path::PathBuf {
     std::fs::create_dir_all(dir).unwrap();
     let text = DEFAULT_SCENE
         .replace("granules = 1000", "granules = 20")
@@ -31,10 +33,16 @@ fn scene_file(dir: &Path, safety: f64, watchdog: f64) -> std::path::PathBuf {
             &format!("time_step_safety = {safety}"),
         )
         .replace(
-            "watchdog_speed_ratio = 200.0",
-            &format!("watchdog_speed_ratio = {watchdog}"),
+            "watchdog_energy_ratio = 2.0",
+            &format!("watchdog_energy_ratio = {:?}", watchdog[0]),
+        )
+        .replace(
+            "watchdog_speed_ratio = 2000.0",
+            &format!("watchdog_speed_ratio = {:?}", watchdog[1]),
         );
     assert!(text.contains(&format!("time_step_safety = {safety}")));
+    assert!(text.contains(&format!("watchdog_energy_ratio = {:?}", watchdog[0])));
+    assert!(text.contains(&format!("watchdog_speed_ratio = {:?}", watchdog[1])));
     let path = dir.join("scene.toml");
     std::fs::write(&path, text).unwrap();
     path
@@ -64,14 +72,14 @@ fn usable_checkpoint(out: &Path) -> Checkpoint {
 }
 
 #[test]
-fn the_watchdog_stops_a_runaway_bed_and_its_checkpoint_resumes() {
+fn the_energy_watchdog_stops_a_runaway_bed_and_its_checkpoint_resumes() {
     let dir = common::fresh_dir("cli_bed_failure", "watchdog");
-    let scene = scene_file(&dir, 1.9, 200.0);
+    let scene = scene_file(&dir, 1.9, [2.0, 2000.0]);
     let out = dir.join("out");
     let r = run(&scene, &out);
     assert_eq!(r.code, 1, "the unstable run must fail:\n{}", r.stderr);
     for needle in [
-        "watchdog limit",
+        "the kinetic energy",
         "granule ",
         "step ",
         "a checkpoint from before the failure, at C = ",
@@ -116,9 +124,25 @@ fn the_watchdog_stops_a_runaway_bed_and_its_checkpoint_resumes() {
 }
 
 #[test]
-fn without_the_watchdog_the_kernel_failure_is_named_and_a_checkpoint_kept() {
+fn a_tight_speed_watchdog_stops_a_sane_run_by_name() {
+    // Limit = the punch speed: falling and rearranging granules outrun it.
+    let dir = common::fresh_dir("cli_bed_failure", "speed");
+    let scene = scene_file(&dir, 0.9, [2.0, 1.0]);
+    let out = dir.join("out");
+    let r = run(&scene, &out);
+    assert_eq!(r.code, 1, "the run must be stopped:\n{}", r.stderr);
+    assert!(
+        r.stderr.contains("watchdog limit of 5.0000e-2 m/s"),
+        "{}",
+        r.stderr
+    );
+    usable_checkpoint(&out);
+}
+
+#[test]
+fn without_the_watchdogs_the_kernel_failure_is_named_and_a_checkpoint_kept() {
     let dir = common::fresh_dir("cli_bed_failure", "kernel");
-    let scene = scene_file(&dir, 1.9, 1e9);
+    let scene = scene_file(&dir, 1.9, [1e9, 1e9]);
     let out = dir.join("out");
     let r = run(&scene, &out);
     assert_eq!(r.code, 1, "the unstable run must fail:\n{}", r.stderr);
@@ -137,9 +161,10 @@ fn without_the_watchdog_the_kernel_failure_is_named_and_a_checkpoint_kept() {
 fn out_of_range_factors_are_rejected_by_name() {
     let dir = common::fresh_dir("cli_bed_failure", "ranges");
     for (safety, watchdog, field) in [
-        (3.0, 200.0, "time_step_safety"),
-        (0.0, 200.0, "time_step_safety"),
-        (0.9, 0.5, "watchdog_speed_ratio"),
+        (3.0, [2.0, 2000.0], "time_step_safety"),
+        (0.0, [2.0, 2000.0], "time_step_safety"),
+        (0.9, [2.0, 0.5], "watchdog_speed_ratio"),
+        (0.9, [0.5, 2000.0], "watchdog_energy_ratio"),
     ] {
         let scene = scene_file(&dir, safety, watchdog);
         let r = run(&scene, &dir.join("out"));

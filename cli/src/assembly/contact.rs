@@ -73,11 +73,22 @@ pub struct ContactPhase {
 fn body<'a>(
     g: &'a GranuleStore,
     mesh: &'a OwnedReference,
+    boxes: (Aabb, Bound, &'a [Aabb]),
+) -> SurfaceBody<'a> {
+    body_at(g, &g.x_pred, mesh, boxes)
+}
+
+/// The kernel's view of granule `g` with `x_pred` as the configuration
+/// to detect on (its x̃, or x_n itself to measure the current overlap).
+fn body_at<'a>(
+    g: &'a GranuleStore,
+    x_pred: &'a [[Real; 3]],
+    mesh: &'a OwnedReference,
     (bounds, sphere, quad_bounds): (Aabb, Bound, &'a [Aabb]),
 ) -> SurfaceBody<'a> {
     SurfaceBody {
         x_n: &g.x,
-        x_pred: &g.x_pred,
+        x_pred,
         mass: &g.mass,
         first_surface: mesh.positions.len() - mesh.surface_nodes,
         quads: &mesh.quads,
@@ -384,32 +395,25 @@ impl ContactPhase {
         any
     }
 
-    /// Most negative granule–granule gap on the current positions x_n, m.
+    /// Most negative granule–granule gap on the current positions x_n, m
+    /// (0 when nothing overlaps): a detection pass on x_n, pairs in
+    /// parallel (a minimum, so the same for any thread count).
     pub(super) fn penetration(
-        &mut self,
         granules: &[GranuleStore],
         mesh: &OwnedReference,
         settings: &PairSettings,
     ) -> Result<Real, granbed_kernel::contact::pair::ContactError> {
         let first = mesh.positions.len() - mesh.surface_nodes;
-        let at_rest: Vec<GranuleStore> = granules
-            .iter()
-            .map(|g| {
-                let mut c = g.clone();
-                c.x_pred.clone_from(&g.x);
-                c
-            })
-            .collect();
-        let bounds: Vec<Bound> = at_rest
+        let bounds: Vec<Bound> = granules
             .iter()
             .map(|g| bounding_sphere(&g.x, first))
             .collect();
-        let boxes: Vec<Aabb> = at_rest
+        let boxes: Vec<Aabb> = granules
             .iter()
             .map(|g| Aabb::of_surface(&g.x, first))
             .collect();
-        let quad_boxes: Vec<Vec<Aabb>> = at_rest
-            .iter()
+        let quad_boxes: Vec<Vec<Aabb>> = granules
+            .par_iter()
             .map(|g| {
                 let mut out = vec![Aabb::EMPTY; mesh.quads.len()];
                 quad_bounds(&g.x, &mesh.quads, &mut out);
@@ -428,23 +432,24 @@ impl ContactPhase {
             },
             &mut pairs,
         )?;
-        let mut min_gap: Real = 0.0;
-        let mut scratch = Vec::new();
-        for p in &pairs[..n] {
-            let (a, b) = (p.a as usize, p.b as usize);
-            let mut w = PairWork::default();
-            detect_growing(
-                &body(&at_rest[a], mesh, (boxes[a], bounds[a], &quad_boxes[a])),
-                &body(&at_rest[b], mesh, (boxes[b], bounds[b], &quad_boxes[b])),
-                settings,
-                &mut scratch,
-                &mut w,
-            )?;
-            for c in w.constraints() {
-                min_gap = min_gap.min(c.gap);
-            }
-        }
-        Ok(min_gap)
+        pairs[..n]
+            .par_iter()
+            .map_init(
+                || (Vec::new(), PairWork::default()),
+                |(scratch, w), p| {
+                    let (a, b) = (p.a as usize, p.b as usize);
+                    let (ga, gb) = (&granules[a], &granules[b]);
+                    detect_growing(
+                        &body_at(ga, &ga.x, mesh, (boxes[a], bounds[a], &quad_boxes[a])),
+                        &body_at(gb, &gb.x, mesh, (boxes[b], bounds[b], &quad_boxes[b])),
+                        settings,
+                        scratch,
+                        w,
+                    )?;
+                    Ok(w.constraints().iter().map(|c| c.gap).fold(0.0, Real::min))
+                },
+            )
+            .try_reduce(|| 0.0, |x: Real, y: Real| Ok(x.min(y)))
     }
 }
 

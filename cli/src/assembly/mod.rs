@@ -76,6 +76,10 @@ pub struct AssemblyParams {
     /// [`AssemblyError::Runaway`] before the motion turns into garbage
     /// (∞: off).
     pub max_node_speed_m_s: Real,
+    /// Energy watchdog: kinetic energy above this multiple of the energy
+    /// put in stops the step with [`AssemblyError::EnergyRunaway`]
+    /// (∞: off).
+    pub kinetic_energy_limit: Real,
     /// Element estimate, or the global 2/ω_max by power iteration per
     /// granule (warm-started; tracked by the element lengths in between).
     pub time_step_method: TimeStepMethod,
@@ -87,7 +91,7 @@ impl AssemblyParams {
     /// physics.md's choices for `material`: ξ = 0.5, gravity 9.81 m/s²,
     /// the material's friction on walls and between granules, symmetric
     /// two-pass with mass sharing and up to three sweeps (a further one
-    /// while a gap deeper than 0.05 µm is left), no speed watchdog, C = 0.9 on the global
+    /// while a gap deeper than 0.05 µm is left), no watchdogs, C = 0.9 on the global
     /// estimate 2/ω_max (power iteration every 10 re-estimates), re-estimated
     /// every 100 steps.
     pub fn standard(material: Material, elements: ElementSettings) -> Self {
@@ -105,6 +109,7 @@ impl AssemblyParams {
             mass_scaling: 1.0,
             time_step_safety: 0.9,
             max_node_speed_m_s: Real::INFINITY,
+            kinetic_energy_limit: Real::INFINITY,
             time_step_method: TimeStepMethod::Global {
                 power_interval: 10,
                 power_iterations: 30,
@@ -589,10 +594,9 @@ impl<'m> Assembly<'m> {
 
     /// Most negative gap between granules on the current positions x_n
     /// (0 if none penetrates), m: the whole detection rerun on x_n.
-    pub fn penetration(&mut self) -> Result<Real, AssemblyError> {
+    pub fn penetration(&self) -> Result<Real, AssemblyError> {
         let step = self.steps;
-        self.contact
-            .penetration(&self.granules, self.mesh, &self.params.contact)
+        ContactPhase::penetration(&self.granules, self.mesh, &self.params.contact)
             .map_err(|error| AssemblyError::Contact { step, error })
     }
 }

@@ -53,6 +53,23 @@ pub enum AssemblyError {
         /// The limit, m/s.
         limit_m_s: Real,
     },
+    /// The energy watchdog: the kinetic energy exceeds
+    /// [`AssemblyParams::kinetic_energy_limit`] × all the energy ever put in (punch or,
+    /// where larger, contact work — the release of initial overlaps —,
+    /// gravity work, initial motion). Physically it cannot exceed it once;
+    /// a growing numerical instability makes it do so within a few steps.
+    EnergyRunaway {
+        /// Step.
+        step: u64,
+        /// The granule with the most kinetic energy.
+        granule: usize,
+        /// Kinetic energy of the assembly, J.
+        kinetic_j: Real,
+        /// Energy put in so far, J.
+        supplied_j: Real,
+        /// The limit's factor.
+        limit: Real,
+    },
     /// The stable step could not be estimated or the motion blew up.
     Unstable {
         /// Step.
@@ -87,6 +104,19 @@ impl fmt::Display for AssemblyError {
                  the watchdog limit of {limit_m_s:.4e} m/s: the motion is going unstable (is the \
                  time-step safety factor too large?)"
             ),
+            Self::EnergyRunaway {
+                step,
+                granule,
+                kinetic_j,
+                supplied_j,
+                limit,
+            } => write!(
+                f,
+                "step {step}: the kinetic energy {kinetic_j:.4e} J (most of it in granule \
+                 {granule}) exceeds {limit} × the {supplied_j:.4e} J put in by the \
+                 punches (or contacts), gravity and the initial motion: the motion is going unstable (is the \
+                 time-step safety factor too large?)"
+            ),
             Self::Unstable { step, granule } => match granule {
                 Some(g) => write!(
                     f,
@@ -101,7 +131,7 @@ impl fmt::Display for AssemblyError {
 impl core::error::Error for AssemblyError {}
 
 pub(super) fn validate(p: &AssemblyParams) -> Result<(), AssemblyError> {
-    let checks: [(bool, &'static str, Real, &'static str); 10] = [
+    let checks: [(bool, &'static str, Real, &'static str); 11] = [
         (
             (1.0..=1e6).contains(&p.mass_scaling),
             "mass_scaling",
@@ -161,6 +191,12 @@ pub(super) fn validate(p: &AssemblyParams) -> Result<(), AssemblyError> {
             "max_node_speed_m_s",
             p.max_node_speed_m_s,
             "> 0 m/s (inf: no watchdog)",
+        ),
+        (
+            p.kinetic_energy_limit >= 1.0,
+            "kinetic_energy_limit",
+            p.kinetic_energy_limit,
+            ">= 1 (inf: no watchdog)",
         ),
     ];
     match checks.into_iter().find(|c| !c.0) {
@@ -260,6 +296,8 @@ pub struct StepReport {
     pub constraints: usize,
     /// Distinct (granule, wall) pairs in contact in the step.
     pub wall_contacts: usize,
+    /// Largest nodal speed |v_{n+½}| over all granules, m/s.
+    pub max_node_speed_m_s: Real,
 }
 
 /// Adds the forces of `w` to `total`; the contact count is summed
@@ -553,6 +591,7 @@ impl Assembly<'_> {
         };
         let e = &mut self.energies;
         let mut kinetic = 0.0;
+        let mut max_speed_squared: Real = 0.0;
         for (granule, (w, wall_forces)) in per.iter().zip(&wall_totals).enumerate() {
             if !w.kinetic.is_finite() {
                 return Err(AssemblyError::Unstable {
@@ -568,6 +607,7 @@ impl Assembly<'_> {
                     limit_m_s: p.max_node_speed_m_s,
                 });
             }
+            max_speed_squared = max_speed_squared.max(w.max_speed_squared);
             e.internal_work += w.internal;
             e.contact_work += w.contact;
             e.damping += w.damping;
@@ -578,6 +618,29 @@ impl Assembly<'_> {
             }
         }
         e.kinetic = kinetic;
+        // Contact work counts where it exceeds the punch work: the release
+        // of the overlaps a packing starts with.
+        let supplied = e.punch_work.max(e.contact_work) + e.gravity_work + e.initial_kinetic;
+        if kinetic > p.kinetic_energy_limit * supplied.max(0.0) && kinetic > 0.0 {
+            let granule = per
+                .iter()
+                .enumerate()
+                .fold((0, Real::NEG_INFINITY), |best, (g, w)| {
+                    if w.kinetic > best.1 {
+                        (g, w.kinetic)
+                    } else {
+                        best
+                    }
+                })
+                .0;
+            return Err(AssemblyError::EnergyRunaway {
+                step,
+                granule,
+                kinetic_j: kinetic,
+                supplied_j: supplied,
+                limit: p.kinetic_energy_limit,
+            });
+        }
         e.plastic += plastic;
         e.hourglass = hourglass;
         for (spec, w) in self.walls.iter().zip(&report.walls) {
@@ -588,6 +651,7 @@ impl Assembly<'_> {
         }
         report.pair_normal = pair_normal;
         report.constraints = constraints;
+        report.max_node_speed_m_s = max_speed_squared.sqrt();
         report.wall_contacts = self
             .contact
             .on_wall

@@ -21,7 +21,10 @@ use crate::assembly::{AssemblyState, Energies, GranuleState};
 /// File name of the checkpoint in the output directory.
 pub const FILE_NAME: &str = "checkpoint.bin";
 /// Format version written and read.
-pub const VERSION: u32 = 1;
+///
+/// 2: samples gained the largest nodal speed and the penetration, the
+/// averaging window the largest nodal speed (version 1 files are refused).
+pub const VERSION: u32 = 2;
 const MAGIC: &[u8; 16] = b"GRANBED-CKPT\0\0\0\0";
 
 /// A bed run's progress besides the assembly state.
@@ -163,9 +166,14 @@ fn energies_from(v: [f64; 10]) -> Energies {
     }
 }
 
-fn sample_to(s: &BedSample) -> [f64; 26] {
+/// Floats per sample: 17 fields, then the 10 energies.
+const SAMPLE_FLOATS: usize = 27;
+/// Floats of the averaging window.
+const WINDOW_FLOATS: usize = 8;
+
+fn sample_to(s: &BedSample) -> [f64; SAMPLE_FLOATS] {
     let e = energies_to(&s.energies);
-    let head = [
+    let head: [f64; SAMPLE_FLOATS - 10] = [
         s.time_s,
         s.strain,
         s.upper_force_n,
@@ -181,12 +189,19 @@ fn sample_to(s: &BedSample) -> [f64; 26] {
         s.heywood_d,
         s.min_jacobian,
         f64::from_bits(s.steps),
-        0.0,
+        s.max_node_speed_m_s,
+        s.penetration_m,
     ];
-    core::array::from_fn(|i| if i < 16 { head[i] } else { e[i - 16] })
+    core::array::from_fn(|i| {
+        if i < head.len() {
+            head[i]
+        } else {
+            e[i - head.len()]
+        }
+    })
 }
 
-fn sample_from(v: [f64; 26]) -> BedSample {
+fn sample_from(v: [f64; SAMPLE_FLOATS]) -> BedSample {
     BedSample {
         time_s: v[0],
         strain: v[1],
@@ -203,7 +218,9 @@ fn sample_from(v: [f64; 26]) -> BedSample {
         heywood_d: v[12],
         min_jacobian: v[13],
         steps: v[14].to_bits(),
-        energies: energies_from(core::array::from_fn(|i| v[16 + i])),
+        max_node_speed_m_s: v[15],
+        penetration_m: v[16],
+        energies: energies_from(core::array::from_fn(|i| v[SAMPLE_FLOATS - 10 + i])),
     }
 }
 
@@ -229,6 +246,7 @@ impl Checkpoint {
             w.pairs,
             w.walls,
             w.min_j,
+            w.max_speed,
         ]);
         e.vecs(&p.samples.iter().map(sample_to).collect::<Vec<_>>());
         e.f64s(&[s.time, f64::from_bits(s.steps), s.dt[0], s.dt[1]]);
@@ -269,8 +287,13 @@ impl Checkpoint {
             next_output,
         ] = <[f64; 5]>::try_from(head).map_err(|_| anyhow::anyhow!("bad run header"))?;
         let snapshots_done = d.u64()? as usize;
-        let w = <[f64; 7]>::try_from(d.f64s()?).map_err(|_| anyhow::anyhow!("bad window"))?;
-        let samples = d.vecs::<26>()?.into_iter().map(sample_from).collect();
+        let w = <[f64; WINDOW_FLOATS]>::try_from(d.f64s()?)
+            .map_err(|_| anyhow::anyhow!("bad window"))?;
+        let samples = d
+            .vecs::<SAMPLE_FLOATS>()?
+            .into_iter()
+            .map(sample_from)
+            .collect();
         let t = <[f64; 4]>::try_from(d.f64s()?).map_err(|_| anyhow::anyhow!("bad time"))?;
         let energies = energies_from(
             <[f64; 10]>::try_from(d.f64s()?).map_err(|_| anyhow::anyhow!("bad energies"))?,
@@ -328,6 +351,7 @@ impl Checkpoint {
                     pairs: w[4],
                     walls: w[5],
                     min_j: w[6],
+                    max_speed: w[7],
                 },
                 next_output,
                 snapshots_done,

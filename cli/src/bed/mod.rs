@@ -42,8 +42,9 @@ Output, in --out DIR (created if missing):
                    (d_V and nominal d), min Jacobian, steps, energies
   summary.json     the scene, Kawakita fit (a, 1/b, R^2, points with C >= 0.25),
                    final strain, max pressure, initial bed height, counts, wall
-                   time, ns per element-step, threads, min Jacobian, energy
-                   residual, peak memory, version
+                   time, ns per element-step, threads, min Jacobian, max nodal
+                   speed / punch speed, deepest overlap (m and / element size),
+                   hourglass / internal work, energy residual, peak memory, version
   vtk/bed_<k>.vtu  VTU snapshots at the scene's snapshot_strains: every granule's
                    surface quads (all hexes with --vtk-full-mesh), cell data
                    granule id, relative density eta0 V0/V, Heywood d_V S/V and d S/V

@@ -15,7 +15,7 @@ use crate::csv::{CsvWriter, Field};
 use crate::output::{create_file, finish_file, finite_ratio, write_json};
 
 /// Columns of `compression.csv`, in order.
-pub const COMPRESSION_COLUMNS: [&str; 24] = [
+pub const COMPRESSION_COLUMNS: [&str; 26] = [
     "time_s",
     "strain",
     "upper_pressure_pa",
@@ -30,6 +30,8 @@ pub const COMPRESSION_COLUMNS: [&str; 24] = [
     "heywood_dv",
     "heywood_d",
     "min_jacobian",
+    "max_node_speed_m_s",
+    "penetration_m",
     "steps",
     "punch_work_j",
     "internal_work_j",
@@ -42,7 +44,7 @@ pub const COMPRESSION_COLUMNS: [&str; 24] = [
     "energy_residual_j",
 ];
 
-fn row(s: &BedSample) -> [Field; 24] {
+fn row(s: &BedSample) -> [Field; 26] {
     let e = &s.energies;
     [
         s.time_s.into(),
@@ -59,6 +61,8 @@ fn row(s: &BedSample) -> [Field; 24] {
         s.heywood_dv.into(),
         s.heywood_d.into(),
         s.min_jacobian.into(),
+        s.max_node_speed_m_s.into(),
+        s.penetration_m.into(),
         Field::Int(s.steps),
         e.punch_work.into(),
         e.internal_work.into(),
@@ -174,6 +178,15 @@ pub struct Summary<'a> {
     pub threads: usize,
     /// Smallest element Jacobian ratio.
     pub min_jacobian: Real,
+    /// Largest nodal speed over the run / punch speed.
+    pub max_node_speed_ratio: Option<Real>,
+    /// Deepest granule–granule overlap at the output rows, m.
+    pub max_penetration_m: Real,
+    /// That overlap / the shortest surface edge of the reference mesh
+    /// (the contact tolerance is 1 % of it).
+    pub max_penetration_rel_element: Option<Real>,
+    /// Hourglass energy / internal work at the end.
+    pub hourglass_to_internal: Option<Real>,
     /// |ledger residual| / punch work.
     pub energy_residual_rel: Option<Real>,
     /// Contact losses / punch work.
@@ -225,6 +238,18 @@ pub fn summary<'a>(scene: &'a Scene, run: &BedRun) -> Summary<'a> {
         .fold(Real::INFINITY, Real::min);
     let e = last.energies;
     let material = scene.material_params().ok();
+    // NaN (a failed detection) propagates: `max` would drop it.
+    let max_penetration_m = run
+        .samples
+        .iter()
+        .map(|s| s.penetration_m)
+        .fold(0.0, |m: Real, p| {
+            if p.is_nan() || m.is_nan() {
+                Real::NAN
+            } else {
+                m.max(p)
+            }
+        });
     Summary {
         version: env!("CARGO_PKG_VERSION"),
         scene,
@@ -253,6 +278,16 @@ pub fn summary<'a>(scene: &'a Scene, run: &BedRun) -> Summary<'a> {
         contact_share: Some(run.phase_times.contact_share()).filter(|x| x.is_finite()),
         threads: run.threads,
         min_jacobian,
+        max_node_speed_ratio: finite_ratio(
+            run.samples
+                .iter()
+                .map(|s| s.max_node_speed_m_s)
+                .fold(0.0, Real::max),
+            scene.punch_speed_m_s,
+        ),
+        max_penetration_m,
+        max_penetration_rel_element: finite_ratio(max_penetration_m, run.element_size_m),
+        hourglass_to_internal: finite_ratio(e.hourglass, e.internal_work),
         energy_residual_rel: finite_ratio(e.residual().abs(), e.punch_work),
         contact_loss_rel: finite_ratio(e.contact_loss(), e.punch_work),
         peak_memory_bytes: peak_memory_bytes(),

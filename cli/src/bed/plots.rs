@@ -57,7 +57,7 @@ const COLOURS: [RGBColor; 10] = [
 
 /// How a series is drawn.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-enum Mark {
+pub(crate) enum Mark {
     /// A solid line.
     Line,
     /// Filled circles.
@@ -69,14 +69,18 @@ enum Mark {
 }
 
 /// One series of a plot.
-struct Series {
+pub(crate) struct Series {
     label: String,
     points: Vec<(f64, f64)>,
     mark: Mark,
 }
 
 impl Series {
-    fn new(label: impl Into<String>, mark: Mark, points: impl Iterator<Item = (f64, f64)>) -> Self {
+    pub(crate) fn new(
+        label: impl Into<String>,
+        mark: Mark,
+        points: impl Iterator<Item = (f64, f64)>,
+    ) -> Self {
         Self {
             label: label.into(),
             // Non-finite values (a degenerate granule, an empty window)
@@ -111,7 +115,7 @@ fn range(values: impl Iterator<Item = f64>, from_zero: bool) -> core::ops::Range
 }
 
 /// The SVG text of `series` under `title`, with axis labels.
-fn xy_svg(
+pub(crate) fn xy_svg(
     title: &str,
     x_desc: &str,
     y_desc: &str,

@@ -29,6 +29,7 @@ use crate::granule::timestep::{
     Linearisation, PowerIterationBuffers, TimeStepControl, TimeStepMethod, power_start,
 };
 use crate::material::Material;
+use crate::math;
 use crate::mesh::reference::ReferenceMesh;
 
 /// Which part of the granule is simulated.
@@ -336,6 +337,12 @@ pub struct PlatenSample {
     pub dt_s: Real,
     /// Smallest element J of the last step.
     pub min_j: Real,
+    /// Largest nodal speed |v_{n+½}| over the sample interval, m/s.
+    pub max_node_speed_m_s: Real,
+    /// Deepest overlap of a surface node with a platen at this instant
+    /// (kinematic contact closes gaps exactly, so round-off unless contact
+    /// failed), m; 0 if none.
+    pub penetration_m: Real,
     /// Energies.
     pub energy: EnergyLedger,
 }
@@ -360,6 +367,7 @@ pub struct PlatenScene<'a> {
     ledger: EnergyLedger,
     window_impulse: [Real; 2],
     window_time: Real,
+    window_max_speed_squared: Real,
     next_output: Real,
     element_steps: u64,
 }
@@ -467,6 +475,7 @@ impl<'a> PlatenScene<'a> {
             ledger: EnergyLedger::default(),
             window_impulse: [0.0; 2],
             window_time: 0.0,
+            window_max_speed_squared: 0.0,
             next_output: params.output_strain_interval,
             element_steps: 0,
         })
@@ -558,8 +567,21 @@ impl<'a> PlatenScene<'a> {
         } else {
             avg(self.window_impulse[1])
         };
+        let max_node_speed_m_s = math::sqrt(self.window_max_speed_squared);
         self.window_impulse = [0.0; 2];
         self.window_time = 0.0;
+        self.window_max_speed_squared = 0.0;
+        // Platens at this instant: the upper at z_top0 − x/2, the lower
+        // (full sphere) mirrored.
+        let z_top = self.z_top0 - 0.5 * self.approach_at(self.time);
+        let full = self.params.symmetry == Symmetry::Full;
+        let penetration_m =
+            self.buf.x[self.mesh.first_surface_node()..]
+                .iter()
+                .fold(0.0, |d: Real, x| {
+                    let below = if full { -z_top - x[2] } else { 0.0 };
+                    math::max(d, math::max(x[2] - z_top, below))
+                });
         PlatenSample {
             time_s: self.time,
             approach_m: self.approach_at(self.time),
@@ -569,6 +591,8 @@ impl<'a> PlatenScene<'a> {
             steps: self.step,
             dt_s: self.dt,
             min_j: self.min_j,
+            max_node_speed_m_s,
+            penetration_m,
             energy: self.ledger,
         }
     }
@@ -668,6 +692,8 @@ impl<'a> PlatenScene<'a> {
         };
 
         let w = correct(b, sizes, self.params.gravity_m_s2);
+        self.window_max_speed_squared =
+            math::max(self.window_max_speed_squared, w.max_speed_squared);
         let kinetic = w.kinetic;
         if !kinetic.is_finite() {
             return Err(unstable);
