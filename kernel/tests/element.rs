@@ -188,7 +188,9 @@ fn element_forces_are_objective() {
 }
 
 /// The hourglass force is the gradient of the hourglass energy (central
-/// differences, 1e-6 relative), so hourglass control is conservative.
+/// differences, 1e-6 relative), so hourglass control is conservative: at a
+/// small hourglass amplitude (±3 µm on a ~0.1 mm element, the quadratic
+/// term) and at a large one (±30 µm, where the quartic stiffening leads).
 #[test]
 fn hourglass_force_is_the_energy_gradient() {
     let mut rng = Rng::new(14);
@@ -202,27 +204,31 @@ fn hourglass_force_is_the_energy_gradient() {
     .unwrap();
     let xe = mesh.hex_coords(700);
     let r = hex_reference(&xe).unwrap();
-    let cur: HexCoords =
-        core::array::from_fn(|i| core::array::from_fn(|a| xe[i][a] + rng.uniform(-3e-6, 3e-6)));
-    let energy = |x: &HexCoords| {
+    for noise in [3e-6, 30e-6] {
+        let cur: HexCoords = core::array::from_fn(|i| {
+            core::array::from_fn(|a| xe[i][a] + rng.uniform(-noise, noise))
+        });
+        let energy = |x: &HexCoords| {
+            let mut s = VOIGT_IDENTITY;
+            hex_forces(&elastic, &UpdateOptions::default(), 0.05, &r, x, &mut s)
+                .unwrap()
+                .hourglass_energy
+        };
         let mut s = VOIGT_IDENTITY;
-        hex_forces(&elastic, &UpdateOptions::default(), 0.05, &r, x, &mut s)
-            .unwrap()
-            .hourglass_energy
-    };
-    let mut s = VOIGT_IDENTITY;
-    let with = hex_forces(&elastic, &UpdateOptions::default(), 0.05, &r, &cur, &mut s).unwrap();
-    let mut s = VOIGT_IDENTITY;
-    let without = hex_forces(&elastic, &UpdateOptions::default(), 0.0, &r, &cur, &mut s).unwrap();
-    let h = 1e-9;
-    for i in 0..8 {
-        for a in 0..3 {
-            let (mut p, mut m) = (cur, cur);
-            p[i][a] += h;
-            m[i][a] -= h;
-            let fd = (energy(&p) - energy(&m)) / (2.0 * h);
-            let f_hg = with.f[i][a] - without.f[i][a];
-            assert_close("dE_hg/dx", fd, f_hg, 1e-6, 1e-9 * f_hg.abs().max(1e-12));
+        let with = hex_forces(&elastic, &UpdateOptions::default(), 0.05, &r, &cur, &mut s).unwrap();
+        let mut s = VOIGT_IDENTITY;
+        let without =
+            hex_forces(&elastic, &UpdateOptions::default(), 0.0, &r, &cur, &mut s).unwrap();
+        let h = 1e-9;
+        for i in 0..8 {
+            for a in 0..3 {
+                let (mut p, mut m) = (cur, cur);
+                p[i][a] += h;
+                m[i][a] -= h;
+                let fd = (energy(&p) - energy(&m)) / (2.0 * h);
+                let f_hg = with.f[i][a] - without.f[i][a];
+                assert_close("dE_hg/dx", fd, f_hg, 1e-6, 1e-9 * f_hg.abs().max(1e-12));
+            }
         }
     }
 }
@@ -394,5 +400,50 @@ fn fbar_patch_and_rigid_motion() {
                 );
             }
         }
+    }
+}
+
+/// The hourglass stiffness doubles at a nodal hourglass amplitude of
+/// `HOURGLASS_STIFFENING_AMPLITUDE` × the element size and grows with its
+/// square (a cube, a pure ξη hourglass mode, which leaves F̄ alone).
+#[test]
+fn hourglass_stiffening_follows_the_amplitude() {
+    let side = 1e-4;
+    let corners: HexCoords = [
+        [-1.0, -1.0, -1.0],
+        [1.0, -1.0, -1.0],
+        [1.0, 1.0, -1.0],
+        [-1.0, 1.0, -1.0],
+        [-1.0, -1.0, 1.0],
+        [1.0, -1.0, 1.0],
+        [1.0, 1.0, 1.0],
+        [-1.0, 1.0, 1.0],
+    ]
+    .map(|p: [Real; 3]| p.map(|c| 0.5 * side * c));
+    let r = hex_reference(&corners).unwrap();
+    let mat = material(GranuleType::B2);
+    let mode = [1.0, -1.0, 1.0, -1.0, 1.0, -1.0, 1.0, -1.0];
+    let force = |d: Real| {
+        let x: HexCoords = core::array::from_fn(|i| {
+            let mut p = corners[i];
+            p[0] += d * mode[i];
+            p
+        });
+        let mut s = VOIGT_IDENTITY;
+        hex_forces(&mat, &UpdateOptions::default(), 0.05, &r, &x, &mut s)
+            .unwrap()
+            .f[0][0]
+    };
+    let a = granbed_kernel::element::force::HOURGLASS_STIFFENING_AMPLITUDE;
+    let tiny = 1e-6 * side;
+    for rel in [0.02, 0.1, 0.3] {
+        let d = rel * side;
+        let linear = force(tiny) * d / tiny;
+        let factor = force(d) / linear;
+        let want = 1.0 + (rel / a) * (rel / a);
+        assert!(
+            (factor / want - 1.0).abs() < 1e-6,
+            "amplitude {rel}: stiffening {factor}, expected {want}"
+        );
     }
 }
