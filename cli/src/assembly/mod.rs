@@ -30,10 +30,12 @@ use granbed_kernel::contact::pair::PairSettings;
 use granbed_kernel::contact::wall::Wall;
 use granbed_kernel::granule::damping::damping_coefficient;
 use granbed_kernel::granule::forces::ElementSettings;
+use granbed_kernel::granule::quality::{WorstElement, worst_element};
 use granbed_kernel::granule::timestep::{
     TimeStepControl, TimeStepMemory, TimeStepMethod, power_start,
 };
 use granbed_kernel::material::Material;
+use rayon::prelude::*;
 
 use crate::model::{GranuleStore, OwnedReference};
 
@@ -590,6 +592,32 @@ impl<'m> Assembly<'m> {
             }
         }
         l
+    }
+
+    /// The worst element of the assembly on x_n: its granule and the
+    /// smallest Gauss-point Jacobian ratio (granules in parallel; the
+    /// smallest ratio, the first granule on a tie; a NaN wins).
+    pub fn worst_element(&self) -> Option<(usize, WorstElement)> {
+        let view = self.mesh.view();
+        let per: Vec<Option<WorstElement>> = self
+            .granules
+            .par_iter()
+            .map(|g| worst_element(&view, &g.x))
+            .collect();
+        per.into_iter()
+            .enumerate()
+            .filter_map(|(g, w)| w.map(|w| (g, w)))
+            .fold(
+                None,
+                |best: Option<(usize, WorstElement)>, (g, w)| match best {
+                    Some((_, b))
+                        if !(w.ratio < b.ratio || w.ratio.is_nan() && !b.ratio.is_nan()) =>
+                    {
+                        best
+                    }
+                    _ => Some((g, w)),
+                },
+            )
     }
 
     /// Most negative gap between granules on the current positions x_n

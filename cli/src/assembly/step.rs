@@ -8,6 +8,7 @@ use granbed_kernel::contact::pair::ContactError;
 use granbed_kernel::contact::wall::{PredictedNodes, WallForce, count_wall_contacts, wall_contact};
 use granbed_kernel::granule::dynamics::{Loads, StepSizes, StepWork, correct, predict};
 use granbed_kernel::granule::forces::{ElementFailure, ForceSummary, elastic_energy};
+use granbed_kernel::granule::quality::worst_element;
 use granbed_kernel::granule::timestep::{Linearisation, PowerIterationBuffers};
 use rayon::prelude::*;
 
@@ -70,6 +71,19 @@ pub enum AssemblyError {
         /// The limit's factor.
         limit: Real,
     },
+    /// An element folded: a Gauss-point Jacobian of its trilinear map is
+    /// not positive (the one-point element's centre may still be fine;
+    /// found when the stable step is estimated).
+    Folded {
+        /// Step.
+        step: u64,
+        /// Granule.
+        granule: usize,
+        /// Element (hex) index.
+        element: usize,
+        /// Its smallest Gauss-point Jacobian ratio J_g(x)/J_g(X).
+        ratio: Real,
+    },
     /// The stable step could not be estimated or the motion blew up.
     Unstable {
         /// Step.
@@ -116,6 +130,16 @@ impl fmt::Display for AssemblyError {
                  {granule}) exceeds {limit} × the {supplied_j:.4e} J put in by the \
                  punches (or contacts), gravity and the initial motion: the motion is going unstable (is the \
                  time-step safety factor too large?)"
+            ),
+            Self::Folded {
+                step,
+                granule,
+                element,
+                ratio,
+            } => write!(
+                f,
+                "granule {granule}, step {step}: element {element} folded (Gauss-point Jacobian \
+                 ratio {ratio:.3e} <= 0: hourglass distortion)"
             ),
             Self::Unstable { step, granule } => match granule {
                 Some(g) => write!(
@@ -355,9 +379,18 @@ impl Assembly<'_> {
             match d {
                 Some(d) if d > 0.0 && d.is_finite() => dt = dt.min(d),
                 _ => {
-                    return Err(AssemblyError::Unstable {
-                        step: self.steps,
-                        granule: Some(g),
+                    let step = self.steps;
+                    return Err(match worst_element(&view, &self.granules[g].x) {
+                        Some(w) if w.ratio <= 0.0 => AssemblyError::Folded {
+                            step,
+                            granule: g,
+                            element: w.element,
+                            ratio: w.ratio,
+                        },
+                        _ => AssemblyError::Unstable {
+                            step,
+                            granule: Some(g),
+                        },
                     });
                 }
             }

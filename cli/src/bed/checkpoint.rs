@@ -22,8 +22,9 @@ use crate::assembly::{AssemblyState, Energies, GranuleState};
 pub const FILE_NAME: &str = "checkpoint.bin";
 /// Format version written and read.
 ///
-/// 2: samples gained the largest nodal speed and the penetration, the
-/// averaging window the largest nodal speed (version 1 files are refused).
+/// 2: samples gained the smallest Gauss-point Jacobian, the largest nodal
+/// speed and the penetration, the averaging window the largest nodal speed
+/// (version 1 files are refused).
 pub const VERSION: u32 = 2;
 const MAGIC: &[u8; 16] = b"GRANBED-CKPT\0\0\0\0";
 
@@ -166,8 +167,8 @@ fn energies_from(v: [f64; 10]) -> Energies {
     }
 }
 
-/// Floats per sample: 17 fields, then the 10 energies.
-const SAMPLE_FLOATS: usize = 27;
+/// Floats per sample: 18 fields, then the 10 energies.
+const SAMPLE_FLOATS: usize = 28;
 /// Floats of the averaging window.
 const WINDOW_FLOATS: usize = 8;
 
@@ -191,6 +192,7 @@ fn sample_to(s: &BedSample) -> [f64; SAMPLE_FLOATS] {
         f64::from_bits(s.steps),
         s.max_node_speed_m_s,
         s.penetration_m,
+        s.min_gauss_jacobian,
     ];
     core::array::from_fn(|i| {
         if i < head.len() {
@@ -220,6 +222,7 @@ fn sample_from(v: [f64; SAMPLE_FLOATS]) -> BedSample {
         steps: v[14].to_bits(),
         max_node_speed_m_s: v[15],
         penetration_m: v[16],
+        min_gauss_jacobian: v[17],
         energies: energies_from(core::array::from_fn(|i| v[SAMPLE_FLOATS - 10 + i])),
     }
 }

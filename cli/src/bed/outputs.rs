@@ -15,7 +15,7 @@ use crate::csv::{CsvWriter, Field};
 use crate::output::{create_file, finish_file, finite_ratio, write_json};
 
 /// Columns of `compression.csv`, in order.
-pub const COMPRESSION_COLUMNS: [&str; 26] = [
+pub const COMPRESSION_COLUMNS: [&str; 27] = [
     "time_s",
     "strain",
     "upper_pressure_pa",
@@ -30,6 +30,7 @@ pub const COMPRESSION_COLUMNS: [&str; 26] = [
     "heywood_dv",
     "heywood_d",
     "min_jacobian",
+    "min_gauss_jacobian",
     "max_node_speed_m_s",
     "penetration_m",
     "steps",
@@ -44,7 +45,7 @@ pub const COMPRESSION_COLUMNS: [&str; 26] = [
     "energy_residual_j",
 ];
 
-fn row(s: &BedSample) -> [Field; 26] {
+fn row(s: &BedSample) -> [Field; 27] {
     let e = &s.energies;
     [
         s.time_s.into(),
@@ -61,6 +62,7 @@ fn row(s: &BedSample) -> [Field; 26] {
         s.heywood_dv.into(),
         s.heywood_d.into(),
         s.min_jacobian.into(),
+        s.min_gauss_jacobian.into(),
         s.max_node_speed_m_s.into(),
         s.penetration_m.into(),
         Field::Int(s.steps),
@@ -176,8 +178,11 @@ pub struct Summary<'a> {
     pub contact_share: Option<f64>,
     /// Threads used.
     pub threads: usize,
-    /// Smallest element Jacobian ratio.
+    /// Smallest element Jacobian ratio (element centres, every step).
     pub min_jacobian: Real,
+    /// Smallest Gauss-point Jacobian ratio at the output rows (≤ 0: an
+    /// element folded).
+    pub min_gauss_jacobian: Real,
     /// Largest nodal speed over the run / punch speed.
     pub max_node_speed_ratio: Option<Real>,
     /// Deepest granule–granule overlap at the output rows, m.
@@ -278,6 +283,16 @@ pub fn summary<'a>(scene: &'a Scene, run: &BedRun) -> Summary<'a> {
         contact_share: Some(run.phase_times.contact_share()).filter(|x| x.is_finite()),
         threads: run.threads,
         min_jacobian,
+        min_gauss_jacobian: run.samples.iter().map(|s| s.min_gauss_jacobian).fold(
+            Real::INFINITY,
+            |m: Real, j| {
+                if j.is_nan() || m.is_nan() {
+                    Real::NAN
+                } else {
+                    m.min(j)
+                }
+            },
+        ),
         max_node_speed_ratio: finite_ratio(
             run.samples
                 .iter()

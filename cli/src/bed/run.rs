@@ -67,6 +67,10 @@ pub struct BedSample {
     pub heywood_d: Real,
     /// Smallest element Jacobian ratio in the interval.
     pub min_jacobian: Real,
+    /// Smallest Gauss-point Jacobian ratio of any element at the end of the
+    /// interval (≤ 0: an element folded; the centre's `min_jacobian` can
+    /// miss it).
+    pub min_gauss_jacobian: Real,
     /// Largest nodal speed in the interval, m/s.
     pub max_node_speed_m_s: Real,
     /// Deepest granule–granule overlap on the positions at the end of the
@@ -340,6 +344,7 @@ pub fn run_bed(
             heywood_dv: a_dv,
             heywood_d: a_d,
             min_jacobian: if w.time > 0.0 { w.min_j } else { 1.0 },
+            min_gauss_jacobian: asm.worst_element().map_or(Real::NAN, |(_, w)| w.ratio),
             max_node_speed_m_s: w.max_speed,
             // A detection that fails (it only can on non-finite positions,
             // which stop the step before) is reported as NaN.

@@ -9,4 +9,5 @@
 pub mod damping;
 pub mod dynamics;
 pub mod forces;
+pub mod quality;
 pub mod timestep;

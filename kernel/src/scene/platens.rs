@@ -337,6 +337,9 @@ pub struct PlatenSample {
     pub dt_s: Real,
     /// Smallest element J of the last step.
     pub min_j: Real,
+    /// Smallest Gauss-point Jacobian ratio of any element at this instant
+    /// (≤ 0: an element folded; see [`crate::granule::quality`]).
+    pub min_gauss_jacobian: Real,
     /// Largest nodal speed |v_{n+½}| over the sample interval, m/s.
     pub max_node_speed_m_s: Real,
     /// Deepest overlap of a surface node with a platen at this instant
@@ -591,6 +594,8 @@ impl<'a> PlatenScene<'a> {
             steps: self.step,
             dt_s: self.dt,
             min_j: self.min_j,
+            min_gauss_jacobian: crate::granule::quality::worst_element(&self.mesh, self.buf.x)
+                .map_or(Real::NAN, |w| w.ratio),
             max_node_speed_m_s,
             penetration_m,
             energy: self.ledger,
