@@ -63,3 +63,109 @@ fn the_quick_granule_study_writes_a_consistent_table_and_diagram() {
     let circles = elements.iter().filter(|e| e.name == "circle").count();
     assert_eq!(circles, names.len() - 1, "points in the diagram");
 }
+
+/// `granbed-cli study stability` (issue #9's suite) on a tiny grid: one
+/// row per bed and granule, the bed row agrees with `granbed-cli bed` on
+/// the same scene (the suite runs exactly that code), the granule rows
+/// reach their strain, the plots are SVG, and every run passes.
+#[test]
+fn the_stability_suite_writes_one_judged_row_per_run() {
+    let dir = common::fresh_dir("cli_study", "stability");
+    let out = dir.to_str().unwrap();
+    let run = cli(&[
+        "study",
+        "stability",
+        "--types",
+        "A1,C3",
+        "--beds",
+        "2",
+        "--granules",
+        "8",
+        "--die-diameter-mm",
+        "4.2",
+        "--strain",
+        "0.3",
+        "--granule-mesh",
+        "4x1",
+        "--granule-strain",
+        "0.5",
+        "--quiet",
+        "--out",
+        out,
+    ]);
+    assert_eq!(run.code, 0, "{}", run.stderr);
+    let t = Table::read(&dir.join("stability.csv"));
+    let kinds = t.text("kind");
+    let types = t.text("type");
+    let seeds = t.num("seed");
+    assert_eq!(kinds, ["bed", "bed", "bed", "bed", "granule", "granule"]);
+    assert_eq!(types, ["A1", "A1", "C3", "C3", "A1", "C3"]);
+    assert_eq!(seeds, [1.0, 2.0, 1.0, 2.0, 0.0, 0.0]);
+    for column in ["passed", "rejected_steps", "stopped_early"] {
+        let want = if column == "passed" { 1.0 } else { 0.0 };
+        assert!(t.num(column).iter().all(|&x| x == want), "{column}");
+    }
+    let final_strain = t.num("final_strain");
+    let target = t.num("target_strain");
+    for (f, c) in final_strain.iter().zip(&target) {
+        assert!(f + 1e-9 >= *c, "reached {f} of {c}");
+    }
+    // The A1 bed of seed 2 run by `bed` gives the same numbers.
+    let bed_dir = dir.join("bed_a1_2");
+    let bed = cli(&[
+        "bed",
+        "--type",
+        "A1",
+        "--granules",
+        "8",
+        "--mesh",
+        "4x1",
+        "--die-diameter-mm",
+        "4.2",
+        "--strain",
+        "0.3",
+        "--seed",
+        "2",
+        "--quiet",
+        "--out",
+        bed_dir.to_str().unwrap(),
+    ]);
+    assert_eq!(bed.code, 0, "{}", bed.stderr);
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(bed_dir.join("summary.json")).unwrap())
+            .unwrap();
+    let f = |key: &str| summary[key].as_f64().unwrap();
+    assert_eq!(t.num("final_strain")[1], f("final_strain"));
+    assert_eq!(t.num("min_jacobian")[1], f("min_jacobian"));
+    assert_eq!(t.num("min_gauss_jacobian")[1], f("min_gauss_jacobian"));
+    assert_eq!(t.num("steps")[1], f("steps"));
+    assert_eq!(t.num("energy_residual_rel")[1], f("energy_residual_rel"));
+    assert_eq!(
+        t.num("max_penetration_rel_element")[1],
+        f("max_penetration_rel_element")
+    );
+    assert_eq!(t.num("max_node_speed_ratio")[1], f("max_node_speed_ratio"));
+    // Nodes touching the punch move with it: the largest speed is at least
+    // the punch speed (and far below the watchdog's 200×).
+    for (k, r) in kinds.iter().zip(t.num("max_node_speed_ratio")) {
+        assert!((0.9..200.0).contains(&r), "{k}: speed ratio {r}");
+    }
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("stability.json")).unwrap())
+            .unwrap();
+    assert_eq!(json["all_passed"], true);
+    assert_eq!(json["runs"].as_array().unwrap().len(), 6);
+    for name in [
+        "min_jacobian_beds.svg",
+        "penetration_beds.svg",
+        "node_speed_beds.svg",
+        "min_jacobian_granules.svg",
+    ] {
+        let svg = std::fs::read_to_string(dir.join(name)).unwrap();
+        let lines = parse_xml(&svg)
+            .iter()
+            .filter(|e| e.name == "polyline" || e.name == "path")
+            .count();
+        assert!(lines >= 2, "{name}: {lines} curves");
+    }
+}
