@@ -86,6 +86,14 @@ pub fn finish_file(mut w: impl Write, path: &Path) -> anyhow::Result<()> {
         .with_context(|| format!("cannot write to `{}`", path.display()))
 }
 
+/// Writes `text` to `path` (created or truncated), naming `path` on failure.
+pub fn write_text(path: &Path, text: &str) -> anyhow::Result<()> {
+    let mut w = create_file(path)?;
+    w.write_all(text.as_bytes())
+        .with_context(|| format!("cannot write to `{}`", path.display()))?;
+    finish_file(w, path)
+}
+
 /// Writes `value` as pretty-printed JSON (and a final line break) to `path`.
 /// Floats are round-trip exact; non-finite ones become `null`.
 pub fn write_json(path: &Path, value: &impl serde::Serialize) -> anyhow::Result<()> {

@@ -163,10 +163,10 @@ pub(super) fn validate(p: &AssemblyParams) -> Result<(), AssemblyError> {
             "1 <= F <= 1e6",
         ),
         (
-            (1..=10).contains(&p.contact_sweeps),
+            (1..=50).contains(&p.contact_sweeps),
             "contact_sweeps",
             Real::from(p.contact_sweeps),
-            "1..=10",
+            "1..=50",
         ),
         (
             (0.0..=2.0).contains(&p.damping_ratio),

@@ -4,7 +4,6 @@
 //! `comparison_pressure.svg` (P against C) and `comparison_density.svg`
 //! (mean granule relative density against C).
 
-use std::io::Write as _;
 use std::path::Path;
 
 use anyhow::Context as _;
@@ -16,7 +15,7 @@ use super::outputs::Summary;
 use super::plots::overlay_svg;
 use super::run::BedSample;
 use crate::csv::{CsvWriter, Field};
-use crate::output::{create_file, finish_file, write_json};
+use crate::output::{create_file, finish_file, write_json, write_text};
 
 /// File name of the comparison table.
 pub const COMPARISON_CSV: &str = "comparison.csv";
@@ -176,11 +175,7 @@ pub fn write_comparison(
         false,
     )?;
     for (name, svg) in [(PRESSURE_SVG, pressure), (DENSITY_SVG, density)] {
-        let path = dir.join(name);
-        let mut file = create_file(&path)?;
-        file.write_all(svg.as_bytes())
-            .with_context(|| format!("cannot write to `{}`", path.display()))?;
-        finish_file(file, &path)?;
+        write_text(&dir.join(name), &svg)?;
     }
     Ok(())
 }

@@ -13,7 +13,6 @@
 //! * `heywood_strain.svg`: mean Heywood coefficient α_SV with d_V and with
 //!   the nominal diameter.
 
-use std::io::Write as _;
 use std::path::Path;
 
 use anyhow::Context as _;
@@ -23,7 +22,7 @@ use plotters::prelude::*;
 
 use super::outputs::KawakitaSummary;
 use super::run::BedSample;
-use crate::output::{create_file, finish_file};
+use crate::output::write_text;
 
 /// Sub-directory of the output directory holding the plots.
 pub const PLOTS_DIR: &str = "plots";
@@ -348,11 +347,7 @@ pub fn write_plots(
         .with_context(|| format!("cannot create directory `{}`", dir.display()))?;
     let svgs = plots(samples, fit)?;
     for (name, svg) in &svgs {
-        let path = dir.join(name);
-        let mut file = create_file(&path)?;
-        file.write_all(svg.as_bytes())
-            .with_context(|| format!("cannot write to `{}`", path.display()))?;
-        finish_file(file, &path)?;
+        write_text(&dir.join(name), svg)?;
     }
     Ok(svgs)
 }

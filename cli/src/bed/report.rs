@@ -3,16 +3,14 @@
 //! inline as SVG, and the scene as TOML. All text is HTML-escaped.
 
 use core::fmt::Write as _;
-use std::io::Write as _;
 use std::path::Path;
 
-use anyhow::Context as _;
 use serde_json::Value;
 
 use super::outputs::Summary;
 use super::scene::{DEFAULT_SCENE, Scene};
 use super::snapshots::{PVD_FILE, VTK_DIR};
-use crate::output::{create_file, finish_file};
+use crate::output::write_text;
 
 /// File name of the report in the output directory.
 pub const REPORT_FILE: &str = "report.html";
@@ -197,10 +195,7 @@ pub fn write_report(
 ) -> anyhow::Result<()> {
     let path = dir.join(REPORT_FILE);
     let html = report_html(scene, summary, svgs)?;
-    let mut file = create_file(&path)?;
-    file.write_all(html.as_bytes())
-        .with_context(|| format!("cannot write to `{}`", path.display()))?;
-    finish_file(file, &path)
+    write_text(&path, &html)
 }
 
 #[cfg(test)]

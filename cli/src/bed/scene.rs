@@ -47,7 +47,7 @@ checkpoint_strain_interval = 0.05
 damping_ratio = 0.5
 # Contact sweeps per step at most (physics.md 5.3); a further sweep runs while
 # a granule overlap deeper than 0.5 % of the element size is left.
-contact_sweeps = 10
+contact_sweeps = 25
 # Uniform mass scaling F >= 1 for quasi-static runs (1 = physical inertia;
 # the summary's quasi-static certificate says whether a run stayed quasi-static).
 mass_scaling = 1.0
@@ -131,7 +131,7 @@ pub struct Scene {
     pub checkpoint_strain_interval: f64,
     /// Damping ratio ξ, 0 ≤ ξ ≤ 2.
     pub damping_ratio: f64,
-    /// Contact sweeps per step at most, 1..=10 (a further one runs while a
+    /// Contact sweeps per step at most, 1..=50 (a further one runs while a
     /// gap deeper than [`super::run::SWEEP_TOLERANCE_REL`] × the element
     /// size is left).
     pub contact_sweeps: u32,
@@ -286,10 +286,10 @@ impl Scene {
                 "0 <= xi <= 2",
             ),
             (
-                (1..=10).contains(&self.contact_sweeps),
+                (1..=50).contains(&self.contact_sweeps),
                 "contact_sweeps",
                 f64::from(self.contact_sweeps),
-                "1..=10",
+                "1..=50",
             ),
         ];
         if let Some((_, field, value, allowed)) = checks.into_iter().find(|c| !c.0) {

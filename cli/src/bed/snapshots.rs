@@ -14,7 +14,6 @@
 //! data arrays base64-encoded inline); `vtkio` has no `.pvd` collection
 //! type, so that short index is written here.
 
-use std::io::Write as _;
 use std::path::{Path, PathBuf};
 
 use anyhow::{Context as _, bail};
@@ -27,7 +26,7 @@ use vtkio::model::{
 
 use crate::assembly::Assembly;
 use crate::model::OwnedReference;
-use crate::output::{create_file, finish_file};
+use crate::output::{create_file, finish_file, write_text};
 
 /// Sub-directory of the output directory holding the snapshots.
 pub const VTK_DIR: &str = "vtk";
@@ -247,10 +246,7 @@ impl SnapshotWriter {
             .filter(|(_, name)| self.dir.join(name).is_file())
             .collect();
         let pvd = self.dir.join(PVD_FILE);
-        let mut file = create_file(&pvd)?;
-        file.write_all(pvd_text(&entries).as_bytes())
-            .with_context(|| format!("cannot write `{}`", pvd.display()))?;
-        finish_file(file, &pvd)
+        write_text(&pvd, &pvd_text(&entries))
     }
 }
 

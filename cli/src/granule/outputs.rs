@@ -3,7 +3,6 @@
 //! Every writer names the file in its error.
 
 use crate::output::{create_file, finish_file};
-use std::io::Write;
 use std::path::Path;
 
 use anyhow::Context as _;
@@ -104,13 +103,7 @@ pub fn write_summary_json(path: &Path, summary: &Summary) -> anyhow::Result<()> 
     crate::output::write_json(path, summary)
 }
 
-/// Writes `text` to `path`.
-pub fn write_text(path: &Path, text: &str) -> anyhow::Result<()> {
-    let mut w = create_file(path)?;
-    w.write_all(text.as_bytes())
-        .with_context(|| format!("cannot write to `{}`", path.display()))?;
-    finish_file(w, path)
-}
+pub use crate::output::write_text;
 
 /// The [`TYPES_CSV`] row of one type's summary (`NaN` for a measure that
 /// is `null` in its summary).

@@ -118,7 +118,7 @@ pub struct StabilityArgs {
     #[arg(long, value_name = "C", default_value_t = 0.7)]
     pub granule_strain: f64,
 
-    /// Override the beds' maximum contact sweeps per step (1..=10; default:
+    /// Override the beds' maximum contact sweeps per step (1..=50; default:
     /// the published scene's), to show what the sweeps buy.
     #[arg(long, value_name = "N")]
     pub contact_sweeps: Option<u32>,

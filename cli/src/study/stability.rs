@@ -19,7 +19,6 @@
 //! `bed`), so "rejected or repaired steps" is 0 for every run that passes
 //! and the error column says what stopped one that did not.
 
-use std::path::Path;
 use std::time::Instant;
 
 use anyhow::Context as _;
@@ -36,7 +35,7 @@ use crate::csv::{CsvWriter, Field};
 use crate::granule::GRANULE_RADIUS_M;
 use crate::granule::run::run_platens;
 use crate::model::{MeshLevel, OwnedReference};
-use crate::output::{Streams, create_file, finish_file, finite_ratio, write_json};
+use crate::output::{Streams, create_file, finish_file, finite_ratio, write_json, write_text};
 
 /// The table of the suite.
 pub const CSV_FILE: &str = "stability.csv";
@@ -194,7 +193,7 @@ pub fn run_bed_case(scene: &Scene) -> anyhow::Result<(Record, BedRun)> {
     let s = summary(scene, &run);
     let record = Record {
         kind: "bed",
-        granule_type: type_name(&scene.granule_type),
+        granule_type: scene.granule_type()?.name(),
         seed: scene.seed,
         target_strain: scene.final_strain,
         final_strain: s.final_strain,
@@ -212,15 +211,6 @@ pub fn run_bed_case(scene: &Scene) -> anyhow::Result<(Record, BedRun)> {
     }
     .judge();
     Ok((record, run))
-}
-
-/// The static name of a validated type name.
-fn type_name(name: &str) -> &'static str {
-    GranuleType::ALL
-        .iter()
-        .map(|t| t.name())
-        .find(|n| n.eq_ignore_ascii_case(name))
-        .unwrap_or("?")
 }
 
 /// Runs one granule of `granule_type` between platens (octant, the
@@ -293,14 +283,6 @@ fn worst(runs: &[&BedRun], y: fn(&BedSample) -> Real, lowest: bool) -> Vec<(Real
             (s.strain, v)
         })
         .collect()
-}
-
-/// Writes `text` to `path`.
-fn write_text(path: &Path, text: &str) -> anyhow::Result<()> {
-    let mut w = create_file(path)?;
-    std::io::Write::write_all(&mut w, text.as_bytes())
-        .with_context(|| format!("cannot write `{}`", path.display()))?;
-    finish_file(w, path)
 }
 
 /// The settings and rows of [`JSON_FILE`].

@@ -30,7 +30,7 @@ use crate::granule::GRANULE_RADIUS_M;
 use crate::granule::run::{mean_force, run_platens};
 use crate::granule::summary::FIT_STRAIN_RANGE;
 use crate::model::{MeshLevel, OwnedReference};
-use crate::output::{Streams, create_file, finish_file};
+use crate::output::{Streams, create_file, finish_file, write_text};
 
 /// The table of the study.
 pub const CSV_FILE: &str = "work_precision.csv";
@@ -383,10 +383,7 @@ impl WorkPrecisionArgs {
             reference.setting.element_name()
         );
         let svg_path = self.out.join(SVG_FILE);
-        let mut w = create_file(&svg_path)?;
-        std::io::Write::write_all(&mut w, diagram(&rows, &title)?.as_bytes())
-            .with_context(|| format!("cannot write `{}`", svg_path.display()))?;
-        finish_file(w, &svg_path)?;
+        write_text(&svg_path, &diagram(&rows, &title)?)?;
         if let Some(d) = rows.iter().find(|r| r.m.setting.name == "default") {
             writeln!(
                 streams.stderr,
