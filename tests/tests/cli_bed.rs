@@ -188,6 +188,20 @@ fn a_stopped_run_resumes_to_the_same_bits() {
         *partial.last().unwrap() < 0.06,
         "the first part ran to {partial:?}"
     );
+    // A short second segment (0.05 → 0.06): the summary's wall time
+    // counts the first segment too, so it exceeds what the checkpoint
+    // recorded for the first (a second segment alone is far shorter).
+    let first_wall = granbed_cli::bed::checkpoint::Checkpoint::read(&parts)
+        .unwrap()
+        .progress
+        .compression_wall_time_s;
+    assert!(first_wall > 0.0);
+    run(&["--resume", parts_s, "--quiet", "--stop-at-strain", "0.06"]);
+    let two_walls = summary(&parts)["wall_time_s"].as_f64().unwrap();
+    assert!(
+        two_walls > first_wall,
+        "wall time {two_walls} s after resuming a run that had taken {first_wall} s"
+    );
     run(&["--resume", parts_s, "--quiet"]);
     assert_eq!(
         std::fs::read(whole.join("compression.csv")).unwrap(),

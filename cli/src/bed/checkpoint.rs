@@ -23,8 +23,9 @@ pub const FILE_NAME: &str = "checkpoint.bin";
 /// Format version written and read.
 ///
 /// 2: samples gained the smallest Gauss-point Jacobian, the largest nodal
-/// speed and the penetration, the averaging window the largest nodal speed
-/// (version 1 files are refused).
+/// speed and the penetration, the averaging window the largest nodal speed,
+/// the run header the compression's wall time so far (version 1 files are
+/// refused).
 pub const VERSION: u32 = 2;
 const MAGIC: &[u8; 16] = b"GRANBED-CKPT\0\0\0\0";
 
@@ -37,6 +38,9 @@ pub struct Progress {
     pub die: DieScene,
     /// Wall time of the pour, s.
     pub pour_wall_time_s: f64,
+    /// Wall time of the compression up to this checkpoint (all segments
+    /// of a resumed run), s.
+    pub compression_wall_time_s: f64,
     /// Samples written so far.
     pub samples: Vec<BedSample>,
     /// The open averaging window.
@@ -238,6 +242,7 @@ impl Checkpoint {
             p.die.punch_speed_m_s,
             p.pour_wall_time_s,
             p.next_output,
+            p.compression_wall_time_s,
         ]);
         e.u64(p.snapshots_done as u64);
         let w = &p.window;
@@ -288,7 +293,8 @@ impl Checkpoint {
             punch_speed_m_s,
             pour_wall_time_s,
             next_output,
-        ] = <[f64; 5]>::try_from(head).map_err(|_| anyhow::anyhow!("bad run header"))?;
+            compression_wall_time_s,
+        ] = <[f64; 6]>::try_from(head).map_err(|_| anyhow::anyhow!("bad run header"))?;
         let snapshots_done = d.u64()? as usize;
         let w = <[f64; WINDOW_FLOATS]>::try_from(d.f64s()?)
             .map_err(|_| anyhow::anyhow!("bad window"))?;
@@ -347,6 +353,7 @@ impl Checkpoint {
                     punch_speed_m_s,
                 },
                 pour_wall_time_s,
+                compression_wall_time_s,
                 samples,
                 window: Window {
                     time: w[0],

@@ -106,7 +106,7 @@ pub struct BedRun {
     pub element_steps: u64,
     /// Wall time of the pour, s.
     pub pour_wall_time_s: f64,
-    /// Wall time of the compression, s.
+    /// Wall time of the compression, s (all segments of a resumed run).
     pub wall_time_s: f64,
     /// Wall time by phase of the compression.
     pub phase_times: crate::assembly::PhaseTimes,
@@ -321,7 +321,10 @@ pub fn run_bed(
     let granules = scene.granules;
     let eta0 = material.params.eta0;
     let d = 2.0 * radius;
+    // Wall time of earlier segments of a resumed run.
+    let wall_before = resumed.map_or(0.0, |c| c.progress.compression_wall_time_s);
     let start = Instant::now();
+    let wall = || wall_before + start.elapsed().as_secs_f64();
     let sample = |asm: &mut Assembly<'_>, w: &Window| {
         let [rho, rho_solid, a_dv, a_d] = geometry(asm, &mesh, eta0, d);
         asm.elastic_energy();
@@ -388,6 +391,7 @@ pub fn run_bed(
                     scene_toml: scene.to_toml(),
                     die,
                     pour_wall_time_s,
+                    compression_wall_time_s: wall(),
                     samples: samples.to_vec(),
                     window: *window,
                     next_output: next,
@@ -433,7 +437,7 @@ pub fn run_bed(
         }
         if strain + 1e-12 >= next || asm.time() >= end {
             let s = sample(&mut asm, &window);
-            observer.sample(&s, start.elapsed().as_secs_f64());
+            observer.sample(&s, wall());
             samples.push(s);
             window = Window {
                 min_j: Real::INFINITY,
@@ -486,7 +490,7 @@ pub fn run_bed(
         steps,
         element_steps: steps * (scene.granules * mesh.hexes.len()) as u64,
         pour_wall_time_s,
-        wall_time_s: start.elapsed().as_secs_f64(),
+        wall_time_s: wall(),
         phase_times: *asm.times(),
         threads: rayon::current_num_threads(),
         stopped,
