@@ -10,7 +10,7 @@ use common::{Rng, assert_close, material, sphere_mesh};
 use granbed_kernel::Real;
 use granbed_kernel::constitutive::UpdateOptions;
 use granbed_kernel::element::force::{hex_forces, mean_deformation_gradient};
-use granbed_kernel::element::hex8::HexCoords;
+use granbed_kernel::element::hex8::{HexCoords, NODE_SIGNS};
 use granbed_kernel::element::reference::hex_reference;
 use granbed_kernel::granule::damping::{damping_forces, rigid_motion};
 use granbed_kernel::material::GranuleType;
@@ -409,17 +409,7 @@ fn fbar_patch_and_rigid_motion() {
 #[test]
 fn hourglass_stiffening_follows_the_amplitude() {
     let side = 1e-4;
-    let corners: HexCoords = [
-        [-1.0, -1.0, -1.0],
-        [1.0, -1.0, -1.0],
-        [1.0, 1.0, -1.0],
-        [-1.0, 1.0, -1.0],
-        [-1.0, -1.0, 1.0],
-        [1.0, -1.0, 1.0],
-        [1.0, 1.0, 1.0],
-        [-1.0, 1.0, 1.0],
-    ]
-    .map(|p: [Real; 3]| p.map(|c| 0.5 * side * c));
+    let corners: HexCoords = NODE_SIGNS.map(|p| p.map(|c| 0.5 * side * c));
     let r = hex_reference(&corners).unwrap();
     let mat = material(GranuleType::B2);
     let mode = [1.0, -1.0, 1.0, -1.0, 1.0, -1.0, 1.0, -1.0];
