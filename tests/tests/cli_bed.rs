@@ -243,6 +243,81 @@ fn heavy_mass_scaling_fails_the_quasi_static_certificate() {
     assert!(run.stderr.contains("mass_scaling"), "{}", run.stderr);
 }
 
+/// `--rate-check` presses the same bed again at half the punch speed: the
+/// twin is in `half_speed/` with half the speed and twice the steps, the
+/// change of P(C) is in the certificate, and `passed` holds all three
+/// figures to their limits.
+#[test]
+fn the_rate_check_presses_the_same_bed_at_half_speed() {
+    let dir = out_dir("rate_check");
+    let mut argv = vec![
+        "bed",
+        "-j",
+        "2",
+        "--out",
+        dir.to_str().unwrap(),
+        "--rate-check",
+    ];
+    argv.extend_from_slice(&SMALL);
+    let run = cli(&argv);
+    assert_eq!(run.code, 0, "{}", run.stderr);
+    assert!(
+        run.stderr.contains("rate check: half the punch speed"),
+        "{}",
+        run.stderr
+    );
+    let (s, twin) = (summary(&dir), summary(&dir.join("half_speed")));
+    assert_eq!(
+        number(&twin["scene"], "punch_speed_m_s"),
+        0.5 * number(&s["scene"], "punch_speed_m_s")
+    );
+    let ratio = number(&twin, "steps") / number(&s, "steps");
+    assert!((ratio - 2.0).abs() < 0.05, "steps at half speed: {ratio} x");
+    let q = &s["quasi_static"];
+    let change = number(q, "rate_change_rel");
+    assert!(change.is_finite() && change > 0.0, "{q}");
+    let within = number(q, "max_kinetic_to_internal") < 0.01
+        && number(q, "force_imbalance_rel") < 0.05
+        && change < granbed_cli::bed::outputs::RATE_CHANGE_LIMIT;
+    assert_eq!(q["passed"], within, "{q}");
+    // Without the check the field is null and does not decide.
+    assert!(summary(&dir.join("half_speed"))["quasi_static"]["rate_change_rel"].is_null());
+}
+
+/// The element and κ are scene fields with CLI overrides; a bad value is
+/// refused naming the field.
+#[test]
+fn the_element_and_kappa_are_scene_fields() {
+    let run = cli(&[
+        "bed",
+        "--print-scene",
+        "--element",
+        "fbar",
+        "--hourglass-kappa",
+        "0.1",
+    ]);
+    assert_eq!(run.code, 0, "{}", run.stderr);
+    let scene = Scene::from_toml(&run.stdout).unwrap();
+    assert_eq!(
+        (scene.element.as_str(), scene.hourglass_kappa),
+        ("fbar", 0.1)
+    );
+    let run = cli(&["bed", "--print-scene", "--hourglass-kappa", "2"]);
+    assert_eq!(run.code, 2);
+    assert!(run.stderr.contains("hourglass_kappa"), "{}", run.stderr);
+    let bad = DEFAULT_SCENE.replace("element = \"one-point\"", "element = \"q8\"");
+    let err = Scene::from_toml(&bad).unwrap_err().to_string();
+    assert!(
+        err.contains("element") && err.contains("one-point, fbar"),
+        "{err}"
+    );
+    // A scene file from before these fields reads with the defaults.
+    let old = DEFAULT_SCENE
+        .replace("element = \"one-point\"\n", "")
+        .replace("hourglass_kappa = 0.05\n", "");
+    assert_eq!(Scene::from_toml(&old).unwrap(), Scene::published());
+}
+
 #[test]
 fn a_failing_run_names_granule_element_step_and_strain_and_keeps_its_outputs() {
     // A punch at 30 m/s crushes the coarse granules within a few steps.

@@ -25,7 +25,7 @@ fn the_quick_granule_study_writes_a_consistent_table_and_diagram() {
     let t = Table::read(&dir.join("work_precision.csv"));
     let names = t.text("setting");
     let steps = t.num("steps");
-    let error = t.num("error_force_l2");
+    let error = t.num("error_curve_l2");
     let reference = t.num("reference");
     let row = |name: &str| {
         names
@@ -62,6 +62,86 @@ fn the_quick_granule_study_writes_a_consistent_table_and_diagram() {
     let elements = parse_xml(&svg);
     let circles = elements.iter().filter(|e| e.name == "circle").count();
     assert_eq!(circles, names.len() - 1, "points in the diagram");
+}
+
+/// `granbed-cli study work-precision --scene bed-small --quick`: the bed
+/// study's table holds the reference (error 0), the default and its
+/// variants on the first pour; its default row is exactly what
+/// `granbed-cli bed` gives for the same scene (the study runs that code);
+/// mass scaling and punch speed change the step count as the physics says;
+/// and the diagram marks the run-to-run spread.
+#[test]
+fn the_quick_bed_study_runs_the_bed_code_and_measures_the_spread() {
+    let dir = common::fresh_dir("cli_study", "bed_quick");
+    let run = cli(&[
+        "study",
+        "work-precision",
+        "--scene",
+        "bed-small",
+        "--quick",
+        "-j",
+        "2",
+        "--out",
+        dir.to_str().unwrap(),
+    ]);
+    assert_eq!(run.code, 0, "{}", run.stderr);
+    assert!(
+        run.stderr
+            .contains("run-to-run spread of the curve over pours"),
+        "{}",
+        run.stderr
+    );
+    let t = Table::read(&dir.join("work_precision.csv"));
+    let names = t.text("setting");
+    assert_eq!(names, ["reference", "default", "mass x10", "speed x2"]);
+    assert!(t.num("seed").iter().all(|&s| s == 1.0));
+    let error = t.num("error_curve_l2");
+    let within = t.num("within_spread");
+    assert_eq!((error[0], within[0]), (0.0, 1.0));
+    assert!(
+        error[1..].iter().all(|e| e.is_finite() && *e > 0.0),
+        "{error:?}"
+    );
+    let a = t.num("kawakita_a");
+    assert!(a.iter().all(|a| a.is_finite() && *a > 0.0), "{a:?}");
+    let steps = t.num("steps");
+    let close = |x: f64, want: f64, what: &str| {
+        assert!(
+            (x / want - 1.0).abs() < 0.05,
+            "{what}: {x}, expected {want}"
+        );
+    };
+    close(steps[1] / steps[2], 10f64.sqrt(), "mass scaling x10");
+    close(steps[1] / steps[3], 2.0, "speed x2");
+    close(steps[0] / steps[1], 2.0, "reference at half speed");
+    // The default row is `granbed-cli bed` on the same scene, bit for bit.
+    let bed = common::fresh_dir("cli_study", "bed_quick_run");
+    let run = cli(&[
+        "bed",
+        "--granules",
+        "15",
+        "--mesh",
+        "4x1",
+        "--die-diameter-mm",
+        "4.2",
+        "--strain",
+        "0.3",
+        "-j",
+        "1",
+        "--quiet",
+        "--out",
+        bed.to_str().unwrap(),
+    ]);
+    assert_eq!(run.code, 0, "{}", run.stderr);
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(bed.join("summary.json")).unwrap()).unwrap();
+    assert_eq!(common::number(&summary, "kawakita_a"), a[1]);
+    assert_eq!(common::number(&summary, "steps"), steps[1]);
+    let svg = std::fs::read_to_string(dir.join("work_precision.svg")).unwrap();
+    let elements = parse_xml(&svg);
+    let circles = elements.iter().filter(|e| e.name == "circle").count();
+    assert_eq!(circles, names.len() - 1, "points in the diagram");
+    assert!(svg.contains("run-to-run spread"), "the spread line's label");
 }
 
 /// `granbed-cli study stability` (issue #9's suite) on a tiny grid: one

@@ -16,9 +16,13 @@ use anyhow::Context as _;
 use clap::Args;
 use granbed_kernel::material::GranuleType;
 
-use crate::granule::TypeList;
+use crate::granule::{ElementArg, TypeList};
 use crate::model::MeshLevel;
 use crate::output::Streams;
+
+/// The rate check's run at half the punch speed, under the output
+/// directory.
+pub const HALF_SPEED_DIR: &str = "half_speed";
 
 pub mod checkpoint;
 pub mod compare;
@@ -123,11 +127,21 @@ pub struct BedArgs {
     #[arg(long, value_name = "MM")]
     pub die_diameter_mm: Option<f64>,
 
+    /// Override: element formulation (one-point, or fbar for verification:
+    /// about 8× the element cost).
+    #[arg(long, value_enum, value_name = "KIND")]
+    pub element: Option<ElementArg>,
+
+    /// Override: hourglass coefficient κ of the one-point element
+    /// (0 ≤ κ ≤ 1).
+    #[arg(long, value_name = "KAPPA")]
+    pub hourglass_kappa: Option<f64>,
+
     /// Continue the run whose checkpoint is in DIR (its `checkpoint.bin`);
     /// the outputs go to DIR. Only --strain, --stop-at-strain,
     /// --time-step-safety, --mass-scaling, -j and --quiet may be given with
     /// it.
-    #[arg(long, value_name = "DIR", conflicts_with_all = ["scene", "out", "granule_type", "granules", "mesh", "seed", "die_diameter_mm"])]
+    #[arg(long, value_name = "DIR", conflicts_with_all = ["scene", "out", "granule_type", "granules", "mesh", "seed", "die_diameter_mm", "element", "hourglass_kappa"])]
     pub resume: Option<PathBuf>,
 
     /// Write a checkpoint and stop once the strain reaches C (continue
@@ -146,6 +160,12 @@ pub struct BedArgs {
     /// --resume, e.g. to continue a run that failed with a smaller step.
     #[arg(long, value_name = "C")]
     pub time_step_safety: Option<f64>,
+
+    /// The quasi-static certificate's rate check: after the run, press the
+    /// same bed again at half the punch speed (into DIR/half_speed; about
+    /// twice the run's cost) and require P(C) to move by less than 5 %.
+    #[arg(long, conflicts_with_all = ["types", "stop_at_strain"])]
+    pub rate_check: bool,
 
     /// Worker threads (0 = all cores). Results do not depend on it.
     #[arg(short = 'j', long, value_name = "N", default_value_t = 0)]
@@ -189,6 +209,16 @@ impl BedArgs {
         }
         if let Some(d) = self.die_diameter_mm {
             scene.die_diameter_mm = d;
+        }
+        if let Some(e) = self.element {
+            scene.element = match e {
+                ElementArg::OnePoint => scene::ELEMENT_ONE_POINT,
+                ElementArg::Fbar => scene::ELEMENT_FBAR,
+            }
+            .to_owned();
+        }
+        if let Some(k) = self.hourglass_kappa {
+            scene.hourglass_kappa = k;
         }
         if let Some(f) = self.mass_scaling {
             scene.mass_scaling = f;
@@ -237,7 +267,10 @@ impl BedArgs {
             checkpoint_dir: Some(out.clone()),
             stop_at_strain: self.stop_at_strain,
         };
-        let result = self.compress(&pool, &scene, control, &out, "bed", streams)?;
+        let mut result = self.compress(&pool, &scene, control, &out, "bed", streams)?;
+        if self.rate_check && result.error.is_none() {
+            self.rate_check(&pool, &scene, &out, &mut result, streams)?;
+        }
         if result.stopped && !self.quiet {
             writeln!(
                 streams.stderr,
@@ -300,6 +333,61 @@ impl BedArgs {
             writeln!(streams.stderr, "{}", outputs::summary_line(scene, &result))?;
         }
         Ok(result)
+    }
+
+    /// `--rate-check`: the same scene (same pour) at half the punch speed
+    /// into `out/half_speed`; the change of P(C) goes into `result` and the
+    /// outputs in `out` are written again with it.
+    fn rate_check(
+        &self,
+        pool: &rayon::ThreadPool,
+        scene: &Scene,
+        out: &std::path::Path,
+        result: &mut run::BedRun,
+        streams: &mut Streams<'_>,
+    ) -> anyhow::Result<()> {
+        let slow = Scene {
+            punch_speed_m_s: 0.5 * scene.punch_speed_m_s,
+            ..scene.clone()
+        };
+        let dir = out.join(HALF_SPEED_DIR);
+        let control = run::RunControl {
+            checkpoint_dir: Some(dir.clone()),
+            ..run::RunControl::default()
+        };
+        let twin = self
+            .compress(pool, &slow, control, &dir, "half speed", streams)
+            .context("the rate check's run at half the punch speed")?;
+        if let Some(e) = twin.error {
+            return Err(anyhow::Error::new(e).context(format!(
+                "the rate check's run at half the punch speed failed (its outputs are in `{}`)",
+                dir.display()
+            )));
+        }
+        let curve = |r: &run::BedRun| -> Vec<(f64, f64)> {
+            r.samples
+                .iter()
+                .map(|s| (s.strain, s.upper_pressure_pa))
+                .collect()
+        };
+        let window = outputs::rate_check_window(scene.final_strain);
+        result.rate_change_rel =
+            crate::study::work_precision::curve_error(&curve(result), &curve(&twin), window);
+        outputs::write_all(out, scene, result)?;
+        if !self.quiet {
+            let q = outputs::summary(scene, result).quasi_static;
+            writeln!(
+                streams.stderr,
+                "rate check: half the punch speed changes P(C) by {} (limit {}); quasi-static \
+                 certificate {}",
+                result
+                    .rate_change_rel
+                    .map_or("n/a (too short a run)".to_owned(), |r| format!("{r:.4}")),
+                outputs::RATE_CHANGE_LIMIT,
+                if q.passed { "passed" } else { "FAILED" }
+            )?;
+        }
+        Ok(())
     }
 
     /// `--types`: pour once, compress every type in `types` from that

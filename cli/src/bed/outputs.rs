@@ -95,20 +95,37 @@ pub struct KawakitaSummary {
 /// masses are scaled), judged over the second half of the run, where the
 /// bed carries load (the first half holds the rearrangement, whose impacts
 /// are dynamic at any mass). **Choices:** kinetic energy below 1 % of the
-/// internal work at every sample, and the punch-force imbalance
-/// |F_up − F_low − F_wall,z| below 5 % of F_up on average.
+/// internal work at every sample, the punch-force imbalance
+/// |F_up − F_low − F_wall,z| below 5 % of F_up on average, and, when the
+/// rate check ran (`--rate-check`), P(C) within [`RATE_CHANGE_LIMIT`] of
+/// the run at half the punch speed.
 #[derive(Clone, Copy, Debug, Serialize)]
 pub struct QuasiStatic {
     /// Largest kinetic / internal work ratio over the second half.
     pub max_kinetic_to_internal: Option<Real>,
     /// Mean |F_up − F_low − F_wall,z| / F_up over the second half.
     pub force_imbalance_rel: Option<Real>,
-    /// Both below their limits.
+    /// Relative L2 change of P(C) over 2 % ≤ C ≤ the final strain at half
+    /// the punch speed (None: the rate check did not run).
+    pub rate_change_rel: Option<Real>,
+    /// Every figure below its limit (the rate change only if checked).
     pub passed: bool,
 }
 
-/// The quasi-static certificate of `samples`.
-pub fn quasi_static(samples: &[BedSample]) -> QuasiStatic {
+/// The rate check's limit on the relative change of P(C) at half the
+/// punch speed (a choice: a curve that moves by 5 % when the loading is
+/// twice as slow is not a quasi-static answer).
+pub const RATE_CHANGE_LIMIT: Real = 0.05;
+
+/// The strain window of the rate check: from 2 % (below, the pressure is
+/// the rearrangement's noise) to `final_strain`.
+pub fn rate_check_window(final_strain: Real) -> [Real; 2] {
+    [0.02, final_strain]
+}
+
+/// The quasi-static certificate of `samples`, with the rate check's
+/// change if it ran.
+pub fn quasi_static(samples: &[BedSample], rate_change_rel: Option<Real>) -> QuasiStatic {
     let half = &samples[samples.len() / 2..];
     let max_kinetic_to_internal = half
         .iter()
@@ -125,8 +142,10 @@ pub fn quasi_static(samples: &[BedSample]) -> QuasiStatic {
     QuasiStatic {
         max_kinetic_to_internal,
         force_imbalance_rel,
+        rate_change_rel,
         passed: max_kinetic_to_internal.is_some_and(|r| r < 0.01)
-            && force_imbalance_rel.is_some_and(|r| r < 0.05),
+            && force_imbalance_rel.is_some_and(|r| r < 0.05)
+            && rate_change_rel.is_none_or(|r| r < RATE_CHANGE_LIMIT),
     }
 }
 
@@ -306,7 +325,7 @@ pub fn summary<'a>(scene: &'a Scene, run: &BedRun) -> Summary<'a> {
         energy_residual_rel: finite_ratio(e.residual().abs(), e.punch_work),
         contact_loss_rel: finite_ratio(e.contact_loss(), e.punch_work),
         peak_memory_bytes: peak_memory_bytes(),
-        quasi_static: quasi_static(&run.samples),
+        quasi_static: quasi_static(&run.samples, run.rate_change_rel),
         error: run.error.as_ref().map(|e| e.to_string()),
     }
 }
@@ -340,9 +359,11 @@ pub fn summary_line(scene: &Scene, run: &BedRun) -> String {
         String::new()
     } else {
         format!(
-            "; NOT quasi-static (kinetic/internal up to {}, force imbalance {})",
+            "; NOT quasi-static (kinetic/internal up to {}, force imbalance {}, change at half \
+             speed {})",
             fmt(q.max_kinetic_to_internal, 1.0),
-            fmt(q.force_imbalance_rel, 1.0)
+            fmt(q.force_imbalance_rel, 1.0),
+            fmt(q.rate_change_rel, 1.0)
         )
     };
     format!(

@@ -13,7 +13,7 @@ use granbed_kernel::analysis::bed::{
     surface_geometry,
 };
 use granbed_kernel::dem::pour::PourParams;
-use granbed_kernel::granule::forces::{ElementKind, ElementSettings};
+use granbed_kernel::granule::forces::ElementSettings;
 
 use super::checkpoint::{self, Checkpoint};
 use super::scene::Scene;
@@ -120,6 +120,10 @@ pub struct BedRun {
     /// state at the last output row before the failure, or a later
     /// periodic checkpoint), if checkpoints are written.
     pub checkpoint_strain: Option<Real>,
+    /// The rate check (`granbed-cli bed --rate-check`): the relative L2
+    /// change of P(C) when the same bed is pressed at half the punch speed
+    /// (None: not checked).
+    pub rate_change_rel: Option<Real>,
 }
 
 /// The time-averaging window of the samples (integrals over the open
@@ -254,9 +258,9 @@ pub fn run_bed(
     let radius = 0.5e-3 * scene.diameter_mm;
     let mesh = OwnedReference::sphere(radius, scene.mesh_level()?, false)?;
     let elements = ElementSettings {
-        kind: ElementKind::OnePoint,
+        kind: scene.element_kind()?,
         update: Default::default(),
-        hourglass_kappa: granbed_kernel::element::force::DEFAULT_HOURGLASS_KAPPA,
+        hourglass_kappa: scene.hourglass_kappa,
     };
     let mut params = AssemblyParams::standard(material, elements);
     params.damping_ratio = scene.damping_ratio;
@@ -496,5 +500,6 @@ pub fn run_bed(
         stopped,
         error,
         checkpoint_strain,
+        rate_change_rel: None,
     })
 }

@@ -3,6 +3,7 @@
 //! embedded default (the published scene) and its validation.
 
 use anyhow::{Context as _, bail};
+use granbed_kernel::granule::forces::ElementKind;
 use granbed_kernel::material::{GranuleType, Material, MaterialParams};
 use serde::{Deserialize, Serialize};
 
@@ -43,6 +44,10 @@ snapshot_strains = [0.0, 0.1, 0.2, 0.3]
 checkpoint_interval_minutes = 10.0
 checkpoint_strain_interval = 0.05
 
+# Element: "one-point" (uniform gradient, hourglass control with
+# coefficient hourglass_kappa) or "fbar" (2x2x2 F-bar, about 8x the cost).
+element = "one-point"
+hourglass_kappa = 0.05
 # Selective damping of the non-rigid modes, fraction of critical.
 damping_ratio = 0.5
 # Contact sweeps per step at most (physics.md 5.3); a further sweep runs while
@@ -129,6 +134,13 @@ pub struct Scene {
     pub checkpoint_interval_minutes: f64,
     /// Strain between checkpoints (> 0).
     pub checkpoint_strain_interval: f64,
+    /// Element formulation: `one-point` or `fbar` (absent: one-point).
+    #[serde(default = "default_element")]
+    pub element: String,
+    /// Hourglass coefficient κ of the one-point element, 0 ≤ κ ≤ 1
+    /// (absent: the kernel's default).
+    #[serde(default = "default_hourglass_kappa")]
+    pub hourglass_kappa: f64,
     /// Damping ratio ξ, 0 ≤ ξ ≤ 2.
     pub damping_ratio: f64,
     /// Contact sweeps per step at most, 1..=50 (a further one runs while a
@@ -158,6 +170,19 @@ pub struct Scene {
 fn unit_scaling() -> f64 {
     1.0
 }
+
+fn default_element() -> String {
+    ELEMENT_ONE_POINT.to_owned()
+}
+
+fn default_hourglass_kappa() -> f64 {
+    granbed_kernel::element::force::DEFAULT_HOURGLASS_KAPPA
+}
+
+/// The scene's name of the one-point element.
+pub const ELEMENT_ONE_POINT: &str = "one-point";
+/// The scene's name of the F-bar element.
+pub const ELEMENT_FBAR: &str = "fbar";
 
 fn default_time_step_safety() -> f64 {
     0.9
@@ -206,7 +231,14 @@ impl Scene {
         }
         self.granule_type()?;
         self.mesh_level()?;
-        let checks: [(bool, &str, f64, &str); 14] = [
+        self.element_kind()?;
+        let checks: [(bool, &str, f64, &str); 15] = [
+            (
+                (0.0..=1.0).contains(&self.hourglass_kappa),
+                "hourglass_kappa",
+                self.hourglass_kappa,
+                "0 <= kappa <= 1",
+            ),
             (
                 self.time_step_safety > 0.0 && self.time_step_safety <= 2.0,
                 "time_step_safety",
@@ -311,6 +343,15 @@ impl Scene {
         self.granule_type
             .parse()
             .map_err(|_| invalid("granule_type", &self.granule_type, "A1, A2, A3, B1 ... C3"))
+    }
+
+    /// The element formulation.
+    pub fn element_kind(&self) -> anyhow::Result<ElementKind> {
+        match self.element.as_str() {
+            ELEMENT_ONE_POINT => Ok(ElementKind::OnePoint),
+            ELEMENT_FBAR => Ok(ElementKind::FBar),
+            other => Err(invalid("element", other, "one-point, fbar")),
+        }
     }
 
     /// The mesh level.

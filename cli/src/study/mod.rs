@@ -14,6 +14,7 @@ use crate::material_args::MaterialArgs;
 use crate::model::MeshLevel;
 use crate::output::Streams;
 
+pub mod bed_small;
 pub mod stability;
 pub mod work_precision;
 
@@ -50,6 +51,10 @@ pub enum Study {
 pub enum StudyScene {
     /// One granule between platens (octant), to 40 % strain.
     Granule,
+    /// A small bed of the published scene (125 coarse 4x1 granules in a
+    /// 5.65 mm die, to 30 %), the default also on further pours for the
+    /// run-to-run spread.
+    BedSmall,
 }
 
 /// Options of `granbed-cli study work-precision`.
@@ -63,10 +68,36 @@ pub struct WorkPrecisionArgs {
     #[arg(long, value_name = "DIR")]
     pub out: PathBuf,
 
-    /// A small grid on the coarse 4x1 mesh (seconds instead of tens of
-    /// minutes; checks the machinery, not the defaults).
+    /// A small grid (granule: on the coarse 4x1 mesh; bed: 15 granules in
+    /// 4.2 mm to 30 %, two pours): seconds instead of tens of minutes;
+    /// checks the machinery, not the defaults.
     #[arg(long)]
     pub quick: bool,
+
+    /// bed-small: granules per bed (default 125; 15 with --quick).
+    #[arg(long, value_name = "N")]
+    pub granules: Option<usize>,
+
+    /// bed-small: die diameter, mm (default 5.65; 4.2 with --quick).
+    #[arg(long, value_name = "MM")]
+    pub die_diameter_mm: Option<f64>,
+
+    /// bed-small: final axial strain (default 0.3; 0.1 with --quick).
+    #[arg(long, value_name = "C")]
+    pub strain: Option<f64>,
+
+    /// bed-small: mesh level of the granules (default 4x1).
+    #[arg(long, value_name = "NxM")]
+    pub mesh: Option<MeshLevel>,
+
+    /// bed-small: poured beds for the spread, 2..=10 (default 3; 2 with
+    /// --quick).
+    #[arg(long, value_name = "N")]
+    pub pours: Option<u64>,
+
+    /// bed-small: worker threads (0 = all cores).
+    #[arg(short = 'j', long, value_name = "N", default_value_t = 0)]
+    pub threads: usize,
 
     /// Granule type.
     #[command(flatten)]

@@ -153,7 +153,7 @@ impl Record {
 
 /// A bed run's observer that keeps nothing (the samples come back in the
 /// [`BedRun`]).
-struct Silent;
+pub(crate) struct Silent;
 
 impl BedObserver for Silent {
     fn sample(&mut self, _: &BedSample, _: f64) {}
@@ -548,6 +548,7 @@ mod tests {
             element_steps: 0,
             pour_wall_time_s: 0.0,
             wall_time_s: 0.0,
+            rate_change_rel: None,
             phase_times: Default::default(),
             threads: 1,
             stopped: false,

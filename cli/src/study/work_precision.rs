@@ -1,12 +1,14 @@
-//! The work-precision study of the single-granule scene (issue #8): each
-//! numerical setting changed alone from the default, run to 40 % strain,
-//! and compared with a reference run.
+//! The work-precision study (issue #8): each numerical setting changed
+//! alone from the default and compared with a reference run, for one
+//! granule between platens (here) or a small bed ([`super::bed_small`]).
 //!
-//! * Error measures: the relative L2 distance of the platen force curve
-//!   F(C) from the reference's over 2 % ≤ C ≤ 40 % (both interpolated
-//!   linearly onto a 0.5 % grid), and the relative error of σ_est.
-//! * Cost: the wall time of the run (stepping and sampling, one thread; the
-//!   mesh generation not included) and its steps.
+//! * Error measures: the relative L2 distance of the load curve from the
+//!   reference's — the platen force F(C) over 2 % ≤ C ≤ 40 % (granule), the
+//!   upper-punch pressure P(C) over 2 % ≤ C ≤ the final strain (bed); both
+//!   interpolated linearly onto a 0.5 % grid — and the relative errors of
+//!   σ_est (granule) or of Kawakita's a and 1/b (bed).
+//! * Cost: the wall time of the run (stepping and sampling; not the mesh
+//!   generation or the pour) and its steps.
 //! * A setting is on the Pareto front when no other run is both faster and
 //!   more accurate.
 //!
@@ -38,8 +40,9 @@ pub const CSV_FILE: &str = "work_precision.csv";
 pub const SVG_FILE: &str = "work_precision.svg";
 
 /// Columns of [`CSV_FILE`].
-pub const COLUMNS: [&str; 15] = [
+pub const COLUMNS: [&str; 21] = [
     "setting",
+    "seed",
     "mesh_n",
     "mesh_m",
     "element",
@@ -50,14 +53,19 @@ pub const COLUMNS: [&str; 15] = [
     "steps",
     "wall_time_s",
     "sigma_est_pa",
-    "error_force_l2",
+    "kawakita_a",
+    "kawakita_inv_b_pa",
+    "error_curve_l2",
     "error_sigma_est",
+    "error_kawakita_a",
+    "error_kawakita_inv_b",
     "reference",
     "pareto",
+    "within_spread",
 ];
 
-/// Strain window of the force-curve error.
-const ERROR_STRAINS: [Real; 2] = [0.02, 0.4];
+/// Strain window of the granule's force-curve error.
+const GRANULE_ERROR_STRAINS: [Real; 2] = [0.02, 0.4];
 /// Grid step of the force-curve error.
 const ERROR_STEP: Real = 0.005;
 
@@ -76,7 +84,7 @@ pub struct Setting {
     pub safety: Real,
     /// Mass scaling F ≥ 1.
     pub mass_scaling: Real,
-    /// Platen speed as a multiple of the standard 5 mm/s.
+    /// Platen or punch speed as a multiple of the scene's.
     pub speed_factor: Real,
 }
 
@@ -94,11 +102,27 @@ impl Setting {
         }
     }
 
-    fn element_name(&self) -> &'static str {
+    /// The setting with another name.
+    pub const fn named(mut self, name: &'static str) -> Self {
+        self.name = name;
+        self
+    }
+
+    /// The element's name as the CSV and the bed scene spell it.
+    pub fn element_name(&self) -> &'static str {
         match self.element {
-            ElementKind::OnePoint => "one-point",
-            ElementKind::FBar => "fbar",
+            ElementKind::OnePoint => crate::bed::scene::ELEMENT_ONE_POINT,
+            ElementKind::FBar => crate::bed::scene::ELEMENT_FBAR,
         }
+    }
+}
+
+impl Setting {
+    /// This setting renamed `name` and changed by `f`.
+    pub fn with(self, name: &'static str, f: &dyn Fn(&mut Setting)) -> Setting {
+        let mut s = self.named(name);
+        f(&mut s);
+        s
     }
 }
 
@@ -110,12 +134,7 @@ pub fn granule_grid(quick: bool) -> (Setting, Vec<Setting>) {
     } else {
         MeshLevel::STANDARD
     });
-    let with = |name, f: &dyn Fn(&mut Setting)| {
-        let mut s = base;
-        s.name = name;
-        f(&mut s);
-        s
-    };
+    let with = |name, f: &dyn Fn(&mut Setting)| base.with(name, f);
     let reference = with("reference", &|s| {
         s.mesh = if quick {
             MeshLevel::new(4, 1)
@@ -152,14 +171,21 @@ pub fn granule_grid(quick: bool) -> (Setting, Vec<Setting>) {
 pub struct Measured {
     /// The settings.
     pub setting: Setting,
+    /// Seed of the pour (bed; 0 for a granule).
+    pub seed: u64,
     /// Steps.
     pub steps: u64,
     /// Wall time, s.
     pub wall_time_s: f64,
-    /// σ_est, Pa (None if the fit had too few samples).
+    /// σ_est, Pa (granule; None if the fit had too few samples).
     pub sigma_est_pa: Option<Real>,
-    /// The force curve: (strain, mean platen force in N).
+    /// Kawakita a and 1/b in Pa (bed; None without a fit).
+    pub kawakita: Option<(Real, Real)>,
+    /// The load curve: (strain, mean platen force in N) for a granule,
+    /// (strain, upper-punch pressure in Pa) for a bed.
     pub curve: Vec<(Real, Real)>,
+    /// Strain window of the curve error.
+    pub error_strains: [Real; 2],
 }
 
 /// Runs `setting` for `material`.
@@ -194,10 +220,13 @@ pub fn run_granule(setting: &Setting, material: &Material) -> anyhow::Result<Mea
     .map(|(sigma, _)| sigma);
     Ok(Measured {
         setting: *setting,
+        seed: 0,
         steps: result.steps,
         wall_time_s: result.wall_time_s,
         sigma_est_pa,
+        kawakita: None,
         curve,
+        error_strains: GRANULE_ERROR_STRAINS,
     })
 }
 
@@ -213,13 +242,19 @@ fn at(curve: &[(Real, Real)], c: Real) -> Option<Real> {
     Some(lo.1 + (hi.1 - lo.1) * (c - lo.0) / (hi.0 - lo.0))
 }
 
-/// Relative L2 distance of `curve` from `reference` on the error grid;
-/// None if either does not cover it.
-pub fn curve_error(curve: &[(Real, Real)], reference: &[(Real, Real)]) -> Option<Real> {
-    let n = ((ERROR_STRAINS[1] - ERROR_STRAINS[0]) / ERROR_STEP).round() as usize;
+/// Relative L2 distance of `curve` from `reference` on the error grid over
+/// `window` (strains); None if either does not cover it.
+pub fn curve_error(
+    curve: &[(Real, Real)],
+    reference: &[(Real, Real)],
+    window: [Real; 2],
+) -> Option<Real> {
+    let n = ((window[1] - window[0]) / ERROR_STEP).round() as usize;
     let (mut diff, mut norm) = (0.0, 0.0);
     for i in 0..=n {
-        let c = ERROR_STRAINS[0] + ERROR_STEP * i as Real;
+        // The last point is the window's end itself (0.02 + 56 × 0.005
+        // rounds above 0.3).
+        let c = (window[0] + ERROR_STEP * i as Real).min(window[1]);
         let (f, r) = (at(curve, c)?, at(reference, c)?);
         diff += (f - r) * (f - r);
         norm += r * r;
@@ -227,29 +262,85 @@ pub fn curve_error(curve: &[(Real, Real)], reference: &[(Real, Real)]) -> Option
     (norm > 0.0).then(|| (diff / norm).sqrt())
 }
 
-/// One row of the table.
-struct Row<'a> {
-    m: &'a Measured,
-    error_force: Real,
-    error_sigma: Real,
-    reference: bool,
-    pareto: bool,
+/// The errors of one run against another (NaN where a figure is missing).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Errors {
+    /// Relative L2 distance of the load curves.
+    pub curve: Real,
+    /// Relative error of σ_est.
+    pub sigma: Real,
+    /// Relative error of Kawakita's a.
+    pub kawakita_a: Real,
+    /// Relative error of Kawakita's 1/b.
+    pub kawakita_inv_b: Real,
 }
 
-/// The rows with their errors against `reference` and the Pareto flags.
-fn rows<'a>(reference: &'a Measured, runs: &'a [Measured]) -> Vec<Row<'a>> {
-    let sigma_ref = reference.sigma_est_pa.unwrap_or(Real::NAN);
+impl Errors {
+    /// The errors of `m` against `reference`.
+    pub fn of(m: &Measured, reference: &Measured) -> Self {
+        let rel = |x: Option<Real>, r: Option<Real>| match (x, r) {
+            (Some(x), Some(r)) => (x - r).abs() / r.abs(),
+            _ => Real::NAN,
+        };
+        let (a, inv_b) = (m.kawakita.map(|k| k.0), m.kawakita.map(|k| k.1));
+        let (ra, rinv_b) = (
+            reference.kawakita.map(|k| k.0),
+            reference.kawakita.map(|k| k.1),
+        );
+        Self {
+            curve: curve_error(&m.curve, &reference.curve, reference.error_strains)
+                .unwrap_or(Real::NAN),
+            sigma: rel(m.sigma_est_pa, reference.sigma_est_pa),
+            kawakita_a: rel(a, ra),
+            kawakita_inv_b: rel(inv_b, rinv_b),
+        }
+    }
+
+    /// The larger of each figure (NaN-ignoring).
+    pub fn max(self, o: Self) -> Self {
+        Self {
+            curve: self.curve.max(o.curve),
+            sigma: self.sigma.max(o.sigma),
+            kawakita_a: self.kawakita_a.max(o.kawakita_a),
+            kawakita_inv_b: self.kawakita_inv_b.max(o.kawakita_inv_b),
+        }
+    }
+}
+
+/// One row of the table.
+pub struct Row<'a> {
+    /// The run.
+    pub m: &'a Measured,
+    /// Its errors against the reference.
+    pub errors: Errors,
+    /// This is the reference run.
+    pub reference: bool,
+    /// On the Pareto front of wall time against the curve error.
+    pub pareto: bool,
+    /// The curve error is within the run-to-run spread of the default
+    /// over poured beds (bed study; None for a granule).
+    pub within_spread: Option<bool>,
+}
+
+/// The rows with their errors against `reference` and the Pareto flags;
+/// `spread` (bed) marks the settings whose curve error stays within it.
+pub fn rows<'a>(
+    reference: &'a Measured,
+    runs: &'a [Measured],
+    spread: Option<Errors>,
+) -> Vec<Row<'a>> {
     let mut rows: Vec<Row<'a>> = core::iter::once(reference)
         .chain(runs)
         .enumerate()
-        .map(|(i, m)| Row {
-            m,
-            error_force: curve_error(&m.curve, &reference.curve).unwrap_or(Real::NAN),
-            error_sigma: m
-                .sigma_est_pa
-                .map_or(Real::NAN, |s| (s - sigma_ref).abs() / sigma_ref),
-            reference: i == 0,
-            pareto: false,
+        .map(|(i, m)| {
+            let errors = Errors::of(m, reference);
+            Row {
+                m,
+                errors,
+                reference: i == 0,
+                pareto: false,
+                within_spread: spread.map(|s| errors.curve <= s.curve),
+            }
         })
         .collect();
     let front: Vec<bool> = rows
@@ -257,7 +348,7 @@ fn rows<'a>(reference: &'a Measured, runs: &'a [Measured]) -> Vec<Row<'a>> {
         .map(|r| {
             !rows
                 .iter()
-                .any(|o| o.m.wall_time_s < r.m.wall_time_s && o.error_force < r.error_force)
+                .any(|o| o.m.wall_time_s < r.m.wall_time_s && o.errors.curve < r.errors.curve)
         })
         .collect();
     for (r, f) in rows.iter_mut().zip(front) {
@@ -266,13 +357,16 @@ fn rows<'a>(reference: &'a Measured, runs: &'a [Measured]) -> Vec<Row<'a>> {
     rows
 }
 
-fn write_csv(path: &Path, rows: &[Row<'_>]) -> anyhow::Result<()> {
+/// Writes the table.
+pub fn write_csv(path: &Path, rows: &[Row<'_>]) -> anyhow::Result<()> {
     let file = create_file(path)?;
     let mut csv = CsvWriter::new(file, &COLUMNS)?;
+    let opt = |x: Option<Real>| Field::Real(x.unwrap_or(Real::NAN));
     for r in rows {
         let s = &r.m.setting;
         csv.write_row(&[
             Field::Text(s.name),
+            Field::Int(r.m.seed),
             Field::from(s.mesh.n),
             Field::from(s.mesh.m),
             Field::Text(s.element_name()),
@@ -282,27 +376,38 @@ fn write_csv(path: &Path, rows: &[Row<'_>]) -> anyhow::Result<()> {
             Field::Real(s.speed_factor),
             Field::Int(r.m.steps),
             Field::Real(r.m.wall_time_s),
-            Field::Real(r.m.sigma_est_pa.unwrap_or(Real::NAN)),
-            Field::Real(r.error_force),
-            Field::Real(r.error_sigma),
+            opt(r.m.sigma_est_pa),
+            opt(r.m.kawakita.map(|k| k.0)),
+            opt(r.m.kawakita.map(|k| k.1)),
+            Field::Real(r.errors.curve),
+            Field::Real(r.errors.sigma),
+            Field::Real(r.errors.kawakita_a),
+            Field::Real(r.errors.kawakita_inv_b),
             Field::from(r.reference),
             Field::from(r.pareto),
+            r.within_spread.map_or(Field::Text(""), Field::from),
         ])
         .with_context(|| format!("cannot write `{}`", path.display()))?;
     }
     finish_file(csv.into_inner(), path)
 }
 
-/// The log-log diagram: wall time against the force-curve error, one
-/// labelled point per setting (the reference, error 0, is left out).
-fn diagram(rows: &[Row<'_>], title: &str) -> anyhow::Result<String> {
+/// The log-log diagram: wall time against the load-curve error, one
+/// labelled point per setting (the reference, error 0, is left out), and
+/// with `spread` (bed) a vertical line at the run-to-run spread.
+pub fn diagram(
+    rows: &[Row<'_>],
+    title: &str,
+    x_desc: &str,
+    spread: Option<Real>,
+) -> anyhow::Result<String> {
     let pts: Vec<(&str, f64, f64, bool)> = rows
         .iter()
-        .filter(|r| !r.reference && r.error_force.is_finite() && r.error_force > 0.0)
+        .filter(|r| !r.reference && r.errors.curve.is_finite() && r.errors.curve > 0.0)
         .map(|r| {
             (
                 r.m.setting.name,
-                r.error_force,
+                r.errors.curve,
                 r.m.wall_time_s.max(1e-3),
                 r.pareto,
             )
@@ -316,7 +421,7 @@ fn diagram(rows: &[Row<'_>], title: &str) -> anyhow::Result<String> {
             1e-4..1.0
         }
     };
-    let xr = bounds(&mut pts.iter().map(|p| p.1));
+    let xr = bounds(&mut pts.iter().map(|p| p.1).chain(spread));
     let yr = bounds(&mut pts.iter().map(|p| p.2));
     let mut svg = String::new();
     {
@@ -327,12 +432,18 @@ fn diagram(rows: &[Row<'_>], title: &str) -> anyhow::Result<String> {
             .margin(20)
             .x_label_area_size(50)
             .y_label_area_size(70)
-            .build_cartesian_2d(xr.log_scale(), yr.log_scale())?;
+            .build_cartesian_2d(xr.log_scale(), yr.clone().log_scale())?;
         chart
             .configure_mesh()
-            .x_desc("relative L2 error of F(C) against the reference")
+            .x_desc(x_desc)
             .y_desc("wall time, s")
             .draw()?;
+        if let Some(x) = spread.filter(|x| *x > 0.0) {
+            chart
+                .draw_series(LineSeries::new([(x, yr.start), (x, yr.end)], BLACK))?
+                .label("run-to-run spread over poured beds");
+            chart.configure_series_labels().border_style(BLACK).draw()?;
+        }
         for (name, x, y, front) in &pts {
             let colour = if *front { RED } else { BLUE };
             chart.draw_series(core::iter::once(Circle::new((*x, *y), 5, colour.filled())))?;
@@ -347,55 +458,92 @@ fn diagram(rows: &[Row<'_>], title: &str) -> anyhow::Result<String> {
     Ok(svg)
 }
 
+/// What a study ran: the reference, the settings, and (bed) the spread.
+pub struct StudyRuns {
+    /// The reference run.
+    pub reference: Measured,
+    /// The settings' runs.
+    pub runs: Vec<Measured>,
+    /// The run-to-run spread of the default over poured beds (bed).
+    pub spread: Option<Errors>,
+    /// The diagram's title.
+    pub title: String,
+    /// The diagram's x axis.
+    pub x_desc: &'static str,
+}
+
+/// Prints one finished run of a study.
+pub fn say(quiet: bool, what: &str, m: &Measured, streams: &mut Streams<'_>) -> anyhow::Result<()> {
+    if !quiet {
+        writeln!(
+            streams.stderr,
+            "study: {what} `{}` (seed {}): {} steps in {:.2} s",
+            m.setting.name, m.seed, m.steps, m.wall_time_s
+        )?;
+    }
+    Ok(())
+}
+
 impl WorkPrecisionArgs {
     /// Runs the study and writes the table and the diagram.
     pub fn run(&self, streams: &mut Streams<'_>) -> anyhow::Result<()> {
-        let material = self.material.material()?;
-        let (reference, grid) = match self.scene {
-            StudyScene::Granule => granule_grid(self.quick),
-        };
         std::fs::create_dir_all(&self.out)
             .with_context(|| format!("cannot create output directory `{}`", self.out.display()))?;
-        let say = |what: &str, m: &Measured, streams: &mut Streams<'_>| -> anyhow::Result<()> {
-            if !self.quiet {
-                writeln!(
-                    streams.stderr,
-                    "study: {what} `{}`: {} steps in {:.2} s",
-                    m.setting.name, m.steps, m.wall_time_s
-                )?;
-            }
-            Ok(())
+        let study = match self.scene {
+            StudyScene::Granule => self.granule_study(streams)?,
+            StudyScene::BedSmall => super::bed_small::study(self, streams)?,
         };
+        let rows = rows(&study.reference, &study.runs, study.spread);
+        write_csv(&self.out.join(CSV_FILE), &rows)?;
+        let svg_path = self.out.join(SVG_FILE);
+        let svg = diagram(
+            &rows,
+            &study.title,
+            study.x_desc,
+            study.spread.map(|s| s.curve),
+        )?;
+        write_text(&svg_path, &svg)?;
+        if let Some(d) = rows.iter().find(|r| r.m.setting.name == "default") {
+            writeln!(
+                streams.stderr,
+                "study: default: curve error {:.3e}, {:.2} s; on the Pareto front: {}{}",
+                d.errors.curve,
+                d.m.wall_time_s,
+                if d.pareto { "yes" } else { "no" },
+                study.spread.map_or(String::new(), |s| format!(
+                    "; run-to-run spread of the curve over pours {:.3e}",
+                    s.curve
+                )),
+            )?;
+        }
+        Ok(())
+    }
+
+    /// The single-granule study.
+    fn granule_study(&self, streams: &mut Streams<'_>) -> anyhow::Result<StudyRuns> {
+        let material = self.material.material()?;
+        let (reference, grid) = granule_grid(self.quick);
         let reference = run_granule(&reference, &material)?;
-        say("reference", &reference, streams)?;
+        say(self.quiet, "reference", &reference, streams)?;
         let mut runs = Vec::with_capacity(grid.len());
         for s in &grid {
             let m = run_granule(s, &material)?;
-            say("setting", &m, streams)?;
+            say(self.quiet, "setting", &m, streams)?;
             runs.push(m);
         }
-        let rows = rows(&reference, &runs);
-        write_csv(&self.out.join(CSV_FILE), &rows)?;
         let title = format!(
             "work-precision, granule {} (reference: {} {}, half speed)",
             self.material.granule_type,
             reference.setting.mesh,
             reference.setting.element_name()
         );
-        let svg_path = self.out.join(SVG_FILE);
-        write_text(&svg_path, &diagram(&rows, &title)?)?;
-        if let Some(d) = rows.iter().find(|r| r.m.setting.name == "default") {
-            writeln!(
-                streams.stderr,
-                "study: default: force error {:.3e}, sigma_est error {:.3e}, {:.2} s; on the \
-                 Pareto front: {}",
-                d.error_force,
-                d.error_sigma,
-                d.m.wall_time_s,
-                if d.pareto { "yes" } else { "no" }
-            )?;
-        }
-        Ok(())
+        Ok(StudyRuns {
+            reference,
+            runs,
+            spread: None,
+            title,
+            x_desc: "relative L2 error of F(C) against the reference",
+        })
     }
 }
 
@@ -407,10 +555,52 @@ mod tests {
     fn the_curve_error_of_a_scaled_curve_is_the_scale() {
         let r: Vec<(Real, Real)> = (0..=100).map(|i| (i as Real * 0.005, i as Real)).collect();
         let c: Vec<(Real, Real)> = r.iter().map(|&(x, y)| (x, 1.1 * y)).collect();
-        let e = curve_error(&c, &r).unwrap();
+        let e = curve_error(&c, &r, GRANULE_ERROR_STRAINS).unwrap();
         assert!((e - 0.1).abs() < 1e-12, "{e}");
-        assert_eq!(curve_error(&r, &r), Some(0.0));
+        assert_eq!(curve_error(&r, &r, GRANULE_ERROR_STRAINS), Some(0.0));
         // A curve that stops early does not cover the window.
-        assert_eq!(curve_error(&c[..50], &r), None);
+        assert_eq!(curve_error(&c[..50], &r, GRANULE_ERROR_STRAINS), None);
+    }
+
+    fn measured(curve: Vec<(Real, Real)>, kawakita: Option<(Real, Real)>) -> Measured {
+        Measured {
+            setting: Setting::default_on(MeshLevel::new(4, 1)),
+            seed: 1,
+            steps: 1,
+            wall_time_s: 1.0,
+            sigma_est_pa: None,
+            kawakita,
+            curve,
+            error_strains: [0.02, 0.3],
+        }
+    }
+
+    #[test]
+    fn bed_errors_are_relative_to_the_reference_and_spread_takes_the_larger() {
+        let r: Vec<(Real, Real)> = (0..=60).map(|i| (i as Real * 0.005, i as Real)).collect();
+        let reference = measured(r.clone(), Some((0.5, 2000.0)));
+        let off = measured(
+            r.iter().map(|&(x, y)| (x, 0.95 * y)).collect(),
+            Some((0.55, 1500.0)),
+        );
+        let e = Errors::of(&off, &reference);
+        assert!((e.curve - 0.05).abs() < 1e-12, "{e:?}");
+        assert!((e.kawakita_a - 0.1).abs() < 1e-12, "{e:?}");
+        assert!((e.kawakita_inv_b - 0.25).abs() < 1e-12, "{e:?}");
+        assert!(e.sigma.is_nan());
+        // No fit: NaN, and the larger of two errors ignores it.
+        let unfit = Errors::of(&measured(r.clone(), None), &reference);
+        assert!(unfit.kawakita_a.is_nan() && unfit.curve == 0.0);
+        let m = unfit.max(e);
+        assert_eq!((m.curve, m.kawakita_a), (e.curve, e.kawakita_a));
+        // The spread marks the rows: the reference (0) is within, `off`
+        // (5 %) is within a 6 % spread and not within a 4 % one.
+        let runs = [off];
+        for (spread, within) in [(0.06, true), (0.04, false)] {
+            let s = Errors { curve: spread, ..e };
+            let rows = rows(&reference, &runs, Some(s));
+            assert_eq!(rows[0].within_spread, Some(true));
+            assert_eq!(rows[1].within_spread, Some(within), "spread {spread}");
+        }
     }
 }
