@@ -137,6 +137,7 @@ impl PointUpdate {
 /// Returns the Kirchhoff stress and diagnostics, or an [`UpdateError`]; never
 /// panics.
 #[allow(non_snake_case)]
+#[inline]
 pub fn update_point(
     mat: &Material,
     opts: &UpdateOptions,

@@ -81,6 +81,7 @@ fn kirchhoff_to_first_pk(tau: &Mat3, f_inv: &Mat3, volume: Real) -> Mat3 {
 ///   on error.
 /// * `kappa`: hourglass coefficient κ (dimensionless).
 #[allow(non_snake_case)]
+#[inline]
 pub fn hex_forces(
     mat: &Material,
     opts: &UpdateOptions,
