@@ -4,6 +4,7 @@
 //! elastic (0.1 % from the virgin state) and plastic (the step from 19.99 %
 //! to 20 %, the state loaded there in 2000 increments, as in an explicit
 //! run), for the one-point element and the F-bar verification element.
+//! Also the memory bandwidth (STREAM triad) for the element's roofline.
 
 use core::hint::black_box;
 
@@ -110,5 +111,29 @@ fn bench_elements(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, bench_elements);
+/// The roofline's memory side: the STREAM triad a = b + s c over three
+/// arrays of 64 Mi doubles (1.5 GiB, beyond every cache), one thread;
+/// criterion reports the bytes moved per second (24 per element: two
+/// reads, one write; the write-allocate read not counted, as in STREAM).
+fn bench_bandwidth(c: &mut Criterion) {
+    const N: usize = 64 << 20;
+    let b = vec![1.0f64; N];
+    let cc = vec![2.0f64; N];
+    let mut a = vec![0.0f64; N];
+    let mut g = c.benchmark_group("memory_bandwidth");
+    g.sample_size(10);
+    g.throughput(Throughput::Bytes((24 * N) as u64));
+    g.bench_function("triad_1_thread", |bench| {
+        bench.iter(|| {
+            let s = black_box(3.0);
+            for ((a, b), c) in a.iter_mut().zip(&b).zip(&cc) {
+                *a = b + s * c;
+            }
+            black_box(&a);
+        })
+    });
+    g.finish();
+}
+
+criterion_group!(benches, bench_elements, bench_bandwidth);
 criterion_main!(benches);

@@ -296,12 +296,19 @@ pub struct PhaseTimes {
     pub correct_s: f64,
     /// Contact sweeps run (over all steps).
     pub sweeps: u64,
+    /// Steps timed.
+    pub steps: u64,
 }
 
 impl PhaseTimes {
     /// Share of the contact phase in the total.
     pub fn contact_share(&self) -> f64 {
         self.contact_s / (self.predict_s + self.contact_s + self.correct_s)
+    }
+
+    /// Sweeps per step over `steps` steps (None for none).
+    pub fn sweeps_per_step(&self) -> Option<f64> {
+        (self.steps > 0).then(|| self.sweeps as f64 / self.steps as f64)
     }
 }
 
@@ -696,6 +703,7 @@ impl Assembly<'_> {
         self.times.predict_s += predicted_at;
         self.times.contact_s += contacted_at - predicted_at;
         self.times.correct_s += done_at - contacted_at;
+        self.times.steps += 1;
         self.time += sizes.dt;
         self.steps += 1;
         self.dt_prev = sizes.dt;

@@ -195,6 +195,8 @@ pub struct Summary<'a> {
     pub ns_per_element_step: Option<f64>,
     /// Share of the contact phase in the compression's wall time.
     pub contact_share: Option<f64>,
+    /// Contact sweeps per step (of this process's segment of the run).
+    pub contact_sweeps_per_step: Option<f64>,
     /// Threads used.
     pub threads: usize,
     /// Smallest element Jacobian ratio (element centres, every step).
@@ -300,6 +302,7 @@ pub fn summary<'a>(scene: &'a Scene, run: &BedRun) -> Summary<'a> {
         pour_wall_time_s: run.pour_wall_time_s,
         ns_per_element_step: finite_ratio(1e9 * run.wall_time_s, run.element_steps as f64),
         contact_share: Some(run.phase_times.contact_share()).filter(|x| x.is_finite()),
+        contact_sweeps_per_step: run.phase_times.sweeps_per_step().filter(|x| x.is_finite()),
         threads: run.threads,
         min_jacobian,
         min_gauss_jacobian: run.samples.iter().map(|s| s.min_gauss_jacobian).fold(

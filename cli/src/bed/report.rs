@@ -18,7 +18,7 @@ pub const REPORT_FILE: &str = "report.html";
 /// The fields of `summary.json` shown first, in this order, with their
 /// meaning; any other field follows (the nested `kawakita` object is
 /// flattened to `kawakita.<field>`, the scene is shown as TOML instead).
-const FIELDS: [(&str, &str); 29] = [
+const FIELDS: [(&str, &str); 30] = [
     ("kawakita_a", "Kawakita a (limiting strain)"),
     ("kawakita_inv_b_pa", "Kawakita 1/b, Pa"),
     (
@@ -51,6 +51,7 @@ const FIELDS: [(&str, &str); 29] = [
         "contact_share",
         "share of the contact phase in the wall time",
     ),
+    ("contact_sweeps_per_step", "contact sweeps per step"),
     ("threads", "threads"),
     ("min_jacobian", "smallest element Jacobian ratio"),
     (
