@@ -108,21 +108,32 @@ pub fn hex_forces(
     let k = kappa * mat.p_wave_modulus() * r.hourglass_geometry;
     let amplitude = HOURGLASS_STIFFENING_AMPLITUDE * r.hourglass_geometry;
     let inv_s2 = 1.0 / (32.0 * amplitude * amplitude);
-    let mut energy = 0.0;
-    for g in &r.gamma0 {
-        let mut q = [0.0; 3];
-        for (xi, gi) in x.iter().zip(g.iter()) {
+    // The four modes side by side: one pass over the nodes for all q_α,
+    // one for all forces. Every sum runs in the order of the mode-by-mode
+    // form (q_α over nodes 0…7; f_I over modes 0…3), so the same bits.
+    let mut q = [[0.0; 3]; 4];
+    for (i, xi) in x.iter().enumerate() {
+        for (qa, g) in q.iter_mut().zip(&r.gamma0) {
             for a in 0..3 {
-                q[a] += xi[a] * gi;
+                qa[a] += xi[a] * g[i];
             }
         }
-        let qq = q[0] * q[0] + q[1] * q[1] + q[2] * q[2];
+    }
+    let mut energy = 0.0;
+    let mut kq = [[0.0; 3]; 4];
+    for (qa, kqa) in q.iter().zip(kq.iter_mut()) {
+        let qq = qa[0] * qa[0] + qa[1] * qa[1] + qa[2] * qa[2];
         let ratio = qq * inv_s2;
         energy += 0.5 * k * qq * (1.0 + 0.5 * ratio);
-        let kq = k * (1.0 + ratio);
-        for (fi, gi) in f.iter_mut().zip(g.iter()) {
+        let stiffness = k * (1.0 + ratio);
+        for a in 0..3 {
+            kqa[a] = stiffness * qa[a];
+        }
+    }
+    for (i, fi) in f.iter_mut().enumerate() {
+        for (kqa, g) in kq.iter().zip(&r.gamma0) {
             for a in 0..3 {
-                fi[a] += kq * q[a] * gi;
+                fi[a] += kqa[a] * g[i];
             }
         }
     }
