@@ -211,11 +211,7 @@ impl BedArgs {
             scene.die_diameter_mm = d;
         }
         if let Some(e) = self.element {
-            scene.element = match e {
-                ElementArg::OnePoint => scene::ELEMENT_ONE_POINT,
-                ElementArg::Fbar => scene::ELEMENT_FBAR,
-            }
-            .to_owned();
+            scene.element = scene::element_name(e.into()).to_owned();
         }
         if let Some(k) = self.hourglass_kappa {
             scene.hourglass_kappa = k;

@@ -184,6 +184,14 @@ pub const ELEMENT_ONE_POINT: &str = "one-point";
 /// The scene's name of the F-bar element.
 pub const ELEMENT_FBAR: &str = "fbar";
 
+/// The scene's name of `kind` (the inverse of [`Scene::element_kind`]).
+pub fn element_name(kind: ElementKind) -> &'static str {
+    match kind {
+        ElementKind::OnePoint => ELEMENT_ONE_POINT,
+        ElementKind::FBar => ELEMENT_FBAR,
+    }
+}
+
 fn default_time_step_safety() -> f64 {
     0.9
 }

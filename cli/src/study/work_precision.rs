@@ -110,14 +110,8 @@ impl Setting {
 
     /// The element's name as the CSV and the bed scene spell it.
     pub fn element_name(&self) -> &'static str {
-        match self.element {
-            ElementKind::OnePoint => crate::bed::scene::ELEMENT_ONE_POINT,
-            ElementKind::FBar => crate::bed::scene::ELEMENT_FBAR,
-        }
+        crate::bed::scene::element_name(self.element)
     }
-}
-
-impl Setting {
     /// This setting renamed `name` and changed by `f`.
     pub fn with(self, name: &'static str, f: &dyn Fn(&mut Setting)) -> Setting {
         let mut s = self.named(name);
