@@ -201,6 +201,50 @@ fn a_wrong_version_is_named() {
     assert!(e.contains("format version 99"), "{e}");
 }
 
+/// A version 2 checkpoint (before the per-granule flags word) still reads,
+/// with every granule deformable. The version 2 bytes are made from this
+/// build's own: two checkpoints of one state that differ only in the
+/// granules' rigid flags differ only in the flags words, which are cut out.
+#[test]
+fn a_version_2_checkpoint_reads_with_every_granule_deformable() {
+    let (dir, _) = base_checkpoint();
+    let mut ck = read(dir).unwrap();
+    let with_flags = |rigid: bool, ck: &mut Checkpoint| {
+        for g in &mut ck.state.granules {
+            g.rigid = rigid;
+        }
+        let d = common::fresh_dir("fuzz_files", &format!("flags_{rigid}"));
+        std::fs::create_dir_all(&d).unwrap();
+        ck.write(&d).unwrap();
+        std::fs::read(d.join(FILE_NAME)).unwrap()
+    };
+    let (on, off) = (with_flags(true, &mut ck), with_flags(false, &mut ck));
+    assert_eq!(on.len(), off.len());
+    let words: Vec<usize> = (36..on.len()).filter(|&k| on[k] != off[k]).collect();
+    assert_eq!(
+        words.len(),
+        ck.state.granules.len(),
+        "one flags word per granule"
+    );
+    let mut payload = Vec::new();
+    let mut from = 36;
+    for &k in &words {
+        payload.extend_from_slice(&off[from..k]);
+        from = k + 8;
+    }
+    payload.extend_from_slice(&off[from..]);
+    let mut v2 = off[..16].to_vec();
+    v2.extend_from_slice(&2u32.to_le_bytes());
+    v2.extend_from_slice(&(payload.len() as u64).to_le_bytes());
+    v2.extend_from_slice(&fnv1a(&payload).to_le_bytes());
+    v2.extend_from_slice(&payload);
+    let old = read(&write_checkpoint("version2", &v2)).expect("a version 2 checkpoint reads");
+    assert_eq!(old, ck, "version 2 reads as the same state, all deformable");
+    // The same bytes labelled version 3 lack the flags: refused.
+    v2[16..20].copy_from_slice(&3u32.to_le_bytes());
+    read(&write_checkpoint("version2as3", &v2)).expect_err("flags missing");
+}
+
 /// The payload property below only resumes the mutants that decode; this
 /// proves that branch runs: the lowest mantissa bit of a float near the
 /// payload's end (the state's numbers, 8-byte fields counted from the end)

@@ -87,6 +87,13 @@ pub struct AssemblyParams {
     pub time_step_method: TimeStepMethod,
     /// Steps between time-step re-estimates; ≥ 1.
     pub time_step_interval: u32,
+    /// Granules move as rigid bodies, without element work, from their
+    /// placement (undeformed, translating) until their first contact with a
+    /// granule or a wall; from then on they are finite-element bodies
+    /// ([`granbed_kernel::granule::dynamics::predict_rigid`]). The same
+    /// motion up to round-off; it saves the element work of granules still
+    /// falling or waiting in the packing.
+    pub rigid_until_touched: bool,
 }
 
 impl AssemblyParams {
@@ -117,6 +124,7 @@ impl AssemblyParams {
                 power_iterations: 30,
             },
             time_step_interval: 100,
+            rigid_until_touched: true,
         }
     }
 }
@@ -229,6 +237,8 @@ pub struct GranuleState {
     pub mode: Vec<[Real; 3]>,
     /// The time-step policy's memory.
     pub time_step: TimeStepMemory,
+    /// Still a rigid body (untouched since its placement).
+    pub rigid: bool,
 }
 
 /// The running assembly.
@@ -250,6 +260,9 @@ pub struct Assembly<'m> {
     time_steps: Vec<TimeStepControl>,
     /// Per granule: the power iteration's mode (its warm start).
     modes: Vec<Vec<[Real; 3]>>,
+    /// Per granule: still a rigid body (untouched since its placement;
+    /// [`AssemblyParams::rigid_until_touched`]).
+    rigid: Vec<bool>,
 }
 
 impl<'m> Assembly<'m> {
@@ -316,6 +329,7 @@ impl<'m> Assembly<'m> {
                     mode
                 })
                 .collect(),
+            rigid: vec![params.rigid_until_touched; placements.len()],
         };
         let kinetic: Real = assembly
             .granules
@@ -407,12 +421,14 @@ impl<'m> Assembly<'m> {
                 .iter()
                 .zip(&self.modes)
                 .zip(&self.time_steps)
-                .map(|((g, mode), control)| GranuleState {
+                .zip(&self.rigid)
+                .map(|(((g, mode), control), &rigid)| GranuleState {
                     x: g.x.clone(),
                     v: g.v.clone(),
                     cp_inv: g.cp_inv.clone(),
                     mode: mode.clone(),
                     time_step: control.memory(),
+                    rigid,
                 })
                 .collect(),
             pairs,
@@ -434,11 +450,12 @@ impl<'m> Assembly<'m> {
         if state.granules.len() != self.granules.len() || !built_ok {
             return Err(mismatch);
         }
-        for (((g, mode), control), s) in self
+        for ((((g, mode), control), rigid), s) in self
             .granules
             .iter_mut()
             .zip(&mut self.modes)
             .zip(&mut self.time_steps)
+            .zip(&mut self.rigid)
             .zip(&state.granules)
         {
             if s.x.len() != g.x.len()
@@ -453,6 +470,7 @@ impl<'m> Assembly<'m> {
             g.cp_inv.clone_from(&s.cp_inv);
             mode.clone_from(&s.mode);
             control.restore(s.time_step);
+            *rigid = s.rigid && self.params.rigid_until_touched;
         }
         if state
             .pairs
@@ -489,7 +507,10 @@ impl<'m> Assembly<'m> {
     }
 
     /// Mutable granule state (to set velocities or fix nodes before a run).
+    /// The granules are deformable bodies from then on: what the caller
+    /// writes need not be a rigid motion.
     pub fn granules_mut(&mut self) -> &mut [GranuleStore] {
+        self.rigid.fill(false);
         &mut self.granules
     }
 

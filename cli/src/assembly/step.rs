@@ -6,7 +6,9 @@ use core::fmt;
 use granbed_kernel::Real;
 use granbed_kernel::contact::pair::ContactError;
 use granbed_kernel::contact::wall::{PredictedNodes, WallForce, count_wall_contacts, wall_contact};
-use granbed_kernel::granule::dynamics::{Loads, StepSizes, StepWork, correct, predict};
+use granbed_kernel::granule::dynamics::{
+    Loads, StepSizes, StepWork, correct, predict, predict_rigid,
+};
 use granbed_kernel::granule::forces::{ElementFailure, ForceSummary, elastic_energy};
 use granbed_kernel::granule::quality::worst_element;
 use granbed_kernel::granule::timestep::{Linearisation, PowerIterationBuffers};
@@ -296,6 +298,9 @@ pub struct PhaseTimes {
     pub correct_s: f64,
     /// Contact sweeps run (over all steps).
     pub sweeps: u64,
+    /// Granule-steps taken as rigid bodies, without element work
+    /// ([`super::AssemblyParams::rigid_until_touched`]).
+    pub rigid_granule_steps: u64,
     /// Steps timed.
     pub steps: u64,
 }
@@ -304,6 +309,13 @@ impl PhaseTimes {
     /// Share of the contact phase in the total.
     pub fn contact_share(&self) -> f64 {
         self.contact_s / (self.predict_s + self.contact_s + self.correct_s)
+    }
+
+    /// Share of the granule-steps that skipped the element work, of
+    /// `granules` granules over the timed steps (None for none).
+    pub fn rigid_share(&self, granules: usize) -> Option<f64> {
+        let all = self.steps * granules as u64;
+        (all > 0).then(|| self.rigid_granule_steps as f64 / all as f64)
     }
 
     /// Sweeps per step over `steps` steps (None for none).
@@ -537,7 +549,11 @@ impl Assembly<'_> {
         let predicted: Vec<Result<ForceSummary, ElementFailure>> = self
             .granules
             .par_iter_mut()
-            .map(|g| {
+            .zip(self.rigid.par_iter())
+            .map(|(g, &rigid)| {
+                if rigid {
+                    return Ok(predict_rigid(&mut g.buffers(), sizes, &loads));
+                }
                 predict(
                     &view,
                     &p.material,
@@ -548,6 +564,7 @@ impl Assembly<'_> {
                 )
             })
             .collect();
+        self.times.rigid_granule_steps += self.rigid.iter().filter(|&&r| r).count() as u64;
         let mut plastic = 0.0;
         let mut hourglass = 0.0;
         let mut min_j = Real::INFINITY;
@@ -600,6 +617,11 @@ impl Assembly<'_> {
             }
             self.contact_sweep(step, &walls, dt2, sweep == 0, &mut wall_totals)?;
             self.times.sweeps += 1;
+            // A granule touched in any sweep is a deformable body from the
+            // next step on (its predictor above saw it undeformed).
+            for (rigid, &touched) in self.rigid.iter_mut().zip(&self.contact.touched) {
+                *rigid &= !touched;
+            }
             // Another sweep only if this one still found a gap deeper than
             // the tolerance (a minimum: the same for any thread count).
             let deepest = self

@@ -26,7 +26,15 @@ pub const FILE_NAME: &str = "checkpoint.bin";
 /// speed and the penetration, the averaging window the largest nodal speed,
 /// the run header the compression's wall time so far (version 1 files are
 /// refused).
-pub const VERSION: u32 = 2;
+///
+/// 3: each granule gained a flags word (bit 0: still a rigid body). Version
+/// 2 files are read with every granule deformable, which continues them
+/// with the same motion up to round-off (not bit for bit).
+pub const VERSION: u32 = 3;
+/// The oldest version read.
+const OLDEST_VERSION: u32 = 2;
+/// Granule flag: still a rigid body.
+const FLAG_RIGID: u64 = 1;
 const MAGIC: &[u8; 16] = b"GRANBED-CKPT\0\0\0\0";
 
 /// A bed run's progress besides the assembly state.
@@ -269,6 +277,7 @@ impl Checkpoint {
             e.u64(u64::from(since));
             e.f64(dt);
             e.f64(length);
+            e.u64(if g.rigid { FLAG_RIGID } else { 0 });
         }
         e.u64(s.pairs.len() as u64);
         for pair in &s.pairs {
@@ -283,7 +292,7 @@ impl Checkpoint {
         e.0
     }
 
-    fn from_payload(bytes: &[u8]) -> anyhow::Result<Self> {
+    fn from_payload(bytes: &[u8], version: u32) -> anyhow::Result<Self> {
         let mut d = Dec(bytes);
         let scene_toml = String::from_utf8(d.bytes()?.to_vec()).context("scene text")?;
         let head = d.f64s()?;
@@ -320,6 +329,14 @@ impl Checkpoint {
                         d.f64()?,
                         d.f64()?,
                     ),
+                    rigid: match version {
+                        OLDEST_VERSION => false,
+                        _ => match d.u64()? {
+                            0 => false,
+                            FLAG_RIGID => true,
+                            other => bail!("unknown granule flags {other:#x}"),
+                        },
+                    },
                 })
             })
             .collect::<anyhow::Result<Vec<_>>>()?;
@@ -415,9 +432,9 @@ impl Checkpoint {
             return Err(bad("no granbed checkpoint header"));
         }
         let version = u32::from_le_bytes(bytes[16..20].try_into().unwrap_or_default());
-        if version != VERSION {
+        if !(OLDEST_VERSION..=VERSION).contains(&version) {
             return Err(bad(&format!(
-                "format version {version}, this build reads {VERSION}"
+                "format version {version}, this build reads {OLDEST_VERSION} to {VERSION}"
             )));
         }
         let len = u64::from_le_bytes(bytes[20..28].try_into().unwrap_or_default());
@@ -429,6 +446,6 @@ impl Checkpoint {
         if fnv1a(payload) != sum {
             return Err(bad("checksum mismatch"));
         }
-        Self::from_payload(payload).map_err(|e| bad(&format!("{e:#}")))
+        Self::from_payload(payload, version).map_err(|e| bad(&format!("{e:#}")))
     }
 }

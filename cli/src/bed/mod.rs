@@ -137,11 +137,17 @@ pub struct BedArgs {
     #[arg(long, value_name = "KAPPA")]
     pub hourglass_kappa: Option<f64>,
 
+    /// Override: granules are rigid bodies, without element work, until
+    /// their first contact (true, the default) or finite-element bodies
+    /// from the start (false); the same motion up to round-off.
+    #[arg(long, value_name = "BOOL")]
+    pub rigid_until_touched: Option<bool>,
+
     /// Continue the run whose checkpoint is in DIR (its `checkpoint.bin`);
     /// the outputs go to DIR. Only --strain, --stop-at-strain,
     /// --time-step-safety, --mass-scaling, -j and --quiet may be given with
     /// it.
-    #[arg(long, value_name = "DIR", conflicts_with_all = ["scene", "out", "granule_type", "granules", "mesh", "seed", "die_diameter_mm", "element", "hourglass_kappa"])]
+    #[arg(long, value_name = "DIR", conflicts_with_all = ["scene", "out", "granule_type", "granules", "mesh", "seed", "die_diameter_mm", "element", "hourglass_kappa", "rigid_until_touched"])]
     pub resume: Option<PathBuf>,
 
     /// Write a checkpoint and stop once the strain reaches C (continue
@@ -218,6 +224,9 @@ impl BedArgs {
         }
         if let Some(f) = self.mass_scaling {
             scene.mass_scaling = f;
+        }
+        if let Some(r) = self.rigid_until_touched {
+            scene.rigid_until_touched = r;
         }
         if let Some(c) = self.time_step_safety {
             scene.time_step_safety = c;

@@ -59,6 +59,10 @@ mass_scaling = 1.0
 # Safety factor on the stable time step 2/omega_max (0 < C <= 2; above 1 the
 # run is unstable, which only tests the failure handling).
 time_step_safety = 0.9
+# Granules move as rigid bodies (no element work) from their placement until
+# their first contact: the same motion up to round-off, cheaper while the bed
+# settles onto its granules and walls. false: finite-element bodies from t = 0.
+rigid_until_touched = true
 # Watchdogs: stop (with a checkpoint from before) when the kinetic energy
 # exceeds this multiple of all the energy put in (punch or contact work,
 # gravity, initial motion), or when a node moves faster than this multiple of
@@ -154,6 +158,9 @@ pub struct Scene {
     /// unstable, for testing the failure handling).
     #[serde(default = "default_time_step_safety")]
     pub time_step_safety: f64,
+    /// Granules are rigid bodies until first touched (absent: true).
+    #[serde(default = "default_rigid_until_touched")]
+    pub rigid_until_touched: bool,
     /// Watchdog limit on the kinetic energy as a multiple of the energy
     /// put in, 1 ≤ r ≤ 1e9 (absent: 2).
     #[serde(default = "default_watchdog_energy_ratio")]
@@ -194,6 +201,10 @@ pub fn element_name(kind: ElementKind) -> &'static str {
 
 fn default_time_step_safety() -> f64 {
     0.9
+}
+
+fn default_rigid_until_touched() -> bool {
+    true
 }
 
 fn default_watchdog_energy_ratio() -> f64 {
