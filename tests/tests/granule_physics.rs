@@ -4,7 +4,7 @@
 
 use std::path::Path;
 
-use granbed_cli::granule::run::{mean_force, run_platens};
+use granbed_cli::granule::run::run_platens;
 use granbed_cli::model::{MeshLevel, OwnedReference, PlatenStore};
 use granbed_kernel::Real;
 use granbed_kernel::analysis::granule::yield_stress_estimate;
@@ -27,7 +27,7 @@ fn run(params: PlatenParams, mesh: &OwnedReference) -> Vec<PlatenSample> {
 fn curve(samples: &[PlatenSample]) -> Vec<(Real, Real)> {
     samples
         .iter()
-        .map(|s| (s.approach_m, mean_force(s)))
+        .map(|s| (s.approach_m, s.mean_force()))
         .collect()
 }
 

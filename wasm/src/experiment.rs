@@ -13,7 +13,9 @@ use granbed_kernel::Real;
 use granbed_kernel::analysis::fit::LineFit;
 use granbed_kernel::analysis::granule::{initial_effective_yield_stress, yield_stress_estimate};
 use granbed_kernel::material::{GranuleType, MaterialParams, ParamError};
-use granbed_kernel::scene::platens::{PlatenParams, PlatenSample, PlatenScene, SceneError};
+use granbed_kernel::scene::platens::{
+    PlatenParams, PlatenSample, PlatenScene, SAMPLE_COLUMNS, SceneError,
+};
 
 use crate::mesh::{OctantMesh, give_back, octant_mesh, take_buffers};
 
@@ -27,26 +29,7 @@ pub const STANDARD_DIAMETER_M: Real = 1.0e-3;
 pub const DIAMETER_RANGE_M: [Real; 2] = [1.0e-6, 1.0];
 
 /// Header of the CSV (the CLI's `force_displacement.csv` columns).
-pub const CSV_COLUMNS: [&str; 18] = [
-    "time_s",
-    "displacement_m",
-    "strain",
-    "force_n",
-    "force_upper_n",
-    "force_lower_n",
-    "kinetic_j",
-    "internal_work_j",
-    "elastic_j",
-    "plastic_j",
-    "hourglass_j",
-    "damping_j",
-    "contact_work_j",
-    "gravity_work_j",
-    "platen_work_j",
-    "min_j",
-    "dt_s",
-    "steps",
-];
+pub const CSV_COLUMNS: [&str; 18] = SAMPLE_COLUMNS;
 
 /// The material fields a caller may override, in the names of
 /// [`MaterialParams`].
@@ -209,12 +192,6 @@ pub struct Measures {
     pub sigma_eff0_pa: Real,
 }
 
-/// The platen force of a sample: the mean of both platens, N (the CLI's
-/// `force_n`).
-pub fn mean_force(s: &PlatenSample) -> Real {
-    0.5 * (s.force_upper_n + s.force_lower_n)
-}
-
 /// A running (or finished) experiment.
 pub struct Experiment {
     scene: Option<PlatenScene<'static>>,
@@ -365,7 +342,7 @@ impl Experiment {
     /// `slope_n_per_m`, … and `sigma_eff0_pa`.
     pub fn measures(&self) -> Measures {
         let [lo, hi] = FIT_STRAIN_RANGE;
-        let points = self.samples.iter().map(|s| (s.approach_m, mean_force(s)));
+        let points = self.samples.iter().map(|s| (s.approach_m, s.mean_force()));
         let fit = yield_stress_estimate(points, self.diameter(), lo, hi);
         Measures {
             sigma_est_pa: fit.map(|(s, _)| s),
@@ -380,26 +357,7 @@ impl Experiment {
         out.push_str(&CSV_COLUMNS.join(","));
         out.push('\n');
         for s in &self.samples {
-            let e = &s.energy;
-            let reals = [
-                s.time_s,
-                s.approach_m,
-                s.strain,
-                mean_force(s),
-                s.force_upper_n,
-                s.force_lower_n,
-                e.kinetic,
-                e.internal_work,
-                e.elastic,
-                e.plastic,
-                e.hourglass,
-                e.damping,
-                e.contact_work,
-                e.gravity_work,
-                e.platen_work,
-                s.min_j,
-                s.dt_s,
-            ];
+            let reals = s.values();
             for x in reals {
                 write_real(&mut out, x);
                 out.push(',');

@@ -241,7 +241,7 @@ impl Granule {
         self.run
             .samples()
             .iter()
-            .map(experiment::mean_force)
+            .map(granbed_kernel::scene::platens::PlatenSample::mean_force)
             .collect()
     }
 

@@ -7,9 +7,8 @@ use std::path::Path;
 
 use anyhow::Context as _;
 use granbed_kernel::material::GranuleType;
-use granbed_kernel::scene::platens::PlatenSample;
+use granbed_kernel::scene::platens::{PlatenSample, SAMPLE_COLUMNS};
 
-use super::run::mean_force;
 use super::summary::Summary;
 use crate::csv::{CsvWriter, Field};
 
@@ -24,28 +23,8 @@ pub const TYPES_CSV: &str = "types.csv";
 /// File name of the overlaid plot of `--types`.
 pub const TYPES_SVG: &str = "force_displacement_types.svg";
 
-/// Header of [`FORCE_CSV`] (units in the names; energies are whole-granule
-/// equivalents).
-pub const FORCE_COLUMNS: [&str; 18] = [
-    "time_s",
-    "displacement_m",
-    "strain",
-    "force_n",
-    "force_upper_n",
-    "force_lower_n",
-    "kinetic_j",
-    "internal_work_j",
-    "elastic_j",
-    "plastic_j",
-    "hourglass_j",
-    "damping_j",
-    "contact_work_j",
-    "gravity_work_j",
-    "platen_work_j",
-    "min_j",
-    "dt_s",
-    "steps",
-];
+/// Header of [`FORCE_CSV`]: the kernel's platen-sample columns.
+pub const FORCE_COLUMNS: [&str; 18] = SAMPLE_COLUMNS;
 
 /// Header of [`TYPES_CSV`].
 pub const TYPES_COLUMNS: [&str; 10] = [
@@ -63,28 +42,8 @@ pub const TYPES_COLUMNS: [&str; 10] = [
 
 /// The cells of one sample, in the order of [`FORCE_COLUMNS`].
 pub fn force_row(s: &PlatenSample) -> [Field; FORCE_COLUMNS.len()] {
-    let e = &s.energy;
-    let r = Field::Real;
-    [
-        r(s.time_s),
-        r(s.approach_m),
-        r(s.strain),
-        r(mean_force(s)),
-        r(s.force_upper_n),
-        r(s.force_lower_n),
-        r(e.kinetic),
-        r(e.internal_work),
-        r(e.elastic),
-        r(e.plastic),
-        r(e.hourglass),
-        r(e.damping),
-        r(e.contact_work),
-        r(e.gravity_work),
-        r(e.platen_work),
-        r(s.min_j),
-        r(s.dt_s),
-        Field::Int(s.steps),
-    ]
+    let v = s.values();
+    core::array::from_fn(|k| v.get(k).map_or(Field::Int(s.steps), |&x| Field::Real(x)))
 }
 
 /// Writes `samples` as [`FORCE_CSV`] rows to `path`.

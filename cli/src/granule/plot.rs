@@ -7,7 +7,6 @@ use granbed_kernel::Real;
 use granbed_kernel::scene::platens::PlatenSample;
 use plotters::prelude::*;
 
-use super::run::mean_force;
 
 /// Plot size, pixels.
 const SIZE: (u32, u32) = (900, 600);
@@ -54,7 +53,7 @@ pub struct FitLine {
 fn points(samples: &[PlatenSample]) -> Vec<(f64, f64)> {
     samples
         .iter()
-        .map(|s| (s.approach_m * 1.0e3, mean_force(s) * 1.0e3))
+        .map(|s| (s.approach_m * 1.0e3, s.mean_force() * 1.0e3))
         .collect()
 }
 

@@ -6,7 +6,6 @@ use granbed_kernel::Real;
 use granbed_kernel::scene::platens::PlatenSample;
 use indicatif::{MultiProgress, ProgressBar, ProgressDrawTarget, ProgressStyle};
 
-use super::run::mean_force;
 
 /// Bar positions per unit strain (the bar counts strain in steps of 1e-4).
 const TICKS_PER_STRAIN: f64 = 1.0e4;
@@ -55,7 +54,7 @@ impl Progress {
         self.bar.set_message(format!(
             "strain {:.4}, F {:.3e} N, {:.0} steps/s",
             s.strain,
-            mean_force(s),
+            s.mean_force(),
             rate
         ));
     }

@@ -91,8 +91,3 @@ pub fn run_platens(
     })
 }
 
-/// The platen force of a sample: the mean of the upper and lower platen
-/// forces, N. The CSV's `force_n` and the σ_est fit both use it.
-pub fn mean_force(s: &PlatenSample) -> Real {
-    0.5 * (s.force_upper_n + s.force_lower_n)
-}

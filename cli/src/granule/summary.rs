@@ -10,7 +10,7 @@ use granbed_kernel::granule::timestep::TimeStepMethod;
 use granbed_kernel::scene::platens::{PlatenParams, SceneError, Symmetry};
 use serde::Serialize;
 
-use super::run::{RunResult, mean_force};
+use super::run::RunResult;
 use crate::model::MeshLevel;
 
 /// Name of the `summary.json` format (its `format` field).
@@ -170,7 +170,7 @@ impl Summary {
         let samples = &result.samples;
         let last = samples.last();
         let [lo, hi] = FIT_STRAIN_RANGE;
-        let points = samples.iter().map(|s| (s.approach_m, mean_force(s)));
+        let points = samples.iter().map(|s| (s.approach_m, s.mean_force()));
         let fit = yield_stress_estimate(points, result.diameter_m, lo, hi);
         let final_strain = last.map_or(0.0, |s| s.strain);
         let mut notes = Vec::new();
@@ -244,7 +244,7 @@ impl Summary {
             final_strain,
             max_force_n: samples
                 .iter()
-                .fold(Real::NEG_INFINITY, |f, s| f.max(mean_force(s))),
+                .fold(Real::NEG_INFINITY, |f, s| f.max(s.mean_force())),
             notes,
             error: result.error.as_ref().map(SceneError::to_string),
         }

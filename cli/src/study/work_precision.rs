@@ -29,7 +29,7 @@ use plotters::prelude::*;
 use super::{StudyScene, WorkPrecisionArgs};
 use crate::csv::{CsvWriter, Field};
 use crate::granule::GRANULE_RADIUS_M;
-use crate::granule::run::{mean_force, run_platens};
+use crate::granule::run::run_platens;
 use crate::granule::summary::FIT_STRAIN_RANGE;
 use crate::model::{MeshLevel, OwnedReference};
 use crate::output::{Streams, create_file, finish_file, write_text};
@@ -202,11 +202,11 @@ pub fn run_granule(setting: &Setting, material: &Material) -> anyhow::Result<Mea
     let curve: Vec<(Real, Real)> = result
         .samples
         .iter()
-        .map(|s| (s.strain, mean_force(s)))
+        .map(|s| (s.strain, s.mean_force()))
         .collect();
     let [lo, hi] = FIT_STRAIN_RANGE;
     let sigma_est_pa = yield_stress_estimate(
-        result.samples.iter().map(|s| (s.approach_m, mean_force(s))),
+        result.samples.iter().map(|s| (s.approach_m, s.mean_force())),
         result.diameter_m,
         lo,
         hi,

@@ -350,6 +350,63 @@ pub struct PlatenSample {
     pub energy: EnergyLedger,
 }
 
+/// Column names of a sample's table row (units in the names; energies are
+/// whole-granule equivalents): [`PlatenSample::values`], then `steps`.
+/// The CLI's `force_displacement.csv` and the browser's CSV use them.
+pub const SAMPLE_COLUMNS: [&str; 18] = [
+    "time_s",
+    "displacement_m",
+    "strain",
+    "force_n",
+    "force_upper_n",
+    "force_lower_n",
+    "kinetic_j",
+    "internal_work_j",
+    "elastic_j",
+    "plastic_j",
+    "hourglass_j",
+    "damping_j",
+    "contact_work_j",
+    "gravity_work_j",
+    "platen_work_j",
+    "min_j",
+    "dt_s",
+    "steps",
+];
+
+impl PlatenSample {
+    /// The platen force: the mean of the upper and lower platen forces, N
+    /// (the table's `force_n`; the σ_est fit uses it too).
+    pub fn mean_force(&self) -> Real {
+        0.5 * (self.force_upper_n + self.force_lower_n)
+    }
+
+    /// The real-valued cells of the table row, in the order of
+    /// [`SAMPLE_COLUMNS`] (all but the last, `steps` = [`Self::steps`]).
+    pub fn values(&self) -> [Real; SAMPLE_COLUMNS.len() - 1] {
+        let e = &self.energy;
+        [
+            self.time_s,
+            self.approach_m,
+            self.strain,
+            self.mean_force(),
+            self.force_upper_n,
+            self.force_lower_n,
+            e.kinetic,
+            e.internal_work,
+            e.elastic,
+            e.plastic,
+            e.hourglass,
+            e.damping,
+            e.contact_work,
+            e.gravity_work,
+            e.platen_work,
+            self.min_j,
+            self.dt_s,
+        ]
+    }
+}
+
 /// The running experiment.
 pub struct PlatenScene<'a> {
     params: PlatenParams,
