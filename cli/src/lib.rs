@@ -40,6 +40,7 @@ pub mod material_args;
 pub mod model;
 pub mod output;
 pub mod pack;
+pub mod plot;
 pub mod point;
 pub mod study;
 pub mod vtk;

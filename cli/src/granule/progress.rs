@@ -6,7 +6,6 @@ use granbed_kernel::Real;
 use granbed_kernel::scene::platens::PlatenSample;
 use indicatif::{MultiProgress, ProgressBar, ProgressDrawTarget, ProgressStyle};
 
-
 /// Bar positions per unit strain (the bar counts strain in steps of 1e-4).
 const TICKS_PER_STRAIN: f64 = 1.0e4;
 

@@ -90,4 +90,3 @@ pub fn run_platens(
         error,
     })
 }
-

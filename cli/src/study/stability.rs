@@ -28,7 +28,6 @@ use granbed_kernel::scene::platens::{PlatenParams, PlatenSample};
 
 use super::StabilityArgs;
 use crate::bed::outputs::summary;
-use crate::bed::plots::{Mark, Series, xy_svg};
 use crate::bed::run::{BedObserver, BedRun, BedSample, RunControl, run_bed};
 use crate::bed::scene::Scene;
 use crate::csv::{CsvWriter, Field};
@@ -36,6 +35,7 @@ use crate::granule::GRANULE_RADIUS_M;
 use crate::granule::run::run_platens;
 use crate::model::{MeshLevel, OwnedReference};
 use crate::output::{Streams, create_file, finish_file, finite_ratio, write_json, write_text};
+use crate::plot::{Mark, Series, xy_svg};
 
 /// The table of the suite.
 pub const CSV_FILE: &str = "stability.csv";

@@ -206,7 +206,10 @@ pub fn run_granule(setting: &Setting, material: &Material) -> anyhow::Result<Mea
         .collect();
     let [lo, hi] = FIT_STRAIN_RANGE;
     let sigma_est_pa = yield_stress_estimate(
-        result.samples.iter().map(|s| (s.approach_m, s.mean_force())),
+        result
+            .samples
+            .iter()
+            .map(|s| (s.approach_m, s.mean_force())),
         result.diameter_m,
         lo,
         hi,

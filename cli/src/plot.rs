@@ -1,0 +1,174 @@
+//! Line and scatter plots as SVG text (plotters' SVG backend, no system
+//! fonts: text is written as SVG `<text>` and laid out by the viewer),
+//! shared by the granule, bed and study plots.
+
+use plotters::prelude::*;
+
+/// Plot size, pixels.
+const SIZE: (u32, u32) = (900, 600);
+
+/// Curve colours: matplotlib's `tab10` (distinct on white, no pale
+/// yellow), enough for the nine types of a `--types all` comparison;
+/// reused cyclically.
+const COLOURS: [RGBColor; 10] = [
+    RGBColor(0x1f, 0x77, 0xb4),
+    RGBColor(0xff, 0x7f, 0x0e),
+    RGBColor(0x2c, 0xa0, 0x2c),
+    RGBColor(0xd6, 0x27, 0x28),
+    RGBColor(0x94, 0x67, 0xbd),
+    RGBColor(0x8c, 0x56, 0x4b),
+    RGBColor(0xe3, 0x77, 0xc2),
+    RGBColor(0x7f, 0x7f, 0x7f),
+    RGBColor(0xbc, 0xbd, 0x22),
+    RGBColor(0x17, 0xbe, 0xcf),
+];
+
+/// How a series is drawn.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Mark {
+    /// A solid line.
+    Line,
+    /// Filled circles.
+    Dots,
+    /// Open circles.
+    Rings,
+    /// A dashed black line (a fit).
+    Dashed,
+}
+
+/// One series of a plot.
+pub struct Series {
+    label: String,
+    points: Vec<(f64, f64)>,
+    mark: Mark,
+}
+
+impl Series {
+    /// A series named `label` drawn as `mark`; non-finite points are left
+    /// out.
+    pub fn new(
+        label: impl Into<String>,
+        mark: Mark,
+        points: impl Iterator<Item = (f64, f64)>,
+    ) -> Self {
+        Self {
+            label: label.into(),
+            // Non-finite values (a degenerate granule, an empty window)
+            // are left out rather than breaking the axes.
+            points: points
+                .filter(|(x, y)| x.is_finite() && y.is_finite())
+                .collect(),
+            mark,
+        }
+    }
+
+    /// The finite points, in order.
+    pub fn points(&self) -> &[(f64, f64)] {
+        &self.points
+    }
+}
+
+/// A padded axis range over `values`, 0 included when `from_zero`; a
+/// degenerate range still gets a unit-width axis.
+fn range(values: impl Iterator<Item = f64>, from_zero: bool) -> core::ops::Range<f64> {
+    let (lo, hi) = values.fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), v| {
+        (lo.min(v), hi.max(v))
+    });
+    let (lo, hi) = if lo <= hi { (lo, hi) } else { (0.0, 1.0) };
+    let (lo, hi) = if from_zero {
+        (lo.min(0.0), hi.max(0.0))
+    } else {
+        (lo, hi)
+    };
+    let span = hi - lo;
+    if span > 0.0 {
+        (lo - 0.03 * span)..(hi + 0.05 * span)
+    } else {
+        let pad = if lo.abs() > 0.0 { 0.05 * lo.abs() } else { 1.0 };
+        (lo - pad)..(hi + pad)
+    }
+}
+
+/// The SVG text of `series` under `title`, with axis labels.
+pub fn xy_svg(
+    title: &str,
+    x_desc: &str,
+    y_desc: &str,
+    series: &[Series],
+    y_from_zero: bool,
+) -> anyhow::Result<String> {
+    let all = || series.iter().flat_map(|s| s.points.iter());
+    let x_range = range(all().map(|p| p.0), true);
+    let y_range = range(all().map(|p| p.1), y_from_zero);
+    let mut svg = String::new();
+    {
+        let root = SVGBackend::with_string(&mut svg, SIZE).into_drawing_area();
+        root.fill(&WHITE)?;
+        let mut chart = ChartBuilder::on(&root)
+            .caption(title, ("sans-serif", 20))
+            .margin(20)
+            .x_label_area_size(50)
+            .y_label_area_size(80)
+            .build_cartesian_2d(x_range, y_range)?;
+        chart
+            .configure_mesh()
+            .x_desc(x_desc)
+            .y_desc(y_desc)
+            .draw()?;
+        let mut colour = COLOURS.iter().cycle();
+        for s in series {
+            let pts = s.points.iter().copied();
+            let label = s.label.as_str();
+            match s.mark {
+                Mark::Line => {
+                    let style = colour.next().unwrap_or(&BLACK).stroke_width(2);
+                    chart
+                        .draw_series(LineSeries::new(pts, style))?
+                        .label(label)
+                        .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], style));
+                }
+                Mark::Dots | Mark::Rings => {
+                    let c = colour.next().unwrap_or(&BLACK);
+                    let style = if s.mark == Mark::Dots {
+                        c.filled()
+                    } else {
+                        c.stroke_width(1)
+                    };
+                    chart
+                        .draw_series(pts.map(move |p| Circle::new(p, 3, style)))?
+                        .label(label)
+                        .legend(move |(x, y)| Circle::new((x + 10, y), 3, style));
+                }
+                Mark::Dashed => {
+                    let style = BLACK.stroke_width(1);
+                    chart
+                        .draw_series(DashedLineSeries::new(pts, 6, 4, style))?
+                        .label(label)
+                        .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], style));
+                }
+            }
+        }
+        chart
+            .configure_series_labels()
+            .position(SeriesLabelPosition::UpperLeft)
+            .background_style(WHITE.mix(0.85))
+            .border_style(BLACK)
+            .draw()?;
+        root.present()?;
+    }
+    Ok(svg)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn ranges_pad_and_survive_degenerate_data() {
+        assert_eq!(range([].into_iter(), false), -0.03..1.05);
+        let r = range([2.0, 2.0].into_iter(), false);
+        assert!(r.start < 2.0 && r.end > 2.0);
+        let r = range([1.0, 3.0].into_iter(), true);
+        assert!(r.start < 0.0 && r.end > 3.0);
+    }
+}
