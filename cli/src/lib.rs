@@ -42,6 +42,7 @@ pub mod output;
 pub mod pack;
 pub mod plot;
 pub mod point;
+pub mod progress;
 pub mod study;
 pub mod vtk;
 

@@ -6,13 +6,14 @@ use std::path::Path;
 
 use anyhow::Context as _;
 use granbed_kernel::Real;
-use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+use indicatif::ProgressBar;
 use serde::Serialize;
 
 use super::run::{BedRun, BedSample};
 use super::scene::Scene;
 use crate::csv::{CsvWriter, Field};
 use crate::output::{create_file, finish_file, finite_ratio, write_json};
+use crate::progress::{StrainBar, draw_target, steps_per_second};
 
 /// Columns of `compression.csv`, in order.
 pub const COMPRESSION_COLUMNS: [&str; 27] = [
@@ -395,49 +396,35 @@ pub fn summary_line(scene: &Scene, run: &BedRun) -> String {
 /// stderr is not a terminal): strain as the position, with pressure,
 /// coordination number, steps per second and the ETA.
 pub struct Progress {
-    bar: ProgressBar,
+    bar: StrainBar,
 }
-
-/// Bar positions per unit strain.
-const TICKS: f64 = 10_000.0;
 
 impl Progress {
     /// A bar up to `final_strain`, its line starting with `label`.
     pub fn new(quiet: bool, final_strain: Real, label: &str) -> Self {
-        let target = if quiet {
-            ProgressDrawTarget::hidden()
-        } else {
-            ProgressDrawTarget::stderr()
-        };
-        let style = ProgressStyle::with_template(
-            "{prefix} [{elapsed_precise}] {bar:30} C {msg} (ETA {eta})",
-        )
-        .unwrap_or_else(|_| ProgressStyle::default_bar());
-        let bar = ProgressBar::with_draw_target(Some((final_strain * TICKS) as u64), target)
-            .with_style(style)
-            .with_prefix(label.to_string());
-        Self { bar }
+        let bar = ProgressBar::with_draw_target(None, draw_target(quiet));
+        let template = "{prefix} [{elapsed_precise}] {bar:30} C {msg} (ETA {eta})";
+        Self {
+            bar: StrainBar::new(bar, template, label, final_strain),
+        }
     }
 
     /// Shows sample `s`, taken `elapsed_s` into the compression.
     pub fn update(&self, s: &BedSample, elapsed_s: f64) {
-        let rate = if elapsed_s > 0.0 {
-            s.steps as f64 / elapsed_s
-        } else {
-            0.0
-        };
-        self.bar.set_position((s.strain * TICKS) as u64);
-        self.bar.set_message(format!(
-            "{:.3}, P {:.1} kPa, Z {:.2}, {:.0} steps/s",
+        self.bar.show(
             s.strain,
-            s.upper_pressure_pa * 1e-3,
-            s.coordination,
-            rate
-        ));
+            format!(
+                "{:.3}, P {:.1} kPa, Z {:.2}, {:.0} steps/s",
+                s.strain,
+                s.upper_pressure_pa * 1e-3,
+                s.coordination,
+                steps_per_second(s.steps, elapsed_s)
+            ),
+        );
     }
 
     /// Removes the bar.
     pub fn finish(&self) {
-        self.bar.finish_and_clear();
+        self.bar.finish();
     }
 }

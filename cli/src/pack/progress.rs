@@ -6,7 +6,9 @@
 //! `--quiet`; it never touches the results.
 
 use granbed_kernel::dem::pour::PourStatus;
-use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+use indicatif::{ProgressBar, ProgressStyle};
+
+use crate::progress::{draw_target, steps_per_second};
 
 /// The progress line of one pour.
 pub struct Progress {
@@ -17,11 +19,7 @@ impl Progress {
     /// A spinner for a pour of `granules` with time limit `max_time_s`,
     /// drawn on stderr when it is a terminal (never when `quiet`).
     pub fn new(quiet: bool, granules: usize, max_time_s: f64) -> Self {
-        let target = if quiet {
-            ProgressDrawTarget::hidden()
-        } else {
-            ProgressDrawTarget::stderr()
-        };
+        let target = draw_target(quiet);
         let style =
             ProgressStyle::with_template("{spinner} pour {prefix} [{elapsed_precise}] {msg}")
                 .unwrap_or_else(|_| ProgressStyle::default_spinner());
@@ -33,11 +31,7 @@ impl Progress {
 
     /// Shows state `s`, reached `elapsed_s` seconds into the pour.
     pub fn update(&self, s: &PourStatus, elapsed_s: f64) {
-        let rate = if elapsed_s > 0.0 {
-            s.steps as f64 / elapsed_s
-        } else {
-            0.0
-        };
+        let rate = steps_per_second(s.steps, elapsed_s);
         self.bar.set_message(format!(
             "t {:.4} s, KE {:.2e} J, v_max {:.2e} m/s, H {:.3} mm, {:.0} steps/s",
             s.time,
