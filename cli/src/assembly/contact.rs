@@ -173,6 +173,32 @@ impl ContactPhase {
         }
     }
 
+    /// Narrows the next sweep to the neighbourhood of the pairs whose last
+    /// sweep found a gap deeper than `tolerance` (m): a granule stays
+    /// marked as moved (its pairs are searched again) only if it is in such
+    /// a pair or touches a granule that is. Elsewhere every gap left is
+    /// shallower than the tolerance, which the sweep loop accepts anyway.
+    pub(super) fn narrow_to_deep_pairs(&mut self, tolerance: Real) {
+        let n = self.touched.len();
+        let mut deep = vec![false; n];
+        for (p, w) in self.pairs.iter().zip(&self.work) {
+            if w.result.min_gap < -tolerance {
+                deep[p.a as usize] = true;
+                deep[p.b as usize] = true;
+            }
+        }
+        let mut near = deep.clone();
+        for (p, w) in self.pairs.iter().zip(&self.work) {
+            if w.force_count > 0 && (deep[p.a as usize] || deep[p.b as usize]) {
+                near[p.a as usize] = true;
+                near[p.b as usize] = true;
+            }
+        }
+        for (t, keep) in self.touched.iter_mut().zip(near) {
+            *t &= keep;
+        }
+    }
+
     /// Broad-phase rebuilds so far.
     pub fn rebuilds(&self) -> u64 {
         self.rebuilds

@@ -94,6 +94,11 @@ pub struct AssemblyParams {
     /// motion up to round-off; it saves the element work of granules still
     /// falling or waiting in the packing.
     pub rigid_until_touched: bool,
+    /// Sweeps after the first search again only the pairs near those the
+    /// last sweep left deeper than `sweep_tolerance_m`
+    /// ([`ContactPhase`]`::narrow_to_deep_pairs`); false: every pair with
+    /// a granule the last sweep moved.
+    pub local_sweeps: bool,
 }
 
 impl AssemblyParams {
@@ -125,6 +130,7 @@ impl AssemblyParams {
             },
             time_step_interval: 100,
             rigid_until_touched: true,
+            local_sweeps: true,
         }
     }
 }

@@ -633,6 +633,9 @@ impl Assembly<'_> {
             if deepest > -p.sweep_tolerance_m {
                 break;
             }
+            if p.local_sweeps {
+                self.contact.narrow_to_deep_pairs(p.sweep_tolerance_m);
+            }
         }
         for w in self.contact.work() {
             pair_normal += w.step.normal;

@@ -143,11 +143,17 @@ pub struct BedArgs {
     #[arg(long, value_name = "BOOL")]
     pub rigid_until_touched: Option<bool>,
 
+    /// Override: contact sweeps after the first search only near the pairs
+    /// still deeper than the tolerance (true, the default) or every pair of
+    /// a moved granule (false).
+    #[arg(long, value_name = "BOOL")]
+    pub local_sweeps: Option<bool>,
+
     /// Continue the run whose checkpoint is in DIR (its `checkpoint.bin`);
     /// the outputs go to DIR. Only --strain, --stop-at-strain,
     /// --time-step-safety, --mass-scaling, -j and --quiet may be given with
     /// it.
-    #[arg(long, value_name = "DIR", conflicts_with_all = ["scene", "out", "granule_type", "granules", "mesh", "seed", "die_diameter_mm", "element", "hourglass_kappa", "rigid_until_touched"])]
+    #[arg(long, value_name = "DIR", conflicts_with_all = ["scene", "out", "granule_type", "granules", "mesh", "seed", "die_diameter_mm", "element", "hourglass_kappa", "rigid_until_touched", "local_sweeps"])]
     pub resume: Option<PathBuf>,
 
     /// Write a checkpoint and stop once the strain reaches C (continue
@@ -227,6 +233,9 @@ impl BedArgs {
         }
         if let Some(r) = self.rigid_until_touched {
             scene.rigid_until_touched = r;
+        }
+        if let Some(l) = self.local_sweeps {
+            scene.local_sweeps = l;
         }
         if let Some(c) = self.time_step_safety {
             scene.time_step_safety = c;

@@ -63,6 +63,9 @@ time_step_safety = 0.9
 # their first contact: the same motion up to round-off, cheaper while the bed
 # settles onto its granules and walls. false: finite-element bodies from t = 0.
 rigid_until_touched = true
+# Contact sweeps after the first search only the neighbourhood of the pairs
+# still deeper than the tolerance (false: every pair of a moved granule).
+local_sweeps = true
 # Watchdogs: stop (with a checkpoint from before) when the kinetic energy
 # exceeds this multiple of all the energy put in (punch or contact work,
 # gravity, initial motion), or when a node moves faster than this multiple of
@@ -159,8 +162,11 @@ pub struct Scene {
     #[serde(default = "default_time_step_safety")]
     pub time_step_safety: f64,
     /// Granules are rigid bodies until first touched (absent: true).
-    #[serde(default = "default_rigid_until_touched")]
+    #[serde(default = "default_true")]
     pub rigid_until_touched: bool,
+    /// Later contact sweeps search only near the deep pairs (absent: true).
+    #[serde(default = "default_true")]
+    pub local_sweeps: bool,
     /// Watchdog limit on the kinetic energy as a multiple of the energy
     /// put in, 1 ≤ r ≤ 1e9 (absent: 2).
     #[serde(default = "default_watchdog_energy_ratio")]
@@ -203,7 +209,7 @@ fn default_time_step_safety() -> f64 {
     0.9
 }
 
-fn default_rigid_until_touched() -> bool {
+fn default_true() -> bool {
     true
 }
 
