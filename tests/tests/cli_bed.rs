@@ -297,6 +297,35 @@ fn the_rate_check_presses_the_same_bed_at_half_speed() {
     assert!(summary(&dir.join("half_speed"))["quasi_static"]["rate_change_rel"].is_null());
 }
 
+/// Runs the bed of `args` twice, with `--<flag> true` and `--<flag>
+/// false`, into fresh directories `<flag>_on` / `<flag>_off`.
+fn on_and_off(flag: &str, args: &[&str]) -> (PathBuf, PathBuf) {
+    let (on, off) = (
+        out_dir(&format!("{flag}_on")),
+        out_dir(&format!("{flag}_off")),
+    );
+    let option = format!("--{flag}");
+    for (dir, value) in [(&on, "true"), (&off, "false")] {
+        let mut argv = vec!["bed", "--quiet", option.as_str(), value];
+        argv.extend_from_slice(&["--out", dir.to_str().unwrap()]);
+        argv.extend_from_slice(args);
+        let r = cli(&argv);
+        assert_eq!(r.code, 0, "{}", r.stderr);
+    }
+    (on, off)
+}
+
+/// A boolean scene field `field` (default true) has the CLI override
+/// `--<flag> false`, and a scene file without it reads as true.
+fn a_boolean_scene_field(flag: &str, field: &str, get: fn(&Scene) -> bool) {
+    let run = cli(&["bed", "--print-scene", &format!("--{flag}"), "false"]);
+    assert_eq!(run.code, 0, "{}", run.stderr);
+    assert!(!get(&Scene::from_toml(&run.stdout).unwrap()));
+    let old = DEFAULT_SCENE.replace(&format!("{field} = true\n"), "");
+    assert_ne!(old, DEFAULT_SCENE);
+    assert!(get(&Scene::from_toml(&old).unwrap()));
+}
+
 /// Untouched granules move as rigid bodies: the compression of a small bed
 /// is the same with and without (to round-off: the element path sees
 /// forces of order ε·E in an undeformed, rotated granule), the summary
@@ -314,14 +343,7 @@ fn untouched_granules_move_rigidly_with_the_same_compression() {
         "--strain",
         "0.06",
     ];
-    let (on, off) = (out_dir("rigid_on"), out_dir("rigid_off"));
-    for (dir, flag) in [(&on, "true"), (&off, "false")] {
-        let mut argv = vec!["bed", "--quiet", "--rigid-until-touched", flag];
-        argv.extend_from_slice(&["--out", dir.to_str().unwrap()]);
-        argv.extend_from_slice(&args);
-        let r = cli(&argv);
-        assert_eq!(r.code, 0, "{}", r.stderr);
-    }
+    let (on, off) = on_and_off("rigid-until-touched", &args);
     let share = |dir: &Path| summary(dir)["rigid_granule_step_share"].as_f64().unwrap();
     println!("rigid share of granule-steps: {}", share(&on));
     assert!(share(&on) > 0.05, "rigid share {}", share(&on));
@@ -350,12 +372,9 @@ fn untouched_granules_move_rigidly_with_the_same_compression() {
             );
         }
     }
-    let run = cli(&["bed", "--print-scene", "--rigid-until-touched", "false"]);
-    assert_eq!(run.code, 0, "{}", run.stderr);
-    assert!(!Scene::from_toml(&run.stdout).unwrap().rigid_until_touched);
-    let old = DEFAULT_SCENE.replace("rigid_until_touched = true\n", "");
-    assert_ne!(old, DEFAULT_SCENE);
-    assert!(Scene::from_toml(&old).unwrap().rigid_until_touched);
+    a_boolean_scene_field("rigid-until-touched", "rigid_until_touched", |s| {
+        s.rigid_until_touched
+    });
 }
 
 /// Later contact sweeps that search only near the pairs still deeper than
@@ -367,14 +386,7 @@ fn untouched_granules_move_rigidly_with_the_same_compression() {
 /// the old one; the switch is a scene field with a CLI override.
 #[test]
 fn local_contact_sweeps_compress_like_full_sweeps() {
-    let (on, off) = (out_dir("local_on"), out_dir("local_off"));
-    for (dir, flag) in [(&on, "true"), (&off, "false")] {
-        let mut argv = vec!["bed", "--quiet", "--local-sweeps", flag];
-        argv.extend_from_slice(&["--out", dir.to_str().unwrap()]);
-        argv.extend_from_slice(&SMALL);
-        let r = cli(&argv);
-        assert_eq!(r.code, 0, "{}", r.stderr);
-    }
+    let (on, off) = on_and_off("local-sweeps", &SMALL);
     let (a, b) = (
         Table::read(&on.join("compression.csv")),
         Table::read(&off.join("compression.csv")),
@@ -406,12 +418,7 @@ fn local_contact_sweeps_compress_like_full_sweeps() {
         sweeps(&on),
         sweeps(&off)
     );
-    let run = cli(&["bed", "--print-scene", "--local-sweeps", "false"]);
-    assert_eq!(run.code, 0, "{}", run.stderr);
-    assert!(!Scene::from_toml(&run.stdout).unwrap().local_sweeps);
-    let old = DEFAULT_SCENE.replace("local_sweeps = true\n", "");
-    assert_ne!(old, DEFAULT_SCENE);
-    assert!(Scene::from_toml(&old).unwrap().local_sweeps);
+    a_boolean_scene_field("local-sweeps", "local_sweeps", |s| s.local_sweeps);
 }
 
 /// The element and κ are scene fields with CLI overrides; a bad value is
