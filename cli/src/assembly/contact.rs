@@ -67,7 +67,16 @@ pub struct ContactPhase {
     /// Per granule: bit k set if it touched wall k (mod 64) in any sweep of
     /// the step.
     pub(super) on_wall: Vec<u64>,
+    /// Scratch of `narrow_to_deep_pairs`, per granule: [`DEEP`] or
+    /// [`NEAR_DEEP`] bits.
+    narrow: Vec<u8>,
 }
+
+/// `narrow` bit: the granule is in a pair deeper than the tolerance.
+const DEEP: u8 = 1;
+/// `narrow` bit: the granule is in a pair deeper than the tolerance or
+/// touches a granule that is.
+const NEAR_DEEP: u8 = 2;
 
 /// The kernel's view of granule `g` on its predicted configuration.
 fn body<'a>(
@@ -179,23 +188,24 @@ impl ContactPhase {
     /// a pair or touches a granule that is. Elsewhere every gap left is
     /// shallower than the tolerance, which the sweep loop accepts anyway.
     pub(super) fn narrow_to_deep_pairs(&mut self, tolerance: Real) {
-        let n = self.touched.len();
-        let mut deep = vec![false; n];
+        let marks = &mut self.narrow;
+        marks.clear();
+        marks.resize(self.touched.len(), 0);
         for (p, w) in self.pairs.iter().zip(&self.work) {
             if w.result.min_gap < -tolerance {
-                deep[p.a as usize] = true;
-                deep[p.b as usize] = true;
+                marks[p.a as usize] = DEEP | NEAR_DEEP;
+                marks[p.b as usize] = DEEP | NEAR_DEEP;
             }
         }
-        let mut near = deep.clone();
         for (p, w) in self.pairs.iter().zip(&self.work) {
-            if w.force_count > 0 && (deep[p.a as usize] || deep[p.b as usize]) {
-                near[p.a as usize] = true;
-                near[p.b as usize] = true;
+            let (a, b) = (p.a as usize, p.b as usize);
+            if w.force_count > 0 && (marks[a] | marks[b]) & DEEP != 0 {
+                marks[a] |= NEAR_DEEP;
+                marks[b] |= NEAR_DEEP;
             }
         }
-        for (t, keep) in self.touched.iter_mut().zip(near) {
-            *t &= keep;
+        for (t, &m) in self.touched.iter_mut().zip(marks.iter()) {
+            *t &= m & NEAR_DEEP != 0;
         }
     }
 
