@@ -5,6 +5,7 @@ use anyhow::{Context as _, bail};
 use granbed_kernel::Real;
 use granbed_kernel::dem::neighbors::Pair;
 use granbed_kernel::dem::pour::{PourBuffers, PourParams};
+use granbed_kernel::element::batch::{ElementBatch, batch_count, regroup};
 use granbed_kernel::element::reference::HexReference;
 use granbed_kernel::granule::dynamics::GranuleBuffers;
 use granbed_kernel::granule::timestep::PowerIterationBuffers;
@@ -75,8 +76,17 @@ pub struct OwnedReference {
     pub surface_nodes: usize,
     /// Per-element reference data.
     pub elements: Vec<HexReference>,
+    /// `elements` regrouped for the batched element (`batch::regroup`).
+    pub batches: Vec<ElementBatch>,
     /// Lumped nodal volumes, m³.
     pub node_volume: Vec<Real>,
+}
+
+/// `elements` regrouped for the batched one-point element.
+pub fn regrouped(elements: &[HexReference]) -> Vec<ElementBatch> {
+    let mut batches = vec![ElementBatch::ZERO; batch_count(elements.len())];
+    regroup(elements, &mut batches).expect("sized by batch_count");
+    batches
 }
 
 /// Owned mesh buffers of one size, lent to the kernel as [`MeshBuffers`].
@@ -156,6 +166,7 @@ impl OwnedReference {
             quads: store.quads,
             node_quads: store.node_quads,
             surface_nodes,
+            batches: regrouped(&elements),
             elements,
             node_volume,
         })
@@ -205,6 +216,7 @@ impl OwnedReference {
             quads: store.quads,
             node_quads: store.node_quads,
             surface_nodes: size.surface_nodes,
+            batches: regrouped(&elements),
             elements,
             node_volume,
         })
@@ -221,6 +233,7 @@ impl OwnedReference {
             },
             node_quads: &self.node_quads,
             elements: &self.elements,
+            batches: &self.batches,
             node_volume: &self.node_volume,
         }
     }

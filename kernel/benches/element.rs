@@ -9,8 +9,9 @@
 use core::hint::black_box;
 
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
+use granbed_kernel::element::batch::{ElementBatch, ElementPath, batch_count, has_avx2, regroup};
 use granbed_kernel::element::reference::{HexReference, hex_reference};
-use granbed_kernel::granule::forces::{ElementKind, ElementSettings, internal_forces};
+use granbed_kernel::granule::forces::{ElementKind, ElementSettings, internal_forces_on};
 use granbed_kernel::material::GranuleType;
 use granbed_kernel::mesh::octant::MeshView;
 use granbed_kernel::mesh::reference::{ReferenceMesh, compute_element_data};
@@ -23,6 +24,7 @@ struct Mesh {
     quads: Vec<[u32; 4]>,
     node_quads: Vec<[u32; 4]>,
     elements: Vec<HexReference>,
+    batches: Vec<ElementBatch>,
     node_volume: Vec<f64>,
     surface: usize,
 }
@@ -36,6 +38,7 @@ fn standard_mesh() -> Mesh {
         quads: vec![[0; 4]; s.quads],
         node_quads: vec![[0; 4]; s.surface_nodes],
         elements: Vec::new(),
+        batches: Vec::new(),
         node_volume: vec![0.0; s.nodes],
         surface: s.surface_nodes,
     };
@@ -60,6 +63,8 @@ fn standard_mesh() -> Mesh {
         surface_nodes: m.surface,
     };
     compute_element_data(&view, &mut m.elements, &mut m.node_volume).unwrap();
+    m.batches = vec![ElementBatch::ZERO; batch_count(s.hexes)];
+    regroup(&m.elements, &mut m.batches).unwrap();
     m
 }
 
@@ -74,6 +79,7 @@ fn bench_elements(c: &mut Criterion) {
         },
         node_quads: &m.node_quads,
         elements: &m.elements,
+        batches: &m.batches,
         node_volume: &m.node_volume,
     };
     let mat = GranuleType::B2.params().validate().unwrap();
@@ -99,14 +105,37 @@ fn bench_elements(c: &mut Criterion) {
         let start = vec![VOIGT_IDENTITY; m.hexes.len() * settings.points_per_element()];
         let mut cp = start.clone();
         let mut f = vec![[0.0; 3]; m.positions.len()];
-        group.bench_function(name, |b| {
-            b.iter(|| {
-                cp.copy_from_slice(&start);
-                let s = internal_forces(&mesh, &mat, &settings, black_box(&x), &mut cp, &mut f)
+        // The one-point element on each path (the same bits; the default
+        // is the fastest the processor has); F-bar has one path.
+        let paths: &[(&str, ElementPath)] = match kind {
+            ElementKind::OnePoint => &[
+                ("scalar", ElementPath::Scalar),
+                ("batched", ElementPath::Batched),
+                ("avx2", ElementPath::Avx2),
+            ],
+            ElementKind::FBar => &[("scalar", ElementPath::Scalar)],
+        };
+        for &(path_name, path) in paths {
+            if path == ElementPath::Avx2 && !has_avx2() {
+                continue;
+            }
+            group.bench_function(format!("{name}/{path_name}"), |b| {
+                b.iter(|| {
+                    cp.copy_from_slice(&start);
+                    let s = internal_forces_on(
+                        path,
+                        &mesh,
+                        &mat,
+                        &settings,
+                        black_box(&x),
+                        &mut cp,
+                        &mut f,
+                    )
                     .unwrap();
-                black_box(s.plastic_elements)
-            })
-        });
+                    black_box(s.plastic_elements)
+                })
+            });
+        }
     }
     group.finish();
 }

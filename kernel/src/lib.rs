@@ -37,6 +37,7 @@ pub mod contact;
 pub mod dem;
 pub mod element;
 pub mod granule;
+pub mod lanes;
 pub mod material;
 pub mod material_point;
 pub mod math;

@@ -7,6 +7,7 @@
 //!   `[xx, yy, zz, yz, xz, xy]` (indices [`XX`] … [`XY`]); shear components are
 //!   stored once, without a factor 2.
 
+use crate::lanes::Num;
 use crate::{Real, math};
 
 /// General 3×3 tensor.
@@ -54,44 +55,94 @@ pub fn voigt_from_mat(m: &Mat3) -> Voigt {
     ]
 }
 
+/// A general 3×3 tensor as rows, `m[i][j]` = row `i`, column `j`, over any
+/// [`Num`]: the form the element batches use ([`crate::lanes`]); the
+/// [`Mat3`] functions below are its `T = Real` instances.
+pub type Rows<T> = [[T; 3]; 3];
+
+/// The rows of a [`Mat3`].
+#[inline(always)]
+pub fn rows(m: &Mat3) -> Rows<Real> {
+    [
+        [m[(0, 0)], m[(0, 1)], m[(0, 2)]],
+        [m[(1, 0)], m[(1, 1)], m[(1, 2)]],
+        [m[(2, 0)], m[(2, 1)], m[(2, 2)]],
+    ]
+}
+
+/// The [`Mat3`] of rows `m`.
+#[inline(always)]
+pub fn from_rows(m: &Rows<Real>) -> Mat3 {
+    Mat3::new(
+        m[0][0], m[0][1], m[0][2], //
+        m[1][0], m[1][1], m[1][2], //
+        m[2][0], m[2][1], m[2][2],
+    )
+}
+
+/// Full symmetric matrix (as rows) from Voigt storage.
+#[inline(always)]
+pub fn rows_from_voigt<T: Num>(v: &[T; 6]) -> Rows<T> {
+    [
+        [v[XX], v[XY], v[XZ]],
+        [v[XY], v[YY], v[YZ]],
+        [v[XZ], v[YZ], v[ZZ]],
+    ]
+}
+
+/// Voigt storage of the symmetric part of `m`, `(m + mᵀ)/2` (as
+/// [`voigt_from_mat`]).
+#[inline(always)]
+pub fn voigt_from_rows<T: Num>(m: &Rows<T>) -> [T; 6] {
+    let half = T::splat(0.5);
+    [
+        m[0][0],
+        m[1][1],
+        m[2][2],
+        half * (m[1][2] + m[2][1]),
+        half * (m[0][2] + m[2][0]),
+        half * (m[0][1] + m[1][0]),
+    ]
+}
+
 /// Trace of a symmetric tensor.
 #[inline]
-pub fn trace(v: &Voigt) -> Real {
+pub fn trace<T: Num>(v: &[T; 6]) -> T {
     v[XX] + v[YY] + v[ZZ]
 }
 
 /// Deviator `v − (tr v / 3) 1`.
 #[inline]
-pub fn deviator(v: &Voigt) -> Voigt {
-    let m = trace(v) / 3.0;
+pub fn deviator<T: Num>(v: &[T; 6]) -> [T; 6] {
+    let m = trace(v) / T::splat(3.0);
     [v[XX] - m, v[YY] - m, v[ZZ] - m, v[YZ], v[XZ], v[XY]]
 }
 
 /// Double contraction `a : b` of two symmetric tensors.
 #[inline]
-pub fn ddot(a: &Voigt, b: &Voigt) -> Real {
+pub fn ddot<T: Num>(a: &[T; 6], b: &[T; 6]) -> T {
     a[XX] * b[XX]
         + a[YY] * b[YY]
         + a[ZZ] * b[ZZ]
-        + 2.0 * (a[YZ] * b[YZ] + a[XZ] * b[XZ] + a[XY] * b[XY])
+        + T::splat(2.0) * (a[YZ] * b[YZ] + a[XZ] * b[XZ] + a[XY] * b[XY])
 }
 
 /// Frobenius norm `√(v : v)` of a symmetric tensor.
 #[inline]
-pub fn norm(v: &Voigt) -> Real {
-    math::sqrt(ddot(v, v))
+pub fn norm<T: Num>(v: &[T; 6]) -> T {
+    ddot(v, v).sqrt()
 }
 
 /// Determinant of a symmetric tensor.
 #[inline]
-pub fn det(v: &Voigt) -> Real {
+pub fn det<T: Num>(v: &[T; 6]) -> T {
     v[XX] * (v[YY] * v[ZZ] - v[YZ] * v[YZ]) - v[XY] * (v[XY] * v[ZZ] - v[YZ] * v[XZ])
         + v[XZ] * (v[XY] * v[YZ] - v[YY] * v[XZ])
 }
 
 /// `a·v + b·1` for a symmetric `v`.
 #[inline]
-pub fn scale_add_identity(v: &Voigt, a: Real, b: Real) -> Voigt {
+pub fn scale_add_identity<T: Num>(v: &[T; 6], a: T, b: T) -> [T; 6] {
     [
         a * v[XX] + b,
         a * v[YY] + b,
@@ -110,13 +161,28 @@ pub fn scale_add_identity(v: &Voigt, a: Real, b: Real) -> Voigt {
 /// line it cost 6 % of a bed run.
 #[inline]
 pub fn push_forward(f: &Mat3, s: &Voigt) -> Voigt {
-    let s = mat_from_voigt(s);
-    let fs =
-        Mat3::from_fn(|i, j| f[(i, 0)] * s[(0, j)] + f[(i, 1)] * s[(1, j)] + f[(i, 2)] * s[(2, j)]);
-    let fsft = Mat3::from_fn(|i, j| {
-        fs[(i, 0)] * f[(j, 0)] + fs[(i, 1)] * f[(j, 1)] + fs[(i, 2)] * f[(j, 2)]
-    });
-    voigt_from_mat(&fsft)
+    push_forward_rows(&rows(f), s)
+}
+
+/// [`push_forward`] over rows: every entry of `F S` and of `(F S) Fᵀ` summed
+/// k = 0, 1, 2, then symmetrised.
+#[inline(always)]
+pub fn push_forward_rows<T: Num>(f: &Rows<T>, s: &[T; 6]) -> [T; 6] {
+    let s = rows_from_voigt(s);
+    // Loops rather than `array::from_fn`, which rustc left out of line.
+    let mut fs = [[T::splat(0.0); 3]; 3];
+    for (fs_i, f_i) in fs.iter_mut().zip(f) {
+        for (j, fs_ij) in fs_i.iter_mut().enumerate() {
+            *fs_ij = f_i[0] * s[0][j] + f_i[1] * s[1][j] + f_i[2] * s[2][j];
+        }
+    }
+    let mut fsft = [[T::splat(0.0); 3]; 3];
+    for (fsft_i, fs_i) in fsft.iter_mut().zip(&fs) {
+        for (fsft_ij, f_j) in fsft_i.iter_mut().zip(f) {
+            *fsft_ij = fs_i[0] * f_j[0] + fs_i[1] * f_j[1] + fs_i[2] * f_j[2];
+        }
+    }
+    voigt_from_rows(&fsft)
 }
 
 /// Inverse of `m` given its (non-zero) determinant, by cofactors.
@@ -124,27 +190,45 @@ pub fn push_forward(f: &Mat3, s: &Voigt) -> Voigt {
 /// The caller has checked `det ≠ 0`; no pivoting or rank test is done.
 #[inline]
 pub fn inverse_with_det(m: &Mat3, det: Real) -> Mat3 {
-    let c = |i: usize, j: usize| m[(i, j)];
-    let inv_det = 1.0 / det;
-    Mat3::new(
-        (c(1, 1) * c(2, 2) - c(1, 2) * c(2, 1)) * inv_det,
-        (c(0, 2) * c(2, 1) - c(0, 1) * c(2, 2)) * inv_det,
-        (c(0, 1) * c(1, 2) - c(0, 2) * c(1, 1)) * inv_det,
-        (c(1, 2) * c(2, 0) - c(1, 0) * c(2, 2)) * inv_det,
-        (c(0, 0) * c(2, 2) - c(0, 2) * c(2, 0)) * inv_det,
-        (c(0, 2) * c(1, 0) - c(0, 0) * c(1, 2)) * inv_det,
-        (c(1, 0) * c(2, 1) - c(1, 1) * c(2, 0)) * inv_det,
-        (c(0, 1) * c(2, 0) - c(0, 0) * c(2, 1)) * inv_det,
-        (c(0, 0) * c(1, 1) - c(0, 1) * c(1, 0)) * inv_det,
-    )
+    from_rows(&inverse_rows_with_det(&rows(m), det))
+}
+
+/// [`inverse_with_det`] over rows.
+#[inline(always)]
+pub fn inverse_rows_with_det<T: Num>(m: &Rows<T>, det: T) -> Rows<T> {
+    let c = |i: usize, j: usize| m[i][j];
+    let inv_det = T::splat(1.0) / det;
+    [
+        [
+            (c(1, 1) * c(2, 2) - c(1, 2) * c(2, 1)) * inv_det,
+            (c(0, 2) * c(2, 1) - c(0, 1) * c(2, 2)) * inv_det,
+            (c(0, 1) * c(1, 2) - c(0, 2) * c(1, 1)) * inv_det,
+        ],
+        [
+            (c(1, 2) * c(2, 0) - c(1, 0) * c(2, 2)) * inv_det,
+            (c(0, 0) * c(2, 2) - c(0, 2) * c(2, 0)) * inv_det,
+            (c(0, 2) * c(1, 0) - c(0, 0) * c(1, 2)) * inv_det,
+        ],
+        [
+            (c(1, 0) * c(2, 1) - c(1, 1) * c(2, 0)) * inv_det,
+            (c(0, 1) * c(2, 0) - c(0, 0) * c(2, 1)) * inv_det,
+            (c(0, 0) * c(1, 1) - c(0, 1) * c(1, 0)) * inv_det,
+        ],
+    ]
 }
 
 /// Determinant of a general 3×3 tensor (cofactor expansion along row 0).
 #[inline]
 pub fn det_mat(m: &Mat3) -> Real {
-    m[(0, 0)] * (m[(1, 1)] * m[(2, 2)] - m[(1, 2)] * m[(2, 1)])
-        - m[(0, 1)] * (m[(1, 0)] * m[(2, 2)] - m[(1, 2)] * m[(2, 0)])
-        + m[(0, 2)] * (m[(1, 0)] * m[(2, 1)] - m[(1, 1)] * m[(2, 0)])
+    det_rows(&rows(m))
+}
+
+/// [`det_mat`] over rows.
+#[inline(always)]
+pub fn det_rows<T: Num>(m: &Rows<T>) -> T {
+    m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1])
+        - m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0])
+        + m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0])
 }
 
 /// Kirchhoff pressure `p = −tr τ / 3` (positive in compression), Pa.

@@ -16,6 +16,7 @@ use alloc::vec::Vec;
 use core::cell::RefCell;
 
 use granbed_kernel::Real;
+use granbed_kernel::element::batch::{ElementBatch, batch_count, regroup};
 use granbed_kernel::element::reference::{HexReference, hex_reference};
 use granbed_kernel::granule::dynamics::GranuleBuffers;
 use granbed_kernel::granule::timestep::PowerIterationBuffers;
@@ -41,6 +42,8 @@ pub struct OctantMesh {
     pub surface_nodes: usize,
     /// Per-element reference data.
     pub elements: Vec<HexReference>,
+    /// `elements` regrouped for the batched element (`batch::regroup`).
+    pub batches: Vec<ElementBatch>,
     /// Lumped nodal volumes, m³.
     pub node_volume: Vec<Real>,
 }
@@ -118,6 +121,11 @@ impl OctantMesh {
             quads: part.quads,
             node_quads: part.node_quads,
             surface_nodes: osize.surface_nodes,
+            batches: {
+                let mut batches = vec![ElementBatch::ZERO; batch_count(elements.len())];
+                regroup(&elements, &mut batches).ok()?;
+                batches
+            },
             elements,
             node_volume,
         })
@@ -134,6 +142,7 @@ impl OctantMesh {
             },
             node_quads: &self.node_quads,
             elements: &self.elements,
+            batches: &self.batches,
             node_volume: &self.node_volume,
         }
     }

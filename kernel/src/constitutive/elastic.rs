@@ -4,6 +4,7 @@
 //! ψ = ½μ(tr b^e − 3) + ½λ(J^e − 1)² − μ ln J^e, per unit reference volume;
 //! τ = μ b^e + (1/3) h(J^e) 1 with h(J) = 3[λJ(J − 1) − μ].
 
+use crate::lanes::Num;
 use crate::material::Material;
 use crate::tensor::{Voigt, scale_add_identity, trace};
 use crate::{Real, math};
@@ -17,8 +18,8 @@ pub fn h(mat: &Material, je: Real) -> Real {
 
 /// [`h`] from the Lamé constants λ, μ (Pa) directly.
 #[inline]
-pub fn h_lame(lambda: Real, mu: Real, je: Real) -> Real {
-    3.0 * (lambda * je * (je - 1.0) - mu)
+pub fn h_lame<T: Num>(lambda: T, mu: T, je: T) -> T {
+    T::splat(3.0) * (lambda * je * (je - T::splat(1.0)) - mu)
 }
 
 /// Derivative h'(J) = 3λ(2J − 1), Pa.
@@ -30,9 +31,14 @@ pub fn dh(mat: &Material, je: Real) -> Real {
 /// Kirchhoff stress τ = μ b^e + (1/3) h(J^e) 1, Pa, for an elastic left
 /// Cauchy–Green tensor `be` (dimensionless, Voigt) with `je = √det b^e`.
 #[inline]
-pub fn kirchhoff(mat: &Material, be: &Voigt, je: Real) -> Voigt {
+pub fn kirchhoff<T: Num>(mat: &Material, be: &[T; 6], je: T) -> [T; 6] {
     // h/3 written out, so that b^e = 1 gives exactly τ = 0.
-    scale_add_identity(be, mat.mu, mat.lambda * je * (je - 1.0) - mat.mu)
+    let mu = T::splat(mat.mu);
+    scale_add_identity(
+        be,
+        mu,
+        T::splat(mat.lambda) * je * (je - T::splat(1.0)) - mu,
+    )
 }
 
 /// Stored energy density ψ(b^e, J^e), J per m³ of reference volume.

@@ -12,8 +12,9 @@ use core::fmt;
 use crate::constitutive::elastic;
 use crate::constitutive::return_map::{ReturnMapSystem, ReturnMethod};
 use crate::constitutive::yield_surface::{self, YieldCoefficients};
+use crate::lanes::{Lanes, Num};
 use crate::material::Material;
-use crate::tensor::{self, Mat3, Voigt};
+use crate::tensor::{self, Mat3, Rows, Voigt};
 use crate::{Real, math};
 
 /// Switches of the update.
@@ -128,6 +129,142 @@ impl PointUpdate {
     }
 }
 
+/// The elastic trial state of a point (physics.md §1.3), over any [`Num`]
+/// (one point, or one point per lane of an element batch). Computed for
+/// any input; [`check_trial`] decides whether it is valid, elastic or
+/// plastic.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Trial<T> {
+    /// J = det F.
+    pub j: T,
+    /// det C_p⁻¹ of the stored state.
+    pub det_cp_inv: T,
+    /// b^e,tr = F C_p⁻¹ Fᵀ (Voigt).
+    pub b: [T; 6],
+    /// J^e,tr = J √det C_p⁻¹.
+    pub je: T,
+    /// θtr = μ tr b^e,tr, Pa.
+    pub theta: T,
+    /// dev τtr = μ dev b^e,tr, Pa (Voigt).
+    pub s: [T; 6],
+    /// βtr = ‖dev τtr‖, Pa.
+    pub beta: T,
+    /// αtr = tr τtr = θtr + h(J^e,tr), Pa.
+    pub alpha: T,
+    /// Relative density η = η0/J.
+    pub eta: T,
+}
+
+impl<const W: usize> Trial<Lanes<W>> {
+    /// The trial state of lane `l`.
+    #[inline(always)]
+    pub fn lane(&self, l: usize) -> Trial<Real> {
+        let pick = |v: &[Lanes<W>; 6]| {
+            let mut out = [0.0; 6];
+            for (o, v) in out.iter_mut().zip(v) {
+                *o = v.0[l];
+            }
+            out
+        };
+        Trial {
+            j: self.j.0[l],
+            det_cp_inv: self.det_cp_inv.0[l],
+            b: pick(&self.b),
+            je: self.je.0[l],
+            theta: self.theta.0[l],
+            s: pick(&self.s),
+            beta: self.beta.0[l],
+            alpha: self.alpha.0[l],
+            eta: self.eta.0[l],
+        }
+    }
+}
+
+/// The trial state at deformation gradient `f` (rows) from the stored
+/// state `cp_inv` = C_p⁻¹.
+#[allow(non_snake_case)]
+#[inline(always)]
+pub fn trial<T: Num>(mat: &Material, f: &Rows<T>, cp_inv: &[T; 6]) -> Trial<T> {
+    let J = tensor::det_rows(f);
+    let det_cp_inv = tensor::det(cp_inv);
+    let b = tensor::push_forward_rows(f, cp_inv);
+    let je = J * det_cp_inv.sqrt();
+    let mu = T::splat(mat.mu);
+    let theta = mu * tensor::trace(&b);
+    let s = tensor::scale_add_identity(&tensor::deviator(&b), mu, T::splat(0.0));
+    let beta = tensor::norm(&s);
+    let alpha = theta + elastic::h_lame(T::splat(mat.lambda), mu, je);
+    Trial {
+        j: J,
+        det_cp_inv,
+        b,
+        je,
+        theta,
+        s,
+        beta,
+        alpha,
+        eta: T::splat(mat.params.eta0) / J,
+    }
+}
+
+/// What [`check_trial`] found for an admissible input.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct TrialCheck {
+    /// The diagnostics of an elastic step (η, J^e,tr, coefficients, φtr).
+    pub info: UpdateInfo,
+    /// `Some((2/3)a2σy²)` if the trial state violates the yield condition
+    /// and the plastic corrector ([`plastic_return`]) must run.
+    pub plastic_scale: Option<Real>,
+}
+
+/// Checks the input of an update: a finite `f`, J > 0, a valid stored state
+/// and a finite η; then evaluates the yield function at the trial state.
+#[inline(always)]
+#[allow(clippy::neg_cmp_op_on_partial_ord)] // NaN must fail the test
+pub fn check_trial(
+    mat: &Material,
+    opts: &UpdateOptions,
+    f: &Rows<Real>,
+    t: &Trial<Real>,
+) -> Result<TrialCheck, UpdateError> {
+    if !f.iter().flatten().all(|x| x.is_finite()) {
+        return Err(UpdateError::NonFinite);
+    }
+    if t.j.is_nan() || t.j <= 0.0 {
+        return Err(UpdateError::InvertedDeformation { j: t.j });
+    }
+    let det_c = t.det_cp_inv;
+    if det_c.is_nan() || det_c <= 0.0 || det_c.is_infinite() {
+        return Err(UpdateError::InvalidState { det: det_c });
+    }
+    if !t.eta.is_finite() {
+        // J > 0 but so small (subnormal) that η = η0/J overflows: crushed
+        // flat, for the update as good as inverted (found by fuzzing).
+        return Err(UpdateError::InvertedDeformation { j: t.j });
+    }
+    let coefficients = yield_surface::coefficients(&mat.params, t.eta);
+    let sy = mat.params.yield_stress_pa;
+    let scale = yield_surface::yield_scale(&coefficients, sy);
+    let phi_tr = yield_surface::yield_function(&coefficients, sy, t.beta, t.alpha);
+    Ok(TrialCheck {
+        info: UpdateInfo {
+            plastic: false,
+            method: ReturnMethod::Elastic,
+            iterations: 0,
+            eps: 0.0,
+            delta: 0.0,
+            gamma: 0.0,
+            eta: t.eta,
+            je: t.je,
+            coefficients,
+            residual: phi_tr / scale,
+        },
+        // Not `φ > tol`: a NaN φ (overflowed trial state) must go to the
+        // corrector, which reports it, never pass as elastic (fuzzing).
+        plastic_scale: (!(phi_tr <= opts.yield_tolerance * scale)).then_some(scale),
+    })
+}
+
 /// Updates one integration point to the end-of-step deformation gradient.
 ///
 /// * `f_np1`: deformation gradient F_{n+1} (reference → current).
@@ -136,7 +273,6 @@ impl PointUpdate {
 ///
 /// Returns the Kirchhoff stress and diagnostics, or an [`UpdateError`]; never
 /// panics.
-#[allow(non_snake_case)]
 #[inline]
 pub fn update_point(
     mat: &Material,
@@ -144,63 +280,50 @@ pub fn update_point(
     f_np1: &Mat3,
     cp_inv: &mut Voigt,
 ) -> Result<PointUpdate, UpdateError> {
-    let F = f_np1;
-    if !F.iter().all(|x| x.is_finite()) {
-        return Err(UpdateError::NonFinite);
-    }
-    let J = tensor::det_mat(F);
-    if J.is_nan() || J <= 0.0 {
-        return Err(UpdateError::InvertedDeformation { j: J });
-    }
-    let det_c = tensor::det(cp_inv);
-    if det_c.is_nan() || det_c <= 0.0 || det_c.is_infinite() {
-        return Err(UpdateError::InvalidState { det: det_c });
-    }
+    update_point_rows(mat, opts, &tensor::rows(f_np1), cp_inv)
+}
 
-    // Trial state (§1.3).
-    let b_tr = tensor::push_forward(F, cp_inv);
-    let je_tr = J * math::sqrt(det_c);
+/// [`update_point`] with F given as rows.
+#[inline]
+pub fn update_point_rows(
+    mat: &Material,
+    opts: &UpdateOptions,
+    f: &Rows<Real>,
+    cp_inv: &mut Voigt,
+) -> Result<PointUpdate, UpdateError> {
+    let t = trial(mat, f, cp_inv);
+    let check = check_trial(mat, opts, f, &t)?;
+    match check.plastic_scale {
+        None => Ok(PointUpdate {
+            tau: elastic::kirchhoff(mat, &t.b, t.je),
+            info: check.info,
+        }),
+        Some(scale) => {
+            let (up, cp_new) = plastic_return(mat, opts, f, &t, check.info, scale)?;
+            *cp_inv = cp_new;
+            Ok(up)
+        }
+    }
+}
+
+/// The plastic corrector (physics.md §1.4, §1.6) of a trial state that
+/// violates the yield condition: the stress and the new C_p⁻¹. `info` and
+/// `scale` are [`check_trial`]'s.
+#[allow(non_snake_case)]
+pub fn plastic_return(
+    mat: &Material,
+    opts: &UpdateOptions,
+    F: &Rows<Real>,
+    t: &Trial<Real>,
+    mut info: UpdateInfo,
+    scale: Real,
+) -> Result<(PointUpdate, Voigt), UpdateError> {
     let mu = mat.mu;
-    let theta_tr = mu * tensor::trace(&b_tr);
-    let s_tr = tensor::scale_add_identity(&tensor::deviator(&b_tr), mu, 0.0);
-    let beta_tr = tensor::norm(&s_tr);
-    let alpha_tr = theta_tr + elastic::h(mat, je_tr);
-    let eta = mat.params.eta0 / J;
-    if !eta.is_finite() {
-        // J > 0 but so small (subnormal) that η = η0/J overflows: crushed
-        // flat, for the update as good as inverted (found by fuzzing).
-        return Err(UpdateError::InvertedDeformation { j: J });
-    }
-    let coefficients = yield_surface::coefficients(&mat.params, eta);
-    let sy = mat.params.yield_stress_pa;
-    let scale = yield_surface::yield_scale(&coefficients, sy);
-    let phi_tr = yield_surface::yield_function(&coefficients, sy, beta_tr, alpha_tr);
-
-    let mut info = UpdateInfo {
-        plastic: false,
-        method: ReturnMethod::Elastic,
-        iterations: 0,
-        eps: 0.0,
-        delta: 0.0,
-        gamma: 0.0,
-        eta,
-        je: je_tr,
-        coefficients,
-        residual: phi_tr / scale,
-    };
-    if phi_tr <= opts.yield_tolerance * scale {
-        return Ok(PointUpdate {
-            tau: elastic::kirchhoff(mat, &b_tr, je_tr),
-            info,
-        });
-    }
-
-    // Plastic corrector (§1.4).
     let system = ReturnMapSystem {
-        theta_tr,
-        je_tr,
-        beta_tr,
-        a1: coefficients.a1,
+        theta_tr: t.theta,
+        je_tr: t.je,
+        beta_tr: t.beta,
+        a1: info.coefficients.a1,
         yield_scale: scale,
         lambda: mat.lambda,
         mu,
@@ -214,8 +337,8 @@ pub fn update_point(
     let alpha = system.alpha(sol.eps);
     let beta = system.beta(sol.eps, sol.delta);
     // Unit deviatoric direction, frozen at its trial value (n = 0 if βtr = 0).
-    let n = if beta_tr > 0.0 {
-        tensor::scale_add_identity(&s_tr, 1.0 / beta_tr, 0.0)
+    let n = if t.beta > 0.0 {
+        tensor::scale_add_identity(&t.s, 1.0 / t.beta, 0.0)
     } else {
         [0.0; 6]
     };
@@ -229,12 +352,11 @@ pub fn update_point(
         theta / (3.0 * mu)
     };
     let be = tensor::scale_add_identity(&n, k, s);
-    let f_inv = tensor::inverse_with_det(F, J);
-    let cp_new = tensor::push_forward(&f_inv, &be);
+    let f_inv = tensor::inverse_rows_with_det(F, t.j);
+    let cp_new = tensor::push_forward_rows(&f_inv, &be);
     if !cp_new.iter().all(|x| x.is_finite()) {
         return Err(UpdateError::NonFinite);
     }
-    *cp_inv = cp_new;
 
     info.plastic = true;
     info.method = sol.method;
@@ -244,7 +366,7 @@ pub fn update_point(
     info.gamma = 3.0 * sol.delta / (4.0 * theta);
     info.je = je;
     info.residual = sol.residual;
-    Ok(PointUpdate { tau, info })
+    Ok((PointUpdate { tau, info }, cp_new))
 }
 
 /// The spherical coefficient `s` of b^e = k n + s 1 with det b^e = (J^e)²,

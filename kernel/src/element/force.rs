@@ -7,11 +7,15 @@
 //! f^hg_I = k Σ q_α (1 + |q_α|²/s²) γ0_αI, E_hg = Σ (k/2)|q_α|² (1 + |q_α|²/(2s²)).
 
 use crate::Real;
-use crate::constitutive::{UpdateError, UpdateInfo, UpdateOptions, update_point};
+use crate::constitutive::update::update_point_rows;
+use crate::constitutive::{UpdateError, UpdateInfo, UpdateOptions};
 use crate::element::hex8::HexCoords;
 use crate::element::reference::HexReference;
+use crate::lanes::Num;
 use crate::material::Material;
-use crate::tensor::{Mat3, Voigt, inverse_with_det, mat_from_voigt};
+use crate::tensor::{
+    Mat3, Rows, Voigt, det_rows, from_rows, inverse_rows_with_det, rows_from_voigt,
+};
 
 /// Default hourglass coefficient κ (physics.md §2.2: range 0.02–0.1).
 pub const DEFAULT_HOURGLASS_KAPPA: Real = 0.05;
@@ -54,25 +58,130 @@ pub struct HexForces {
 /// Mean deformation gradient F̄ = Σ_I x_I ⊗ B0_I (exact for affine motion).
 #[inline]
 pub fn mean_deformation_gradient(r: &HexReference, x: &HexCoords) -> Mat3 {
-    let mut f = Mat3::zeros();
-    for (xi, bi) in x.iter().zip(r.b0.iter()) {
-        for a in 0..3 {
-            for b in 0..3 {
-                f[(a, b)] += xi[a] * bi[b];
+    from_rows(&mean_gradient_rows(&r.b0, x))
+}
+
+/// [`mean_deformation_gradient`] as rows over any [`Num`]: F̄_ab summed over
+/// the nodes in order from zero.
+#[inline(always)]
+pub fn mean_gradient_rows<T: Num>(b0: &[[T; 3]; 8], x: &[[T; 3]; 8]) -> Rows<T> {
+    let mut f = [[T::splat(0.0); 3]; 3];
+    for (xi, bi) in x.iter().zip(b0.iter()) {
+        for (fa, &xa) in f.iter_mut().zip(xi) {
+            for (fab, &bb) in fa.iter_mut().zip(bi) {
+                *fab = *fab + xa * bb;
             }
         }
     }
     f
 }
 
-/// V0 τ F⁻ᵀ from τ, F⁻¹ and V0: (τ F⁻ᵀ)_ab = Σ_k τ_ak (F⁻¹)_bk, summed
-/// k = 0, 1, 2, then scaled by V0.
+/// What an element contributes once its stress is known (over any [`Num`],
+/// one element or a batch of them side by side).
+#[derive(Clone, Copy, Debug)]
+pub struct NodalForces<T> {
+    /// Internal plus hourglass force of each node, `[node][xyz]`, N.
+    pub f: [[T; 3]; 8],
+    /// Hourglass energy, J.
+    pub hourglass_energy: T,
+}
+
+/// The reference data [`nodal_forces`] reads, as references so that the
+/// scalar element borrows its [`HexReference`] and a batch its lanes.
+#[derive(Clone, Copy, Debug)]
+pub struct ElementGeometry<'a, T> {
+    /// V0, m³.
+    pub volume: T,
+    /// B0_I, `[node][xyz]`, 1/m.
+    pub b0: &'a [[T; 3]; 8],
+    /// γ0_αI, `[mode][node]`.
+    pub gamma0: &'a [[T; 8]; 4],
+    /// V0 Σ|B0_I|²/3, m.
+    pub hourglass_geometry: T,
+}
+
+impl<'a> ElementGeometry<'a, Real> {
+    /// The geometry of one element.
+    #[inline(always)]
+    pub fn of(r: &'a HexReference) -> Self {
+        Self {
+            volume: r.volume,
+            b0: &r.b0,
+            gamma0: &r.gamma0,
+            hourglass_geometry: r.hourglass_geometry,
+        }
+    }
+}
+
+/// Nodal forces f_I = V0 τ F̄⁻ᵀ B0_I plus the stiffening hourglass forces, for
+/// nodes at `x` with F̄ = `f` (J = `j`) and Kirchhoff stress `tau`.
+/// `kappa_modulus` = κ(λ + 2μ), Pa.
+#[allow(non_snake_case)]
 #[inline(always)]
-fn kirchhoff_to_first_pk(tau: &Mat3, f_inv: &Mat3, volume: Real) -> Mat3 {
-    Mat3::from_fn(|a, b| {
-        (tau[(a, 0)] * f_inv[(b, 0)] + tau[(a, 1)] * f_inv[(b, 1)] + tau[(a, 2)] * f_inv[(b, 2)])
-            * volume
-    })
+pub fn nodal_forces<T: Num>(
+    kappa_modulus: Real,
+    g: &ElementGeometry<'_, T>,
+    x: &[[T; 3]; 8],
+    f: &Rows<T>,
+    j: T,
+    tau: &[T; 6],
+) -> NodalForces<T> {
+    // P = V0 τ F⁻ᵀ: (τ F⁻ᵀ)_ab = Σ_k τ_ak (F⁻¹)_bk, summed k = 0, 1, 2, then
+    // scaled by V0; f_I = P B0_I. The products are written out: left to
+    // nalgebra's generic `Mul`, whether they were inlined depended on how
+    // rustc partitioned the crate (out of line they cost 5 % of a bed run).
+    // Same summation order as nalgebra's, so the same bits.
+    let t = rows_from_voigt(tau);
+    let f_inv = inverse_rows_with_det(f, j);
+    let mut P = [[T::splat(0.0); 3]; 3];
+    for (Pa, ta) in P.iter_mut().zip(&t) {
+        for (Pab, f_inv_b) in Pa.iter_mut().zip(&f_inv) {
+            *Pab = (ta[0] * f_inv_b[0] + ta[1] * f_inv_b[1] + ta[2] * f_inv_b[2]) * g.volume;
+        }
+    }
+    let mut out = [[T::splat(0.0); 3]; 8];
+    for (fi, bi) in out.iter_mut().zip(g.b0.iter()) {
+        for (fia, Pa) in fi.iter_mut().zip(&P) {
+            *fia = Pa[0] * bi[0] + Pa[1] * bi[1] + Pa[2] * bi[2];
+        }
+    }
+    // Hourglass stiffness, stiffening with the amplitude.
+    let k = T::splat(kappa_modulus) * g.hourglass_geometry;
+    let amplitude = T::splat(HOURGLASS_STIFFENING_AMPLITUDE) * g.hourglass_geometry;
+    let inv_s2 = T::splat(1.0) / (T::splat(32.0) * amplitude * amplitude);
+    // The four modes side by side: one pass over the nodes for all q_α,
+    // one for all forces. Every sum runs in the order of the mode-by-mode
+    // form (q_α over nodes 0…7; f_I over modes 0…3), so the same bits.
+    let mut q = [[T::splat(0.0); 3]; 4];
+    for (i, xi) in x.iter().enumerate() {
+        for (qa, gm) in q.iter_mut().zip(g.gamma0) {
+            for (qab, &xb) in qa.iter_mut().zip(xi) {
+                *qab = *qab + xb * gm[i];
+            }
+        }
+    }
+    let mut energy = T::splat(0.0);
+    let mut kq = [[T::splat(0.0); 3]; 4];
+    for (qa, kqa) in q.iter().zip(kq.iter_mut()) {
+        let qq = qa[0] * qa[0] + qa[1] * qa[1] + qa[2] * qa[2];
+        let ratio = qq * inv_s2;
+        energy = energy + T::splat(0.5) * k * qq * (T::splat(1.0) + T::splat(0.5) * ratio);
+        let stiffness = k * (T::splat(1.0) + ratio);
+        for (kqab, &qab) in kqa.iter_mut().zip(qa) {
+            *kqab = stiffness * qab;
+        }
+    }
+    for (i, fi) in out.iter_mut().enumerate() {
+        for (kqa, gm) in kq.iter().zip(g.gamma0) {
+            for (fia, &kqab) in fi.iter_mut().zip(kqa) {
+                *fia = *fia + kqab * gm[i];
+            }
+        }
+    }
+    NodalForces {
+        f: out,
+        hourglass_energy: energy,
+    }
 }
 
 /// Forces of one element at current node positions `x` (m).
@@ -80,6 +189,9 @@ fn kirchhoff_to_first_pk(tau: &Mat3, f_inv: &Mat3, volume: Real) -> Mat3 {
 /// * `cp_inv`: in/out, the element's C_p⁻¹ (start → end of step); untouched
 ///   on error.
 /// * `kappa`: hourglass coefficient κ (dimensionless).
+///
+/// [`crate::element::batch`] evaluates several elements side by side with
+/// the same bits.
 #[allow(non_snake_case)]
 #[inline]
 pub fn hex_forces(
@@ -90,56 +202,20 @@ pub fn hex_forces(
     x: &HexCoords,
     cp_inv: &mut Voigt,
 ) -> Result<HexForces, UpdateError> {
-    let F = mean_deformation_gradient(r, x);
-    let up = update_point(mat, opts, &F, cp_inv)?;
-    let j = crate::tensor::det_mat(&F);
-    // P = τ F⁻ᵀ; f_I = V0 P B0_I. The products are written out: left to
-    // nalgebra's generic `Mul`, whether they were inlined depended on how
-    // rustc partitioned the crate (out of line they cost 5 % of a bed run).
-    // Same summation order as nalgebra's, so the same bits.
-    let P = kirchhoff_to_first_pk(&mat_from_voigt(&up.tau), &inverse_with_det(&F, j), r.volume);
-    let mut f = [[0.0; 3]; 8];
-    for (fi, bi) in f.iter_mut().zip(r.b0.iter()) {
-        for a in 0..3 {
-            fi[a] = P[(a, 0)] * bi[0] + P[(a, 1)] * bi[1] + P[(a, 2)] * bi[2];
-        }
-    }
-    // Hourglass stiffness, stiffening with the amplitude.
-    let k = kappa * mat.p_wave_modulus() * r.hourglass_geometry;
-    let amplitude = HOURGLASS_STIFFENING_AMPLITUDE * r.hourglass_geometry;
-    let inv_s2 = 1.0 / (32.0 * amplitude * amplitude);
-    // The four modes side by side: one pass over the nodes for all q_α,
-    // one for all forces. Every sum runs in the order of the mode-by-mode
-    // form (q_α over nodes 0…7; f_I over modes 0…3), so the same bits.
-    let mut q = [[0.0; 3]; 4];
-    for (i, xi) in x.iter().enumerate() {
-        for (qa, g) in q.iter_mut().zip(&r.gamma0) {
-            for a in 0..3 {
-                qa[a] += xi[a] * g[i];
-            }
-        }
-    }
-    let mut energy = 0.0;
-    let mut kq = [[0.0; 3]; 4];
-    for (qa, kqa) in q.iter().zip(kq.iter_mut()) {
-        let qq = qa[0] * qa[0] + qa[1] * qa[1] + qa[2] * qa[2];
-        let ratio = qq * inv_s2;
-        energy += 0.5 * k * qq * (1.0 + 0.5 * ratio);
-        let stiffness = k * (1.0 + ratio);
-        for a in 0..3 {
-            kqa[a] = stiffness * qa[a];
-        }
-    }
-    for (i, fi) in f.iter_mut().enumerate() {
-        for (kqa, g) in kq.iter().zip(&r.gamma0) {
-            for a in 0..3 {
-                fi[a] += kqa[a] * g[i];
-            }
-        }
-    }
+    let F = mean_gradient_rows(&r.b0, x);
+    let up = update_point_rows(mat, opts, &F, cp_inv)?;
+    let j = det_rows(&F);
+    let out = nodal_forces(
+        kappa * mat.p_wave_modulus(),
+        &ElementGeometry::of(r),
+        x,
+        &F,
+        j,
+        &up.tau,
+    );
     Ok(HexForces {
-        f,
-        hourglass_energy: energy,
+        f: out.f,
+        hourglass_energy: out.hourglass_energy,
         j,
         tau: up.tau,
         info: up.info,

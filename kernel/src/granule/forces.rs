@@ -6,8 +6,9 @@ use core::fmt;
 
 use crate::Real;
 use crate::constitutive::{UpdateError, UpdateOptions};
+use crate::element::batch::{ElementPath, one_point_elements};
 use crate::element::fbar::{fbar_elastic_energy, fbar_forces};
-use crate::element::force::hex_forces;
+use crate::element::force::HexForces;
 use crate::material::Material;
 use crate::mesh::reference::ReferenceMesh;
 use crate::tensor::Voigt;
@@ -79,12 +80,27 @@ pub struct ForceSummary {
 /// Evaluates all elements at positions `x` (`[node][xyz]`, m) and writes the
 /// assembled internal + hourglass force into `f` (`[node][xyz]`, N, zeroed
 /// first). `cp_inv` holds [`ElementSettings::points_per_element`] C_p⁻¹ per
-/// element, element by element (in/out).
+/// element, element by element (in/out). The one-point element runs on the
+/// fastest [`ElementPath`] of the processor (all paths give the same bits).
 ///
 /// Lengths: `x`, `f` = nodes; `cp_inv` = hexes × points per element
 /// (checked by the scene's setup; a mismatch panics on indexing — see the
 /// crate's slice policy).
 pub fn internal_forces(
+    mesh: &ReferenceMesh<'_>,
+    mat: &Material,
+    settings: &ElementSettings,
+    x: &[[Real; 3]],
+    cp_inv: &mut [Voigt],
+    f: &mut [[Real; 3]],
+) -> Result<ForceSummary, ElementFailure> {
+    internal_forces_on(ElementPath::fastest(), mesh, mat, settings, x, cp_inv, f)
+}
+
+/// [`internal_forces`] with the one-point element on a chosen `path`
+/// (to compare the paths, or to pin one).
+pub fn internal_forces_on(
+    path: ElementPath,
     mesh: &ReferenceMesh<'_>,
     mat: &Material,
     settings: &ElementSettings,
@@ -105,13 +121,9 @@ pub fn internal_forces(
             fi[2] += fe[2];
         }
     };
-    let hexes = mesh.mesh.hexes.iter().enumerate();
     match settings.kind {
         ElementKind::OnePoint => {
-            for (((element, hex), r), c) in hexes.zip(mesh.elements.iter()).zip(cp_inv.iter_mut()) {
-                let xe = core::array::from_fn(|i| x[hex[i] as usize]);
-                let out = hex_forces(mat, &settings.update, settings.hourglass_kappa, r, &xe, c)
-                    .map_err(|error| ElementFailure { element, error })?;
+            let mut sink = |_: usize, hex: &[u32; 8], out: &HexForces| {
                 scatter(hex, &out.f);
                 s.hourglass_energy += out.hourglass_energy;
                 s.plastic_dissipation += out.plastic_dissipation;
@@ -121,11 +133,24 @@ pub fn internal_forces(
                     s.max_iterations = s.max_iterations.max(out.info.iterations);
                 }
                 s.a2_clamped += usize::from(out.info.coefficients.a2_clamped);
-            }
+            };
+            one_point_elements(
+                path,
+                mat,
+                &settings.update,
+                settings.hourglass_kappa,
+                mesh.mesh.hexes,
+                mesh.elements,
+                mesh.batches,
+                x,
+                cp_inv,
+                &mut sink,
+            )
+            .map_err(|(element, error)| ElementFailure { element, error })?;
         }
         ElementKind::FBar => {
             let (states, _) = cp_inv.as_chunks_mut::<8>();
-            for ((element, hex), c) in hexes.zip(states.iter_mut()) {
+            for ((element, hex), c) in mesh.mesh.hexes.iter().enumerate().zip(states.iter_mut()) {
                 let xr = core::array::from_fn(|i| mesh.mesh.positions[hex[i] as usize]);
                 let xe = core::array::from_fn(|i| x[hex[i] as usize]);
                 let out = fbar_forces(mat, &settings.update, &xr, &xe, c)

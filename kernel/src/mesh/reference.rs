@@ -3,6 +3,7 @@
 //! then owns only its x, v, f and C_p⁻¹.
 
 use crate::Real;
+use crate::element::batch::ElementBatch;
 use crate::element::reference::{HexReference, hex_reference};
 use crate::mesh::octant::MeshView;
 use crate::mesh::sphere::MeshError;
@@ -17,6 +18,10 @@ pub struct ReferenceMesh<'a> {
     pub node_quads: &'a [[u32; 4]],
     /// Per-element reference data, one per hex.
     pub elements: &'a [HexReference],
+    /// `elements` regrouped for the batched one-point element
+    /// ([`crate::element::batch::regroup`], `batch_count(hexes)` long), or
+    /// empty to have each batch gather its lanes (slower, the same bits).
+    pub batches: &'a [ElementBatch],
     /// Lumped volume share of each node (Σ over its elements), m³; nodal
     /// mass = ρ0 × this.
     pub node_volume: &'a [Real],

@@ -1,0 +1,418 @@
+//! The one-point element evaluated [`BATCH`] elements side by side, with the
+//! bits of [`hex_forces`] (structure of arrays, issue #8).
+//!
+//! A batch gathers its elements' nodes and reference data into [`Lanes`],
+//! and runs the kinematics, the elastic trial state, the elastic stress, the
+//! nodal forces and the hourglass forces once for all lanes — the same code
+//! as the scalar element ([`mean_gradient_rows`], [`trial`],
+//! [`nodal_forces`] are generic over [`Num`]), so every lane gets exactly the
+//! scalar result. Per lane, in scalar code: the input checks and the yield
+//! test ([`check_trial`]) and, for a lane that yields, the plastic corrector
+//! ([`plastic_return`]). A batch in which any lane fails is evaluated again
+//! element by element by [`hex_forces`], so errors, and the states left
+//! behind, are those of the scalar loop.
+//!
+//! [`ElementPath`] chooses the code: element by element, portable batches
+//! (the build's vector width: 2 lanes with x86-64's SSE2), or batches compiled
+//! for AVX2 (4 lanes), taken only when the processor has it (detected at run
+//! time with `cpuid`, no `std` needed). All three give the same bits;
+//! [`ElementPath::fastest`] is AVX2 where available, else element by element.
+//!
+//! This is the kernel's only `unsafe` code (the workspace denies it
+//! elsewhere): reading `cpuid`/`xgetbv`, and calling the AVX2-compiled loop,
+//! which is sound only once [`has_avx2`] said yes — each block says so.
+#![allow(unsafe_code)]
+
+use crate::Real;
+use crate::constitutive::return_map::ReturnMethod;
+use crate::constitutive::update::{Trial, check_trial, plastic_return, trial};
+use crate::constitutive::yield_surface::YieldCoefficients;
+use crate::constitutive::{UpdateError, UpdateInfo, UpdateOptions, elastic};
+use crate::element::force::{
+    ElementGeometry, HexForces, hex_forces, mean_gradient_rows, nodal_forces,
+};
+use crate::element::reference::HexReference;
+use crate::lanes::{Lanes, Num};
+use crate::material::Material;
+use crate::tensor::{Voigt, det_rows};
+
+/// Elements per batch.
+pub const BATCH: usize = 4;
+
+/// How the one-point element loop is evaluated; every path gives the same
+/// bits.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ElementPath {
+    /// Element by element ([`hex_forces`]).
+    Scalar,
+    /// [`BATCH`] elements side by side in the build's instruction set.
+    Batched,
+    /// Batches compiled for AVX2; falls back to [`ElementPath::Batched`] on
+    /// a processor without AVX2.
+    Avx2,
+}
+
+impl ElementPath {
+    /// The fastest path this processor supports: AVX2 batches if it has
+    /// AVX2, otherwise element by element (portable batches at SSE2's two
+    /// lanes measured slower than the scalar element: BENCHMARKS.md).
+    pub fn fastest() -> Self {
+        if has_avx2() { Self::Avx2 } else { Self::Scalar }
+    }
+}
+
+/// Whether the processor (and the operating system, which must save the
+/// 256-bit registers) supports AVX2. Detected once with `cpuid`/`xgetbv`
+/// and cached; `false` on other architectures.
+pub fn has_avx2() -> bool {
+    use core::sync::atomic::{AtomicU8, Ordering};
+    static CACHE: AtomicU8 = AtomicU8::new(0);
+    match CACHE.load(Ordering::Relaxed) {
+        1 => false,
+        2 => true,
+        _ => {
+            let yes = detect_avx2();
+            CACHE.store(if yes { 2 } else { 1 }, Ordering::Relaxed);
+            yes
+        }
+    }
+}
+
+#[cfg(target_arch = "x86_64")]
+fn detect_avx2() -> bool {
+    use core::arch::x86_64::{__cpuid, __cpuid_count, _xgetbv};
+    // Leaf 1: ECX bit 27 OSXSAVE (xgetbv usable), bit 28 AVX.
+    #[allow(unused_unsafe)]
+    let (max_leaf, leaf1) = unsafe { (__cpuid(0).eax, __cpuid(1)) };
+    if max_leaf < 7 || leaf1.ecx & (1 << 27) == 0 || leaf1.ecx & (1 << 28) == 0 {
+        return false;
+    }
+    // SAFETY: OSXSAVE is set, so xgetbv exists; XCR0 bits 1 and 2 say the
+    // OS saves the SSE and AVX register state.
+    let xcr0 = unsafe { _xgetbv(0) };
+    if xcr0 & 0b110 != 0b110 {
+        return false;
+    }
+    // Leaf 7, sub-leaf 0: EBX bit 5 AVX2.
+    #[allow(unused_unsafe)]
+    let leaf7 = unsafe { __cpuid_count(7, 0) };
+    leaf7.ebx & (1 << 5) != 0
+}
+
+#[cfg(not(target_arch = "x86_64"))]
+fn detect_avx2() -> bool {
+    false
+}
+
+/// One element's results as the element loop consumes them.
+pub type ElementOutput = HexForces;
+
+/// The reference data of [`BATCH`] consecutive elements regrouped into
+/// lanes (lane l = element l of the batch; structure of arrays), so that a
+/// batch loads it as it computes. Built once per mesh by [`regroup`] and
+/// shared by every granule; 1 856 bytes per batch.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ElementBatch {
+    /// V0, m³.
+    pub volume: Lanes<BATCH>,
+    /// V0 Σ|B0_I|²/3, m.
+    pub hourglass_geometry: Lanes<BATCH>,
+    /// B0_I, `[node][xyz]`, 1/m.
+    pub b0: [[Lanes<BATCH>; 3]; 8],
+    /// γ0_αI, `[mode][node]`.
+    pub gamma0: [[Lanes<BATCH>; 8]; 4],
+}
+
+impl ElementBatch {
+    /// All lanes zero (to fill buffers before [`regroup`]).
+    pub const ZERO: Self = {
+        let zero = Lanes([0.0; BATCH]);
+        Self {
+            volume: zero,
+            hourglass_geometry: zero,
+            b0: [[zero; 3]; 8],
+            gamma0: [[zero; 8]; 4],
+        }
+    };
+
+    /// The lanes of `refs`.
+    #[inline(always)]
+    pub fn gather(refs: &[HexReference; BATCH]) -> Self {
+        let mut g = Self::ZERO;
+        for (l, r) in refs.iter().enumerate() {
+            g.volume.0[l] = r.volume;
+            g.hourglass_geometry.0[l] = r.hourglass_geometry;
+            for (gb, rb) in g.b0.iter_mut().zip(&r.b0) {
+                for (v, &w) in gb.iter_mut().zip(rb) {
+                    v.0[l] = w;
+                }
+            }
+            for (gg, rg) in g.gamma0.iter_mut().zip(&r.gamma0) {
+                for (v, &w) in gg.iter_mut().zip(rg) {
+                    v.0[l] = w;
+                }
+            }
+        }
+        g
+    }
+}
+
+/// Number of full batches of `elements` elements (the remainder is
+/// evaluated element by element).
+pub fn batch_count(elements: usize) -> usize {
+    elements / BATCH
+}
+
+/// Regroups the per-element reference data `elements` into `out`, which
+/// must hold [`batch_count`]`(elements.len())` batches; `Err` names the
+/// expected length otherwise.
+pub fn regroup(elements: &[HexReference], out: &mut [ElementBatch]) -> Result<(), usize> {
+    let expected = batch_count(elements.len());
+    if out.len() != expected {
+        return Err(expected);
+    }
+    let (chunks, _) = elements.as_chunks::<BATCH>();
+    for (o, refs) in out.iter_mut().zip(chunks) {
+        *o = ElementBatch::gather(refs);
+    }
+    Ok(())
+}
+
+/// Evaluates the one-point elements `hexes` (with their reference data
+/// `refs` and states `cp_inv`, one per element) at node positions `x`, and
+/// hands each element's result to `sink(element, &hex, &output)` in element
+/// order. Stops at the first element whose update fails and returns its
+/// index with the error; the states of the elements before it are updated,
+/// the failing one's and those after it are not (as an element-by-element
+/// loop would leave them).
+///
+/// `batches` is `refs` regrouped by [`regroup`], or empty (then each batch
+/// gathers its lanes from `refs`, which costs time, not bits).
+///
+/// Lengths: `refs` and `cp_inv` as `hexes`; node ids index `x`.
+#[allow(clippy::too_many_arguments)]
+pub fn one_point_elements(
+    path: ElementPath,
+    mat: &Material,
+    opts: &UpdateOptions,
+    kappa: Real,
+    hexes: &[[u32; 8]],
+    refs: &[HexReference],
+    batches: &[ElementBatch],
+    x: &[[Real; 3]],
+    cp_inv: &mut [Voigt],
+    sink: &mut dyn FnMut(usize, &[u32; 8], &ElementOutput),
+) -> Result<(), (usize, UpdateError)> {
+    let job = Job {
+        mat,
+        opts,
+        kappa,
+        hexes,
+        refs,
+        batches,
+        x,
+    };
+    match path {
+        ElementPath::Scalar => job.scalar(0, cp_inv, sink),
+        ElementPath::Batched => job.batched(cp_inv, sink),
+        ElementPath::Avx2 if has_avx2() => {
+            // SAFETY: the processor supports AVX2 (checked above).
+            unsafe { job.batched_avx2(cp_inv, sink) }
+        }
+        ElementPath::Avx2 => job.batched(cp_inv, sink),
+    }
+}
+
+/// Placeholder diagnostics, overwritten for every lane before use.
+const UNSET: UpdateInfo = UpdateInfo {
+    plastic: false,
+    method: ReturnMethod::Elastic,
+    iterations: 0,
+    eps: 0.0,
+    delta: 0.0,
+    gamma: 0.0,
+    eta: 0.0,
+    je: 0.0,
+    coefficients: YieldCoefficients {
+        a1: 0.0,
+        a2: 0.0,
+        a2_clamped: false,
+    },
+    residual: 0.0,
+};
+
+/// The inputs shared by every element of a loop.
+struct Job<'a> {
+    mat: &'a Material,
+    opts: &'a UpdateOptions,
+    kappa: Real,
+    hexes: &'a [[u32; 8]],
+    refs: &'a [HexReference],
+    batches: &'a [ElementBatch],
+    x: &'a [[Real; 3]],
+}
+
+impl Job<'_> {
+    /// Elements `first..first + cp_inv.len()` one by one.
+    fn scalar(
+        &self,
+        first: usize,
+        cp_inv: &mut [Voigt],
+        sink: &mut dyn FnMut(usize, &[u32; 8], &ElementOutput),
+    ) -> Result<(), (usize, UpdateError)> {
+        for (k, c) in cp_inv.iter_mut().enumerate() {
+            let e = first + k;
+            let hex = &self.hexes[e];
+            let xe = core::array::from_fn(|i| self.x[hex[i] as usize]);
+            let out = hex_forces(self.mat, self.opts, self.kappa, &self.refs[e], &xe, c)
+                .map_err(|error| (e, error))?;
+            sink(e, hex, &out);
+        }
+        Ok(())
+    }
+
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2")]
+    unsafe fn batched_avx2(
+        &self,
+        cp_inv: &mut [Voigt],
+        sink: &mut dyn FnMut(usize, &[u32; 8], &ElementOutput),
+    ) -> Result<(), (usize, UpdateError)> {
+        self.batched(cp_inv, sink)
+    }
+
+    #[cfg(not(target_arch = "x86_64"))]
+    unsafe fn batched_avx2(
+        &self,
+        cp_inv: &mut [Voigt],
+        sink: &mut dyn FnMut(usize, &[u32; 8], &ElementOutput),
+    ) -> Result<(), (usize, UpdateError)> {
+        self.batched(cp_inv, sink)
+    }
+
+    /// All elements in batches of [`BATCH`], the remainder one by one.
+    #[inline(always)]
+    fn batched(
+        &self,
+        cp_inv: &mut [Voigt],
+        sink: &mut dyn FnMut(usize, &[u32; 8], &ElementOutput),
+    ) -> Result<(), (usize, UpdateError)> {
+        let full = batch_count(cp_inv.len()) * BATCH;
+        let (head, tail) = cp_inv.split_at_mut(full);
+        let (states, _) = head.as_chunks_mut::<BATCH>();
+        for (b, c) in states.iter_mut().enumerate() {
+            if !self.batch(b, c, sink) {
+                self.scalar(b * BATCH, c, sink)?;
+            }
+        }
+        self.scalar(full, tail, sink)
+    }
+
+    /// Batch `b` (elements `b·BATCH…`) side by side: updates the states and
+    /// hands the outputs to `sink`, in element order. Returns `false`,
+    /// having changed nothing, if any lane fails (the caller redoes the
+    /// batch element by element). Plain loops throughout: `array::map` and
+    /// `array::from_fn` were left out of line and copied through memory.
+    #[allow(non_snake_case)]
+    #[inline(always)]
+    fn batch(
+        &self,
+        b: usize,
+        cp_inv: &mut [Voigt; BATCH],
+        sink: &mut dyn FnMut(usize, &[u32; 8], &ElementOutput),
+    ) -> bool {
+        const W: usize = BATCH;
+        let first = b * W;
+        let hexes = &self.hexes[first..first + W];
+        let refs = &self.refs[first..first + W];
+        let gathered;
+        let g = match self.batches.get(b) {
+            Some(g) => g,
+            None => {
+                let (chunk, _) = refs.as_chunks::<W>();
+                gathered = ElementBatch::gather(&chunk[0]);
+                &gathered
+            }
+        };
+        let zero = Lanes::<W>::splat(0.0);
+        let mut x = [[zero; 3]; 8];
+        let mut c = [zero; 6];
+        for (l, hex) in hexes.iter().enumerate() {
+            for (xi, &node) in x.iter_mut().zip(hex) {
+                let p = &self.x[node as usize];
+                for (xia, &pa) in xi.iter_mut().zip(p) {
+                    xia.0[l] = pa;
+                }
+            }
+            for (ck, &v) in c.iter_mut().zip(&cp_inv[l]) {
+                ck.0[l] = v;
+            }
+        }
+
+        let F = mean_gradient_rows(&g.b0, &x);
+        let t = trial(self.mat, &F, &c);
+        let mut tau = elastic::kirchhoff(self.mat, &t.b, t.je);
+        // Per lane: the checks and, if it yields, the corrector.
+        let mut info = [UNSET; W];
+        let mut new_state: [Option<Voigt>; W] = [None; W];
+        let mut dissipation = [0.0; W];
+        for l in 0..W {
+            let mut lane_f = [[0.0; 3]; 3];
+            for (row, f_row) in lane_f.iter_mut().zip(&F) {
+                for (v, fv) in row.iter_mut().zip(f_row) {
+                    *v = fv.0[l];
+                }
+            }
+            let lane_t: Trial<Real> = t.lane(l);
+            let Ok(check) = check_trial(self.mat, self.opts, &lane_f, &lane_t) else {
+                return false;
+            };
+            info[l] = check.info;
+            if let Some(scale) = check.plastic_scale {
+                let Ok((up, cp)) =
+                    plastic_return(self.mat, self.opts, &lane_f, &lane_t, check.info, scale)
+                else {
+                    return false;
+                };
+                for (tk, uk) in tau.iter_mut().zip(up.tau) {
+                    tk.0[l] = uk;
+                }
+                info[l] = up.info;
+                new_state[l] = Some(cp);
+                dissipation[l] = g.volume.0[l] * up.dissipation_density();
+            }
+        }
+        let j = det_rows(&F);
+        let geometry = ElementGeometry {
+            volume: g.volume,
+            b0: &g.b0,
+            gamma0: &g.gamma0,
+            hourglass_geometry: g.hourglass_geometry,
+        };
+        let kappa_modulus = self.kappa * self.mat.p_wave_modulus();
+        let forces = nodal_forces(kappa_modulus, &geometry, &x, &F, j, &tau);
+        for l in 0..W {
+            if let Some(cp) = new_state[l] {
+                cp_inv[l] = cp;
+            }
+            let mut out = HexForces {
+                f: [[0.0; 3]; 8],
+                hourglass_energy: forces.hourglass_energy.0[l],
+                j: j.0[l],
+                tau: [0.0; 6],
+                info: info[l],
+                plastic_dissipation: dissipation[l],
+            };
+            for (o, fl) in out.f.iter_mut().zip(&forces.f) {
+                for (oa, fa) in o.iter_mut().zip(fl) {
+                    *oa = fa.0[l];
+                }
+            }
+            for (o, tk) in out.tau.iter_mut().zip(&tau) {
+                *o = tk.0[l];
+            }
+            sink(first + l, &self.hexes[first + l], &out);
+        }
+        true
+    }
+}

@@ -1,0 +1,155 @@
+//! Arithmetic on several values side by side, with the scalar code's bits.
+//!
+//! [`Num`] is the arithmetic the element and the elastic trial state need
+//! (`+ − × ÷`, negation, square root, constants). It is implemented for
+//! [`Real`] (one value) and for [`Lanes`] (`W` values, every operation
+//! applied lane by lane). Code written once over `T: Num` therefore gives,
+//! in every lane of a `Lanes<W>`, exactly the bits the `Real` instance gives
+//! for that lane's input: the operations and their order are the same, and
+//! IEEE 754 rounds `+ − × ÷ √` correctly whatever the vector width (no fused
+//! multiply-add is ever formed — Rust does not contract `a * b + c`).
+//!
+//! The lane loops are plain array loops; the compiler turns them into vector
+//! instructions of the width the enclosing function is compiled for (SSE2:
+//! 2 lanes, AVX2: 4 — see [`crate::element::batch`] for the run-time
+//! dispatch).
+
+use core::ops::{Add, Div, Mul, Neg, Sub};
+
+use crate::{Real, math};
+
+/// The arithmetic shared by scalars and lane bundles.
+pub trait Num:
+    Copy
+    + Add<Output = Self>
+    + Sub<Output = Self>
+    + Mul<Output = Self>
+    + Div<Output = Self>
+    + Neg<Output = Self>
+{
+    /// Number of lanes.
+    const LANES: usize;
+    /// Every lane set to `v`.
+    fn splat(v: Real) -> Self;
+    /// Correctly rounded square root of every lane ([`math::sqrt`]).
+    fn sqrt(self) -> Self;
+    /// Lane `l` (`l < LANES`).
+    fn lane(self, l: usize) -> Real;
+    /// Lanes built from `f(l)`.
+    fn from_fn(f: impl FnMut(usize) -> Real) -> Self;
+}
+
+impl Num for Real {
+    const LANES: usize = 1;
+    #[inline(always)]
+    fn splat(v: Real) -> Self {
+        v
+    }
+    #[inline(always)]
+    fn sqrt(self) -> Self {
+        math::sqrt(self)
+    }
+    #[inline(always)]
+    fn lane(self, _l: usize) -> Real {
+        self
+    }
+    #[inline(always)]
+    fn from_fn(mut f: impl FnMut(usize) -> Real) -> Self {
+        f(0)
+    }
+}
+
+/// `W` values operated on lane by lane.
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[repr(transparent)]
+pub struct Lanes<const W: usize>(pub [Real; W]);
+
+macro_rules! lane_op {
+    ($trait:ident, $method:ident, $op_assign:tt) => {
+        impl<const W: usize> $trait for Lanes<W> {
+            type Output = Self;
+            #[inline(always)]
+            fn $method(self, other: Self) -> Self {
+                let mut out = self.0;
+                for (o, b) in out.iter_mut().zip(other.0) {
+                    *o $op_assign b;
+                }
+                Self(out)
+            }
+        }
+    };
+}
+
+lane_op!(Add, add, +=);
+lane_op!(Sub, sub, -=);
+lane_op!(Mul, mul, *=);
+lane_op!(Div, div, /=);
+
+impl<const W: usize> Neg for Lanes<W> {
+    type Output = Self;
+    #[inline(always)]
+    fn neg(self) -> Self {
+        let mut out = self.0;
+        for o in &mut out {
+            *o = -*o;
+        }
+        Self(out)
+    }
+}
+
+impl<const W: usize> Num for Lanes<W> {
+    const LANES: usize = W;
+    #[inline(always)]
+    fn splat(v: Real) -> Self {
+        Self([v; W])
+    }
+    #[inline(always)]
+    fn sqrt(self) -> Self {
+        let mut out = self.0;
+        for o in &mut out {
+            *o = math::sqrt(*o);
+        }
+        Self(out)
+    }
+    #[inline(always)]
+    fn lane(self, l: usize) -> Real {
+        self.0[l]
+    }
+    #[inline(always)]
+    fn from_fn(mut f: impl FnMut(usize) -> Real) -> Self {
+        // A loop rather than `array::from_fn`, which rustc left out of line.
+        let mut out = [0.0; W];
+        for (l, o) in out.iter_mut().enumerate() {
+            *o = f(l);
+        }
+        Self(out)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Lane l of every operation equals the scalar operation on lane l.
+    #[test]
+    fn lanes_give_the_scalar_bits() {
+        let a = Lanes([1.0 / 3.0, -2.5e-300, 7.0e300, 0.1]);
+        let b = Lanes([3.0, 1.0e-10, 0.3, -0.0]);
+        type Scalar = fn(Real, Real) -> Real;
+        let ops: [(Lanes<4>, Scalar); 4] = [
+            (a + b, |x, y| x + y),
+            (a - b, |x, y| x - y),
+            (a * b, |x, y| x * y),
+            (a / b, |x, y| x / y),
+        ];
+        for (lanes, scalar) in ops {
+            for l in 0..4 {
+                assert_eq!(lanes.lane(l).to_bits(), scalar(a.0[l], b.0[l]).to_bits());
+            }
+        }
+        for l in 0..4 {
+            assert_eq!((-a).lane(l).to_bits(), (-a.0[l]).to_bits());
+            assert_eq!(b.sqrt().lane(l).to_bits(), math::sqrt(b.0[l]).to_bits());
+        }
+    }
+}

@@ -1,0 +1,229 @@
+//! The one-point element loop gives the same bits on every path: element by
+//! element, in portable batches and in AVX2 batches (when the processor has
+//! it) — forces, energies, diagnostics and the stored states, through
+//! elastic and plastic steps with lanes of both kinds in one batch, for a
+//! count of elements that leaves a remainder, and on failure (the same
+//! element reported, the same states left behind).
+
+mod common;
+
+use common::{Rng, material, sphere_mesh};
+use granbed_kernel::Real;
+use granbed_kernel::constitutive::UpdateError;
+use granbed_kernel::element::batch::{
+    BATCH, ElementBatch, ElementPath, batch_count, has_avx2, one_point_elements, regroup,
+};
+use granbed_kernel::element::reference::{HexReference, hex_reference};
+use granbed_kernel::material::GranuleType;
+use granbed_kernel::mesh::sphere::SphereMeshParams;
+use granbed_kernel::tensor::{VOIGT_IDENTITY, Voigt};
+
+/// The paths, each with its reference data regrouped (`true`) or gathered
+/// by every batch.
+const PATHS: [(ElementPath, bool); 4] = [
+    (ElementPath::Scalar, false),
+    (ElementPath::Batched, true),
+    (ElementPath::Avx2, true),
+    (ElementPath::Avx2, false),
+];
+
+/// Everything an element hands to the loop, as bits.
+fn bits(e: usize, out: &granbed_kernel::element::force::HexForces) -> Vec<u64> {
+    let mut v = vec![e as u64];
+    v.extend(out.f.iter().flatten().map(|x| x.to_bits()));
+    v.extend(out.tau.iter().map(|x| x.to_bits()));
+    v.extend(
+        [
+            out.hourglass_energy,
+            out.j,
+            out.plastic_dissipation,
+            out.info.eps,
+            out.info.delta,
+            out.info.gamma,
+            out.info.eta,
+            out.info.je,
+            out.info.residual,
+            out.info.coefficients.a1,
+            out.info.coefficients.a2,
+        ]
+        .map(Real::to_bits),
+    );
+    v.push(u64::from(out.info.plastic));
+    v.push(u64::from(out.info.iterations));
+    v
+}
+
+struct Pass {
+    result: Result<(), (usize, UpdateError)>,
+    outputs: Vec<Vec<u64>>,
+    plastic: usize,
+}
+
+fn run(
+    (path, regrouped): (ElementPath, bool),
+    hexes: &[[u32; 8]],
+    refs: &[HexReference],
+    x: &[[Real; 3]],
+    cp: &mut [Voigt],
+) -> Pass {
+    let mat = material(GranuleType::B2);
+    let mut batches = Vec::new();
+    if regrouped {
+        batches = vec![ElementBatch::ZERO; batch_count(refs.len())];
+        regroup(refs, &mut batches).unwrap();
+    }
+    let mut outputs = Vec::new();
+    let mut plastic = 0;
+    let result = one_point_elements(
+        path,
+        &mat,
+        &Default::default(),
+        0.05,
+        hexes,
+        refs,
+        &batches,
+        x,
+        cp,
+        &mut |e, _, out| {
+            plastic += usize::from(out.info.plastic);
+            outputs.push(bits(e, out));
+        },
+    );
+    Pass {
+        result,
+        outputs,
+        plastic,
+    }
+}
+
+#[test]
+fn every_path_gives_the_scalar_bits_through_elastic_and_plastic_steps() {
+    let mesh = sphere_mesh(&SphereMeshParams::standard());
+    // 1279 elements: 319 full batches and a remainder of 3.
+    let count = mesh.hexes.len() - 1;
+    assert_ne!(count % BATCH, 0);
+    let hexes = &mesh.hexes[..count];
+    let refs: Vec<HexReference> = (0..count)
+        .map(|e| hex_reference(&mesh.hex_coords(e)).unwrap())
+        .collect();
+    let mut states: Vec<Vec<Voigt>> = PATHS.iter().map(|_| vec![VOIGT_IDENTITY; count]).collect();
+    let mut rng = Rng::new(7);
+    let size = 1.0e-3 / 8.0;
+    let (mut mixed_batches, mut plastic_steps) = (0, 0);
+    for step in 1..=40 {
+        // Uniaxial strain to 20 % with shear, and a node jitter of 2 % of
+        // the element, so that neighbouring elements differ.
+        let c = 0.005 * step as Real;
+        let x: Vec<[Real; 3]> = mesh
+            .positions
+            .iter()
+            .map(|p| {
+                [
+                    p[0] + 0.2 * c * p[2] + rng.uniform(-0.02, 0.02) * size,
+                    p[1] + rng.uniform(-0.02, 0.02) * size,
+                    p[2] * (1.0 - c) + rng.uniform(-0.02, 0.02) * size,
+                ]
+            })
+            .collect();
+        let passes: Vec<Pass> = PATHS
+            .iter()
+            .zip(states.iter_mut())
+            .map(|(&path, cp)| run(path, hexes, &refs, &x, cp))
+            .collect();
+        let scalar = &passes[0];
+        assert!(scalar.result.is_ok(), "step {step}: {:?}", scalar.result);
+        for (path, pass) in PATHS.iter().zip(&passes).skip(1) {
+            assert_eq!(pass.result, scalar.result, "{path:?}, step {step}");
+            assert_eq!(pass.outputs.len(), count, "{path:?}, step {step}");
+            for (a, b) in pass.outputs.iter().zip(&scalar.outputs) {
+                assert_eq!(a, b, "{path:?}, step {step}, element {}", b[0]);
+            }
+        }
+        for cp in &states[1..] {
+            let same = cp
+                .iter()
+                .flatten()
+                .zip(states[0].iter().flatten())
+                .all(|(a, b)| a.to_bits() == b.to_bits());
+            assert!(same, "stored states differ at step {step}");
+        }
+        if scalar.plastic > 0 {
+            plastic_steps += 1;
+            // Batches with both elastic and plastic lanes.
+            mixed_batches += scalar
+                .outputs
+                .chunks(BATCH)
+                .filter(|b| {
+                    let p = b.iter().filter(|o| o[o.len() - 2] == 1).count();
+                    p > 0 && p < b.len()
+                })
+                .count();
+        }
+    }
+    assert!(plastic_steps >= 10, "only {plastic_steps} plastic steps");
+    assert!(
+        mixed_batches > 0,
+        "no batch mixed elastic and plastic lanes"
+    );
+}
+
+#[test]
+fn a_failing_element_is_reported_alike_and_leaves_the_same_states() {
+    let mesh = sphere_mesh(&SphereMeshParams::standard());
+    let count = 4 * BATCH + 1;
+    let hexes = &mesh.hexes[..count];
+    let refs: Vec<HexReference> = (0..count)
+        .map(|e| hex_reference(&mesh.hex_coords(e)).unwrap())
+        .collect();
+    // Compress 25 % (plastic), then flip element 6 (inside the second
+    // batch) through its centre: J < 0 there.
+    let mut x: Vec<[Real; 3]> = mesh
+        .positions
+        .iter()
+        .map(|p| [p[0], p[1], 0.75 * p[2]])
+        .collect();
+    let bad = 6;
+    let centre: [Real; 3] =
+        core::array::from_fn(|a| hexes[bad].iter().map(|&n| x[n as usize][a]).sum::<Real>() / 8.0);
+    for &n in &hexes[bad][..4] {
+        let p = &mut x[n as usize];
+        p[2] = 2.0 * centre[2] - p[2];
+    }
+    let mut reference: Option<(Pass, Vec<Voigt>)> = None;
+    for path in PATHS {
+        let mut cp = vec![VOIGT_IDENTITY; count];
+        let pass = run(path, hexes, &refs, &x, &mut cp);
+        let Err((element, UpdateError::InvertedDeformation { .. })) = pass.result else {
+            panic!(
+                "{path:?}: expected an inverted element, got {:?}",
+                pass.result
+            );
+        };
+        assert!(element <= bad, "{path:?}: element {element}");
+        match &reference {
+            None => reference = Some((pass, cp)),
+            Some((scalar, scalar_cp)) => {
+                assert_eq!(pass.result, scalar.result, "{path:?}");
+                assert_eq!(pass.outputs, scalar.outputs, "{path:?}");
+                assert_eq!(&cp, scalar_cp, "{path:?}: states left behind");
+            }
+        }
+    }
+    let (scalar, cp) = reference.unwrap();
+    assert!(
+        scalar.plastic > 0,
+        "the elements before the failure yielded"
+    );
+    assert!(cp.iter().any(|c| c != &VOIGT_IDENTITY));
+}
+
+/// The kernel's own `cpuid`/`xgetbv` detection agrees with the standard
+/// library's.
+#[test]
+fn avx2_detection_agrees_with_std_and_picks_the_fastest_path() {
+    #[cfg(target_arch = "x86_64")]
+    assert_eq!(has_avx2(), std::is_x86_feature_detected!("avx2"));
+    #[cfg(not(target_arch = "x86_64"))]
+    assert!(!has_avx2());
+    assert_eq!(ElementPath::fastest() == ElementPath::Avx2, has_avx2());
+}
