@@ -15,7 +15,8 @@
 //! * [`constitutive`]: the finite-strain porous elastoplastic update;
 //! * [`material_point`]: one integration point driven along a load path;
 //! * [`mesh`]: the cubed-sphere reference mesh of a granule;
-//! * [`element`]: the 8-node hexahedron;
+//! * [`element`]: the 8-node hexahedron (one at a time, or four side by side);
+//! * [`lanes`]: arithmetic over one value or several side by side, same bits;
 //! * [`granule`]: element loop, damping and time step of one granule;
 //! * [`contact`]: contact with rigid walls;
 //! * [`dem`]: the discrete-element pour of rigid spheres;

@@ -227,3 +227,46 @@ fn avx2_detection_agrees_with_std_and_picks_the_fastest_path() {
     assert!(!has_avx2());
     assert_eq!(ElementPath::fastest() == ElementPath::Avx2, has_avx2());
 }
+
+/// Regrouped reference data of the wrong length are not used (no panic,
+/// no other bits): the batches gather their lanes instead.
+#[test]
+fn regrouped_data_of_the_wrong_length_are_ignored() {
+    let mesh = sphere_mesh(&SphereMeshParams::standard());
+    let count = 3 * BATCH;
+    let hexes = &mesh.hexes[..count];
+    let refs: Vec<HexReference> = (0..count)
+        .map(|e| hex_reference(&mesh.hex_coords(e)).unwrap())
+        .collect();
+    let x: Vec<[Real; 3]> = mesh
+        .positions
+        .iter()
+        .map(|p| [p[0], p[1], 0.8 * p[2]])
+        .collect();
+    let mat = material(GranuleType::B2);
+    // Two batches, of elements 4…11: valid geometry, but the wrong one
+    // for batch 0 — used, it would change the forces.
+    let mut short = vec![ElementBatch::ZERO; batch_count(count - BATCH)];
+    regroup(&refs[BATCH..], &mut short).unwrap();
+    let mut outputs: Vec<Vec<Vec<u64>>> = Vec::new();
+    for batches in [&[][..], &short[..]] {
+        let mut cp = vec![VOIGT_IDENTITY; count];
+        let mut out = Vec::new();
+        one_point_elements(
+            ElementPath::Batched,
+            &mat,
+            &Default::default(),
+            0.05,
+            hexes,
+            &refs,
+            batches,
+            &x,
+            &mut cp,
+            &mut |e, _, o| out.push(bits(e, o)),
+        )
+        .unwrap();
+        outputs.push(out);
+    }
+    assert_eq!(outputs[0].len(), count);
+    assert_eq!(outputs[0], outputs[1]);
+}

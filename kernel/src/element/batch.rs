@@ -186,8 +186,9 @@ pub fn regroup(elements: &[HexReference], out: &mut [ElementBatch]) -> Result<()
 /// the failing one's and those after it are not (as an element-by-element
 /// loop would leave them).
 ///
-/// `batches` is `refs` regrouped by [`regroup`], or empty (then each batch
-/// gathers its lanes from `refs`, which costs time, not bits).
+/// `batches` is `refs` regrouped by [`regroup`]; if it is empty (or not
+/// [`batch_count`] long) each batch gathers its lanes from `refs`, which
+/// costs time, not bits.
 ///
 /// Lengths: `refs` and `cp_inv` as `hexes`; node ids index `x`.
 #[allow(clippy::too_many_arguments)]
@@ -209,7 +210,11 @@ pub fn one_point_elements(
         kappa,
         hexes,
         refs,
-        batches,
+        batches: if batches.len() == batch_count(hexes.len()) {
+            batches
+        } else {
+            &[]
+        },
         x,
     };
     match path {
