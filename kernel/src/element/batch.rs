@@ -373,6 +373,9 @@ impl Job<'_> {
                 return false;
             };
             info[l] = check.info;
+            // V0 × 0 as the scalar element computes it (−0 or NaN for a
+            // malformed volume, like the scalar path).
+            dissipation[l] = g.volume.0[l] * 0.0;
             if let Some(scale) = check.plastic_scale {
                 let Ok((up, cp)) =
                     plastic_return(self.mat, self.opts, &lane_f, &lane_t, check.info, scale)
