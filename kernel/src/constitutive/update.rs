@@ -62,6 +62,30 @@ pub struct UpdateInfo {
     pub residual: Real,
 }
 
+impl UpdateInfo {
+    /// The diagnostics of an elastic step: relative density `eta`, elastic
+    /// volume ratio `je`, the yield coefficients and φ/((2/3)a2σy²).
+    pub const fn elastic(
+        eta: Real,
+        je: Real,
+        coefficients: YieldCoefficients,
+        residual: Real,
+    ) -> Self {
+        Self {
+            plastic: false,
+            method: ReturnMethod::Elastic,
+            iterations: 0,
+            eps: 0.0,
+            delta: 0.0,
+            gamma: 0.0,
+            eta,
+            je,
+            coefficients,
+            residual,
+        }
+    }
+}
+
 /// Why an update could not be done. The state is left unchanged.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum UpdateError {
@@ -247,18 +271,7 @@ pub fn check_trial(
     let scale = yield_surface::yield_scale(&coefficients, sy);
     let phi_tr = yield_surface::yield_function(&coefficients, sy, t.beta, t.alpha);
     Ok(TrialCheck {
-        info: UpdateInfo {
-            plastic: false,
-            method: ReturnMethod::Elastic,
-            iterations: 0,
-            eps: 0.0,
-            delta: 0.0,
-            gamma: 0.0,
-            eta: t.eta,
-            je: t.je,
-            coefficients,
-            residual: phi_tr / scale,
-        },
+        info: UpdateInfo::elastic(t.eta, t.je, coefficients, phi_tr / scale),
         // Not `φ > tol`: a NaN φ (overflowed trial state) must go to the
         // corrector, which reports it, never pass as elastic (fuzzing).
         plastic_scale: (!(phi_tr <= opts.yield_tolerance * scale)).then_some(scale),

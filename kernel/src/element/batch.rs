@@ -24,7 +24,6 @@
 #![allow(unsafe_code)]
 
 use crate::Real;
-use crate::constitutive::return_map::ReturnMethod;
 use crate::constitutive::update::{Trial, check_trial, plastic_return, trial};
 use crate::constitutive::yield_surface::YieldCoefficients;
 use crate::constitutive::{UpdateError, UpdateInfo, UpdateOptions, elastic};
@@ -219,32 +218,26 @@ pub fn one_point_elements(
     };
     match path {
         ElementPath::Scalar => job.scalar(0, cp_inv, sink),
-        ElementPath::Batched => job.batched(cp_inv, sink),
+        #[cfg(target_arch = "x86_64")]
         ElementPath::Avx2 if has_avx2() => {
             // SAFETY: the processor supports AVX2 (checked above).
             unsafe { job.batched_avx2(cp_inv, sink) }
         }
-        ElementPath::Avx2 => job.batched(cp_inv, sink),
+        ElementPath::Batched | ElementPath::Avx2 => job.batched(cp_inv, sink),
     }
 }
 
 /// Placeholder diagnostics, overwritten for every lane before use.
-const UNSET: UpdateInfo = UpdateInfo {
-    plastic: false,
-    method: ReturnMethod::Elastic,
-    iterations: 0,
-    eps: 0.0,
-    delta: 0.0,
-    gamma: 0.0,
-    eta: 0.0,
-    je: 0.0,
-    coefficients: YieldCoefficients {
+const UNSET: UpdateInfo = UpdateInfo::elastic(
+    0.0,
+    0.0,
+    YieldCoefficients {
         a1: 0.0,
         a2: 0.0,
         a2_clamped: false,
     },
-    residual: 0.0,
-};
+    0.0,
+);
 
 /// The inputs shared by every element of a loop.
 struct Job<'a> {
@@ -278,15 +271,6 @@ impl Job<'_> {
 
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx2")]
-    unsafe fn batched_avx2(
-        &self,
-        cp_inv: &mut [Voigt],
-        sink: &mut dyn FnMut(usize, &[u32; 8], &ElementOutput),
-    ) -> Result<(), (usize, UpdateError)> {
-        self.batched(cp_inv, sink)
-    }
-
-    #[cfg(not(target_arch = "x86_64"))]
     unsafe fn batched_avx2(
         &self,
         cp_inv: &mut [Voigt],
