@@ -238,10 +238,11 @@ fn avx2_detection_agrees_with_std_and_picks_the_fastest_path() {
     assert_eq!(ElementPath::fastest() == ElementPath::Avx2, has_avx2());
 }
 
-/// Regrouped reference data of the wrong length are not used (no panic,
-/// no other bits): the batches gather their lanes instead.
+/// Regrouped reference data of the wrong length, or of another mesh with
+/// as many elements, are not used (no panic, no other bits): the batches
+/// gather their lanes instead.
 #[test]
-fn regrouped_data_of_the_wrong_length_are_ignored() {
+fn regrouped_data_of_the_wrong_length_or_mesh_are_ignored() {
     let mesh = sphere_mesh(&SphereMeshParams::standard());
     let count = 3 * BATCH;
     let hexes = &mesh.hexes[..count];
@@ -258,8 +259,15 @@ fn regrouped_data_of_the_wrong_length_are_ignored() {
     // for batch 0 — used, it would change the forces.
     let mut short = vec![ElementBatch::ZERO; batch_count(count - BATCH)];
     regroup(&refs[BATCH..], &mut short).unwrap();
+    // Three batches of the elements after these: the right length, the
+    // wrong mesh.
+    let others: Vec<HexReference> = (count..2 * count)
+        .map(|e| hex_reference(&mesh.hex_coords(e)).unwrap())
+        .collect();
+    let mut other = vec![ElementBatch::ZERO; batch_count(count)];
+    regroup(&others, &mut other).unwrap();
     let mut outputs: Vec<Vec<Vec<u64>>> = Vec::new();
-    for batches in [&[][..], &short[..]] {
+    for batches in [&[][..], &short[..], &other[..]] {
         let mut cp = vec![VOIGT_IDENTITY; count];
         let mut out = Vec::new();
         one_point_elements(
@@ -279,4 +287,5 @@ fn regrouped_data_of_the_wrong_length_are_ignored() {
     }
     assert_eq!(outputs[0].len(), count);
     assert_eq!(outputs[0], outputs[1]);
+    assert_eq!(outputs[0], outputs[2]);
 }

@@ -19,9 +19,10 @@
 //! [`ElementPath::fastest`] is AVX2 where available, else element by element.
 //!
 //! This is the kernel's only `unsafe` code (the workspace denies it
-//! elsewhere): reading `cpuid`/`xgetbv`, and calling the AVX2-compiled loop,
-//! which is sound only once [`has_avx2`] said yes — each block says so.
-#![allow(unsafe_code)]
+//! elsewhere), allowed function by function: reading `cpuid`/`xgetbv`
+//! (`detect_avx2`), and declaring and calling the AVX2-compiled loop
+//! (`Job::batched_avx2`, [`one_point_elements`]), which is sound only once
+//! [`has_avx2`] said yes — each block says so.
 
 use crate::Real;
 use crate::constitutive::update::{Trial, check_trial, plastic_return, trial};
@@ -78,6 +79,7 @@ pub fn has_avx2() -> bool {
 }
 
 #[cfg(target_arch = "x86_64")]
+#[allow(unsafe_code)]
 fn detect_avx2() -> bool {
     use core::arch::x86_64::{__cpuid, __cpuid_count, _xgetbv};
     // Leaf 1: ECX bit 27 OSXSAVE (xgetbv usable), bit 28 AVX.
@@ -185,12 +187,14 @@ pub fn regroup(elements: &[HexReference], out: &mut [ElementBatch]) -> Result<()
 /// the failing one's and those after it are not (as an element-by-element
 /// loop would leave them).
 ///
-/// `batches` is `refs` regrouped by [`regroup`]; if it is empty (or not
-/// [`batch_count`] long) each batch gathers its lanes from `refs`, which
-/// costs time, not bits.
+/// `batches` is `refs` regrouped by [`regroup`]; if it is empty, not
+/// [`batch_count`] long, or its first or last batch holds other volumes
+/// than `refs`, each batch gathers its lanes from `refs`, which costs time,
+/// not bits.
 ///
 /// Lengths: `refs` and `cp_inv` as `hexes`; node ids index `x`.
 #[allow(clippy::too_many_arguments)]
+#[allow(unsafe_code)]
 pub fn one_point_elements(
     path: ElementPath,
     mat: &Material,
@@ -209,7 +213,7 @@ pub fn one_point_elements(
         kappa,
         hexes,
         refs,
-        batches: if batches.len() == batch_count(hexes.len()) {
+        batches: if regrouped_from(batches, refs) {
             batches
         } else {
             &[]
@@ -225,6 +229,25 @@ pub fn one_point_elements(
         }
         ElementPath::Batched | ElementPath::Avx2 => job.batched(cp_inv, sink),
     }
+}
+
+/// Whether `batches` can be `refs` regrouped: [`batch_count`] long, and
+/// the volumes of the first and the last batch are those of their
+/// elements (a cheap check that catches the regrouped data of another mesh
+/// with as many elements; a full comparison would cost what regrouping
+/// saves).
+fn regrouped_from(batches: &[ElementBatch], refs: &[HexReference]) -> bool {
+    let lanes_match = |b: usize| {
+        let volumes = &refs[b * BATCH..(b + 1) * BATCH];
+        batches[b]
+            .volume
+            .0
+            .iter()
+            .zip(volumes)
+            .all(|(v, r)| v.to_bits() == r.volume.to_bits())
+    };
+    batches.len() == batch_count(refs.len())
+        && (batches.is_empty() || (lanes_match(0) && lanes_match(batches.len() - 1)))
 }
 
 /// Placeholder diagnostics, overwritten for every lane before use.
@@ -271,6 +294,9 @@ impl Job<'_> {
 
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx2")]
+    #[allow(unsafe_code)]
+    /// # Safety
+    /// The processor must support AVX2 ([`has_avx2`]).
     unsafe fn batched_avx2(
         &self,
         cp_inv: &mut [Voigt],
