@@ -16,6 +16,7 @@
 //! * [`model`]: owned buffers for the kernel's meshes;
 //! * [`material_args`]: `--type` and the material-parameter overrides;
 //! * [`output`]: the standard streams and `--out` destinations;
+//! * [`quasi_static`]: the quasi-static certificate of the summaries;
 //! * [`csv`]: a small CSV writer with round-trip exact floats;
 //! * [`vtk`]: a VTK XML unstructured-grid (`.vtu`) writer;
 //! * [`error`]: usage errors and the exit-status mapping.
@@ -43,6 +44,7 @@ pub mod pack;
 pub mod plot;
 pub mod point;
 pub mod progress;
+pub mod quasi_static;
 pub mod study;
 pub mod vtk;
 

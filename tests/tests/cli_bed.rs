@@ -291,7 +291,7 @@ fn the_rate_check_presses_the_same_bed_at_half_speed() {
     assert!(change.is_finite() && change > 0.0, "{q}");
     let within = number(q, "max_kinetic_to_internal") < 0.01
         && number(q, "force_imbalance_rel") < 0.05
-        && change < granbed_cli::bed::outputs::RATE_CHANGE_LIMIT;
+        && change < granbed_kernel::analysis::quasi_static::RATE_CHANGE_LIMIT;
     assert_eq!(q["passed"], within, "{q}");
     // Without the check the field is null and does not decide.
     assert!(summary(&dir.join("half_speed"))["quasi_static"]["rate_change_rel"].is_null());

@@ -34,7 +34,7 @@ const FORCE_HEADER: &str = "time_s,displacement_m,strain,force_n,force_upper_n,f
                             contact_work_j,gravity_work_j,platen_work_j,min_j,dt_s,steps";
 
 /// Keys `summary.json` must have.
-const SUMMARY_KEYS: [&str; 44] = [
+const SUMMARY_KEYS: [&str; 46] = [
     "format",
     "format_version",
     "granbed_version",
@@ -60,6 +60,7 @@ const SUMMARY_KEYS: [&str; 44] = [
     "time_step_safety",
     "output_strain_interval",
     "gravity_m_s2",
+    "mass_scaling",
     "sigma_est_pa",
     "sigma_eff0_pa",
     "slope_n_per_m",
@@ -75,6 +76,7 @@ const SUMMARY_KEYS: [&str; 44] = [
     "hourglass_energy_rel",
     "damping_rel",
     "min_jacobian",
+    "quasi_static",
     "final_strain",
     "max_force_n",
     "notes",
@@ -286,13 +288,15 @@ fn platens_carry_equal_forces() {
 fn bad_input_names_the_flag() {
     let dir = out_dir("bad");
     let out = dir.to_str().unwrap();
-    let cases: [(&[&str], &str); 8] = [
+    let cases: [(&[&str], &str); 10] = [
         (&["--strain", "0"], "--strain"),
         (&["--strain", "0.95"], "--strain"),
         (&["--speed-mm-s", "-1"], "--speed-mm-s"),
         (&["--gravity"], "--gravity"),
         (&["--mesh", "3x1"], "--mesh"),
         (&["--damping-ratio", "3"], "--damping-ratio"),
+        (&["--mass-scaling", "0.5"], "--mass-scaling 0.5"),
+        (&["--mass-scaling", "nan"], "--mass-scaling NaN"),
         (&["--types", "A1,X9"], "--types"),
         (&["--type", "A1", "--types", "B2"], "--types"),
     ];
@@ -319,6 +323,82 @@ fn bad_input_names_the_flag() {
     let missing = cli(&["granule"]);
     assert_eq!(missing.code, 2);
     assert!(missing.stderr.contains("--out"), "{}", missing.stderr);
+}
+
+/// `--mass-scaling F`: √F fewer steps, the same curve within the rate
+/// check's limit, and the quasi-static certificate in the summary — passed
+/// for a coarse B2 at ×10 with the rate check run, measured force imbalance
+/// with the full granule, and failed (with a warning on stderr) for a
+/// granule so heavy that its inertia carries the load.
+#[test]
+fn mass_scaling_keeps_the_curve_and_the_certificate_says_so() {
+    let quick = ["--quiet", "--mesh", "4x1", "--strain", "0.2"];
+    let plain = out_dir("mass_x1");
+    granule_ok(&plain, &quick);
+    let scaled = out_dir("mass_x10");
+    let run = granule_ok(
+        &scaled,
+        &[&quick[..], &["--mass-scaling", "10", "--rate-check"]].concat(),
+    );
+    assert!(!run.stderr.contains("NOT quasi-static"), "{}", run.stderr);
+    let (s1, s10) = (summary(&plain), summary(&scaled));
+    assert_eq!(s1["mass_scaling"], 1.0);
+    assert_eq!(s10["mass_scaling"], 10.0);
+    let steps = |s: &Value| number(s, "steps");
+    assert_close(
+        "step ratio",
+        steps(&s1) / steps(&s10),
+        10f64.sqrt(),
+        0.03,
+        0.0,
+    );
+    for s in [&s1, &s10] {
+        let q = &s["quasi_static"];
+        assert_eq!(q["passed"], true, "{q}");
+        assert!(number(q, "max_kinetic_to_internal") < 0.01, "{q}");
+        // Octant: the lower platen mirrors the upper one, nothing to measure.
+        assert!(q["force_imbalance_rel"].is_null(), "{q}");
+    }
+    assert!(s1["quasi_static"]["rate_change_rel"].is_null());
+    let change = number(&s10["quasi_static"], "rate_change_rel");
+    assert!(change > 0.0 && change < 0.05, "rate change {change}");
+    // The curves of x1 and x10 agree as closely as the rate check says x10
+    // and x2.5 do.
+    let force = |d: &Path| Table::read(&d.join("force_displacement.csv")).num("force_n");
+    let (f1, f10) = (force(&plain), force(&scaled));
+    assert_eq!(f1.len(), f10.len());
+    let tail = f1.len() / 2..f1.len();
+    let dist: f64 = tail
+        .clone()
+        .map(|i| (f10[i] - f1[i]).powi(2))
+        .sum::<f64>()
+        .sqrt();
+    let norm: f64 = tail.map(|i| f1[i] * f1[i]).sum::<f64>().sqrt();
+    assert!(dist / norm < 0.05, "x1 vs x10 curves: {}", dist / norm);
+
+    // The full granule measures the platen force imbalance.
+    let full = out_dir("mass_full");
+    granule_ok(
+        &full,
+        &[&quick[..], &["--symmetry", "full", "--mass-scaling", "10"]].concat(),
+    );
+    let q = &summary(&full)["quasi_static"];
+    assert!(number(q, "force_imbalance_rel") < 0.05, "{q}");
+    assert_eq!(q["passed"], true, "{q}");
+
+    // At x1e6 the granule is a heavy ball hitting the platens: the
+    // certificate fails and stderr says so; the run itself succeeds.
+    let heavy = out_dir("mass_heavy");
+    let run = granule_ok(&heavy, &[&quick[..], &["--mass-scaling", "1e6"]].concat());
+    let q = &summary(&heavy)["quasi_static"];
+    assert_eq!(q["passed"], false, "{q}");
+    assert!(number(q, "max_kinetic_to_internal") > 0.01, "{q}");
+    assert!(
+        run.stderr
+            .contains("NOT quasi-static with mass scaling 1000000"),
+        "{}",
+        run.stderr
+    );
 }
 
 /// `--types` runs each type into its own directory and tabulates them; the

@@ -48,6 +48,13 @@ test('B2: the shown sigma_est is the native one; the CSV is the CLI\'s', async (
   assert.equal(value, ref.summary.sigma_est_pa);
   assert.equal(await page.textContent('#sigma-eff0'), formatStress(ref.summary.sigma_eff0_pa));
   assert.equal(await page.textContent('#slope'), formatSlope(ref.summary.slope_n_per_m));
+  // The quasi-static row is the CLI summary's certificate (same masses).
+  assert.equal(ref.summary.mass_scaling, 1);
+  assert.equal(await page.getAttribute('#quasi-static', 'data-value'), String(ref.summary.quasi_static.passed));
+  assert.match(
+    await page.textContent('#quasi-static'),
+    new RegExp(`^yes: kinetic/internal work ≤ ${ref.summary.quasi_static.max_kinetic_to_internal.toExponential(1).replace('+', '\\+')} \\(limit 1 %\\), masses ×1$`),
+  );
   const wall = Number(await page.getAttribute('#wall', 'data-value'));
   console.log(
     `browser B2 8x2: sigma_est shown "${shown}" (${value} Pa), native ${ref.summary.sigma_est_pa} Pa; ` +

@@ -12,6 +12,7 @@ use core::fmt::Write as _;
 use granbed_kernel::Real;
 use granbed_kernel::analysis::fit::LineFit;
 use granbed_kernel::analysis::granule::{initial_effective_yield_stress, yield_stress_estimate};
+use granbed_kernel::analysis::quasi_static::{Certificate, certificate, judged};
 use granbed_kernel::material::{GranuleType, MaterialParams, ParamError};
 use granbed_kernel::scene::platens::{
     PlatenParams, PlatenSample, PlatenScene, SAMPLE_COLUMNS, SceneError,
@@ -190,6 +191,9 @@ pub struct Measures {
     pub fit: Option<LineFit>,
     /// σ_y,eff0 = √a2(η0)·σ_y, Pa.
     pub sigma_eff0_pa: Real,
+    /// The quasi-static certificate over the second half of the samples
+    /// (the CLI summary's `quasi_static`, without the rate check).
+    pub quasi_static: Certificate,
 }
 
 /// A running (or finished) experiment.
@@ -348,6 +352,12 @@ impl Experiment {
             sigma_est_pa: fit.map(|(s, _)| s),
             fit: fit.map(|(_, f)| f),
             sigma_eff0_pa: initial_effective_yield_stress(&self.params.material.params),
+            quasi_static: certificate(
+                judged(&self.samples)
+                    .iter()
+                    .map(|s| s.load_sample(self.params.symmetry)),
+                None,
+            ),
         }
     }
 

@@ -282,6 +282,24 @@ impl Granule {
         self.run.measures().fit.map(|f| f.r_squared)
     }
 
+    /// Largest kinetic / internal work ratio over the second half of the
+    /// run (the quasi-static certificate's figure); `undefined` before any
+    /// internal work.
+    pub fn max_kinetic_to_internal(&self) -> Option<f64> {
+        self.run.measures().quasi_static.max_kinetic_to_internal
+    }
+
+    /// Whether the run so far passes the quasi-static certificate (kinetic
+    /// energy below 1 % of the internal work over its second half).
+    pub fn quasi_static(&self) -> bool {
+        self.run.measures().quasi_static.passed
+    }
+
+    /// Mass scaling F of the experiment (masses ×F).
+    pub fn mass_scaling(&self) -> f64 {
+        self.run.params().mass_scaling
+    }
+
     /// The error message that stopped the run, if any.
     pub fn error(&self) -> Option<String> {
         self.run.error().map(|e| e.message.clone())

@@ -47,12 +47,17 @@ fn coarse_b2_matches_the_cli_bit_for_bit() {
         hexes: mesh.hexes.len(),
         params: &params,
     };
-    let summary = Summary::new(&setup, &cli);
+    let summary = Summary::new(&setup, &cli, None);
     let m = run.measures();
     assert_eq!(m.sigma_est_pa, summary.sigma_est_pa);
     assert_eq!(m.sigma_eff0_pa, summary.sigma_eff0_pa);
     assert_eq!(m.fit.map(|f| f.slope), summary.slope_n_per_m);
     assert!(m.sigma_est_pa.unwrap() > 0.0);
+    assert_eq!(
+        m.quasi_static.max_kinetic_to_internal,
+        summary.quasi_static.max_kinetic_to_internal
+    );
+    assert!(m.quasi_static.passed && summary.quasi_static.passed);
 
     let dir = std::env::temp_dir().join(format!("granbed-wasm-native-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();

@@ -107,7 +107,7 @@ function readInputs() {
 }
 
 function resetResults() {
-  for (const id of ['sigma-est', 'sigma-eff0', 'slope', 'r2', 'steps', 'wall']) {
+  for (const id of ['sigma-est', 'sigma-eff0', 'slope', 'r2', 'steps', 'quasi-static', 'wall']) {
     $(id).textContent = '–';
     delete $(id).dataset.value;
   }
@@ -151,6 +151,11 @@ function finish(msg) {
   set('slope', formatSlope(msg.slope), msg.slope);
   set('r2', msg.r2 === null ? 'n/a' : msg.r2.toFixed(5), msg.r2);
   set('steps', String(msg.steps), msg.steps);
+  set('quasi-static',
+    msg.kineticToInternal === null
+      ? 'n/a'
+      : `${msg.quasiStatic ? 'yes' : 'NO'}: kinetic/internal work ≤ ${msg.kineticToInternal.toExponential(1)} (limit 1 %), masses ×${msg.massScaling}`,
+    msg.quasiStatic);
   set('wall', `${(msg.wallMs / 1e3).toFixed(2)} s`, msg.wallMs / 1e3);
   csvUrl = URL.createObjectURL(new Blob([msg.csv], { type: 'text/csv' }));
   const a = $('download');

@@ -384,7 +384,7 @@ impl BedArgs {
                 .map(|s| (s.strain, s.upper_pressure_pa))
                 .collect()
         };
-        let window = outputs::rate_check_window(scene.final_strain);
+        let window = crate::quasi_static::rate_check_window(scene.final_strain);
         result.rate_change_rel =
             crate::study::work_precision::curve_error(&curve(result), &curve(&twin), window);
         outputs::write_all(out, scene, result)?;
@@ -397,7 +397,7 @@ impl BedArgs {
                 result
                     .rate_change_rel
                     .map_or("n/a (too short a run)".to_owned(), |r| format!("{r:.4}")),
-                outputs::RATE_CHANGE_LIMIT,
+                granbed_kernel::analysis::quasi_static::RATE_CHANGE_LIMIT,
                 if q.passed { "passed" } else { "FAILED" }
             )?;
         }

@@ -6,6 +6,7 @@ use std::path::Path;
 
 use anyhow::Context as _;
 use granbed_kernel::Real;
+use granbed_kernel::analysis::quasi_static::LoadSample;
 use indicatif::ProgressBar;
 use serde::Serialize;
 
@@ -14,6 +15,7 @@ use super::scene::Scene;
 use crate::csv::{CsvWriter, Field};
 use crate::output::{create_file, finish_file, finite_ratio, write_json};
 use crate::progress::{StrainBar, draw_target, steps_per_second};
+use crate::quasi_static::QuasiStatic;
 
 /// Columns of `compression.csv`, in order.
 pub const COMPRESSION_COLUMNS: [&str; 27] = [
@@ -92,62 +94,19 @@ pub struct KawakitaSummary {
     pub points: usize,
 }
 
-/// Whether a run stayed quasi-static (issue #8's certificate, needed once
-/// masses are scaled), judged over the second half of the run, where the
-/// bed carries load (the first half holds the rearrangement, whose impacts
-/// are dynamic at any mass). **Choices:** kinetic energy below 1 % of the
-/// internal work at every sample, the punch-force imbalance
-/// |F_up − F_low − F_wall,z| below 5 % of F_up on average, and, when the
-/// rate check ran (`--rate-check`), P(C) within [`RATE_CHANGE_LIMIT`] of
-/// the run at half the punch speed.
-#[derive(Clone, Copy, Debug, Serialize)]
-pub struct QuasiStatic {
-    /// Largest kinetic / internal work ratio over the second half.
-    pub max_kinetic_to_internal: Option<Real>,
-    /// Mean |F_up − F_low − F_wall,z| / F_up over the second half.
-    pub force_imbalance_rel: Option<Real>,
-    /// Relative L2 change of P(C) over 2 % ≤ C ≤ the final strain at half
-    /// the punch speed (None: the rate check did not run).
-    pub rate_change_rel: Option<Real>,
-    /// Every figure below its limit (the rate change only if checked).
-    pub passed: bool,
-}
-
-/// The rate check's limit on the relative change of P(C) at half the
-/// punch speed (a choice: a curve that moves by 5 % when the loading is
-/// twice as slow is not a quasi-static answer).
-pub const RATE_CHANGE_LIMIT: Real = 0.05;
-
-/// The strain window of the rate check: from 2 % (below, the pressure is
-/// the rearrangement's noise) to `final_strain`.
-pub fn rate_check_window(final_strain: Real) -> [Real; 2] {
-    [0.02, final_strain]
-}
-
-/// The quasi-static certificate of `samples`, with the rate check's
-/// change if it ran.
+/// The quasi-static certificate of a bed run: the upper punch drives, the
+/// lower punch and the die-wall friction take up.
 pub fn quasi_static(samples: &[BedSample], rate_change_rel: Option<Real>) -> QuasiStatic {
-    let half = &samples[samples.len() / 2..];
-    let max_kinetic_to_internal = half
+    let loads: Vec<LoadSample> = samples
         .iter()
-        .filter(|s| s.energies.internal_work > 0.0)
-        .map(|s| s.energies.kinetic / s.energies.internal_work)
-        .fold(None, |m: Option<Real>, r| Some(m.map_or(r, |m| m.max(r))));
-    let loaded: Vec<Real> = half
-        .iter()
-        .filter(|s| s.upper_force_n > 0.0)
-        .map(|s| (s.upper_force_n - s.lower_force_n - s.die_friction_z_n).abs() / s.upper_force_n)
+        .map(|s| LoadSample {
+            kinetic_j: s.energies.kinetic,
+            internal_work_j: s.energies.internal_work,
+            force_in_n: s.upper_force_n,
+            force_out_n: Some(s.lower_force_n + s.die_friction_z_n),
+        })
         .collect();
-    let force_imbalance_rel =
-        (!loaded.is_empty()).then(|| loaded.iter().sum::<Real>() / loaded.len() as Real);
-    QuasiStatic {
-        max_kinetic_to_internal,
-        force_imbalance_rel,
-        rate_change_rel,
-        passed: max_kinetic_to_internal.is_some_and(|r| r < 0.01)
-            && force_imbalance_rel.is_some_and(|r| r < 0.05)
-            && rate_change_rel.is_none_or(|r| r < RATE_CHANGE_LIMIT),
-    }
+    crate::quasi_static::judge(&loads, rate_change_rel)
 }
 
 /// The fields of `summary.json`.

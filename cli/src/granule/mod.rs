@@ -19,7 +19,7 @@ use granbed_kernel::Real;
 use granbed_kernel::granule::forces::ElementKind;
 use granbed_kernel::granule::timestep::TimeStepMethod;
 use granbed_kernel::material::{GranuleType, Material};
-use granbed_kernel::scene::platens::{PlatenParams, SceneError, Symmetry};
+use granbed_kernel::scene::platens::{PlatenParams, STANDARD_MASS_SCALING, SceneError, Symmetry};
 use indicatif::MultiProgress;
 use rayon::prelude::*;
 
@@ -62,15 +62,19 @@ Output, in --out DIR (created if missing; with --types in DIR/<TYPE>/ per type):
     steps                 time steps so far
   summary.json            every input, sigma_est (4/(pi d) dF/dx fitted over
                           strain 0.1 to 0.4; null with fewer than two samples
-                          there), sigma_eff0, fit, energy checks, cost, and
-                          \"error\" if the kernel stopped the run
+                          there), sigma_eff0, fit, energy checks, the
+                          quasi-static certificate (kinetic/internal work over
+                          the second half, with --rate-check the change at half
+                          the speed), cost, and \"error\" if the kernel stopped
+                          the run
   force_displacement.svg  force against approach, with the sigma_est fit line
 With --types, also in DIR: types.csv (one row per type) and
 force_displacement_types.svg (all types overlaid).
 Floats are written round-trip exact. Progress bars go to stderr when it is a
 terminal, then one summary line per type. If the kernel fails, the rows so far,
 the summary (with its \"error\") and the plot are still written, and the error
-names the type, step, strain and element.
+names the type, step, strain and element. A run that fails the quasi-static
+certificate says so on stderr (exit status 0: the outputs are complete).
 
 Exit status: 0 success, 1 runtime failure (kernel or I/O error), 2 usage or
 validation error.";
@@ -254,6 +258,24 @@ pub struct GranuleArgs {
     #[arg(long)]
     pub gravity: bool,
 
+    /// Uniform mass scaling F (1 ≤ F ≤ 10⁶): masses ×F, gravity ÷F, so the
+    /// stable step grows by √F. Check `quasi_static` in summary.json, and
+    /// note that F > 1 raises σ_est of soft granules (A3: +1.1 % at ×4,
+    /// +2.4 % at ×10; BENCHMARKS.md).
+    #[arg(
+        long,
+        value_name = "F",
+        default_value_t = STANDARD_MASS_SCALING,
+        allow_negative_numbers = true
+    )]
+    pub mass_scaling: f64,
+
+    /// The quasi-static certificate's rate check: run again at half the
+    /// platen speed (about twice the cost) and require the force curve to
+    /// move by less than 5 % over 2 % ≤ strain ≤ --strain.
+    #[arg(long)]
+    pub rate_check: bool,
+
     /// Threads for --types (one type per thread; 0 = all cores). Results
     /// do not depend on it; wall times may.
     #[arg(short = 'j', long, value_name = "N", default_value_t = 0)]
@@ -303,6 +325,7 @@ impl GranuleArgs {
         p.output_strain_interval = self.output_strain;
         p.gravity_m_s2 = if self.gravity { GRAVITY_M_S2 } else { 0.0 };
         p.symmetry = self.symmetry.into();
+        p.mass_scaling = self.mass_scaling;
         p
     }
 
@@ -327,6 +350,7 @@ impl GranuleArgs {
                 self.strain
             ),
             "hourglass_kappa" => format!("`--hourglass-kappa {value}` rejected"),
+            "mass_scaling" => format!("`--mass-scaling {value}` rejected"),
             "gravity_m_s2" => {
                 "`--gravity` rejected: it needs `--symmetry full` (in octant mode z = 0 is a \
                  symmetry plane)"
@@ -384,6 +408,13 @@ impl GranuleArgs {
         bar.finish();
         let result =
             result.map_err(|e| anyhow::Error::new(e).context(format!("granule {name}")))?;
+        let rate_change_rel = if self.rate_check && result.error.is_none() {
+            Some(rate_change(job.params, mesh, &result).with_context(|| {
+                format!("granule {name}: the rate check's run at half the platen speed")
+            })?)
+        } else {
+            None
+        };
         let setup = RunSetup {
             granule_type: name,
             mesh: self.mesh,
@@ -391,7 +422,7 @@ impl GranuleArgs {
             hexes: mesh.hexes.len(),
             params: &job.params,
         };
-        let summary = Summary::new(&setup, &result);
+        let summary = Summary::new(&setup, &result, rate_change_rel);
         write_outputs(&job.dir, &result, &summary)
             .with_context(|| format!("granule {name}: writing the outputs"))?;
         Ok(Outcome {
@@ -431,13 +462,46 @@ impl GranuleArgs {
         if self.types.is_some() {
             write_type_outputs(&self.out, &outcomes, self.mesh, self.symmetry.into())?;
         }
-        if !self.quiet {
-            for o in &outcomes {
+        for o in &outcomes {
+            if !self.quiet {
                 writeln!(streams.stderr, "{}", o.summary.line())?;
+            }
+            if o.result.error.is_none() && !o.summary.quasi_static.passed {
+                writeln!(streams.stderr, "{}", o.summary.not_quasi_static())?;
             }
         }
         kernel_failures(&outcomes)
     }
+}
+
+/// The rate check of a finished run `result` of `params`: the relative L2
+/// change of its force curve when the platens move at half the speed
+/// (same masses), over the certificate's strain window; NaN for a run too
+/// short for the window (which fails the certificate).
+fn rate_change(
+    params: PlatenParams,
+    mesh: &OwnedReference,
+    result: &RunResult,
+) -> anyhow::Result<Real> {
+    let slow = PlatenParams {
+        approach_speed_m_s: 0.5 * params.approach_speed_m_s,
+        ..params
+    };
+    let twin = run::run_platens(slow, mesh, &mut |_, _| {})?;
+    if let Some(e) = twin.error {
+        anyhow::bail!("the run failed: {e}");
+    }
+    let curve = |r: &RunResult| -> Vec<(Real, Real)> {
+        r.samples
+            .iter()
+            .map(|s| (s.strain, s.mean_force()))
+            .collect()
+    };
+    let window = crate::quasi_static::rate_check_window(params.final_strain);
+    Ok(
+        crate::study::work_precision::curve_error(&curve(result), &curve(&twin), window)
+            .unwrap_or(Real::NAN),
+    )
 }
 
 /// Writes the CSV, summary and plot of one run into `dir`.

@@ -5,13 +5,17 @@
 use crate::output::finite_ratio as ratio;
 use granbed_kernel::Real;
 use granbed_kernel::analysis::granule::{initial_effective_yield_stress, yield_stress_estimate};
+use granbed_kernel::analysis::quasi_static::{
+    FORCE_IMBALANCE_LIMIT, KINETIC_TO_INTERNAL_LIMIT, LoadSample, RATE_CHANGE_LIMIT,
+};
 use granbed_kernel::granule::forces::ElementKind;
 use granbed_kernel::granule::timestep::TimeStepMethod;
-use granbed_kernel::scene::platens::{PlatenParams, SceneError, Symmetry};
+use granbed_kernel::scene::platens::{PlatenParams, PlatenSample, SceneError, Symmetry};
 use serde::Serialize;
 
 use super::run::RunResult;
 use crate::model::MeshLevel;
+use crate::quasi_static::QuasiStatic;
 
 /// Name of the `summary.json` format (its `format` field).
 pub const FORMAT: &str = "granbed-granule-summary";
@@ -110,6 +114,8 @@ pub struct Summary {
     pub output_strain_interval: Real,
     /// Gravity, m/s² (in −z).
     pub gravity_m_s2: Real,
+    /// Uniform mass scaling F (masses ×F, gravity ÷F).
+    pub mass_scaling: Real,
 
     /// Granule yield stress estimate σ_est = 4/(πd)·dF/dx over
     /// [`Summary::sigma_est_strain_range`], Pa; `null` with fewer than two
@@ -152,6 +158,9 @@ pub struct Summary {
     pub damping_rel: Option<Real>,
     /// Smallest element J over all samples.
     pub min_jacobian: Real,
+    /// The quasi-static certificate over the second half of the samples
+    /// (the platen force imbalance is measured with full symmetry only).
+    pub quasi_static: QuasiStatic,
     /// Strain of the last sample.
     pub final_strain: Real,
     /// Largest mean platen force over the samples, N.
@@ -163,8 +172,9 @@ pub struct Summary {
 }
 
 impl Summary {
-    /// The summary of `result`, a run of `setup`.
-    pub fn new(setup: &RunSetup<'_>, result: &RunResult) -> Self {
+    /// The summary of `result`, a run of `setup`; `rate_change_rel` is the
+    /// rate check's change of the force curve, if it ran.
+    pub fn new(setup: &RunSetup<'_>, result: &RunResult, rate_change_rel: Option<Real>) -> Self {
         let p = setup.params;
         let m = &p.material.params;
         let samples = &result.samples;
@@ -222,6 +232,7 @@ impl Summary {
             },
             output_strain_interval: p.output_strain_interval,
             gravity_m_s2: p.gravity_m_s2,
+            mass_scaling: p.mass_scaling,
             sigma_est_pa: fit.map(|(sigma, _)| sigma),
             sigma_est_strain_range: FIT_STRAIN_RANGE,
             sigma_eff0_pa: initial_effective_yield_stress(m),
@@ -241,6 +252,7 @@ impl Summary {
             hourglass_energy_rel: ratio(e.hourglass, e.internal_work),
             damping_rel: ratio(e.damping, e.contact_work),
             min_jacobian: samples.iter().fold(Real::INFINITY, |j, s| j.min(s.min_j)),
+            quasi_static: quasi_static(samples, p.symmetry, rate_change_rel),
             final_strain,
             max_force_n: samples
                 .iter()
@@ -248,6 +260,25 @@ impl Summary {
             notes,
             error: result.error.as_ref().map(SceneError::to_string),
         }
+    }
+
+    /// The stderr warning of a run that failed the quasi-static
+    /// certificate, with its figures.
+    pub fn not_quasi_static(&self) -> String {
+        let q = &self.quasi_static;
+        let fmt = |x: Option<Real>| x.map_or_else(|| "n/a".to_owned(), |v| format!("{v:.3e}"));
+        format!(
+            "granule {}: NOT quasi-static with mass scaling {} (kinetic/internal work up to {} \
+             [limit {}], force imbalance {} [limit {}], change at half speed {} [limit {}])",
+            self.granule_type,
+            self.mass_scaling,
+            fmt(q.max_kinetic_to_internal),
+            KINETIC_TO_INTERNAL_LIMIT,
+            fmt(q.force_imbalance_rel),
+            FORCE_IMBALANCE_LIMIT,
+            fmt(q.rate_change_rel),
+            RATE_CHANGE_LIMIT,
+        )
     }
 
     /// The one-line stderr report of the run.
@@ -270,4 +301,15 @@ impl Summary {
             self.wall_time_s
         )
     }
+}
+
+/// The quasi-static certificate of a platen run (the second half of its
+/// samples; see [`PlatenSample::load_sample`]).
+fn quasi_static(
+    samples: &[PlatenSample],
+    symmetry: Symmetry,
+    rate_change_rel: Option<Real>,
+) -> QuasiStatic {
+    let loads: Vec<LoadSample> = samples.iter().map(|s| s.load_sample(symmetry)).collect();
+    crate::quasi_static::judge(&loads, rate_change_rel)
 }

@@ -79,15 +79,7 @@ pub fn bed_grid(mesh: MeshLevel, quick: bool) -> (Setting, Vec<Setting>) {
             with("fbar", &|s| s.element = ElementKind::FBar),
         ]);
     }
-    // A setting equal to the default (e.g. "mass x1" when the default is
-    // unscaled) would be a second run of the same thing.
-    let mut kept: Vec<Setting> = Vec::with_capacity(grid.len());
-    for s in grid {
-        if !kept.iter().any(|k| k.named("") == s.named("")) {
-            kept.push(s);
-        }
-    }
-    (reference, kept)
+    (reference, super::work_precision::distinct(grid))
 }
 
 /// The study's scene for `setting` on pour `seed`.

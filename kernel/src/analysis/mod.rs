@@ -3,8 +3,10 @@
 //! * [`fit`]: least-squares lines;
 //! * [`granule`]: σ_est and σ_y,eff0 of the single-granule experiment;
 //! * [`bed`]: pressure, strain, Kawakita fit, granule η_g and α_SV,
-//!   coordination number and mean relative density of a compressed bed.
+//!   coordination number and mean relative density of a compressed bed;
+//! * [`quasi_static`]: the quasi-static certificate of a loading run.
 
 pub mod bed;
 pub mod fit;
 pub mod granule;
+pub mod quasi_static;

@@ -1,0 +1,50 @@
+//! The quasi-static certificate as the summaries of `granbed-cli bed` and
+//! `granbed-cli granule` write it (issue #8): the kernel's [`certificate`]
+//! over the [`judged`] samples, with the rate check's curve change if it
+//! ran.
+
+use granbed_kernel::Real;
+use granbed_kernel::analysis::quasi_static::{Certificate, LoadSample, certificate, judged};
+use serde::Serialize;
+
+/// `quasi_static` in `summary.json`: the certificate's figures and verdict
+/// (limits in [`granbed_kernel::analysis::quasi_static`]).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct QuasiStatic {
+    /// Largest kinetic / internal work ratio over the second half.
+    pub max_kinetic_to_internal: Option<Real>,
+    /// Mean |F_in − F_out| / F_in over the loaded samples of the second
+    /// half (`null` where not measured: an octant granule).
+    pub force_imbalance_rel: Option<Real>,
+    /// Relative L2 change of the load curve at half the loading speed
+    /// (`null`: the rate check did not run).
+    pub rate_change_rel: Option<Real>,
+    /// Every figure below its limit.
+    pub passed: bool,
+}
+
+impl From<Certificate> for QuasiStatic {
+    fn from(c: Certificate) -> Self {
+        Self {
+            max_kinetic_to_internal: c.max_kinetic_to_internal,
+            force_imbalance_rel: c.force_imbalance_rel,
+            rate_change_rel: c.rate_change_rel,
+            passed: c.passed,
+        }
+    }
+}
+
+/// The certificate of a run whose samples, in time order, read as
+/// `samples`.
+pub fn judge(samples: &[LoadSample], rate_change_rel: Option<Real>) -> QuasiStatic {
+    certificate(judged(samples).iter().copied(), rate_change_rel).into()
+}
+
+/// The start of the rate check's strain window: below 2 %, the load is
+/// the contact's and the rearrangement's noise.
+pub const RATE_CHECK_FROM_STRAIN: Real = 0.02;
+
+/// The rate check's strain window for a run to `final_strain`.
+pub fn rate_check_window(final_strain: Real) -> [Real; 2] {
+    [RATE_CHECK_FROM_STRAIN, final_strain]
+}
