@@ -15,16 +15,8 @@ fn out_dir(name: &str) -> PathBuf {
     common::fresh_dir("cli_bed", name)
 }
 
-const SMALL: [&str; 8] = [
-    "--granules",
-    "30",
-    "--mesh",
-    "4x1",
-    "--die-diameter-mm",
-    "5",
-    "--strain",
-    "0.3",
-];
+/// The CI bed of these tests: 30 coarse granules to 30 %.
+const SMALL: [&str; 8] = common::small_bed("30", "0.3");
 
 fn bed(dir: &Path, threads: &str) -> common::Run {
     let mut argv = vec![

@@ -43,15 +43,8 @@ fn tiny_bed(dir: &Path, strain: &str, extra: &[&str]) {
         scene.to_str().unwrap(),
         "--out",
         dir.to_str().unwrap(),
-        "--granules",
-        "20",
-        "--mesh",
-        "4x1",
-        "--die-diameter-mm",
-        "5",
-        "--strain",
-        strain,
     ];
+    argv.extend_from_slice(&common::small_bed("20", strain));
     argv.extend_from_slice(extra);
     let run = cli(&argv);
     assert_eq!(run.code, 0, "bed failed:\n{}", run.stderr);

@@ -33,22 +33,16 @@ const SAME_AS_SUMMARY: [(&str, &str); 7] = [
 #[test]
 fn three_types_from_one_pour_are_ordered_by_yield_stress() {
     let dir = out_dir("a2b2c2");
-    let run = cli(&[
+    let mut argv = vec![
         "bed",
         "--quiet",
         "--out",
         dir.to_str().unwrap(),
         "--types",
         "A2,b2,C2",
-        "--granules",
-        "30",
-        "--mesh",
-        "4x1",
-        "--die-diameter-mm",
-        "5",
-        "--strain",
-        "0.15",
-    ]);
+    ];
+    argv.extend_from_slice(&common::small_bed("30", "0.15"));
+    let run = cli(&argv);
     assert_eq!(run.code, 0, "bed --types failed:\n{}", run.stderr);
 
     let table = Table::read(&dir.join("comparison.csv"));

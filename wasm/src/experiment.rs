@@ -29,9 +29,6 @@ pub const STANDARD_DIAMETER_M: Real = 1.0e-3;
 /// Allowed granule diameters, m.
 pub const DIAMETER_RANGE_M: [Real; 2] = [1.0e-6, 1.0];
 
-/// Header of the CSV (the CLI's `force_displacement.csv` columns).
-pub const CSV_COLUMNS: [&str; 18] = SAMPLE_COLUMNS;
-
 /// The material fields a caller may override, in the names of
 /// [`MaterialParams`].
 pub const MATERIAL_FIELDS: [&str; 8] = [
@@ -364,7 +361,7 @@ impl Experiment {
     /// The samples as CSV, the CLI's `force_displacement.csv` byte for byte.
     pub fn csv(&self) -> String {
         let mut out = String::new();
-        out.push_str(&CSV_COLUMNS.join(","));
+        out.push_str(&SAMPLE_COLUMNS.join(",")); // the CLI's header
         out.push('\n');
         for s in &self.samples {
             let reals = s.values();

@@ -23,9 +23,6 @@ pub const TYPES_CSV: &str = "types.csv";
 /// File name of the overlaid plot of `--types`.
 pub const TYPES_SVG: &str = "force_displacement_types.svg";
 
-/// Header of [`FORCE_CSV`]: the kernel's platen-sample columns.
-pub const FORCE_COLUMNS: [&str; 18] = SAMPLE_COLUMNS;
-
 /// Header of [`TYPES_CSV`].
 pub const TYPES_COLUMNS: [&str; 10] = [
     "type",
@@ -40,8 +37,9 @@ pub const TYPES_COLUMNS: [&str; 10] = [
     "return_map_gap_rel",
 ];
 
-/// The cells of one sample, in the order of [`FORCE_COLUMNS`].
-pub fn force_row(s: &PlatenSample) -> [Field; FORCE_COLUMNS.len()] {
+/// The cells of one sample, in the order of [`SAMPLE_COLUMNS`] (the header
+/// of [`FORCE_CSV`]).
+pub fn force_row(s: &PlatenSample) -> [Field; SAMPLE_COLUMNS.len()] {
     let v = s.values();
     core::array::from_fn(|k| v.get(k).map_or(Field::Int(s.steps), |&x| Field::Real(x)))
 }
@@ -49,7 +47,7 @@ pub fn force_row(s: &PlatenSample) -> [Field; FORCE_COLUMNS.len()] {
 /// Writes `samples` as [`FORCE_CSV`] rows to `path`.
 pub fn write_force_csv(path: &Path, samples: &[PlatenSample]) -> anyhow::Result<()> {
     let ctx = || format!("cannot write to `{}`", path.display());
-    let mut csv = CsvWriter::new(create_file(path)?, &FORCE_COLUMNS).with_context(ctx)?;
+    let mut csv = CsvWriter::new(create_file(path)?, &SAMPLE_COLUMNS).with_context(ctx)?;
     for s in samples {
         csv.write_row(&force_row(s)).with_context(ctx)?;
     }

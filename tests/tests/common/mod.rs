@@ -122,6 +122,22 @@ impl Table {
     }
 }
 
+/// The `granbed-cli bed` flags of a CI-sized bed: `granules` coarse (4x1,
+/// 160-hex) granules poured into a 5 mm die and pressed to `strain`.
+#[allow(dead_code)]
+pub const fn small_bed<'a>(granules: &'a str, strain: &'a str) -> [&'a str; 8] {
+    [
+        "--granules",
+        granules,
+        "--mesh",
+        "4x1",
+        "--die-diameter-mm",
+        "5",
+        "--strain",
+        strain,
+    ]
+}
+
 /// Asserts |actual − expected| ≤ abs + rel·|expected|, naming the quantity.
 #[track_caller]
 pub fn assert_close(what: &str, actual: f64, expected: f64, rel: f64, abs: f64) {
