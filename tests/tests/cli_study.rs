@@ -67,6 +67,77 @@ fn the_quick_granule_study_writes_a_consistent_table_and_diagram() {
     assert_eq!(circles, names.len() - 1, "points in the diagram");
 }
 
+/// `--types A3,C3`: each type's own table in DIR/<TYPE>/, and the main
+/// table holds per setting the largest error over the types and the summed
+/// steps and wall time; the bed study refuses `--types`.
+#[test]
+fn the_granule_study_over_types_takes_the_largest_error() {
+    let dir = common::fresh_dir("cli_study", "quick_types");
+    let run = cli(&[
+        "study",
+        "work-precision",
+        "--quick",
+        "--quiet",
+        "--types",
+        "A3,C3",
+        "--out",
+        dir.to_str().unwrap(),
+    ]);
+    assert_eq!(run.code, 0, "{}", run.stderr);
+    let all = Table::read(&dir.join("work_precision.csv"));
+    let per_type = [
+        Table::read(&dir.join("A3").join("work_precision.csv")),
+        Table::read(&dir.join("C3").join("work_precision.csv")),
+    ];
+    assert_eq!(all.text("setting"), per_type[0].text("setting"));
+    assert_eq!(all.text("setting"), per_type[1].text("setting"));
+    let (a3, c3) = (&per_type[0], &per_type[1]);
+    for column in ["error_curve_l2", "error_sigma_est"] {
+        let largest: Vec<f64> = a3
+            .num(column)
+            .iter()
+            .zip(c3.num(column))
+            .map(|(a, c)| a.max(c))
+            .collect();
+        assert_eq!(all.num(column), largest, "{column}");
+    }
+    // The two types differ, so the largest is not always the same type's.
+    assert_ne!(a3.num("error_curve_l2"), c3.num("error_curve_l2"));
+    let steps: Vec<f64> = a3
+        .num("steps")
+        .iter()
+        .zip(c3.num("steps"))
+        .map(|(a, c)| a + c)
+        .collect();
+    assert_eq!(all.num("steps"), steps);
+    let wall: Vec<f64> = a3
+        .num("wall_time_s")
+        .iter()
+        .zip(c3.num("wall_time_s"))
+        .map(|(a, c)| a + c)
+        .collect();
+    for (w, s) in all.num("wall_time_s").iter().zip(wall) {
+        assert!((w / s - 1.0).abs() < 1e-12, "{w} vs {s}");
+    }
+
+    let bed = cli(&[
+        "study",
+        "work-precision",
+        "--scene",
+        "bed-small",
+        "--types",
+        "A3,C3",
+        "--out",
+        dir.join("bed").to_str().unwrap(),
+    ]);
+    assert_eq!(bed.code, 2, "{}", bed.stderr);
+    assert!(
+        bed.stderr.contains("`--types` is for `--scene granule`"),
+        "{}",
+        bed.stderr
+    );
+}
+
 /// `granbed-cli study work-precision --scene bed-small --quick`: the bed
 /// study's table holds the reference (error 0), the default and its
 /// variants on the first pour; its default row is exactly what

@@ -218,6 +218,7 @@ pub fn study(args: &WorkPrecisionArgs, streams: &mut Streams<'_>) -> anyhow::Res
         reference.setting.element_name()
     );
     Ok(StudyRuns {
+        errors: super::work_precision::errors_against(&reference, &runs),
         reference,
         runs,
         spread,

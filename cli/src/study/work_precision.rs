@@ -24,7 +24,7 @@ use anyhow::Context as _;
 use granbed_kernel::Real;
 use granbed_kernel::analysis::granule::yield_stress_estimate;
 use granbed_kernel::granule::forces::ElementKind;
-use granbed_kernel::material::Material;
+use granbed_kernel::material::{GranuleType, Material};
 use granbed_kernel::scene::platens::{PlatenParams, STANDARD_MASS_SCALING};
 use plotters::prelude::*;
 
@@ -33,6 +33,7 @@ use crate::csv::{CsvWriter, Field};
 use crate::granule::GRANULE_RADIUS_M;
 use crate::granule::run::run_platens;
 use crate::granule::summary::FIT_STRAIN_RANGE;
+use crate::material_args::MaterialArgs;
 use crate::model::{MeshLevel, OwnedReference};
 use crate::output::{Streams, create_file, finish_file, write_text};
 
@@ -348,25 +349,33 @@ pub struct Row<'a> {
     pub within_spread: Option<bool>,
 }
 
-/// The rows with their errors against `reference` and the Pareto flags;
+/// The errors of `reference` (zero) and of each of `runs` against it.
+pub fn errors_against(reference: &Measured, runs: &[Measured]) -> Vec<Errors> {
+    core::iter::once(reference)
+        .chain(runs)
+        .map(|m| Errors::of(m, reference))
+        .collect()
+}
+
+/// The rows of `reference` and `runs` with their `errors` (one per row,
+/// the reference's first; see [`errors_against`]) and the Pareto flags;
 /// `spread` (bed) marks the settings whose curve error stays within it.
 pub fn rows<'a>(
     reference: &'a Measured,
     runs: &'a [Measured],
+    errors: &[Errors],
     spread: Option<Errors>,
 ) -> Vec<Row<'a>> {
     let mut rows: Vec<Row<'a>> = core::iter::once(reference)
         .chain(runs)
+        .zip(errors)
         .enumerate()
-        .map(|(i, m)| {
-            let errors = Errors::of(m, reference);
-            Row {
-                m,
-                errors,
-                reference: i == 0,
-                pareto: false,
-                within_spread: spread.map(|s| errors.curve <= s.curve),
-            }
+        .map(|(i, (m, &errors))| Row {
+            m,
+            errors,
+            reference: i == 0,
+            pareto: false,
+            within_spread: spread.map(|s| errors.curve <= s.curve),
         })
         .collect();
     let front: Vec<bool> = rows
@@ -484,12 +493,54 @@ pub fn diagram(
     Ok(svg)
 }
 
-/// What a study ran: the reference, the settings, and (bed) the spread.
+/// The study of several types as one: per setting (and for the
+/// reference) the summed steps and wall time, and the largest of each
+/// error over the types. The title, axis and spread are left empty.
+fn over_types(per_type: &[(GranuleType, Measured, Vec<Measured>)]) -> StudyRuns {
+    let combine = |ms: &[&Measured]| Measured {
+        steps: ms.iter().map(|m| m.steps).sum(),
+        wall_time_s: ms.iter().map(|m| m.wall_time_s).sum(),
+        sigma_est_pa: None,
+        kawakita: None,
+        curve: Vec::new(),
+        ..ms[0].clone()
+    };
+    let largest = |es: &mut dyn Iterator<Item = Errors>| {
+        es.reduce(Errors::max)
+            .expect("a study of several types has at least one")
+    };
+    let references: Vec<&Measured> = per_type.iter().map(|(_, r, _)| r).collect();
+    let settings = per_type.first().map_or(0, |(_, _, runs)| runs.len());
+    let runs: Vec<Measured> = (0..settings)
+        .map(|i| combine(&per_type.iter().map(|(_, _, r)| &r[i]).collect::<Vec<_>>()))
+        .collect();
+    let mut errors = vec![Errors::of(references[0], references[0])];
+    errors.extend((0..settings).map(|i| {
+        largest(
+            &mut per_type
+                .iter()
+                .map(|(_, reference, r)| Errors::of(&r[i], reference)),
+        )
+    }));
+    StudyRuns {
+        reference: combine(&references),
+        runs,
+        errors,
+        spread: None,
+        title: String::new(),
+        x_desc: "",
+    }
+}
+
+/// What a study ran: the reference, the settings, their errors, and (bed)
+/// the spread.
 pub struct StudyRuns {
     /// The reference run.
     pub reference: Measured,
     /// The settings' runs.
     pub runs: Vec<Measured>,
+    /// The errors of the reference (zero) and of each run, in that order.
+    pub errors: Vec<Errors>,
     /// The run-to-run spread of the default over poured beds (bed).
     pub spread: Option<Errors>,
     /// The diagram's title.
@@ -513,13 +564,19 @@ pub fn say(quiet: bool, what: &str, m: &Measured, streams: &mut Streams<'_>) -> 
 impl WorkPrecisionArgs {
     /// Runs the study and writes the table and the diagram.
     pub fn run(&self, streams: &mut Streams<'_>) -> anyhow::Result<()> {
+        if self.types.is_some() && self.scene != StudyScene::Granule {
+            return Err(crate::error::InputError(
+                "`--types` is for `--scene granule` (the bed study runs --type)".to_owned(),
+            )
+            .into());
+        }
         std::fs::create_dir_all(&self.out)
             .with_context(|| format!("cannot create output directory `{}`", self.out.display()))?;
         let study = match self.scene {
             StudyScene::Granule => self.granule_study(streams)?,
             StudyScene::BedSmall => super::bed_small::study(self, streams)?,
         };
-        let rows = rows(&study.reference, &study.runs, study.spread);
+        let rows = rows(&study.reference, &study.runs, &study.errors, study.spread);
         write_csv(&self.out.join(CSV_FILE), &rows)?;
         let svg_path = self.out.join(SVG_FILE);
         let svg = diagram(
@@ -545,30 +602,62 @@ impl WorkPrecisionArgs {
         Ok(())
     }
 
-    /// The single-granule study.
+    /// The single-granule study, of one type or (`--types`) of several.
     fn granule_study(&self, streams: &mut Streams<'_>) -> anyhow::Result<StudyRuns> {
-        let material = self.material.material()?;
-        let (reference, grid) = granule_grid(self.quick);
-        let reference = run_granule(&reference, &material)?;
-        say(self.quiet, "reference", &reference, streams)?;
-        let mut runs = Vec::with_capacity(grid.len());
-        for s in &grid {
-            let m = run_granule(s, &material)?;
-            say(self.quiet, "setting", &m, streams)?;
-            runs.push(m);
+        let types = match &self.types {
+            Some(list) => list.0.clone(),
+            None => vec![self.material.granule_type],
+        };
+        let (reference_setting, grid) = granule_grid(self.quick);
+        let mut per_type = Vec::with_capacity(types.len());
+        for &granule_type in &types {
+            let material = MaterialArgs {
+                granule_type,
+                ..self.material
+            }
+            .material()?;
+            let reference = run_granule(&reference_setting, &material)?;
+            say(self.quiet, "reference", &reference, streams)?;
+            let mut runs = Vec::with_capacity(grid.len());
+            for s in &grid {
+                let m = run_granule(s, &material)?;
+                say(self.quiet, "setting", &m, streams)?;
+                runs.push(m);
+            }
+            per_type.push((granule_type, reference, runs));
         }
-        let title = format!(
-            "work-precision, granule {} (reference: {} {}, half speed)",
-            self.material.granule_type,
-            reference.setting.mesh,
-            reference.setting.element_name()
+        let reference_name = format!(
+            "{} {}, half speed",
+            reference_setting.mesh,
+            reference_setting.element_name()
         );
+        if let [(t, reference, runs)] = &per_type[..] {
+            return Ok(StudyRuns {
+                errors: errors_against(reference, runs),
+                reference: reference.clone(),
+                runs: runs.clone(),
+                spread: None,
+                title: format!("work-precision, granule {t} (reference: {reference_name})"),
+                x_desc: "relative L2 error of F(C) against the reference",
+            });
+        }
+        for (t, reference, runs) in &per_type {
+            let dir = self.out.join(t.name());
+            std::fs::create_dir_all(&dir)
+                .with_context(|| format!("cannot create `{}`", dir.display()))?;
+            let errors = errors_against(reference, runs);
+            write_csv(&dir.join(CSV_FILE), &rows(reference, runs, &errors, None))?;
+        }
+        let names: Vec<&str> = types.iter().map(|t| t.name()).collect();
         Ok(StudyRuns {
-            reference,
-            runs,
+            title: format!(
+                "work-precision, granule types {} (largest error over the types; reference: \
+                 {reference_name})",
+                names.join(",")
+            ),
+            x_desc: "largest relative L2 error of F(C) over the types",
             spread: None,
-            title,
-            x_desc: "relative L2 error of F(C) against the reference",
+            ..over_types(&per_type)
         })
     }
 }
@@ -624,7 +713,12 @@ mod tests {
         let runs = [off];
         for (spread, within) in [(0.06, true), (0.04, false)] {
             let s = Errors { curve: spread, ..e };
-            let rows = rows(&reference, &runs, Some(s));
+            let rows = rows(
+                &reference,
+                &runs,
+                &errors_against(&reference, &runs),
+                Some(s),
+            );
             assert_eq!(rows[0].within_spread, Some(true));
             assert_eq!(rows[1].within_spread, Some(within), "spread {spread}");
         }
@@ -654,7 +748,7 @@ mod tests {
             run(0.3, 1.026, 102.0), // faster, better curve, worse σ_est: on the front too
             run(0.5, 1.030, 102.5), // dominated by the run above
         ];
-        let rows = rows(&reference, &runs, None);
+        let rows = rows(&reference, &runs, &errors_against(&reference, &runs), None);
         let front: Vec<bool> = rows.iter().map(|r| r.pareto).collect();
         assert_eq!(front, [true, false, true, true, false]);
         // A figure only the faster run lacks does not let it dominate.
