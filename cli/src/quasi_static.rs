@@ -45,6 +45,18 @@ pub fn judge(samples: &[LoadSample], rate_change_rel: Option<Real>) -> QuasiStat
 pub const RATE_CHECK_FROM_STRAIN: Real = 0.02;
 
 /// The rate check's strain window for a run to `final_strain`.
-pub fn rate_check_window(final_strain: Real) -> [Real; 2] {
+fn rate_check_window(final_strain: Real) -> [Real; 2] {
     [RATE_CHECK_FROM_STRAIN, final_strain]
+}
+
+/// The rate check's figure: the relative L2 distance of the load curve
+/// `curve` from `half_speed`, the same run at half the loading speed (both
+/// (strain, load) in strain order), over 2 % ≤ C ≤ `final_strain`; `None`
+/// if either curve does not cover that window.
+pub fn rate_change(
+    curve: &[(Real, Real)],
+    half_speed: &[(Real, Real)],
+    final_strain: Real,
+) -> Option<Real> {
+    crate::study::work_precision::curve_error(curve, half_speed, rate_check_window(final_strain))
 }

@@ -12,7 +12,7 @@ use core::fmt::Write as _;
 use granbed_kernel::Real;
 use granbed_kernel::analysis::fit::LineFit;
 use granbed_kernel::analysis::granule::{initial_effective_yield_stress, yield_stress_estimate};
-use granbed_kernel::analysis::quasi_static::{Certificate, certificate, judged};
+use granbed_kernel::analysis::quasi_static::Certificate;
 use granbed_kernel::material::{GranuleType, MaterialParams, ParamError};
 use granbed_kernel::scene::platens::{
     PlatenParams, PlatenSample, PlatenScene, SAMPLE_COLUMNS, SceneError,
@@ -349,12 +349,7 @@ impl Experiment {
             sigma_est_pa: fit.map(|(s, _)| s),
             fit: fit.map(|(_, f)| f),
             sigma_eff0_pa: initial_effective_yield_stress(&self.params.material.params),
-            quasi_static: certificate(
-                judged(&self.samples)
-                    .iter()
-                    .map(|s| s.load_sample(self.params.symmetry)),
-                None,
-            ),
+            quasi_static: PlatenSample::certificate(&self.samples, self.params.symmetry, None),
         }
     }
 

@@ -384,9 +384,8 @@ impl BedArgs {
                 .map(|s| (s.strain, s.upper_pressure_pa))
                 .collect()
         };
-        let window = crate::quasi_static::rate_check_window(scene.final_strain);
         result.rate_change_rel =
-            crate::study::work_precision::curve_error(&curve(result), &curve(&twin), window);
+            crate::quasi_static::rate_change(&curve(result), &curve(&twin), scene.final_strain);
         outputs::write_all(out, scene, result)?;
         if !self.quiet {
             let q = outputs::summary(scene, result).quasi_static;

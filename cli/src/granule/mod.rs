@@ -64,9 +64,10 @@ Output, in --out DIR (created if missing; with --types in DIR/<TYPE>/ per type):
                           strain 0.1 to 0.4; null with fewer than two samples
                           there), sigma_eff0, fit, energy checks, the
                           quasi-static certificate (kinetic/internal work over
-                          the second half, with --rate-check the change at half
-                          the speed), cost, and \"error\" if the kernel stopped
-                          the run
+                          the second half, with --symmetry full the platen force
+                          imbalance, with --rate-check the change at half the
+                          speed), cost, and \"error\" if the kernel stopped the
+                          run
   force_displacement.svg  force against approach, with the sigma_est fit line
 With --types, also in DIR: types.csv (one row per type) and
 force_displacement_types.svg (all types overlaid).
@@ -271,8 +272,9 @@ pub struct GranuleArgs {
     pub mass_scaling: f64,
 
     /// The quasi-static certificate's rate check: run again at half the
-    /// platen speed (about twice the cost) and require the force curve to
-    /// move by less than 5 % over 2 % ≤ strain ≤ --strain.
+    /// platen speed (a second run of twice the first one's cost) and
+    /// require the force curve to move by less than 5 % over
+    /// 2 % ≤ strain ≤ --strain (which must exceed 0.02).
     #[arg(long)]
     pub rate_check: bool,
 
@@ -372,6 +374,14 @@ impl GranuleArgs {
     /// Validates every type's material and experiment (usage errors name
     /// the flag) before anything is written.
     fn jobs(&self, mesh: &OwnedReference) -> anyhow::Result<Vec<Job>> {
+        if self.rate_check && !(self.strain > crate::quasi_static::RATE_CHECK_FROM_STRAIN) {
+            return Err(InputError(format!(
+                "`--rate-check` needs `--strain` above {} (its window starts there; got {})",
+                crate::quasi_static::RATE_CHECK_FROM_STRAIN,
+                self.strain
+            ))
+            .into());
+        }
         let mut jobs = Vec::new();
         for granule_type in self.types() {
             let material = MaterialArgs {
@@ -408,13 +418,6 @@ impl GranuleArgs {
         bar.finish();
         let result =
             result.map_err(|e| anyhow::Error::new(e).context(format!("granule {name}")))?;
-        let rate_change_rel = if self.rate_check && result.error.is_none() {
-            Some(rate_change(job.params, mesh, &result).with_context(|| {
-                format!("granule {name}: the rate check's run at half the platen speed")
-            })?)
-        } else {
-            None
-        };
         let setup = RunSetup {
             granule_type: name,
             mesh: self.mesh,
@@ -422,9 +425,18 @@ impl GranuleArgs {
             hexes: mesh.hexes.len(),
             params: &job.params,
         };
-        let summary = Summary::new(&setup, &result, rate_change_rel);
+        let mut summary = Summary::new(&setup, &result, None);
         write_outputs(&job.dir, &result, &summary)
             .with_context(|| format!("granule {name}: writing the outputs"))?;
+        // The rate check after the run's own outputs are written: a failed
+        // check loses nothing.
+        if self.rate_check && result.error.is_none() {
+            let change = rate_change(job.params, mesh, &result).with_context(|| {
+                format!("granule {name}: the rate check's run at half the platen speed")
+            })?;
+            summary = Summary::new(&setup, &result, Some(change));
+            outputs::write_summary_json(&job.dir.join(outputs::SUMMARY_JSON), &summary)?;
+        }
         Ok(Outcome {
             job,
             result,
@@ -476,8 +488,7 @@ impl GranuleArgs {
 
 /// The rate check of a finished run `result` of `params`: the relative L2
 /// change of its force curve when the platens move at half the speed
-/// (same masses), over the certificate's strain window; NaN for a run too
-/// short for the window (which fails the certificate).
+/// (same masses), over the certificate's strain window.
 fn rate_change(
     params: PlatenParams,
     mesh: &OwnedReference,
@@ -497,11 +508,8 @@ fn rate_change(
             .map(|s| (s.strain, s.mean_force()))
             .collect()
     };
-    let window = crate::quasi_static::rate_check_window(params.final_strain);
-    Ok(
-        crate::study::work_precision::curve_error(&curve(result), &curve(&twin), window)
-            .unwrap_or(Real::NAN),
-    )
+    crate::quasi_static::rate_change(&curve(result), &curve(&twin), params.final_strain)
+        .context("the curves do not cover the rate check's strain window")
 }
 
 /// Writes the CSV, summary and plot of one run into `dir`.

@@ -6,7 +6,7 @@ use crate::output::finite_ratio as ratio;
 use granbed_kernel::Real;
 use granbed_kernel::analysis::granule::{initial_effective_yield_stress, yield_stress_estimate};
 use granbed_kernel::analysis::quasi_static::{
-    FORCE_IMBALANCE_LIMIT, KINETIC_TO_INTERNAL_LIMIT, LoadSample, RATE_CHANGE_LIMIT,
+    FORCE_IMBALANCE_LIMIT, KINETIC_TO_INTERNAL_LIMIT, RATE_CHANGE_LIMIT,
 };
 use granbed_kernel::granule::forces::ElementKind;
 use granbed_kernel::granule::timestep::TimeStepMethod;
@@ -252,7 +252,7 @@ impl Summary {
             hourglass_energy_rel: ratio(e.hourglass, e.internal_work),
             damping_rel: ratio(e.damping, e.contact_work),
             min_jacobian: samples.iter().fold(Real::INFINITY, |j, s| j.min(s.min_j)),
-            quasi_static: quasi_static(samples, p.symmetry, rate_change_rel),
+            quasi_static: PlatenSample::certificate(samples, p.symmetry, rate_change_rel).into(),
             final_strain,
             max_force_n: samples
                 .iter()
@@ -301,15 +301,4 @@ impl Summary {
             self.wall_time_s
         )
     }
-}
-
-/// The quasi-static certificate of a platen run (the second half of its
-/// samples; see [`PlatenSample::load_sample`]).
-fn quasi_static(
-    samples: &[PlatenSample],
-    symmetry: Symmetry,
-    rate_change_rel: Option<Real>,
-) -> QuasiStatic {
-    let loads: Vec<LoadSample> = samples.iter().map(|s| s.load_sample(symmetry)).collect();
-    crate::quasi_static::judge(&loads, rate_change_rel)
 }

@@ -102,7 +102,8 @@ pub struct WorkPrecisionArgs {
     /// granule: several granule types instead of --type (`all` or a comma
     /// list such as `A3,B2,C3`): every setting runs on each, and the table
     /// holds each setting's largest error over the types and its summed
-    /// wall time (each type's own table goes to DIR/<TYPE>/).
+    /// wall time (with two or more types, each type's own table goes to
+    /// DIR/<TYPE>/).
     #[arg(long, value_name = "LIST", conflicts_with = "granule_type")]
     pub types: Option<crate::granule::TypeList>,
 

@@ -322,6 +322,24 @@ impl Errors {
         pairs.iter().all(|&(x, o)| x <= o || o.is_nan())
     }
 
+    /// The larger of each figure, NaN if either lacks it (the largest
+    /// error over granule types: a figure missing on one type is missing).
+    pub fn max_over(self, o: Self) -> Self {
+        let m = |a: Real, b: Real| {
+            if a.is_nan() || b.is_nan() {
+                Real::NAN
+            } else {
+                a.max(b)
+            }
+        };
+        Self {
+            curve: m(self.curve, o.curve),
+            sigma: m(self.sigma, o.sigma),
+            kawakita_a: m(self.kawakita_a, o.kawakita_a),
+            kawakita_inv_b: m(self.kawakita_inv_b, o.kawakita_inv_b),
+        }
+    }
+
     /// The larger of each figure (NaN-ignoring).
     pub fn max(self, o: Self) -> Self {
         Self {
@@ -506,7 +524,7 @@ fn over_types(per_type: &[(GranuleType, Measured, Vec<Measured>)]) -> StudyRuns 
         ..ms[0].clone()
     };
     let largest = |es: &mut dyn Iterator<Item = Errors>| {
-        es.reduce(Errors::max)
+        es.reduce(Errors::max_over)
             .expect("a study of several types has at least one")
     };
     let references: Vec<&Measured> = per_type.iter().map(|(_, r, _)| r).collect();
@@ -760,5 +778,46 @@ mod tests {
         };
         let b = Errors { sigma: 0.02, ..a };
         assert!(b.no_worse_than(&a) && !a.no_worse_than(&b));
+    }
+
+    #[test]
+    fn over_types_takes_each_largest_error_and_keeps_a_missing_one() {
+        let r: Vec<(Real, Real)> = (0..=80)
+            .map(|i| (i as Real * 0.005, 1.0 + i as Real))
+            .collect();
+        let run = |wall: Real, scale: Real, sigma: Option<Real>| Measured {
+            wall_time_s: wall,
+            sigma_est_pa: sigma,
+            error_strains: GRANULE_ERROR_STRAINS,
+            curve: r.iter().map(|&(x, y)| (x, scale * y)).collect(),
+            ..measured(Vec::new(), None)
+        };
+        let reference = run(10.0, 1.0, Some(100.0));
+        // Setting 0: type X is off by 2 % in F, type Y by 5 %; setting 1
+        // the other way round, and type Y has no σ_est there.
+        let x = (
+            GranuleType::A3,
+            reference.clone(),
+            vec![run(1.0, 1.02, Some(101.0)), run(2.0, 1.05, Some(103.0))],
+        );
+        let y = (
+            GranuleType::C3,
+            reference.clone(),
+            vec![run(3.0, 1.05, Some(102.0)), run(4.0, 1.02, None)],
+        );
+        let study = over_types(&[x, y]);
+        assert_eq!(study.reference.wall_time_s, 20.0);
+        assert_eq!(
+            study.runs.iter().map(|m| m.wall_time_s).collect::<Vec<_>>(),
+            [4.0, 6.0]
+        );
+        let e = &study.errors;
+        assert_eq!(e[0].curve, 0.0);
+        assert!((e[1].curve - 0.05).abs() < 1e-12 && (e[1].sigma - 0.02).abs() < 1e-12);
+        assert!((e[2].curve - 0.05).abs() < 1e-12, "{:?}", e[2]);
+        assert!(
+            e[2].sigma.is_nan(),
+            "a σ_est missing on one type is missing"
+        );
     }
 }

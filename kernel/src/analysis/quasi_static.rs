@@ -72,7 +72,8 @@ pub fn certificate(
     let mut max_ratio: Option<Real> = None;
     let (mut measured, mut imbalance_sum, mut loaded) = (false, 0.0, 0_usize);
     for s in samples {
-        if s.internal_work_j > 0.0 {
+        // NaN figures are judged (and fail), not skipped.
+        if !(s.internal_work_j <= 0.0) {
             // A NaN ratio sticks (and fails the certificate).
             let r = s.kinetic_j / s.internal_work_j;
             max_ratio = Some(match max_ratio {
@@ -82,7 +83,7 @@ pub fn certificate(
         }
         if let Some(out) = s.force_out_n {
             measured = true;
-            if s.force_in_n > 0.0 {
+            if !(s.force_in_n <= 0.0) {
                 imbalance_sum += crate::math::abs(s.force_in_n - out) / s.force_in_n;
                 loaded += 1;
             }
@@ -145,5 +146,11 @@ mod tests {
         let nan = sample(Real::NAN, 1.0, 5.0, None);
         assert!(!certificate([nan, ok], None).passed);
         assert!(!certificate([ok, nan, ok], None).passed);
+        let nan_work = sample(1e-4, Real::NAN, 5.0, None);
+        assert!(!certificate([ok, nan_work], None).passed);
+        let nan_force = sample(1e-4, 1.0, Real::NAN, Some(5.0));
+        let loaded = sample(1e-4, 1.0, 5.0, Some(5.0));
+        assert!(certificate([loaded], None).passed);
+        assert!(!certificate([loaded, nan_force], None).passed);
     }
 }

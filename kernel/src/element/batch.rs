@@ -233,9 +233,10 @@ pub fn one_point_elements(
 
 /// Whether `batches` can be `refs` regrouped: [`batch_count`] long, and
 /// the volumes of the first and the last batch are those of their
-/// elements (a cheap check that catches the regrouped data of another mesh
-/// with as many elements; a full comparison would cost what regrouping
-/// saves).
+/// elements. A cheap check: it catches the regrouped data of another mesh
+/// with as many elements unless those elements have the same volumes at
+/// both ends (a rotated copy of the mesh would pass); a full comparison
+/// would cost what regrouping saves.
 fn regrouped_from(batches: &[ElementBatch], refs: &[HexReference]) -> bool {
     let lanes_match = |b: usize| {
         let volumes = &refs[b * BATCH..(b + 1) * BATCH];

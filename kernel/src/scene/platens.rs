@@ -402,6 +402,21 @@ impl PlatenSample {
         0.5 * (self.force_upper_n + self.force_lower_n)
     }
 
+    /// The quasi-static certificate of a run's `samples` (in time order;
+    /// [`crate::analysis::quasi_static::judged`] picks the second half),
+    /// with the rate check's change of the force curve if it ran.
+    pub fn certificate(
+        samples: &[PlatenSample],
+        symmetry: Symmetry,
+        rate_change_rel: Option<Real>,
+    ) -> crate::analysis::quasi_static::Certificate {
+        use crate::analysis::quasi_static::{certificate, judged};
+        certificate(
+            judged(samples).iter().map(|s| s.load_sample(symmetry)),
+            rate_change_rel,
+        )
+    }
+
     /// The sample as the quasi-static certificate reads it: the upper
     /// platen drives, the lower one takes up — measured with
     /// [`Symmetry::Full`] only (an octant's lower platen is the mirror
