@@ -374,7 +374,7 @@ impl GranuleArgs {
     /// Validates every type's material and experiment (usage errors name
     /// the flag) before anything is written.
     fn jobs(&self, mesh: &OwnedReference) -> anyhow::Result<Vec<Job>> {
-        if self.rate_check && !(self.strain > crate::quasi_static::RATE_CHECK_FROM_STRAIN) {
+        if self.rate_check && self.strain <= crate::quasi_static::RATE_CHECK_FROM_STRAIN {
             return Err(InputError(format!(
                 "`--rate-check` needs `--strain` above {} (its window starts there; got {})",
                 crate::quasi_static::RATE_CHECK_FROM_STRAIN,

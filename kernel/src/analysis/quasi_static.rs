@@ -73,7 +73,7 @@ pub fn certificate(
     let (mut measured, mut imbalance_sum, mut loaded) = (false, 0.0, 0_usize);
     for s in samples {
         // NaN figures are judged (and fail), not skipped.
-        if !(s.internal_work_j <= 0.0) {
+        if s.internal_work_j > 0.0 || s.internal_work_j.is_nan() {
             // A NaN ratio sticks (and fails the certificate).
             let r = s.kinetic_j / s.internal_work_j;
             max_ratio = Some(match max_ratio {
@@ -83,7 +83,7 @@ pub fn certificate(
         }
         if let Some(out) = s.force_out_n {
             measured = true;
-            if !(s.force_in_n <= 0.0) {
+            if s.force_in_n > 0.0 || s.force_in_n.is_nan() {
                 imbalance_sum += crate::math::abs(s.force_in_n - out) / s.force_in_n;
                 loaded += 1;
             }
