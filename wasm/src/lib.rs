@@ -295,6 +295,11 @@ impl Granule {
         self.run.measures().quasi_static.passed
     }
 
+    /// The certificate's limit on the kinetic / internal work ratio.
+    pub fn kinetic_to_internal_limit(&self) -> f64 {
+        granbed_kernel::analysis::quasi_static::KINETIC_TO_INTERNAL_LIMIT
+    }
+
     /// Mass scaling F of the experiment (masses ×F).
     pub fn mass_scaling(&self) -> f64 {
         self.run.params().mass_scaling

@@ -154,7 +154,7 @@ function finish(msg) {
   set('quasi-static',
     msg.kineticToInternal === null
       ? 'n/a'
-      : `${msg.quasiStatic ? 'yes' : 'NO'}: kinetic/internal work ≤ ${msg.kineticToInternal.toExponential(1)} (limit 1 %), masses ×${msg.massScaling}`,
+      : `${msg.quasiStatic ? 'yes' : 'NO'}: kinetic/internal work ≤ ${msg.kineticToInternal.toExponential(1)} (limit ${100 * msg.kineticLimit} %), masses ×${msg.massScaling}`,
     msg.quasiStatic);
   set('wall', `${(msg.wallMs / 1e3).toFixed(2)} s`, msg.wallMs / 1e3);
   csvUrl = URL.createObjectURL(new Blob([msg.csv], { type: 'text/csv' }));

@@ -62,6 +62,7 @@ function run(inputs) {
     r2: g.fit_r_squared() ?? null,
     kineticToInternal: g.max_kinetic_to_internal() ?? null,
     quasiStatic: g.quasi_static(),
+    kineticLimit: g.kinetic_to_internal_limit(),
     massScaling: g.mass_scaling(),
     steps: g.steps(),
     strain: g.strain(),
