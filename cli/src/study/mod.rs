@@ -103,7 +103,7 @@ pub struct WorkPrecisionArgs {
     /// list such as `A3,B2,C3`): every setting runs on each, and the table
     /// holds each setting's largest error over the types and its summed
     /// wall time (with two or more types, each type's own table goes to
-    /// DIR/<TYPE>/).
+    /// `DIR/<TYPE>/`).
     #[arg(long, value_name = "LIST", conflicts_with = "granule_type")]
     pub types: Option<crate::granule::TypeList>,
 
