@@ -160,8 +160,7 @@ fn the_quick_bed_study_runs_the_bed_code_and_measures_the_spread() {
     ]);
     assert_eq!(run.code, 0, "{}", run.stderr);
     assert!(
-        run.stderr
-            .contains("run-to-run spread of the curve over pours"),
+        run.stderr.contains("run-to-run spread over pours: curve"),
         "{}",
         run.stderr
     );

@@ -4,7 +4,8 @@
 //! the punch speed, no mass scaling) on the same poured bed; the default
 //! is also run on further pours (seeds 2…N), and the largest distance of
 //! those runs from the first pour's is the run-to-run **spread**. A faster
-//! setting is acceptable when its error stays within the spread.
+//! setting is acceptable when its errors (P(C), a, 1/b) all stay within the
+//! spread.
 //!
 //! All runs of one seed start from one pour (the packing is poured once and
 //! handed to every run), so a setting's error holds no pour-to-pour noise.
@@ -223,7 +224,7 @@ pub fn study(args: &WorkPrecisionArgs, streams: &mut Streams<'_>) -> anyhow::Res
         runs,
         spread,
         title,
-        x_desc: "relative L2 error of P(C) against the reference",
+        x_desc: "largest relative error against the reference (P(C) L2, a, 1/b)",
     })
 }
 
