@@ -127,7 +127,7 @@ fn write_inp(
         let ids: Vec<String> = h.iter().map(|id| (id + 1).to_string()).collect();
         writeln!(w, "{}, {}", e + 1, ids.join(", "))?;
     }
-    let first_surface = mesh.positions.len() - mesh.surface_nodes;
+    let first_surface = mesh.surface_range().start;
     let mut sets: Vec<(&str, Vec<usize>)> =
         vec![("SURFNODES", (first_surface..mesh.positions.len()).collect())];
     if args.octant {

@@ -130,6 +130,12 @@ impl MeshStore {
 }
 
 impl OwnedReference {
+    /// The outer surface nodes' indices (the last `surface_nodes` nodes):
+    /// the only nodes contact forces act on.
+    pub fn surface_range(&self) -> core::ops::Range<usize> {
+        self.positions.len() - self.surface_nodes..self.positions.len()
+    }
+
     /// Generates the sphere of `radius` (m) at `level`, the positive octant
     /// of it when `octant`, and computes the element data.
     pub fn sphere(radius: Real, level: MeshLevel, octant: bool) -> anyhow::Result<Self> {

@@ -59,11 +59,18 @@ pub struct ContactPhase {
     head: Vec<u32>,
     next: Vec<u32>,
     rebuilds: u64,
-    /// Per granule: f_c before the current sweep (for the x̃ update).
+    /// Per granule: f_c of its surface nodes (the last `surface_nodes`;
+    /// contact forces act on no other node) before the current sweep, for
+    /// the x̃ update.
     pub(super) f_before: Vec<Vec<[Real; 3]>>,
     /// Per granule: whether the last sweep put a contact force on it (only
-    /// then did its x̃ move, so only then can its pairs change).
+    /// then did its x̃ move, so only then can its pairs change); narrowed
+    /// by `narrow_to_deep_pairs` to the granules whose pairs the next sweep
+    /// searches again.
     pub(super) touched: Vec<bool>,
+    /// Per granule: whether the last sweep put a contact force on it (not
+    /// narrowed): only such a granule's f_c differs from `f_before`.
+    pub(super) forced: Vec<bool>,
     /// Per granule: bit k set if it touched wall k (mod 64) in any sweep of
     /// the step.
     pub(super) on_wall: Vec<u64>,
@@ -99,7 +106,7 @@ fn body_at<'a>(
         x_n: &g.x,
         x_pred,
         mass: &g.mass,
-        first_surface: mesh.positions.len() - mesh.surface_nodes,
+        first_surface: mesh.surface_range().start,
         quads: &mesh.quads,
         node_quads: &mesh.node_quads,
         bounds,
@@ -239,7 +246,7 @@ impl ContactPhase {
         mesh: &OwnedReference,
         margin: Real,
     ) -> Result<(), ContactError> {
-        let first = mesh.positions.len() - mesh.surface_nodes;
+        let first = mesh.surface_range().start;
         // In place: this runs every sweep of every step.
         self.bounds.resize(granules.len(), Bound::default());
         self.boxes.resize(granules.len(), Aabb::EMPTY);
@@ -439,7 +446,7 @@ impl ContactPhase {
         mesh: &OwnedReference,
         settings: &PairSettings,
     ) -> Result<Real, granbed_kernel::contact::pair::ContactError> {
-        let first = mesh.positions.len() - mesh.surface_nodes;
+        let first = mesh.surface_range().start;
         let bounds: Vec<Bound> = granules
             .iter()
             .map(|g| bounding_sphere(&g.x, first))

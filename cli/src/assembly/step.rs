@@ -458,7 +458,7 @@ impl Assembly<'_> {
         self.contact
             .detect(&self.granules, mesh, &p.contact, first)
             .map_err(contact_error)?;
-        let surface = mesh.positions.len() - mesh.surface_nodes..mesh.positions.len();
+        let surface = mesh.surface_range();
         if p.mass_sharing {
             self.contact.count_pairs(&self.granules, mesh);
             self.contact
@@ -517,6 +517,7 @@ impl Assembly<'_> {
             })
             .collect();
         self.contact.touched = touched.iter().map(|t| t.0).collect();
+        self.contact.forced.clone_from(&self.contact.touched);
         if first {
             self.contact.on_wall = touched.iter().map(|t| t.1).collect();
         } else {
@@ -592,14 +593,25 @@ impl Assembly<'_> {
         let mut wall_totals = vec![vec![WallForce::default(); walls.len()]; self.granules.len()];
         let mut pair_normal = 0.0;
         let mut constraints = 0;
+        // Contact forces act on surface nodes only, so only those move in
+        // a sweep and only their f_c is kept from before it; a granule the
+        // last sweep put no force on keeps its x̃ (its update would add
+        // zeros).
+        let surface = self.mesh.surface_range();
         for sweep in 0..p.contact_sweeps {
             if sweep > 0 {
                 self.granules
                     .par_iter_mut()
                     .zip(self.contact.f_before.par_iter())
-                    .for_each(|(g, before)| {
-                        for (((x, f), f0), m) in
-                            g.x_pred.iter_mut().zip(&g.f_c).zip(before).zip(&g.mass)
+                    .zip(self.contact.forced.par_iter())
+                    .filter(|(_, forced)| **forced)
+                    .for_each(|((g, before), _)| {
+                        let s = surface.clone();
+                        for (((x, f), f0), m) in g.x_pred[s.clone()]
+                            .iter_mut()
+                            .zip(&g.f_c[s.clone()])
+                            .zip(before)
+                            .zip(&g.mass[s])
                         {
                             for a in 0..3 {
                                 x[a] += dt2 * (f[a] - f0[a]) / m;
@@ -611,9 +623,13 @@ impl Assembly<'_> {
                 // Reuse the buffers: this runs every sweep of every step.
                 let before = &mut self.contact.f_before;
                 before.resize_with(self.granules.len(), Vec::new);
-                for (b, g) in before.iter_mut().zip(&self.granules) {
-                    b.clone_from(&g.f_c);
-                }
+                before
+                    .par_iter_mut()
+                    .zip(self.granules.par_iter())
+                    .for_each(|(b, g)| {
+                        b.clear();
+                        b.extend_from_slice(&g.f_c[surface.clone()]);
+                    });
             }
             self.contact_sweep(step, &walls, dt2, sweep == 0, &mut wall_totals)?;
             self.times.sweeps += 1;
