@@ -341,14 +341,30 @@ impl Errors {
     }
 
     /// The largest figure this run has (NaN if it has none): the
-    /// diagram's abscissa. A run that another faster run is no worse than
-    /// ([`Errors::no_worse_than`]) never plots left of it.
+    /// diagram's abscissa. Of two runs with the same figures, one that the
+    /// other is no worse than ([`Errors::no_worse_than`]) never plots left
+    /// of it (a figure only one run lacks can break that).
     pub fn largest(&self) -> Real {
         [self.curve, self.sigma, self.kawakita_a, self.kawakita_inv_b]
             .into_iter()
             .filter(|x| !x.is_nan())
             .reduce(Real::max)
             .unwrap_or(Real::NAN)
+    }
+
+    /// Every figure within `spread`'s; a figure either lacks (NaN) is not
+    /// judged — unlike [`Errors::no_worse_than`], where a figure only the
+    /// other run has counts against this one.
+    pub fn within(&self, spread: &Self) -> bool {
+        let pairs = [
+            (self.curve, spread.curve),
+            (self.sigma, spread.sigma),
+            (self.kawakita_a, spread.kawakita_a),
+            (self.kawakita_inv_b, spread.kawakita_inv_b),
+        ];
+        pairs
+            .iter()
+            .all(|&(x, s)| x <= s || x.is_nan() || s.is_nan())
     }
 
     /// The larger of each figure (NaN-ignoring).
@@ -374,8 +390,7 @@ pub struct Row<'a> {
     /// is faster with no error larger ([`Errors::no_worse_than`]).
     pub pareto: bool,
     /// Every error is within the run-to-run spread of the default over
-    /// poured beds (bed study; None for a granule): no figure larger than
-    /// the spread's, a figure the spread lacks not judged.
+    /// poured beds (bed study; None for a granule): [`Errors::within`].
     pub within_spread: Option<bool>,
 }
 
@@ -405,7 +420,7 @@ pub fn rows<'a>(
             errors,
             reference: i == 0,
             pareto: false,
-            within_spread: spread.map(|s| errors.no_worse_than(&s)),
+            within_spread: spread.map(|s| errors.within(&s)),
         })
         .collect();
     let front: Vec<bool> = rows
@@ -508,7 +523,7 @@ pub fn diagram(
         if let Some(x) = spread.filter(|x| *x > 0.0) {
             chart
                 .draw_series(LineSeries::new([(x, yr.start), (x, yr.end)], BLACK))?
-                .label("run-to-run spread over poured beds");
+                .label("run-to-run spread over pours, largest error (within_spread judges each)");
             chart.configure_series_labels().border_style(BLACK).draw()?;
         }
         for (name, x, y, front) in &pts {
@@ -771,6 +786,10 @@ mod tests {
             kawakita_inv_b: Real::NAN,
             ..e
         };
+        // A figure the row lacks is not judged either: a run without a
+        // Kawakita fit is within a spread whose curve it stays inside.
+        let unfit = Errors::of(&measured(r.clone(), None), &reference);
+        assert!(unfit.within(&a_out) && !e.within(&a_out));
         for (s, within) in [(a_out, false), (no_fit, true)] {
             let rows = rows(
                 &reference,
