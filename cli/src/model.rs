@@ -3,6 +3,7 @@
 
 use anyhow::{Context as _, bail};
 use granbed_kernel::Real;
+use granbed_kernel::contact::face_lists::face_diagonal;
 use granbed_kernel::dem::neighbors::Pair;
 use granbed_kernel::dem::pour::{PourBuffers, PourParams};
 use granbed_kernel::element::batch::{ElementBatch, batch_count, regroup};
@@ -134,6 +135,17 @@ impl OwnedReference {
     /// the only nodes contact forces act on.
     pub fn surface_range(&self) -> core::ops::Range<usize> {
         self.positions.len() - self.surface_nodes..self.positions.len()
+    }
+
+    /// Mean of the surface quads' larger diagonals on the reference
+    /// positions, m (0 without quads).
+    pub fn mean_face_diagonal(&self) -> Real {
+        let sum: Real = self
+            .quads
+            .iter()
+            .map(|q| face_diagonal(&q.map(|i| self.positions[i as usize])))
+            .sum();
+        sum / (self.quads.len().max(1) as Real)
     }
 
     /// Generates the sphere of `radius` (m) at `level`, the positive octant

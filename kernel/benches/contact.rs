@@ -1,14 +1,19 @@
 //! Criterion benches of granule contact: one node-to-quad projection on a
 //! warped face, and a full contact pass (detection of both passes + the
 //! kinematic forces) on a dense pair: two standard 1280-hex granules whose
-//! surfaces overlap by 60 µm, as in a compressed bed.
+//! surfaces overlap by 60 µm, as in a compressed bed; detection on that
+//! pair trying every face against detection through per-node face lists
+//! (and the lists' build).
 
 use core::hint::black_box;
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use granbed_kernel::contact::broad::bounding_sphere;
+use granbed_kernel::contact::face_lists::{
+    AnchorSurface, FaceLists, FaceListsMut, ListLengths, ReachBox, build,
+};
 use granbed_kernel::contact::pair::{
-    CandidateFace, Constraint, NodeForce, PairSettings, detect, forces,
+    CandidateFace, Constraint, NodeForce, PairSettings, detect, detect_listed, forces,
 };
 use granbed_kernel::contact::quad::project;
 use granbed_kernel::contact::surface::{Aabb, SurfaceBody, quad_bounds};
@@ -66,6 +71,19 @@ fn body<'a>(
     }
 }
 
+/// One pass's face-list buffers: nodes, starts, faces, used.
+type ListBuffers = (Vec<u32>, Vec<u32>, Vec<u32>, Vec<u32>);
+
+/// `x`'s surface as the face lists' anchor.
+fn anchor<'a>(m: &'a Sphere, x: &'a [[f64; 3]]) -> AnchorSurface<'a> {
+    let first = x.len() - m.surface;
+    AnchorSurface {
+        x: &x[first..],
+        first_surface: first,
+        quads: &m.quads,
+    }
+}
+
 fn benches(c: &mut Criterion) {
     let quad = [
         [0.0, 0.0, 0.0],
@@ -103,6 +121,77 @@ fn benches(c: &mut Criterion) {
     let n = detect(&a, &b, &settings, &mut scratch, &mut constraints).unwrap();
     eprintln!("dense pair: {n} constraints (both passes)");
     let mut out = vec![NodeForce::default(); 5 * 1024];
+    c.bench_function("detect on a dense pair (every face)", |bench| {
+        bench.iter(|| detect(&a, &b, &settings, &mut scratch, &mut constraints).unwrap())
+    });
+    // Face lists with the bed's default skin (0.05 of the mean face
+    // diagonal, about 7 µm here), built on the same configuration.
+    let (a_anchor, b_anchor) = (anchor(&m, &a_x), anchor(&m, &b_x));
+    let drift = 7e-6;
+    let mut reach = vec![ReachBox::default(); m.quads.len()];
+    let mut lists = [(); 2].map(|_| {
+        (
+            vec![0u32; m.surface],
+            vec![0u32; m.surface + 1],
+            vec![0u32; 64 * m.surface],
+            vec![0u32; m.quads.len()],
+        )
+    });
+    let mut build_both = |lists: &mut [ListBuffers; 2]| {
+        let mut lengths = [ListLengths::default(); 2];
+        for (k, (slave, master)) in [(&a_anchor, &b_anchor), (&b_anchor, &a_anchor)]
+            .into_iter()
+            .enumerate()
+        {
+            let l = &mut lists[k];
+            let out = FaceListsMut {
+                nodes: &mut l.0,
+                starts: &mut l.1,
+                faces: &mut l.2,
+                used: &mut l.3,
+            };
+            lengths[k] = build(
+                slave,
+                master,
+                settings.window_fraction,
+                drift,
+                &mut reach,
+                out,
+            )
+            .unwrap();
+        }
+        lengths
+    };
+    let len = build_both(&mut lists);
+    eprintln!("face lists: {len:?}");
+    c.bench_function("face lists of a dense pair (both passes)", |bench| {
+        bench.iter(|| build_both(&mut lists))
+    });
+    let view = |k: usize| {
+        let l = &lists[k];
+        FaceLists {
+            nodes: &l.0[..len[k].nodes],
+            starts: &l.1[..len[k].nodes + 1],
+            faces: &l.2[..len[k].faces],
+            used: &l.3[..len[k].used],
+        }
+    };
+    let (ab, ba) = (view(0), view(1));
+    let mut slot = vec![u32::MAX; m.quads.len()];
+    c.bench_function("detect on a dense pair (face lists)", |bench| {
+        bench.iter(|| {
+            detect_listed(
+                &a,
+                &b,
+                &settings,
+                [&ab, &ba],
+                &mut scratch,
+                &mut slot,
+                &mut constraints,
+            )
+            .unwrap()
+        })
+    });
     c.bench_function("contact pass on a dense pair (detect + forces)", |bench| {
         bench.iter(|| {
             let n = detect(&a, &b, &settings, &mut scratch, &mut constraints).unwrap();

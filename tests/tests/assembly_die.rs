@@ -112,33 +112,64 @@ fn a_small_die_compresses_to_thirty_percent() {
     );
 }
 
-#[test]
-fn the_die_is_bit_identical_on_one_and_two_threads() {
-    let (scene, centres, params) = small_die();
+/// The bits of every granule's positions and velocities at 8 % strain
+/// (granules in contact, rebuilds, sweeps) run with `params` on `threads`
+/// threads, then the punch work's bits and the face-list builds.
+fn die_at_eight_percent(params: AssemblyParams, threads: usize) -> (Vec<u64>, u64, u64) {
+    let (scene, centres, _) = small_die();
     let mesh = OwnedReference::sphere(R, MeshLevel::new(4, 1), false).unwrap();
     let placed = placements(&centres, 7);
-    let run = |threads| {
-        let pool = rayon::ThreadPoolBuilder::new()
-            .num_threads(threads)
-            .build()
-            .unwrap();
-        pool.install(|| {
-            let mut asm = Assembly::new(params, &mesh, &placed, scene.walls()).unwrap();
-            // 8 % strain: granules in contact, rebuilds, sweeps.
-            while scene.strain_at(asm.time()) < 0.08 {
-                asm.step().unwrap();
-            }
-            let touching = asm.contact().pairs_in_contact();
-            assert!(touching > 10, "only {touching} pairs in contact");
-            let state: Vec<_> = asm
-                .granules()
-                .iter()
-                .map(|g| (g.x.clone(), g.v.clone()))
-                .collect();
-            (state, asm.energies().punch_work)
-        })
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .unwrap();
+    pool.install(|| {
+        let mut asm = Assembly::new(params, &mesh, &placed, scene.walls()).unwrap();
+        while scene.strain_at(asm.time()) < 0.08 {
+            asm.step().unwrap();
+        }
+        let touching = asm.contact().pairs_in_contact();
+        assert!(touching > 10, "only {touching} pairs in contact");
+        let state = asm
+            .granules()
+            .iter()
+            .flat_map(|g| g.x.iter().chain(&g.v))
+            .flatten()
+            .map(|c| c.to_bits())
+            .collect();
+        (
+            state,
+            asm.energies().punch_work.to_bits(),
+            asm.contact().list_builds(),
+        )
+    })
+}
+
+#[test]
+fn the_die_is_bit_identical_on_one_and_two_threads() {
+    let (_, _, params) = small_die();
+    assert!(
+        die_at_eight_percent(params, 1) == die_at_eight_percent(params, 2),
+        "the result depends on the thread count"
+    );
+}
+
+#[test]
+fn face_lists_give_the_bits_of_searching_every_face() {
+    let (_, _, params) = small_die();
+    let without = AssemblyParams {
+        face_list_skin: 0.0,
+        ..params
     };
-    assert!(run(1) == run(2), "the result depends on the thread count");
+    let (bits, work, builds) = die_at_eight_percent(params, 2);
+    let (bits_all, work_all, builds_all) = die_at_eight_percent(without, 2);
+    eprintln!("face-list builds: {builds}");
+    assert_eq!(builds_all, 0, "no lists without a skin");
+    // Lists were renewed as the granules moved, not built once.
+    let pairs_built_once = 200;
+    assert!(builds > pairs_built_once, "only {builds} list builds");
+    assert!(work == work_all, "punch work differs");
+    assert!(bits == bits_all, "the motion differs with face lists");
 }
 
 /// Benchmark (BENCHMARKS.md): the same die with the standard 8x2 mesh to

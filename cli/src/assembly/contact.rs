@@ -5,9 +5,10 @@ use granbed_kernel::Real;
 use granbed_kernel::contact::broad::{
     Bound, BroadScratch, GranulePair, bounding_sphere, candidate_pairs, needs_rebuild,
 };
+use granbed_kernel::contact::face_lists::{self, AnchorSurface, FaceLists, FaceListsMut, ReachBox};
 use granbed_kernel::contact::pair::{
     CandidateFace, Constraint, ContactError, Involvement, NodeForce, PairForce, PairSettings, Side,
-    detect, forces, mark_involvement,
+    detect, detect_listed, forces, mark_involvement,
 };
 use granbed_kernel::contact::surface::{Aabb, SurfaceBody, quad_bounds};
 use rayon::prelude::*;
@@ -26,6 +27,89 @@ pub struct PairWork {
     /// What every sweep of the last step did together: forces summed,
     /// constraint counts of the first sweep, the smallest gap.
     pub step: PairForce,
+    /// The face lists of the pair's two passes.
+    lists: PairLists,
+}
+
+/// A pair's face lists (pass A→B, pass B→A) and what they were built for.
+#[derive(Clone, Debug, Default)]
+struct PairLists {
+    /// The pair and its granules' anchor epochs at the build (`None`: not
+    /// built); the lists serve only while all three are the same.
+    key: Option<(GranulePair, u32, u32)>,
+    pass: [OwnedLists; 2],
+}
+
+/// One pass's lists in the layout of [`FaceLists`].
+#[derive(Clone, Debug, Default)]
+struct OwnedLists {
+    nodes: Vec<u32>,
+    starts: Vec<u32>,
+    faces: Vec<u32>,
+    used: Vec<u32>,
+}
+
+impl OwnedLists {
+    fn view(&self) -> FaceLists<'_> {
+        FaceLists {
+            nodes: &self.nodes,
+            starts: &self.starts,
+            faces: &self.faces,
+            used: &self.used,
+        }
+    }
+
+    /// Builds the lists of `slave` → `master` on their anchors, growing
+    /// the face buffer until it fits.
+    fn build(
+        &mut self,
+        slave: &AnchorSurface<'_>,
+        master: &AnchorSurface<'_>,
+        window_fraction: Real,
+        drift: Real,
+        scratch: &mut Vec<ReachBox>,
+    ) -> Result<(), ContactError> {
+        scratch.resize(scratch.len().max(master.quads.len()), ReachBox::default());
+        self.nodes.resize(slave.x.len(), 0);
+        self.starts.resize(slave.x.len() + 1, 0);
+        self.used.resize(master.quads.len(), 0);
+        if self.faces.is_empty() {
+            self.faces.resize(256, 0);
+        }
+        let len = loop {
+            let out = FaceListsMut {
+                nodes: &mut self.nodes,
+                starts: &mut self.starts,
+                faces: &mut self.faces,
+                used: &mut self.used,
+            };
+            match face_lists::build(slave, master, window_fraction, drift, scratch, out) {
+                Ok(len) => break len,
+                Err(ContactError::Capacity {
+                    buffer: "face lists",
+                    ..
+                }) => {
+                    let grown = 2 * self.faces.len();
+                    self.faces.resize(grown, 0);
+                }
+                Err(e) => return Err(e),
+            }
+        };
+        self.nodes.truncate(len.nodes);
+        self.starts.truncate(len.nodes + 1);
+        self.faces.truncate(len.faces);
+        self.used.truncate(len.used);
+        Ok(())
+    }
+}
+
+/// Per-thread scratch of the detection.
+#[derive(Default)]
+struct DetectScratch {
+    faces: Vec<CandidateFace>,
+    reach: Vec<ReachBox>,
+    /// Per master quad, its candidate index (`u32::MAX`: none).
+    slot: Vec<u32>,
 }
 
 impl PairWork {
@@ -77,6 +161,15 @@ pub struct ContactPhase {
     /// Scratch of `narrow_to_deep_pairs`, per granule: [`DEEP`] or
     /// [`NEAR_DEEP`] bits.
     narrow: Vec<u8>,
+    /// Face-list drift, m (0: no face lists).
+    list_drift: Real,
+    /// Per granule: its surface nodes' x̃ when its anchor was last renewed
+    /// (the configuration its pairs' face lists were built on).
+    anchors: Vec<Vec<[Real; 3]>>,
+    /// Per granule: how many times its anchor was renewed.
+    epochs: Vec<u32>,
+    /// Face-list builds so far (both passes of a pair count one).
+    list_builds: u64,
 }
 
 /// `narrow` bit: the granule is in a pair deeper than the tolerance.
@@ -128,6 +221,17 @@ impl ContactPhase {
             next: vec![0; n],
             ..Self::default()
         }
+    }
+
+    /// Uses per-node face lists with drift `drift` (m; 0: none).
+    pub fn with_face_lists(mut self, drift: Real) -> Self {
+        self.list_drift = drift;
+        self
+    }
+
+    /// Face-list builds so far (a pair's two passes count one).
+    pub fn list_builds(&self) -> u64 {
+        self.list_builds
     }
 
     /// Candidate pairs of the current list.
@@ -304,21 +408,88 @@ impl ContactPhase {
         settings: &PairSettings,
         first: bool,
     ) -> Result<(), ContactError> {
+        let drift = self.list_drift;
+        if drift > 0.0 {
+            self.renew_anchors(granules, mesh);
+        }
         let (boxes, bounds, quad_boxes) = (&self.boxes, &self.bounds, &self.quad_boxes);
-        let touched = &self.touched;
-        self.pairs
+        let (touched, anchors, epochs) = (&self.touched, &self.anchors, &self.epochs);
+        let first_surface = mesh.surface_range().start;
+        let anchor = |g: usize| AnchorSurface {
+            x: &anchors[g],
+            first_surface,
+            quads: &mesh.quads,
+        };
+        let builds = self
+            .pairs
             .par_iter()
             .zip(self.work.par_iter_mut())
-            .try_for_each_init(Vec::new, |scratch, (p, w)| {
-                let (a, b) = (p.a as usize, p.b as usize);
-                if !first && !touched[a] && !touched[b] {
-                    w.count = 0;
-                    return Ok(());
+            .try_fold(
+                || (DetectScratch::default(), 0u64),
+                |(mut scratch, mut builds), (p, w)| {
+                    let (a, b) = (p.a as usize, p.b as usize);
+                    if !first && !touched[a] && !touched[b] {
+                        w.count = 0;
+                        return Ok((scratch, builds));
+                    }
+                    let body_a = body(&granules[a], mesh, (boxes[a], bounds[a], &quad_boxes[a]));
+                    let body_b = body(&granules[b], mesh, (boxes[b], bounds[b], &quad_boxes[b]));
+                    if drift <= 0.0 {
+                        detect_growing(&body_a, &body_b, settings, &mut scratch, w, false)?;
+                        return Ok((scratch, builds));
+                    }
+                    let m = settings.margin;
+                    if body_a
+                        .bounds
+                        .expanded(m)
+                        .intersect(&body_b.bounds.expanded(m))
+                        .is_empty()
+                    {
+                        // Both passes would stop here: nothing to list.
+                        w.count = 0;
+                        return Ok((scratch, builds));
+                    }
+                    let key = Some((*p, epochs[a], epochs[b]));
+                    if w.lists.key != key {
+                        let (ab, ba) = w.lists.pass.split_at_mut(1);
+                        let f = settings.window_fraction;
+                        ab[0].build(&anchor(a), &anchor(b), f, drift, &mut scratch.reach)?;
+                        ba[0].build(&anchor(b), &anchor(a), f, drift, &mut scratch.reach)?;
+                        w.lists.key = key;
+                        builds += 1;
+                    }
+                    detect_growing(&body_a, &body_b, settings, &mut scratch, w, true)?;
+                    Ok((scratch, builds))
+                },
+            )
+            .map(|r| r.map(|(_, builds)| builds))
+            .try_reduce(|| 0, |x, y| Ok(x + y))?;
+        self.list_builds += builds;
+        Ok(())
+    }
+
+    /// Renews the anchor of every granule whose x̃ has left it by more than
+    /// the face-list drift (or holds a NaN, or has none yet): its surface
+    /// x̃ becomes the anchor and its epoch advances, so its pairs rebuild
+    /// their lists.
+    fn renew_anchors(&mut self, granules: &[GranuleStore], mesh: &OwnedReference) {
+        let surface = mesh.surface_range();
+        let drift = self.list_drift;
+        self.anchors.resize(granules.len(), Vec::new());
+        self.epochs.resize(granules.len(), 0);
+        self.anchors
+            .par_iter_mut()
+            .zip(self.epochs.par_iter_mut())
+            .zip(granules.par_iter())
+            .for_each(|((anchor, epoch), g)| {
+                let moved = face_lists::drift(&g.x_pred, surface.start, anchor);
+                // A NaN renews too.
+                if moved.is_nan() || moved > drift {
+                    anchor.clear();
+                    anchor.extend_from_slice(&g.x_pred[surface.clone()]);
+                    *epoch = epoch.wrapping_add(1);
                 }
-                let body_a = body(&granules[a], mesh, (boxes[a], bounds[a], &quad_boxes[a]));
-                let body_b = body(&granules[b], mesh, (boxes[b], bounds[b], &quad_boxes[b]));
-                detect_growing(&body_a, &body_b, settings, scratch, w)
-            })
+            });
     }
 
     /// Contact counts per node for the mass sharing: pairs in list order,
@@ -478,7 +649,7 @@ impl ContactPhase {
         pairs[..n]
             .par_iter()
             .map_init(
-                || (Vec::new(), PairWork::default()),
+                || (DetectScratch::default(), PairWork::default()),
                 |(scratch, w), p| {
                     let (a, b) = (p.a as usize, p.b as usize);
                     let (ga, gb) = (&granules[a], &granules[b]);
@@ -488,6 +659,7 @@ impl ContactPhase {
                         settings,
                         scratch,
                         w,
+                        false,
                     )?;
                     Ok(w.constraints().iter().map(|c| c.gap).fold(0.0, Real::min))
                 },
@@ -496,24 +668,44 @@ impl ContactPhase {
     }
 }
 
-/// [`detect`] into `w` with the (per-thread) candidate-face `scratch`,
-/// doubling the pair's constraint list until it fits.
+/// Detection of the pair into `w` with the (per-thread) `scratch` —
+/// through the pair's face lists ([`detect_listed`]) when `listed`, else
+/// trying every face ([`detect`]) —, doubling the pair's constraint list
+/// until it fits.
 fn detect_growing(
     a: &SurfaceBody<'_>,
     b: &SurfaceBody<'_>,
     settings: &PairSettings,
-    scratch: &mut Vec<CandidateFace>,
+    scratch: &mut DetectScratch,
     w: &mut PairWork,
+    listed: bool,
 ) -> Result<(), ContactError> {
     let need = a.quads.len().max(b.quads.len());
-    if scratch.len() < need {
-        scratch.resize(need, CandidateFace::default());
+    if scratch.faces.len() < need {
+        scratch.faces.resize(need, CandidateFace::default());
+    }
+    if scratch.slot.len() < need {
+        scratch.slot.resize(need, u32::MAX);
     }
     if w.constraints.is_empty() {
         w.constraints.resize(64, Constraint::default());
     }
+    let lists = [w.lists.pass[0].view(), w.lists.pass[1].view()];
     loop {
-        match detect(a, b, settings, scratch, &mut w.constraints) {
+        let found = if listed {
+            detect_listed(
+                a,
+                b,
+                settings,
+                [&lists[0], &lists[1]],
+                &mut scratch.faces,
+                &mut scratch.slot,
+                &mut w.constraints,
+            )
+        } else {
+            detect(a, b, settings, &mut scratch.faces, &mut w.constraints)
+        };
+        match found {
             Ok(n) => {
                 w.count = n;
                 return Ok(());

@@ -99,6 +99,13 @@ pub struct AssemblyParams {
     /// ([`ContactPhase`]`::narrow_to_deep_pairs`); false: every pair with
     /// a granule the last sweep moved.
     pub local_sweeps: bool,
+    /// Skin of the per-node face lists, as a fraction of the reference
+    /// mesh's mean surface-face diagonal: a pair's lists are rebuilt once a
+    /// surface node of either granule has moved this far from where they
+    /// were built ([`granbed_kernel::contact::face_lists`]); the constraints
+    /// are the same bits as searching every face. 0: no lists (every sweep
+    /// tries every face near the overlap); 0 ≤ s ≤ 1.
+    pub face_list_skin: Real,
 }
 
 impl AssemblyParams {
@@ -131,9 +138,14 @@ impl AssemblyParams {
             time_step_interval: 100,
             rigid_until_touched: true,
             local_sweeps: true,
+            face_list_skin: FACE_LIST_SKIN,
         }
     }
 }
+
+/// The default [`AssemblyParams::face_list_skin`] (measured in
+/// BENCHMARKS.md, "Face lists").
+pub const FACE_LIST_SKIN: Real = 0.05;
 
 /// Where a granule starts: its mesh is rotated by `rotation` (a proper
 /// orthogonal matrix, row-major) about the mesh centre, then moved to
@@ -312,7 +324,8 @@ impl<'m> Assembly<'m> {
                 params.material.density0 * params.mass_scaling,
                 radius,
             ),
-            contact: ContactPhase::new(&granules, mesh),
+            contact: ContactPhase::new(&granules, mesh)
+                .with_face_lists(params.face_list_skin * mesh.mean_face_diagonal()),
             params,
             mesh,
             granules,

@@ -157,7 +157,13 @@ impl fmt::Display for AssemblyError {
 impl core::error::Error for AssemblyError {}
 
 pub(super) fn validate(p: &AssemblyParams) -> Result<(), AssemblyError> {
-    let checks: [(bool, &'static str, Real, &'static str); 11] = [
+    let checks: [(bool, &'static str, Real, &'static str); 12] = [
+        (
+            (0.0..=1.0).contains(&p.face_list_skin),
+            "face_list_skin",
+            p.face_list_skin,
+            "0 <= s <= 1 (0: no face lists)",
+        ),
         (
             (1.0..=1e6).contains(&p.mass_scaling),
             "mass_scaling",

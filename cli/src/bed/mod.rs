@@ -149,10 +149,17 @@ pub struct BedArgs {
     #[arg(long, value_name = "BOOL")]
     pub local_sweeps: Option<bool>,
 
+    /// Override: skin of the contact search's per-node face lists as a
+    /// fraction of the mean surface-face diagonal (0 ≤ s ≤ 1, 0: none;
+    /// default 0.05). Only the speed depends on it, so it may be given with
+    /// --resume.
+    #[arg(long, value_name = "S")]
+    pub face_list_skin: Option<f64>,
+
     /// Continue the run whose checkpoint is in DIR (its `checkpoint.bin`);
     /// the outputs go to DIR. Only --strain, --stop-at-strain,
-    /// --time-step-safety, --mass-scaling, -j and --quiet may be given with
-    /// it.
+    /// --time-step-safety, --mass-scaling, --face-list-skin, -j and --quiet
+    /// may be given with it.
     #[arg(long, value_name = "DIR", conflicts_with_all = ["scene", "out", "granule_type", "granules", "mesh", "seed", "die_diameter_mm", "element", "hourglass_kappa", "rigid_until_touched", "local_sweeps"])]
     pub resume: Option<PathBuf>,
 
@@ -239,6 +246,9 @@ impl BedArgs {
         }
         if let Some(c) = self.time_step_safety {
             scene.time_step_safety = c;
+        }
+        if let Some(s) = self.face_list_skin {
+            scene.face_list_skin = s;
         }
         scene.validate()?;
         Ok(scene)

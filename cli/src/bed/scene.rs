@@ -66,6 +66,11 @@ rigid_until_touched = true
 # Contact sweeps after the first search only the neighbourhood of the pairs
 # still deeper than the tolerance (false: every pair of a moved granule).
 local_sweeps = true
+# Skin of the contact search's per-node face lists, as a fraction of the mean
+# surface-face diagonal: a pair's lists are rebuilt once a node has moved this
+# far (0: try every face near the overlap every sweep). The results are the
+# same bits either way; only the speed depends on it.
+face_list_skin = 0.05
 # Watchdogs: stop (with a checkpoint from before) when the kinetic energy
 # exceeds this multiple of all the energy put in (punch or contact work,
 # gravity, initial motion), or when a node moves faster than this multiple of
@@ -167,6 +172,11 @@ pub struct Scene {
     /// Later contact sweeps search only near the deep pairs (absent: true).
     #[serde(default = "default_true")]
     pub local_sweeps: bool,
+    /// Skin of the contact search's face lists, 0 ≤ s ≤ 1 of the mean
+    /// surface-face diagonal, 0 = none (absent: the default); the same
+    /// bits for any value.
+    #[serde(default = "default_face_list_skin")]
+    pub face_list_skin: f64,
     /// Watchdog limit on the kinetic energy as a multiple of the energy
     /// put in, 1 ≤ r ≤ 1e9 (absent: 2).
     #[serde(default = "default_watchdog_energy_ratio")]
@@ -178,6 +188,10 @@ pub struct Scene {
     /// Material overrides.
     #[serde(default)]
     pub material: MaterialOverrides,
+}
+
+fn default_face_list_skin() -> f64 {
+    crate::assembly::FACE_LIST_SKIN
 }
 
 fn unit_scaling() -> f64 {
@@ -257,7 +271,13 @@ impl Scene {
         self.granule_type()?;
         self.mesh_level()?;
         self.element_kind()?;
-        let checks: [(bool, &str, f64, &str); 15] = [
+        let checks: [(bool, &str, f64, &str); 16] = [
+            (
+                (0.0..=1.0).contains(&self.face_list_skin),
+                "face_list_skin",
+                self.face_list_skin,
+                "0 <= s <= 1 (0: no face lists)",
+            ),
             (
                 (0.0..=1.0).contains(&self.hourglass_kappa),
                 "hourglass_kappa",

@@ -23,6 +23,7 @@
 use core::fmt;
 
 use crate::Real;
+use crate::contact::face_lists::{FaceLists, face_diagonal};
 use crate::contact::quad::{
     QuadProjection, QuadSieve, Vec3, dot, norm, project, project_clamped, sub,
 };
@@ -256,6 +257,55 @@ pub fn detect(
     scratch: &mut [CandidateFace],
     out: &mut [Constraint],
 ) -> Result<usize, ContactError> {
+    check_buffers(a, b, scratch)?;
+    let mut count = detect_pass(a, b, Side::A, settings, scratch, &mut AllFaces, out, 0)?;
+    if settings.symmetric {
+        count = detect_pass(b, a, Side::B, settings, scratch, &mut AllFaces, out, count)?;
+    }
+    Ok(count)
+}
+
+/// Finds the same constraints as [`detect`], to the bit, trying each slave
+/// node only against the faces of its list (`lists[0]`: pass A→B,
+/// `lists[1]`: pass B→A, from [`crate::contact::face_lists::build`] on
+/// anchors that no surface node of A or B has left by more than the
+/// lists' drift). `slot` has one entry per quad of the larger body, all
+/// `u32::MAX` on entry, and is left so.
+pub fn detect_listed(
+    a: &SurfaceBody<'_>,
+    b: &SurfaceBody<'_>,
+    settings: &PairSettings,
+    lists: [&FaceLists<'_>; 2],
+    scratch: &mut [CandidateFace],
+    slot: &mut [u32],
+    out: &mut [Constraint],
+) -> Result<usize, ContactError> {
+    check_buffers(a, b, scratch)?;
+    let need = a.quads.len().max(b.quads.len());
+    if slot.len() < need {
+        return Err(ContactError::BufferLength {
+            buffer: "slot",
+            expected: need,
+            got: slot.len(),
+        });
+    }
+    let mut faces = ListedFaces {
+        lists: lists[0],
+        slot,
+    };
+    let mut count = detect_pass(a, b, Side::A, settings, scratch, &mut faces, out, 0)?;
+    if settings.symmetric {
+        faces.lists = lists[1];
+        count = detect_pass(b, a, Side::B, settings, scratch, &mut faces, out, count)?;
+    }
+    Ok(count)
+}
+
+fn check_buffers(
+    a: &SurfaceBody<'_>,
+    b: &SurfaceBody<'_>,
+    scratch: &[CandidateFace],
+) -> Result<(), ContactError> {
     let need = a.quads.len().max(b.quads.len());
     if scratch.len() < need {
         return Err(ContactError::BufferLength {
@@ -273,32 +323,113 @@ pub fn detect(
             });
         }
     }
-    let mut count = detect_pass(a, b, Side::A, settings, scratch, out, 0)?;
-    if settings.symmetric {
-        count = detect_pass(b, a, Side::B, settings, scratch, out, count)?;
-    }
-    Ok(count)
+    Ok(())
 }
 
 /// How far outside a face (in ξ, η beyond ±1) a node may project and still
 /// be tried against a concave edge.
 const EDGE_REACH: Real = 0.25;
 
-/// Largest face diagonal of quad `x`, m.
-fn face_diagonal(x: &[Vec3; 4]) -> Real {
-    let d1 = norm(&sub(&x[2], &x[0]));
-    let d2 = norm(&sub(&x[3], &x[1]));
-    if d1 > d2 { d1 } else { d2 }
+/// Which master faces a pass builds and which a slave node is tried
+/// against: all of them ([`AllFaces`]) or the node's list
+/// ([`ListedFaces`]). Both give a node its candidate faces in ascending
+/// quad order, so both find the same constraints.
+trait PassFaces {
+    /// How many master quads may become candidates.
+    fn quad_count(&self, master: &SurfaceBody<'_>) -> usize;
+    /// The `i`-th of them, ascending in `i`.
+    fn quad(&self, i: usize) -> usize;
+    /// Records that quad `q` is candidate `index` of the pass.
+    fn note(&mut self, q: usize, index: usize);
+    /// Slave nodes that may find a face (ascending), each with its index
+    /// for [`Self::faces_of`].
+    fn nodes(&self, slave: &SurfaceBody<'_>) -> impl Iterator<Item = (usize, usize)>;
+    /// Node `k`'s candidates among `candidates`, ascending.
+    fn faces_of<'c>(
+        &self,
+        k: usize,
+        candidates: &'c [CandidateFace],
+    ) -> impl Iterator<Item = &'c CandidateFace> + Clone;
+    /// Undoes [`Self::note`] at the end of the pass.
+    fn clear(&mut self);
 }
 
-/// One pass: `slave`'s nodes against `master`'s faces; appends to `out`
-/// from `start` and returns the new length.
+/// Every master face, every slave surface node.
+struct AllFaces;
+
+impl PassFaces for AllFaces {
+    fn quad_count(&self, master: &SurfaceBody<'_>) -> usize {
+        master.quads.len()
+    }
+    fn quad(&self, i: usize) -> usize {
+        i
+    }
+    fn note(&mut self, _: usize, _: usize) {}
+    fn nodes(&self, slave: &SurfaceBody<'_>) -> impl Iterator<Item = (usize, usize)> {
+        (slave.first_surface..slave.x_pred.len()).map(|s| (s, 0))
+    }
+    fn faces_of<'c>(
+        &self,
+        _: usize,
+        candidates: &'c [CandidateFace],
+    ) -> impl Iterator<Item = &'c CandidateFace> + Clone {
+        candidates.iter()
+    }
+    fn clear(&mut self) {}
+}
+
+/// The faces of each node's list that are candidates of this sweep.
+struct ListedFaces<'l, 's> {
+    lists: &'l FaceLists<'l>,
+    /// Per master quad: its candidate index, `u32::MAX` if none.
+    slot: &'s mut [u32],
+}
+
+impl PassFaces for ListedFaces<'_, '_> {
+    fn quad_count(&self, _: &SurfaceBody<'_>) -> usize {
+        self.lists.used.len()
+    }
+    fn quad(&self, i: usize) -> usize {
+        self.lists.used[i] as usize
+    }
+    fn note(&mut self, q: usize, index: usize) {
+        self.slot[q] = index as u32;
+    }
+    fn nodes(&self, _: &SurfaceBody<'_>) -> impl Iterator<Item = (usize, usize)> {
+        self.lists
+            .nodes
+            .iter()
+            .enumerate()
+            .map(|(k, &s)| (s as usize, k))
+    }
+    fn faces_of<'c>(
+        &self,
+        k: usize,
+        candidates: &'c [CandidateFace],
+    ) -> impl Iterator<Item = &'c CandidateFace> + Clone {
+        let slot: &[u32] = self.slot;
+        self.lists
+            .faces_of(k)
+            .iter()
+            .filter_map(move |&q| candidates.get(slot[q as usize] as usize))
+    }
+    fn clear(&mut self) {
+        for &q in self.lists.used {
+            self.slot[q as usize] = u32::MAX;
+        }
+    }
+}
+
+/// One pass: `slave`'s nodes against `master`'s faces (those `pass`
+/// offers); appends to `out` from `start` and returns the new length.
+#[allow(clippy::too_many_arguments)]
 fn detect_pass(
     slave: &SurfaceBody<'_>,
     master: &SurfaceBody<'_>,
     side: Side,
     settings: &PairSettings,
     scratch: &mut [CandidateFace],
+    pass: &mut impl PassFaces,
     out: &mut [Constraint],
     start: usize,
 ) -> Result<usize, ContactError> {
@@ -314,7 +445,9 @@ fn detect_pass(
     // bounding sphere, with their windows and reach.
     let slave_reach = slave.sphere.radius + m;
     let mut faces = 0;
-    for (q, bounds) in master.quad_bounds.iter().enumerate() {
+    for i in 0..pass.quad_count(master) {
+        let q = pass.quad(i);
+        let bounds = &master.quad_bounds[q];
         if bounds.overlaps(&region) && bounds.distance_to(&slave.sphere.centre) <= slave_reach {
             let corners = master.quad_pred(q);
             let window = settings.window_fraction * face_diagonal(&corners);
@@ -326,6 +459,7 @@ fn detect_pass(
                 reach: bounds.expanded(window),
                 sieve: QuadSieve::new(&corners),
             };
+            pass.note(q, faces);
             faces += 1;
         }
     }
@@ -334,16 +468,17 @@ fn detect_pass(
     // Only nodes inside the master's bounding sphere can be behind its
     // surface.
     let (centre, reach) = (master.sphere.centre, master.sphere.radius + m);
-    for s in slave.first_surface..slave.x_pred.len() {
+    let mut full = false;
+    for (s, k) in pass.nodes(slave) {
         let p = slave.x_pred[s];
         if !region.contains(&p) || norm(&sub(&p, &centre)) > reach {
             continue;
         }
-        if let Some(c) = closest_face(slave, s, candidates, settings) {
-            let slot = out.get_mut(count).ok_or(ContactError::Capacity {
-                buffer: "constraints",
-                capacity: count,
-            })?;
+        if let Some(c) = closest_face(slave, s, pass.faces_of(k, candidates), settings) {
+            let Some(slot) = out.get_mut(count) else {
+                full = true;
+                break;
+            };
             *slot = Constraint {
                 side,
                 slave: s as u32,
@@ -354,6 +489,13 @@ fn detect_pass(
             };
             count += 1;
         }
+    }
+    pass.clear();
+    if full {
+        return Err(ContactError::Capacity {
+            buffer: "constraints",
+            capacity: count,
+        });
     }
     Ok(count)
 }
@@ -368,10 +510,10 @@ struct Hit {
 /// inside the face, −g_max < g < 0, opposing normals; the smallest |g|
 /// wins. With no face, a concave edge or corner shared by several faces is
 /// tried: the closest point on it with the faces' averaged normal.
-fn closest_face(
+fn closest_face<'c>(
     slave: &SurfaceBody<'_>,
     s: usize,
-    candidates: &[CandidateFace],
+    candidates: impl Iterator<Item = &'c CandidateFace> + Clone,
     settings: &PairSettings,
 ) -> Option<Hit> {
     let p = slave.x_pred[s];
@@ -382,7 +524,7 @@ fn closest_face(
     };
     let mut best: Option<Hit> = None;
     let mut near_outside = false;
-    for face in candidates {
+    for face in candidates.clone() {
         if !face.reach.contains(&p)
             || !face
                 .sieve
@@ -426,7 +568,7 @@ fn closest_face(
         // cannot be nearer (its closest point on that edge is a point of
         // the hit's face too), so only other faces can.
         let depth = abs(hit.projection.gap);
-        let nearer = candidates.iter().any(|face| {
+        let nearer = candidates.clone().any(|face| {
             face.quad != hit.quad
                 && face.bounds.distance_to(&p) < depth
                 && project_clamped(&p, &face.corners)
@@ -448,9 +590,12 @@ const NEARER_TOLERANCE: Real = 1e-9;
 /// The closest point of `p` on the candidate faces confined to their
 /// edges, when two or more faces share it (a concave edge or corner): the
 /// normal is their average, the gap is measured along it.
-fn concave_edge(p: &Vec3, candidates: &[CandidateFace]) -> Option<Hit> {
+fn concave_edge<'c>(
+    p: &Vec3,
+    candidates: impl Iterator<Item = &'c CandidateFace> + Clone,
+) -> Option<Hit> {
     let mut best: Option<(Real, u32, QuadProjection, Real)> = None;
-    for face in candidates {
+    for face in candidates.clone() {
         if !face.reach.contains(p) {
             continue;
         }

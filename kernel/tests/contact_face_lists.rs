@@ -1,0 +1,244 @@
+//! Per-node face lists (`contact::face_lists`): detection through lists
+//! built on an anchor gives the full pass's constraints to the bit while
+//! no surface node has moved farther than the lists' drift — and does not
+//! when the lists were built without that skin (so the comparison can fail).
+
+mod common;
+
+use common::{Rng, sphere_mesh};
+use granbed_kernel::Real;
+use granbed_kernel::contact::broad::bounding_sphere;
+use granbed_kernel::contact::face_lists::{
+    AnchorSurface, FaceLists, FaceListsMut, ReachBox, build, drift,
+};
+use granbed_kernel::contact::pair::{
+    CandidateFace, Constraint, PairSettings, detect, detect_listed,
+};
+use granbed_kernel::contact::surface::{Aabb, SurfaceBody, quad_bounds};
+use granbed_kernel::mesh::sphere::SphereMeshParams;
+
+type Vec3 = [Real; 3];
+
+/// Owned lists of one pass.
+#[derive(Default)]
+struct Lists {
+    nodes: Vec<u32>,
+    starts: Vec<u32>,
+    faces: Vec<u32>,
+    used: Vec<u32>,
+}
+
+impl Lists {
+    fn view(&self) -> FaceLists<'_> {
+        FaceLists {
+            nodes: &self.nodes,
+            starts: &self.starts,
+            faces: &self.faces,
+            used: &self.used,
+        }
+    }
+}
+
+fn build_lists(slave: &AnchorSurface<'_>, master: &AnchorSurface<'_>, d: Real) -> Lists {
+    let mut l = Lists {
+        nodes: vec![0; slave.x.len()],
+        starts: vec![0; slave.x.len() + 1],
+        faces: vec![0; 8],
+        used: vec![0; master.quads.len()],
+    };
+    let mut scratch = vec![ReachBox::default(); master.quads.len()];
+    let len = loop {
+        let out = FaceListsMut {
+            nodes: &mut l.nodes,
+            starts: &mut l.starts,
+            faces: &mut l.faces,
+            used: &mut l.used,
+        };
+        match build(slave, master, 0.25, d, &mut scratch, out) {
+            Ok(len) => break len,
+            Err(_) => {
+                let grown = 2 * l.faces.len();
+                l.faces.resize(grown, 0);
+            }
+        }
+    };
+    l.nodes.truncate(len.nodes);
+    l.starts.truncate(len.nodes + 1);
+    l.faces.truncate(len.faces);
+    l.used.truncate(len.used);
+    l
+}
+
+struct Scene {
+    mesh: common::OwnedMesh,
+    first: usize,
+    /// Anchor and predicted positions of bodies A and B (all nodes).
+    anchor: [Vec<Vec3>; 2],
+    pred: [Vec<Vec3>; 2],
+}
+
+/// Two granules (radius 0.5 mm, n = 4) pressed `overlap` into each other
+/// along a random direction, each randomly rotated; the predicted
+/// positions move every surface node by a random vector of length at most
+/// `moved` from its anchor.
+fn scene(seed: u64, overlap: Real, moved: Real) -> Scene {
+    let mesh = sphere_mesh(&SphereMeshParams::new(0.5e-3, 4, 1));
+    let first = mesh.size.nodes - mesh.size.surface_nodes;
+    let mut rng = Rng::new(seed);
+    let dir = {
+        let v: Vec3 = core::array::from_fn(|_| rng.uniform(-1.0, 1.0));
+        let n = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
+        v.map(|c| c / n)
+    };
+    let gap = 1.0e-3 - overlap;
+    let place = |rng: &mut Rng, centre: Vec3| -> Vec<Vec3> {
+        let r = rng.rotation();
+        mesh.positions
+            .iter()
+            .map(|p| {
+                core::array::from_fn(|i| centre[i] + (0..3).map(|j| r[(i, j)] * p[j]).sum::<Real>())
+            })
+            .collect()
+    };
+    let anchor = [
+        place(&mut rng, [0.0; 3]),
+        place(&mut rng, dir.map(|c| c * gap)),
+    ];
+    let pred = anchor.clone().map(|x| {
+        x.iter()
+            .enumerate()
+            .map(|(i, p)| {
+                if i < first {
+                    return *p;
+                }
+                let c = moved / (3.0 as Real).sqrt();
+                core::array::from_fn(|k| p[k] + rng.uniform(-c, c))
+            })
+            .collect()
+    });
+    Scene {
+        mesh,
+        first,
+        anchor,
+        pred,
+    }
+}
+
+fn body<'a>(s: &'a Scene, x: &'a [Vec3], boxes: &'a [Aabb], mass: &'a [Real]) -> SurfaceBody<'a> {
+    SurfaceBody {
+        x_n: x,
+        x_pred: x,
+        mass,
+        first_surface: s.first,
+        quads: &s.mesh.quads,
+        node_quads: &s.mesh.node_quads,
+        bounds: Aabb::of_surface(x, s.first),
+        sphere: bounding_sphere(x, s.first),
+        quad_bounds: boxes,
+    }
+}
+
+/// (full pass, listed pass) constraints of scene `s`, lists built with
+/// drift `d`.
+fn both(s: &Scene, d: Real) -> (Vec<Constraint>, Vec<Constraint>) {
+    let settings = PairSettings::standard(0.1);
+    let boxes: Vec<Vec<Aabb>> = s
+        .pred
+        .iter()
+        .map(|x| {
+            let mut b = vec![Aabb::EMPTY; s.mesh.quads.len()];
+            quad_bounds(x, &s.mesh.quads, &mut b);
+            b
+        })
+        .collect();
+    let mass = vec![1e-9; s.mesh.positions.len()];
+    let a = body(s, &s.pred[0], &boxes[0], &mass);
+    let b = body(s, &s.pred[1], &boxes[1], &mass);
+    let mut scratch = vec![CandidateFace::default(); s.mesh.quads.len()];
+    let mut full = vec![Constraint::default(); 4096];
+    let n = detect(&a, &b, &settings, &mut scratch, &mut full).unwrap();
+    full.truncate(n);
+
+    let anchors = s.anchor.each_ref().map(|x| AnchorSurface {
+        x: &x[s.first..],
+        first_surface: s.first,
+        quads: &s.mesh.quads,
+    });
+    let ab = build_lists(&anchors[0], &anchors[1], d);
+    let ba = build_lists(&anchors[1], &anchors[0], d);
+    let mut slot = vec![u32::MAX; s.mesh.quads.len()];
+    let mut listed = vec![Constraint::default(); 4096];
+    let n = detect_listed(
+        &a,
+        &b,
+        &settings,
+        [&ab.view(), &ba.view()],
+        &mut scratch,
+        &mut slot,
+        &mut listed,
+    )
+    .unwrap();
+    listed.truncate(n);
+    assert!(slot.iter().all(|&k| k == u32::MAX), "slot left clean");
+    (full, listed)
+}
+
+/// Bit patterns of a constraint list, so −0.0 ≠ 0.0 and NaN = NaN.
+fn bits(c: &[Constraint]) -> Vec<(u8, u32, u32, Vec<u64>)> {
+    c.iter()
+        .map(|c| {
+            let mut v: Vec<u64> = c.weights.iter().map(|w| w.to_bits()).collect();
+            v.extend(c.normal.iter().map(|n| n.to_bits()));
+            v.push(c.gap.to_bits());
+            (c.side as u8, c.slave, c.quad, v)
+        })
+        .collect()
+}
+
+#[test]
+fn listed_detection_finds_the_full_passes_constraints_while_nodes_stay_within_the_drift() {
+    // Nodes moved up to 100 µm, more than the faces' windows (about 70 µm).
+    let d = 100e-6;
+    let mut constraints = 0;
+    for seed in 0..40 {
+        let overlap = 20e-6 + 2e-6 * seed as Real;
+        let s = scene(seed, overlap, d);
+        for body in 0..2 {
+            let moved = drift(&s.pred[body], s.first, &s.anchor[body][s.first..]);
+            assert!(moved <= d, "seed {seed}: moved {moved} > {d}");
+        }
+        let (full, listed) = both(&s, d);
+        assert_eq!(bits(&full), bits(&listed), "seed {seed}");
+        constraints += full.len();
+    }
+    assert!(
+        constraints > 100,
+        "the scenes touch: {constraints} constraints"
+    );
+}
+
+#[test]
+fn lists_without_the_skin_miss_constraints_of_moved_nodes() {
+    // The same scenes (nodes moved up to 100 µm), lists built as if nothing
+    // would move: some node now reaches a face its list lacks, and the
+    // listed pass differs.
+    let differ = (0..40)
+        .filter(|&seed| {
+            let s = scene(seed, 20e-6 + 2e-6 * seed as Real, 100e-6);
+            let (full, listed) = both(&s, 0.0);
+            bits(&full) != bits(&listed)
+        })
+        .count();
+    assert!(differ > 0, "no scene tells the skin is needed");
+}
+
+#[test]
+fn drift_is_the_largest_surface_displacement_and_nan_for_bad_input() {
+    let x = [[0.0; 3], [1.0, 0.0, 0.0], [0.0, 3.0, 4.0]];
+    let anchor = [[1.0, 0.0, 0.0], [0.0, 0.0, 0.0]];
+    assert_eq!(drift(&x, 1, &anchor), 5.0);
+    assert!(drift(&x, 2, &anchor).is_nan());
+    assert!(drift(&x, 4, &anchor).is_nan());
+    let nan = [[0.0; 3], [Real::NAN, 0.0, 0.0], [0.0; 3]];
+    assert!(drift(&nan, 1, &anchor).is_nan());
+}
