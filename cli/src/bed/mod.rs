@@ -151,7 +151,7 @@ pub struct BedArgs {
 
     /// Override: skin of the contact search's per-node face lists as a
     /// fraction of the mean surface-face diagonal (0 ≤ s ≤ 1, 0: none;
-    /// default 0.05). Only the speed depends on it, so it may be given with
+    /// default 0.02). Only the speed depends on it, so it may be given with
     /// --resume.
     #[arg(long, value_name = "S")]
     pub face_list_skin: Option<f64>,
