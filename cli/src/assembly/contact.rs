@@ -344,30 +344,35 @@ impl ContactPhase {
 
     /// Bounding spheres and boxes of every granule's predicted surface,
     /// then the candidate list, rebuilt if a granule drifted half the margin.
+    /// After the first sweep of a step (`first_sweep` false) only the
+    /// granules the last sweep moved (`forced`) get new boxes: the others'
+    /// x̃ and so their boxes are unchanged.
     pub(super) fn broad(
         &mut self,
         granules: &[GranuleStore],
         mesh: &OwnedReference,
         margin: Real,
+        first_sweep: bool,
     ) -> Result<(), ContactError> {
         let first = mesh.surface_range().start;
+        let moved = |g: usize| first_sweep || self.forced.get(g).is_none_or(|&f| f);
         // In place: this runs every sweep of every step.
         self.bounds.resize(granules.len(), Bound::default());
         self.boxes.resize(granules.len(), Aabb::EMPTY);
+        self.quad_boxes
+            .resize(granules.len(), vec![Aabb::EMPTY; mesh.quads.len()]);
         self.bounds
             .par_iter_mut()
             .zip(self.boxes.par_iter_mut())
+            .zip(self.quad_boxes.par_iter_mut())
             .zip(granules.par_iter())
-            .for_each(|((b, a), g)| {
+            .enumerate()
+            .filter(|(g, _)| moved(*g))
+            .for_each(|(_, (((b, a), quads), g))| {
                 *b = bounding_sphere(&g.x_pred, first);
                 *a = Aabb::of_surface(&g.x_pred, first);
+                quad_bounds(&g.x_pred, &mesh.quads, quads);
             });
-        self.quad_boxes
-            .resize(granules.len(), vec![Aabb::EMPTY; mesh.quads.len()]);
-        self.quad_boxes
-            .par_iter_mut()
-            .zip(granules.par_iter())
-            .for_each(|(out, g)| quad_bounds(&g.x_pred, &mesh.quads, out));
         if !self.built.is_empty() && !needs_rebuild(&self.built, &self.bounds, margin) {
             return Ok(());
         }
@@ -410,7 +415,7 @@ impl ContactPhase {
     ) -> Result<(), ContactError> {
         let drift = self.list_drift;
         if drift > 0.0 {
-            self.renew_anchors(granules, mesh);
+            self.renew_anchors(granules, mesh, first);
         }
         let (boxes, bounds, quad_boxes) = (&self.boxes, &self.bounds, &self.quad_boxes);
         let (touched, anchors, epochs) = (&self.touched, &self.anchors, &self.epochs);
@@ -471,17 +476,21 @@ impl ContactPhase {
     /// Renews the anchor of every granule whose x̃ has left it by more than
     /// the face-list drift (or holds a NaN, or has none yet): its surface
     /// x̃ becomes the anchor and its epoch advances, so its pairs rebuild
-    /// their lists.
-    fn renew_anchors(&mut self, granules: &[GranuleStore], mesh: &OwnedReference) {
+    /// their lists. After the first sweep only granules the last sweep
+    /// moved are checked.
+    fn renew_anchors(&mut self, granules: &[GranuleStore], mesh: &OwnedReference, first: bool) {
         let surface = mesh.surface_range();
         let drift = self.list_drift;
+        let forced = &self.forced;
         self.anchors.resize(granules.len(), Vec::new());
         self.epochs.resize(granules.len(), 0);
         self.anchors
             .par_iter_mut()
             .zip(self.epochs.par_iter_mut())
             .zip(granules.par_iter())
-            .for_each(|((anchor, epoch), g)| {
+            .enumerate()
+            .filter(|(k, _)| first || forced.get(*k).is_none_or(|&f| f))
+            .for_each(|(_, ((anchor, epoch), g))| {
                 let moved = face_lists::drift(&g.x_pred, surface.start, anchor);
                 // A NaN renews too.
                 if moved.is_nan() || moved > drift {

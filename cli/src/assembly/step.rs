@@ -459,7 +459,7 @@ impl Assembly<'_> {
         let contact_error = |error| AssemblyError::Contact { step, error };
         let mesh = self.mesh;
         self.contact
-            .broad(&self.granules, mesh, p.contact.margin)
+            .broad(&self.granules, mesh, p.contact.margin, first)
             .map_err(contact_error)?;
         self.contact
             .detect(&self.granules, mesh, &p.contact, first)
