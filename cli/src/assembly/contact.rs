@@ -504,10 +504,16 @@ impl ContactPhase {
     /// Contact counts per node for the mass sharing: pairs in list order,
     /// then every granule's wall contacts (`walls` adds them).
     pub(super) fn count_pairs(&mut self, granules: &[GranuleStore], mesh: &OwnedReference) {
-        for (s, t) in self.share.iter_mut().zip(&mut self.tag) {
-            s.fill(0);
-            t.fill(u32::MAX);
-        }
+        // Contacts involve surface nodes only: the other entries stay 0 and
+        // u32::MAX from `new`.
+        let surface = mesh.surface_range();
+        self.share
+            .par_iter_mut()
+            .zip(self.tag.par_iter_mut())
+            .for_each(|(s, t)| {
+                s[surface.clone()].fill(0);
+                t[surface.clone()].fill(u32::MAX);
+            });
         for (k, (p, w)) in self.pairs.iter().zip(&self.work).enumerate() {
             if w.count == 0 {
                 continue;
