@@ -125,9 +125,9 @@ fn benches(c: &mut Criterion) {
         bench.iter(|| detect(&a, &b, &settings, &mut scratch, &mut constraints).unwrap())
     });
     // Face lists with the bed's default skin (0.02 of the mean face
-    // diagonal, about 2.8 µm here), built on the same configuration.
+    // diagonal, about 2.7 µm here), built on the same configuration.
     let (a_anchor, b_anchor) = (anchor(&m, &a_x), anchor(&m, &b_x));
-    let drift = 2.8e-6;
+    let drift = 2.7e-6;
     let mut reach = vec![ReachBox::default(); m.quads.len()];
     let mut lists = [(); 2].map(|_| {
         (
