@@ -54,6 +54,8 @@ fn a_small_die_compresses_to_thirty_percent() {
             worst_gap = worst_gap.min(asm.penetration().unwrap());
             let missed = asm.contact().missed_pairs();
             assert!(missed.is_empty(), "broad phase missed {missed:?}");
+            let stale = asm.contact().stale_boxes(asm.granules(), &mesh);
+            assert!(stale.is_empty(), "boxes of granules {stale:?} are stale");
         }
         if asm.time() > 2.0 / 3.0 * end {
             let walls = &asm.last().walls;

@@ -244,6 +244,23 @@ impl ContactPhase {
         &self.work
     }
 
+    /// Granules whose bounding sphere, box or quad boxes (as the last sweep
+    /// left them) differ from those of their x̃ now: always empty, since a
+    /// sweep skips only granules whose x̃ did not move. For tests.
+    pub fn stale_boxes(&self, granules: &[GranuleStore], mesh: &OwnedReference) -> Vec<usize> {
+        let first = mesh.surface_range().start;
+        let mut quads = vec![Aabb::EMPTY; mesh.quads.len()];
+        (0..granules.len())
+            .filter(|&g| {
+                let x = &granules[g].x_pred;
+                quad_bounds(x, &mesh.quads, &mut quads);
+                self.bounds.get(g) != Some(&bounding_sphere(x, first))
+                    || self.boxes.get(g) != Some(&Aabb::of_surface(x, first))
+                    || self.quad_boxes.get(g) != Some(&quads)
+            })
+            .collect()
+    }
+
     /// The check the skin argument of `contact::broad` promises: granule
     /// pairs whose bounding spheres (on the last x̃) overlap but are not in
     /// the candidate list, found by brute force over all pairs. Always
