@@ -310,34 +310,52 @@ impl Errors {
         }
     }
 
+    /// The four figures in a fixed order: curve, σ_est, Kawakita a, 1/b.
+    fn figures(&self) -> [Real; 4] {
+        [self.curve, self.sigma, self.kawakita_a, self.kawakita_inv_b]
+    }
+
+    /// Errors from figures in the order of [`Errors::figures`].
+    fn from_figures([curve, sigma, kawakita_a, kawakita_inv_b]: [Real; 4]) -> Self {
+        Self {
+            curve,
+            sigma,
+            kawakita_a,
+            kawakita_inv_b,
+        }
+    }
+
+    /// Figure by figure, `f` of this run's and `other`'s.
+    fn combine(&self, other: &Self, f: impl Fn(Real, Real) -> Real) -> Self {
+        let (x, o) = (self.figures(), other.figures());
+        Self::from_figures(core::array::from_fn(|k| f(x[k], o[k])))
+    }
+
+    /// Whether `test` holds for every pair of this run's and `other`'s
+    /// figures.
+    fn all_pairs(&self, other: &Self, test: impl Fn(Real, Real) -> bool) -> bool {
+        self.figures()
+            .into_iter()
+            .zip(other.figures())
+            .all(|(x, o)| test(x, o))
+    }
+
     /// No figure larger than `other`'s, a figure `other` lacks (NaN)
     /// excepted; a figure only `other` has counts against `self`.
     pub fn no_worse_than(&self, other: &Self) -> bool {
-        let pairs = [
-            (self.curve, other.curve),
-            (self.sigma, other.sigma),
-            (self.kawakita_a, other.kawakita_a),
-            (self.kawakita_inv_b, other.kawakita_inv_b),
-        ];
-        pairs.iter().all(|&(x, o)| x <= o || o.is_nan())
+        self.all_pairs(other, |x, o| x <= o || o.is_nan())
     }
 
     /// The larger of each figure, NaN if either lacks it (the largest
     /// error over granule types: a figure missing on one type is missing).
     pub fn max_over(self, o: Self) -> Self {
-        let m = |a: Real, b: Real| {
+        self.combine(&o, |a, b| {
             if a.is_nan() || b.is_nan() {
                 Real::NAN
             } else {
                 a.max(b)
             }
-        };
-        Self {
-            curve: m(self.curve, o.curve),
-            sigma: m(self.sigma, o.sigma),
-            kawakita_a: m(self.kawakita_a, o.kawakita_a),
-            kawakita_inv_b: m(self.kawakita_inv_b, o.kawakita_inv_b),
-        }
+        })
     }
 
     /// The largest figure this run has (NaN if it has none): the
@@ -345,7 +363,7 @@ impl Errors {
     /// other is no worse than ([`Errors::no_worse_than`]) never plots left
     /// of it (a figure only one run lacks can break that).
     pub fn largest(&self) -> Real {
-        [self.curve, self.sigma, self.kawakita_a, self.kawakita_inv_b]
+        self.figures()
             .into_iter()
             .filter(|x| !x.is_nan())
             .reduce(Real::max)
@@ -356,25 +374,12 @@ impl Errors {
     /// judged — unlike [`Errors::no_worse_than`], where a figure only the
     /// other run has counts against this one.
     pub fn within(&self, spread: &Self) -> bool {
-        let pairs = [
-            (self.curve, spread.curve),
-            (self.sigma, spread.sigma),
-            (self.kawakita_a, spread.kawakita_a),
-            (self.kawakita_inv_b, spread.kawakita_inv_b),
-        ];
-        pairs
-            .iter()
-            .all(|&(x, s)| x <= s || x.is_nan() || s.is_nan())
+        self.all_pairs(spread, |x, s| x <= s || x.is_nan() || s.is_nan())
     }
 
     /// The larger of each figure (NaN-ignoring).
     pub fn max(self, o: Self) -> Self {
-        Self {
-            curve: self.curve.max(o.curve),
-            sigma: self.sigma.max(o.sigma),
-            kawakita_a: self.kawakita_a.max(o.kawakita_a),
-            kawakita_inv_b: self.kawakita_inv_b.max(o.kawakita_inv_b),
-        }
+        self.combine(&o, Real::max)
     }
 }
 
