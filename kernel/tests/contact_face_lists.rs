@@ -242,3 +242,100 @@ fn drift_is_the_largest_surface_displacement_and_nan_for_bad_input() {
     let nan = [[0.0; 3], [Real::NAN, 0.0, 0.0], [0.0; 3]];
     assert!(drift(&nan, 1, &anchor).is_nan());
 }
+
+/// The "nearer face" rule may let a small face overrule a deep hit on a
+/// large one: the small face must be in the node's list although the
+/// node is beyond its own window (lists grown by each face's own window
+/// missed it, and the listed pass kept the far-side contact).
+#[test]
+fn a_small_face_that_overrules_a_hit_on_a_large_one_is_listed() {
+    // Master: a small face 0 (diagonal 0.14, window 0.035) in z = 0 and,
+    // not connected to it, a large face 1 (diagonal 1.28, window 0.32)
+    // in z = 0.3, both facing +z. The slave quad (facing −z) lies 0.2
+    // behind face 1 and 0.02–0.16 from face 0's box: face 0 is nearer
+    // than the hit's depth, so there is no contact.
+    let master: Vec<Vec3> = vec![
+        [0.9, 0.45, 0.0],
+        [1.0, 0.45, 0.0],
+        [1.0, 0.55, 0.0],
+        [0.9, 0.55, 0.0],
+        [0.8, 0.0, 0.3],
+        [1.6, 0.0, 0.3],
+        [1.6, 1.0, 0.3],
+        [0.8, 1.0, 0.3],
+    ];
+    let master_quads = [[0u32, 1, 2, 3], [4, 5, 6, 7]];
+    let slave: Vec<Vec3> = vec![
+        [1.02, 0.5, 0.1],
+        [1.02, 0.6, 0.1],
+        [1.12, 0.6, 0.1],
+        [1.12, 0.5, 0.1],
+    ];
+    let slave_quads = [[0u32, 1, 2, 3]];
+    let slave_node_quads = [[0u32, u32::MAX, u32::MAX, u32::MAX]; 4];
+    let master_node_quads = vec![[u32::MAX; 4]; master.len()];
+    let boxes = |x: &[Vec3], q: &[[u32; 4]]| {
+        let mut b = vec![Aabb::EMPTY; q.len()];
+        quad_bounds(x, q, &mut b);
+        b
+    };
+    let (slave_boxes, master_boxes) = (boxes(&slave, &slave_quads), boxes(&master, &master_quads));
+    let mass = [1.0; 8];
+    let a = SurfaceBody {
+        x_n: &slave,
+        x_pred: &slave,
+        mass: &mass[..4],
+        first_surface: 0,
+        quads: &slave_quads,
+        node_quads: &slave_node_quads,
+        bounds: Aabb::of_surface(&slave, 0),
+        sphere: bounding_sphere(&slave, 0),
+        quad_bounds: &slave_boxes,
+    };
+    let b = SurfaceBody {
+        x_n: &master,
+        x_pred: &master,
+        mass: &mass,
+        first_surface: 0,
+        quads: &master_quads,
+        node_quads: &master_node_quads,
+        bounds: Aabb::of_surface(&master, 0),
+        sphere: bounding_sphere(&master, 0),
+        quad_bounds: &master_boxes,
+    };
+    let settings = PairSettings {
+        margin: 0.5,
+        symmetric: false,
+        ..PairSettings::standard(0.0)
+    };
+    let mut scratch = vec![CandidateFace::default(); 2];
+    let mut full = vec![Constraint::default(); 16];
+    let n = detect(&a, &b, &settings, &mut scratch, &mut full).unwrap();
+    assert_eq!(n, 0, "the full pass holds no node: {:?}", &full[..n]);
+
+    let slave_anchor = AnchorSurface {
+        x: &slave,
+        first_surface: 0,
+        quads: &slave_quads,
+    };
+    let master_anchor = AnchorSurface {
+        x: &master,
+        first_surface: 0,
+        quads: &master_quads,
+    };
+    let ab = build_lists(&slave_anchor, &master_anchor, 1e-3);
+    let ba = build_lists(&master_anchor, &slave_anchor, 1e-3);
+    let mut slot = vec![u32::MAX; 2];
+    let mut listed = vec![Constraint::default(); 16];
+    let n = detect_listed(
+        &a,
+        &b,
+        &settings,
+        [&ab.view(), &ba.view()],
+        &mut scratch,
+        &mut slot,
+        &mut listed,
+    )
+    .unwrap();
+    assert_eq!(n, 0, "the listed pass holds {:?}", &listed[..n]);
+}

@@ -12,16 +12,18 @@
 //! pass (the faces left out are the ones every test of the full pass
 //! skips, and the faces kept are tried in the same ascending order).
 //!
-//! Why the skin is enough: a face's reach on x̃ is its box grown by its
-//! window g_max = f·diag. If every corner moved at most d, the box grew by
-//! at most d and the diagonal by at most 2d, so the reach lies inside the
-//! anchor box grown by g_max,anchor + (1 + 2f)·d; the slave node moved at
-//! most d too. A face is therefore listed for a node when the node's anchor
-//! lies in the face's anchor box grown by τ = g_max,anchor + (2 + 2f)·d
-//! (plus a relative 1e-6 against round-off). The full pass's other uses of
-//! a face — the "nearer face" check (box distance below a depth that is
-//! below g_max) and the concave-edge search (reach test first) — never
-//! look beyond the reach either.
+//! Why the skin is enough: the full pass uses a face O for a node p only
+//! (a) when O's reach — its box grown by its window g_O = f·diag_O —
+//! holds p (the hit search and the concave-edge search), or (b) when O's
+//! box is nearer to p than the depth of another face's hit (the "nearer
+//! face" check), a depth below *that* face's window. Both are within
+//! G = f × the master's largest face diagonal of O's box. If every corner
+//! moved at most d, a box grew by at most d and a diagonal by at most 2d,
+//! so G grew by at most 2f·d; the slave node moved at most d too. A face
+//! is therefore listed for a node when the node's anchor lies in the
+//! face's anchor box grown by τ = G_anchor + (2 + 2f)·d (times 1 + 1e-6
+//! against round-off). (Growing each box by its own window instead is not
+//! enough: a small face can overrule the hit on a larger one.)
 //!
 //! Buffers (caller-owned, see [`FaceListsMut`]): `nodes` (slave node ids
 //! with at least one face, ascending), `starts` (`nodes.len() + 1`
@@ -129,14 +131,24 @@ pub fn build(
     check_len("starts", out.starts.len(), slave.x.len() + 1)?;
     check_len("used", out.used.len(), master.quads.len())?;
     let slave_box = Aabb::of_points(slave.x);
-    let skin = (2.0 + 2.0 * window_fraction) * drift;
+    // The master's largest face diagonal (a face with a NaN corner has a
+    // NaN box, which no test of the full pass accepts: it does not count).
+    let mut largest: Real = 0.0;
+    for quad in master.quads {
+        if let Some(c) = master.corners(quad) {
+            let diagonal = face_diagonal(&c);
+            if diagonal > largest {
+                largest = diagonal;
+            }
+        }
+    }
+    let tau = (window_fraction * largest + (2.0 + 2.0 * window_fraction) * drift) * (1.0 + 1e-6);
     let mut candidates = 0;
     let mut reach_all = Aabb::EMPTY;
     for (q, quad) in master.quads.iter().enumerate() {
         let Some(corners) = master.corners(quad) else {
             continue;
         };
-        let tau = (window_fraction * face_diagonal(&corners) + skin) * (1.0 + 1e-6);
         let reach = Aabb::of_points(&corners).expanded(tau);
         if reach.overlaps(&slave_box) {
             scratch[candidates] = ReachBox {
