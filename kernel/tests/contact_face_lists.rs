@@ -124,54 +124,56 @@ fn scene(seed: u64, overlap: Real, moved: Real) -> Scene {
     }
 }
 
-fn body<'a>(s: &'a Scene, x: &'a [Vec3], boxes: &'a [Aabb], mass: &'a [Real]) -> SurfaceBody<'a> {
+/// A body on `x` (its own predicted and current positions).
+fn surface<'a>(
+    x: &'a [Vec3],
+    first: usize,
+    (quads, node_quads): (&'a [[u32; 4]], &'a [[u32; 4]]),
+    boxes: &'a [Aabb],
+    mass: &'a [Real],
+) -> SurfaceBody<'a> {
     SurfaceBody {
         x_n: x,
         x_pred: x,
         mass,
-        first_surface: s.first,
-        quads: &s.mesh.quads,
-        node_quads: &s.mesh.node_quads,
-        bounds: Aabb::of_surface(x, s.first),
-        sphere: bounding_sphere(x, s.first),
+        first_surface: first,
+        quads,
+        node_quads,
+        bounds: Aabb::of_surface(x, first),
+        sphere: bounding_sphere(x, first),
         quad_bounds: boxes,
     }
 }
 
-/// (full pass, listed pass) constraints of scene `s`, lists built with
-/// drift `d`.
-fn both(s: &Scene, d: Real) -> (Vec<Constraint>, Vec<Constraint>) {
-    let settings = PairSettings::standard(0.1);
-    let boxes: Vec<Vec<Aabb>> = s
-        .pred
-        .iter()
-        .map(|x| {
-            let mut b = vec![Aabb::EMPTY; s.mesh.quads.len()];
-            quad_bounds(x, &s.mesh.quads, &mut b);
-            b
-        })
-        .collect();
-    let mass = vec![1e-9; s.mesh.positions.len()];
-    let a = body(s, &s.pred[0], &boxes[0], &mass);
-    let b = body(s, &s.pred[1], &boxes[1], &mass);
-    let mut scratch = vec![CandidateFace::default(); s.mesh.quads.len()];
-    let mut full = vec![Constraint::default(); 4096];
-    let n = detect(&a, &b, &settings, &mut scratch, &mut full).unwrap();
-    full.truncate(n);
+/// The box of every quad of `quads` on `x`.
+fn boxes(x: &[Vec3], quads: &[[u32; 4]]) -> Vec<Aabb> {
+    let mut b = vec![Aabb::EMPTY; quads.len()];
+    quad_bounds(x, quads, &mut b);
+    b
+}
 
-    let anchors = s.anchor.each_ref().map(|x| AnchorSurface {
-        x: &x[s.first..],
-        first_surface: s.first,
-        quads: &s.mesh.quads,
-    });
+/// (full pass, listed pass) constraints of `a` against `b`, the lists
+/// built on `anchors` (A's, B's) with drift `d`; checks that the listed
+/// pass leaves its slot buffer clean.
+fn full_and_listed(
+    (a, b): (&SurfaceBody<'_>, &SurfaceBody<'_>),
+    settings: &PairSettings,
+    anchors: [AnchorSurface<'_>; 2],
+    d: Real,
+) -> (Vec<Constraint>, Vec<Constraint>) {
+    let quads = a.quads.len().max(b.quads.len());
+    let mut scratch = vec![CandidateFace::default(); quads];
+    let mut full = vec![Constraint::default(); 4096];
+    let n = detect(a, b, settings, &mut scratch, &mut full).unwrap();
+    full.truncate(n);
     let ab = build_lists(&anchors[0], &anchors[1], d);
     let ba = build_lists(&anchors[1], &anchors[0], d);
-    let mut slot = vec![u32::MAX; s.mesh.quads.len()];
+    let mut slot = vec![u32::MAX; quads];
     let mut listed = vec![Constraint::default(); 4096];
     let n = detect_listed(
-        &a,
-        &b,
-        &settings,
+        a,
+        b,
+        settings,
         [&ab.view(), &ba.view()],
         &mut scratch,
         &mut slot,
@@ -181,6 +183,23 @@ fn both(s: &Scene, d: Real) -> (Vec<Constraint>, Vec<Constraint>) {
     listed.truncate(n);
     assert!(slot.iter().all(|&k| k == u32::MAX), "slot left clean");
     (full, listed)
+}
+
+/// (full pass, listed pass) constraints of scene `s`, lists built with
+/// drift `d`.
+fn both(s: &Scene, d: Real) -> (Vec<Constraint>, Vec<Constraint>) {
+    let settings = PairSettings::standard(0.1);
+    let mesh = (&s.mesh.quads[..], &s.mesh.node_quads[..]);
+    let quad_boxes = s.pred.each_ref().map(|x| boxes(x, mesh.0));
+    let mass = vec![1e-9; s.mesh.positions.len()];
+    let a = surface(&s.pred[0], s.first, mesh, &quad_boxes[0], &mass);
+    let b = surface(&s.pred[1], s.first, mesh, &quad_boxes[1], &mass);
+    let anchors = s.anchor.each_ref().map(|x| AnchorSurface {
+        x: &x[s.first..],
+        first_surface: s.first,
+        quads: mesh.0,
+    });
+    full_and_listed((&a, &b), &settings, anchors, d)
 }
 
 /// Bit patterns of a constraint list, so −0.0 ≠ 0.0 and NaN = NaN.
@@ -274,68 +293,35 @@ fn a_small_face_that_overrules_a_hit_on_a_large_one_is_listed() {
     let slave_quads = [[0u32, 1, 2, 3]];
     let slave_node_quads = [[0u32, u32::MAX, u32::MAX, u32::MAX]; 4];
     let master_node_quads = vec![[u32::MAX; 4]; master.len()];
-    let boxes = |x: &[Vec3], q: &[[u32; 4]]| {
-        let mut b = vec![Aabb::EMPTY; q.len()];
-        quad_bounds(x, q, &mut b);
-        b
-    };
     let (slave_boxes, master_boxes) = (boxes(&slave, &slave_quads), boxes(&master, &master_quads));
     let mass = [1.0; 8];
-    let a = SurfaceBody {
-        x_n: &slave,
-        x_pred: &slave,
-        mass: &mass[..4],
-        first_surface: 0,
-        quads: &slave_quads,
-        node_quads: &slave_node_quads,
-        bounds: Aabb::of_surface(&slave, 0),
-        sphere: bounding_sphere(&slave, 0),
-        quad_bounds: &slave_boxes,
-    };
-    let b = SurfaceBody {
-        x_n: &master,
-        x_pred: &master,
-        mass: &mass,
-        first_surface: 0,
-        quads: &master_quads,
-        node_quads: &master_node_quads,
-        bounds: Aabb::of_surface(&master, 0),
-        sphere: bounding_sphere(&master, 0),
-        quad_bounds: &master_boxes,
-    };
+    let a = surface(
+        &slave,
+        0,
+        (&slave_quads, &slave_node_quads),
+        &slave_boxes,
+        &mass[..4],
+    );
+    let b = surface(
+        &master,
+        0,
+        (&master_quads, &master_node_quads),
+        &master_boxes,
+        &mass,
+    );
     let settings = PairSettings {
         margin: 0.5,
         symmetric: false,
         ..PairSettings::standard(0.0)
     };
-    let mut scratch = vec![CandidateFace::default(); 2];
-    let mut full = vec![Constraint::default(); 16];
-    let n = detect(&a, &b, &settings, &mut scratch, &mut full).unwrap();
-    assert_eq!(n, 0, "the full pass holds no node: {:?}", &full[..n]);
-
-    let slave_anchor = AnchorSurface {
-        x: &slave,
-        first_surface: 0,
-        quads: &slave_quads,
-    };
-    let master_anchor = AnchorSurface {
-        x: &master,
-        first_surface: 0,
-        quads: &master_quads,
-    };
-    let ab = build_lists(&slave_anchor, &master_anchor, 1e-3);
-    let ba = build_lists(&master_anchor, &slave_anchor, 1e-3);
-    let mut slot = vec![u32::MAX; 2];
-    let mut listed = vec![Constraint::default(); 16];
-    let n = detect_listed(
-        &a,
-        &b,
-        &settings,
-        [&ab.view(), &ba.view()],
-        &mut scratch,
-        &mut slot,
-        &mut listed,
-    )
-    .unwrap();
-    assert_eq!(n, 0, "the listed pass holds {:?}", &listed[..n]);
+    let anchors = [(&slave, &slave_quads[..]), (&master, &master_quads[..])].map(|(x, quads)| {
+        AnchorSurface {
+            x,
+            first_surface: 0,
+            quads,
+        }
+    });
+    let (full, listed) = full_and_listed((&a, &b), &settings, anchors, 1e-3);
+    assert!(full.is_empty(), "the full pass holds no node: {full:?}");
+    assert!(listed.is_empty(), "the listed pass holds {listed:?}");
 }

@@ -212,7 +212,12 @@ pub fn face_diagonal(x: &[Vec3; 4]) -> Real {
     if d1 > d2 { d1 } else { d2 }
 }
 
-fn check_len(buffer: &'static str, got: usize, expected: usize) -> Result<(), ContactError> {
+/// [`ContactError::BufferLength`] when `got` < `expected`.
+pub(crate) fn check_len(
+    buffer: &'static str,
+    got: usize,
+    expected: usize,
+) -> Result<(), ContactError> {
     if got < expected {
         Err(ContactError::BufferLength {
             buffer,

@@ -23,7 +23,7 @@
 use core::fmt;
 
 use crate::Real;
-use crate::contact::face_lists::{FaceLists, face_diagonal};
+use crate::contact::face_lists::{FaceLists, check_len, face_diagonal};
 use crate::contact::quad::{
     QuadProjection, QuadSieve, Vec3, dot, norm, project, project_clamped, sub,
 };
@@ -281,14 +281,7 @@ pub fn detect_listed(
     out: &mut [Constraint],
 ) -> Result<usize, ContactError> {
     check_buffers(a, b, scratch)?;
-    let need = a.quads.len().max(b.quads.len());
-    if slot.len() < need {
-        return Err(ContactError::BufferLength {
-            buffer: "slot",
-            expected: need,
-            got: slot.len(),
-        });
-    }
+    check_len("slot", slot.len(), a.quads.len().max(b.quads.len()))?;
     let mut faces = ListedFaces {
         lists: lists[0],
         slot,
@@ -306,14 +299,7 @@ fn check_buffers(
     b: &SurfaceBody<'_>,
     scratch: &[CandidateFace],
 ) -> Result<(), ContactError> {
-    let need = a.quads.len().max(b.quads.len());
-    if scratch.len() < need {
-        return Err(ContactError::BufferLength {
-            buffer: "scratch",
-            expected: need,
-            got: scratch.len(),
-        });
-    }
+    check_len("scratch", scratch.len(), a.quads.len().max(b.quads.len()))?;
     for body in [a, b] {
         if body.quad_bounds.len() != body.quads.len() {
             return Err(ContactError::BufferLength {
