@@ -277,6 +277,11 @@ pub struct GranuleStore {
     pub f_d: Vec<[Real; 3]>,
     /// Lumped masses, kg.
     pub mass: Vec<Real>,
+    /// The masses the kinematic contact sees, kg: `mass`, or under selective
+    /// mass scaling the effective nodal masses of
+    /// [`granbed_kernel::granule::damping::selective_contact_masses`]
+    /// (set by the owner of the contact phase).
+    pub contact_mass: Vec<Real>,
     /// Per node, bit a = velocity component a held at zero.
     pub fixed: Vec<u8>,
     /// C_p⁻¹ per integration point.
@@ -297,6 +302,7 @@ impl GranuleStore {
             f_c: vec![[0.0; 3]; n],
             f_d: vec![[0.0; 3]; n],
             mass: vec![0.0; n],
+            contact_mass: vec![0.0; n],
             fixed: vec![0; n],
             cp_inv: vec![[0.0; 6]; mesh.hexes.len() * points],
         }

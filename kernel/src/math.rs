@@ -42,6 +42,12 @@ pub fn cos(x: Real) -> Real {
     libm::cos(x)
 }
 
+/// Arc cosine (radians), for x in [−1, 1].
+#[inline]
+pub fn acos(x: Real) -> Real {
+    libm::acos(x)
+}
+
 /// Tangent (radians).
 #[inline]
 pub fn tan(x: Real) -> Real {

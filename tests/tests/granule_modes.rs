@@ -58,10 +58,11 @@ fn free_run(
         gravity_m_s2: 0.0,
         damping_c,
         rigid_modes: true,
+        selective_mass_factor: 1.0,
     };
     for _ in 0..steps {
         predict(&view, mat, &settings(0.05), &mut b, sizes, &loads).ok()?;
-        let w = correct(&mut b, sizes, 0.0);
+        let w = correct(&mut b, sizes, &loads);
         if !observe(&b, &w) {
             break;
         }
@@ -283,6 +284,7 @@ fn the_rigid_predictor_is_the_element_predictor_for_an_untouched_granule() {
                 R,
             ),
             rigid_modes: true,
+            selective_mass_factor: 1.0,
         };
         for _ in 0..2000 {
             if rigid {
@@ -290,7 +292,7 @@ fn the_rigid_predictor_is_the_element_predictor_for_an_untouched_granule() {
             } else {
                 predict(&view, &mat, &settings(0.05), &mut b, sizes, &loads).unwrap();
             }
-            correct(&mut b, sizes, 9.81);
+            correct(&mut b, sizes, &loads);
         }
         (b.x.to_vec(), b.v.to_vec(), dt)
     };

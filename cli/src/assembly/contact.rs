@@ -198,7 +198,7 @@ fn body_at<'a>(
     SurfaceBody {
         x_n: &g.x,
         x_pred,
-        mass: &g.mass,
+        mass: &g.contact_mass,
         first_surface: mesh.surface_range().start,
         quads: &mesh.quads,
         node_quads: &mesh.node_quads,

@@ -28,7 +28,7 @@ use granbed_kernel::Real;
 use granbed_kernel::contact::broad::{Bound, GranulePair};
 use granbed_kernel::contact::pair::PairSettings;
 use granbed_kernel::contact::wall::Wall;
-use granbed_kernel::granule::damping::damping_coefficient;
+use granbed_kernel::granule::damping::{RigidFrame, damping_coefficient, rigid_motion};
 use granbed_kernel::granule::forces::ElementSettings;
 use granbed_kernel::granule::quality::{WorstElement, worst_element};
 use granbed_kernel::granule::timestep::{
@@ -70,6 +70,12 @@ pub struct AssemblyParams {
     /// weight is kept (gravity is divided by F) and the damping follows
     /// the slower modes. 1 = physical masses.
     pub mass_scaling: Real,
+    /// The mass scaling acts on the granules' deformational modes only:
+    /// each granule's translation and spin keep their physical inertia
+    /// (selective mass scaling, `granbed_kernel::granule::dynamics`), so the
+    /// granules rearrange as heavy as they are while the stable step grows
+    /// by √F as with uniform scaling. false: uniform scaling.
+    pub selective_mass_scaling: bool,
     /// Safety factor C on the estimate of the stable step; (0, 2]. Above
     /// 1 the step exceeds the estimated stability limit: only for testing
     /// how a run fails (the watchdog stops it).
@@ -109,6 +115,18 @@ pub struct AssemblyParams {
 }
 
 impl AssemblyParams {
+    /// The kernel's [`Loads::selective_mass_factor`]: the mass scaling if it
+    /// is selective, else 1.
+    ///
+    /// [`Loads::selective_mass_factor`]: granbed_kernel::granule::dynamics::Loads::selective_mass_factor
+    pub fn selective_mass_factor(&self) -> Real {
+        if self.selective_mass_scaling {
+            self.mass_scaling
+        } else {
+            1.0
+        }
+    }
+
     /// physics.md's choices for `material`: ξ = 0.5, gravity 9.81 m/s²,
     /// the material's friction on walls and between granules, symmetric
     /// two-pass with mass sharing and up to three sweeps (a further one
@@ -128,6 +146,7 @@ impl AssemblyParams {
             contact_sweeps: 3,
             sweep_tolerance_m: 0.05e-6,
             mass_scaling: 1.0,
+            selective_mass_scaling: false,
             time_step_safety: 0.9,
             max_node_speed_m_s: Real::INFINITY,
             kinetic_energy_limit: Real::INFINITY,
@@ -281,6 +300,9 @@ pub struct Assembly<'m> {
     /// Per granule: still a rigid body (untouched since its placement;
     /// [`AssemblyParams::rigid_until_touched`]).
     rigid: Vec<bool>,
+    /// Per granule under selective mass scaling: its rigid frame at x_n of
+    /// the current step (empty otherwise).
+    frames: Vec<RigidFrame>,
 }
 
 impl<'m> Assembly<'m> {
@@ -307,6 +329,7 @@ impl<'m> Assembly<'m> {
                 for m in &mut g.mass {
                     *m *= params.mass_scaling;
                 }
+                g.contact_mass.clone_from(&g.mass);
                 for (x, x0) in g.x.iter_mut().zip(&mesh.positions) {
                     let r = p.rotation;
                     *x = core::array::from_fn(|a| {
@@ -349,13 +372,23 @@ impl<'m> Assembly<'m> {
                 })
                 .collect(),
             rigid: vec![params.rigid_until_touched; placements.len()],
+            frames: Vec::new(),
         };
-        let kinetic: Real = assembly
+        let mut kinetic: Real = assembly
             .granules
             .iter()
             .flat_map(|g| g.mass.iter().zip(&g.v))
             .map(|(m, v)| 0.5 * m * (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]))
             .sum();
+        let f = assembly.params.selective_mass_factor();
+        if f > 1.0 {
+            // ½ v·M'v: the rigid part of the motion carries m'/F.
+            for g in &assembly.granules {
+                kinetic -= 0.5
+                    * (1.0 - 1.0 / f)
+                    * rigid_motion(&g.mass, &g.x, &g.v).twice_kinetic_energy();
+            }
+        }
         assembly.energies.initial_kinetic = kinetic;
         assembly.energies.kinetic = kinetic;
         assembly.share_first_estimate(placements)?;

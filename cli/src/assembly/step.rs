@@ -6,6 +6,7 @@ use core::fmt;
 use granbed_kernel::Real;
 use granbed_kernel::contact::pair::ContactError;
 use granbed_kernel::contact::wall::{PredictedNodes, WallForce, count_wall_contacts, wall_contact};
+use granbed_kernel::granule::damping::{RigidFrame, selective_contact_masses};
 use granbed_kernel::granule::dynamics::{
     Loads, StepSizes, StepWork, correct, predict, predict_rigid,
 };
@@ -496,7 +497,7 @@ impl Assembly<'_> {
                     &[]
                 };
                 let body = PredictedNodes {
-                    mass: &g.mass,
+                    mass: &g.contact_mass,
                     x_n: &g.x,
                     x_pred: &g.x_pred,
                 };
@@ -550,9 +551,24 @@ impl Assembly<'_> {
             gravity_m_s2: p.gravity_m_s2 / p.mass_scaling,
             damping_c: self.damping_c,
             rigid_modes: true,
+            selective_mass_factor: p.selective_mass_factor(),
         };
         let view = self.mesh.view();
         let clock = std::time::Instant::now();
+        // Selective mass scaling: each granule's frame (for the rigid
+        // response in the sweeps) and its contact masses, at x_n.
+        let selective = p.selective_mass_factor();
+        if selective > 1.0 {
+            self.frames = self
+                .granules
+                .par_iter_mut()
+                .map(|g| {
+                    let frame = RigidFrame::of(&g.mass, &g.x);
+                    selective_contact_masses(&frame, &g.mass, &g.x, selective, &mut g.contact_mass);
+                    frame
+                })
+                .collect();
+        }
         let predicted: Vec<Result<ForceSummary, ElementFailure>> = self
             .granules
             .par_iter_mut()
@@ -572,6 +588,7 @@ impl Assembly<'_> {
             })
             .collect();
         self.times.rigid_granule_steps += self.rigid.iter().filter(|&&r| r).count() as u64;
+
         let mut plastic = 0.0;
         let mut hourglass = 0.0;
         let mut min_j = Real::INFINITY;
@@ -602,25 +619,53 @@ impl Assembly<'_> {
         // Contact forces act on surface nodes only, so only those move in
         // a sweep and only their f_c is kept from before it; a granule the
         // last sweep put no force on keeps its x̃ (its update would add
-        // zeros).
+        // zeros). With selective mass scaling the surface also moves by the
+        // granule's rigid response to Δf (M'⁻¹ exactly, as in `correct`);
+        // the interior's share of it is left to `correct`.
         let surface = self.mesh.surface_range();
+        let frames = self.frames.clone();
         for sweep in 0..p.contact_sweeps {
             if sweep > 0 {
                 self.granules
                     .par_iter_mut()
                     .zip(self.contact.f_before.par_iter())
                     .zip(self.contact.forced.par_iter())
-                    .filter(|(_, forced)| **forced)
-                    .for_each(|((g, before), _)| {
+                    .enumerate()
+                    .filter(|(_, (_, forced))| **forced)
+                    .for_each(|(gi, ((g, before), _))| {
                         let s = surface.clone();
-                        for (((x, f), f0), m) in g.x_pred[s.clone()]
+                        let g = &mut *g;
+                        let rigid = frames.get(gi).map(|frame| {
+                            frame.response(
+                                g.x[s.clone()]
+                                    .iter()
+                                    .zip(&g.f_c[s.clone()])
+                                    .zip(before)
+                                    .map(|((x, f), f0)| {
+                                        (*x, [f[0] - f0[0], f[1] - f0[1], f[2] - f0[2]])
+                                    }),
+                            )
+                        });
+                        for ((((x, f), f0), m), xn) in g.x_pred[s.clone()]
                             .iter_mut()
                             .zip(&g.f_c[s.clone()])
                             .zip(before)
-                            .zip(&g.mass[s])
+                            .zip(&g.mass[s.clone()])
+                            .zip(&g.x[s.clone()])
                         {
-                            for a in 0..3 {
-                                x[a] += dt2 * (f[a] - f0[a]) / m;
+                            match &rigid {
+                                None => {
+                                    for a in 0..3 {
+                                        x[a] += dt2 * (f[a] - f0[a]) / m;
+                                    }
+                                }
+                                Some(r) => {
+                                    let u = r.velocity_at(xn);
+                                    for a in 0..3 {
+                                        x[a] +=
+                                            dt2 * ((f[a] - f0[a]) / m + (selective - 1.0) * u[a]);
+                                    }
+                                }
                             }
                         }
                     });
@@ -667,7 +712,7 @@ impl Assembly<'_> {
         let per: Vec<StepWork> = self
             .granules
             .par_iter_mut()
-            .map(|g| correct(&mut g.buffers(), sizes, p.gravity_m_s2 / p.mass_scaling))
+            .map(|g| correct(&mut g.buffers(), sizes, &loads))
             .collect();
 
         let mut report = StepReport {

@@ -168,11 +168,16 @@ pub struct BedArgs {
     #[arg(long, value_name = "C")]
     pub stop_at_strain: Option<f64>,
 
-    /// Override: uniform mass scaling F ≥ 1 for quasi-static runs (the
-    /// stable step grows by √F; check the quasi-static certificate in
-    /// summary.json).
+    /// Override: mass scaling F ≥ 1 for quasi-static runs (the stable step
+    /// grows by √F; check the quasi-static certificate in summary.json).
     #[arg(long, value_name = "F")]
     pub mass_scaling: Option<f64>,
+
+    /// Override: the mass scaling acts on the granules' deformational modes
+    /// only, their translation and spin keep the physical inertia (true),
+    /// or on every mode (false, the default).
+    #[arg(long, value_name = "BOOL")]
+    pub selective_mass_scaling: Option<bool>,
 
     /// Override: safety factor on the stable time step 2/ω_max
     /// (0 < C ≤ 2; default 0.9; above 1 the run is unstable). Allowed with
@@ -237,6 +242,9 @@ impl BedArgs {
         }
         if let Some(f) = self.mass_scaling {
             scene.mass_scaling = f;
+        }
+        if let Some(s) = self.selective_mass_scaling {
+            scene.selective_mass_scaling = s;
         }
         if let Some(r) = self.rigid_until_touched {
             scene.rigid_until_touched = r;

@@ -53,9 +53,13 @@ damping_ratio = 0.5
 # Contact sweeps per step at most (physics.md 5.3); a further sweep runs while
 # a granule overlap deeper than 0.5 % of the element size is left.
 contact_sweeps = 25
-# Uniform mass scaling F >= 1 for quasi-static runs (1 = physical inertia;
-# the summary's quasi-static certificate says whether a run stayed quasi-static).
+# Mass scaling F >= 1 for quasi-static runs (1 = physical inertia; the
+# summary's quasi-static certificate says whether a run stayed quasi-static).
 mass_scaling = 1.0
+# false: the scaling is uniform (every mode of a granule is F times heavier).
+# true: selective, on the granules' deformational modes only; translation and
+# spin keep their physical inertia. The stable step grows by sqrt(F) either way.
+selective_mass_scaling = false
 # Safety factor on the stable time step 2/omega_max (0 < C <= 2; above 1 the
 # run is unstable, which only tests the failure handling).
 time_step_safety = 0.9
@@ -159,9 +163,13 @@ pub struct Scene {
     /// gap deeper than [`super::run::SWEEP_TOLERANCE_REL`] × the element
     /// size is left).
     pub contact_sweeps: u32,
-    /// Uniform mass scaling F, 1 ≤ F ≤ 1e6 (absent: 1).
+    /// Mass scaling F, 1 ≤ F ≤ 1e6 (absent: 1).
     #[serde(default = "unit_scaling")]
     pub mass_scaling: f64,
+    /// The mass scaling acts on the deformational modes only (absent:
+    /// false, uniform).
+    #[serde(default)]
+    pub selective_mass_scaling: bool,
     /// Safety factor on the stable step, 0 < C ≤ 2 (absent: 0.9; above 1
     /// unstable, for testing the failure handling).
     #[serde(default = "default_time_step_safety")]

@@ -74,6 +74,14 @@ pub fn bed_grid(mesh: MeshLevel, quick: bool) -> (Setting, Vec<Setting>) {
             with("mass x1", &|s| s.mass_scaling = 1.0),
             with("mass x4", &|s| s.mass_scaling = 4.0),
             with("mass x100", &|s| s.mass_scaling = 100.0),
+            with("selective x10", &|s| {
+                s.mass_scaling = 10.0;
+                s.selective_mass = true;
+            }),
+            with("selective x100", &|s| {
+                s.mass_scaling = 100.0;
+                s.selective_mass = true;
+            }),
             with("safety 0.7", &|s| s.safety = 0.7),
             with("kappa 0.02", &|s| s.kappa = 0.02),
             with("kappa 0.1", &|s| s.kappa = 0.1),
@@ -101,6 +109,7 @@ fn scene_for(args: &WorkPrecisionArgs, size: &Size, setting: &Setting, seed: u64
         element: setting.element_name().to_string(),
         hourglass_kappa: setting.kappa,
         mass_scaling: setting.mass_scaling,
+        selective_mass_scaling: setting.selective_mass,
         time_step_safety: setting.safety,
         material: MaterialOverrides {
             youngs_modulus_pa: m.youngs_modulus_pa,
@@ -244,7 +253,8 @@ mod tests {
                 s.element != base.element,
                 s.kappa != base.kappa,
                 s.safety != base.safety,
-                s.mass_scaling != base.mass_scaling,
+                // The mass scaling: its factor and whether it is selective.
+                s.mass_scaling != base.mass_scaling || s.selective_mass != base.selective_mass,
                 s.speed_factor != base.speed_factor,
             ];
             assert_eq!(

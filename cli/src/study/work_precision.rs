@@ -43,7 +43,7 @@ pub const CSV_FILE: &str = "work_precision.csv";
 pub const SVG_FILE: &str = "work_precision.svg";
 
 /// Columns of [`CSV_FILE`].
-pub const COLUMNS: [&str; 21] = [
+pub const COLUMNS: [&str; 22] = [
     "setting",
     "seed",
     "mesh_n",
@@ -52,6 +52,7 @@ pub const COLUMNS: [&str; 21] = [
     "hourglass_kappa",
     "time_step_safety",
     "mass_scaling",
+    "selective_mass_scaling",
     "speed_factor",
     "steps",
     "wall_time_s",
@@ -87,6 +88,10 @@ pub struct Setting {
     pub safety: Real,
     /// Mass scaling F ≥ 1.
     pub mass_scaling: Real,
+    /// The mass scaling acts on the deformational modes only (bed; a
+    /// granule between platens has no free rigid modes, so there it is
+    /// uniform scaling either way).
+    pub selective_mass: bool,
     /// Platen or punch speed as a multiple of the scene's.
     pub speed_factor: Real,
 }
@@ -101,6 +106,7 @@ impl Setting {
             kappa: 0.05,
             safety: 0.9,
             mass_scaling: STANDARD_MASS_SCALING,
+            selective_mass: false,
             speed_factor: 1.0,
         }
     }
@@ -458,6 +464,7 @@ pub fn write_csv(path: &Path, rows: &[Row<'_>]) -> anyhow::Result<()> {
             Field::Real(s.kappa),
             Field::Real(s.safety),
             Field::Real(s.mass_scaling),
+            Field::from(s.selective_mass),
             Field::Real(s.speed_factor),
             Field::Int(r.m.steps),
             Field::Real(r.m.wall_time_s),

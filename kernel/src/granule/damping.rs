@@ -25,6 +25,11 @@ pub struct RigidMotion {
     pub velocity: [Real; 3],
     /// Angular velocity, rad/s.
     pub omega: [Real; 3],
+    /// Total mass Σ m_I of the nodes, kg.
+    pub mass: Real,
+    /// Angular momentum about the centre of mass L = Σ m_I r_I × (v_I − v_c),
+    /// kg m²/s (J_c ω when J_c is invertible).
+    pub angular_momentum: [Real; 3],
 }
 
 impl RigidMotion {
@@ -43,15 +48,43 @@ impl RigidMotion {
             self.velocity[2] + w[0] * r[1] - w[1] * r[0],
         ]
     }
+
+    /// Σ m_I |P v_I|² = m |v_c|² + ω·L: twice the kinetic energy of the
+    /// rigid part of the motion, J.
+    pub fn twice_kinetic_energy(&self) -> Real {
+        let (v, w, l) = (self.velocity, self.omega, self.angular_momentum);
+        self.mass * (v[0] * v[0] + v[1] * v[1] + v[2] * v[2])
+            + (w[0] * l[0] + w[1] * l[1] + w[2] * l[2])
+    }
+
+    /// No motion at all (the projection when the rigid modes are held).
+    pub const REST: RigidMotion = RigidMotion {
+        centre: [0.0; 3],
+        velocity: [0.0; 3],
+        omega: [0.0; 3],
+        mass: 0.0,
+        angular_momentum: [0.0; 3],
+    };
 }
 
 /// The mass-orthogonal projection of velocities `v` onto the six rigid modes
 /// of nodes at `x` with masses `mass` (kg). All slices have one entry per node.
 pub fn rigid_motion(mass: &[Real], x: &[[Real; 3]], v: &[[Real; 3]]) -> RigidMotion {
+    rigid_motion_of(mass, x, |i| v[i])
+}
+
+/// [`rigid_motion`] of the velocity field `v(I)` given node by node (for a
+/// field the caller has not stored, such as M⁻¹f).
+pub fn rigid_motion_of(
+    mass: &[Real],
+    x: &[[Real; 3]],
+    v: impl Fn(usize) -> [Real; 3],
+) -> RigidMotion {
     let mut m = 0.0;
     let mut mx = [0.0; 3];
     let mut mv = [0.0; 3];
-    for ((mi, xi), vi) in mass.iter().zip(x).zip(v) {
+    for (i, (mi, xi)) in mass.iter().zip(x).enumerate() {
+        let vi = v(i);
         m += mi;
         for a in 0..3 {
             mx[a] += mi * xi[a];
@@ -62,7 +95,8 @@ pub fn rigid_motion(mass: &[Real], x: &[[Real; 3]], v: &[[Real; 3]]) -> RigidMot
     let velocity = mv.map(|s| s / m);
     let mut l = [0.0; 3];
     let mut inertia = Mat3::zeros();
-    for ((mi, xi), vi) in mass.iter().zip(x).zip(v) {
+    for (i, (mi, xi)) in mass.iter().zip(x).enumerate() {
+        let vi = v(i);
         let r = [xi[0] - centre[0], xi[1] - centre[1], xi[2] - centre[2]];
         let u = [
             vi[0] - velocity[0],
@@ -72,12 +106,7 @@ pub fn rigid_motion(mass: &[Real], x: &[[Real; 3]], v: &[[Real; 3]]) -> RigidMot
         l[0] += mi * (r[1] * u[2] - r[2] * u[1]);
         l[1] += mi * (r[2] * u[0] - r[0] * u[2]);
         l[2] += mi * (r[0] * u[1] - r[1] * u[0]);
-        let r2 = r[0] * r[0] + r[1] * r[1] + r[2] * r[2];
-        for a in 0..3 {
-            for b in 0..3 {
-                inertia[(a, b)] += mi * (if a == b { r2 } else { 0.0 } - r[a] * r[b]);
-            }
-        }
+        add_point_inertia(&mut inertia, *mi, &r);
     }
     let det = det_mat(&inertia);
     let omega = if det > 0.0 {
@@ -90,6 +119,149 @@ pub fn rigid_motion(mass: &[Real], x: &[[Real; 3]], v: &[[Real; 3]]) -> RigidMot
         centre,
         velocity,
         omega,
+        mass: m,
+        angular_momentum: l,
+    }
+}
+
+/// Adds the inertia m (|r|²1 − r⊗r) of a point mass `m` at `r` from the
+/// centre to `inertia`.
+#[inline]
+fn add_point_inertia(inertia: &mut Mat3, m: Real, r: &[Real; 3]) {
+    let r2 = r[0] * r[0] + r[1] * r[1] + r[2] * r[2];
+    for a in 0..3 {
+        for b in 0..3 {
+            inertia[(a, b)] += m * (if a == b { r2 } else { 0.0 } - r[a] * r[b]);
+        }
+    }
+}
+
+/// The smallest eigenvalue of the symmetric 3×3 matrix `j` (closed form,
+/// no iteration; NaN in, NaN out).
+fn smallest_eigenvalue(j: &Mat3) -> Real {
+    let q = (j[(0, 0)] + j[(1, 1)] + j[(2, 2)]) / 3.0;
+    let off = j[(0, 1)] * j[(0, 1)] + j[(0, 2)] * j[(0, 2)] + j[(1, 2)] * j[(1, 2)];
+    let diag = [0, 1, 2].map(|a| j[(a, a)] - q);
+    let p2 = diag[0] * diag[0] + diag[1] * diag[1] + diag[2] * diag[2] + 2.0 * off;
+    if p2 == 0.0 {
+        return q;
+    }
+    let p = crate::math::sqrt(p2 / 6.0);
+    let mut b = *j;
+    for a in 0..3 {
+        b[(a, a)] -= q;
+    }
+    let half_det = det_mat(&(b / p)) / 2.0;
+    let phi = crate::math::acos(half_det.clamp(-1.0, 1.0)) / 3.0;
+    q + 2.0 * p * crate::math::cos(phi + 2.0 * core::f64::consts::FRAC_PI_3)
+}
+
+/// A granule's total mass, centre of mass and inertia about it: what the
+/// rigid response to a set of forces needs.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct RigidFrame {
+    /// Σ m_I, kg.
+    pub mass: Real,
+    /// Centre of mass x_c, m.
+    pub centre: [Real; 3],
+    /// J_c = Σ m_I (|r_I|²1 − r_I⊗r_I), kg m².
+    pub inertia: Mat3,
+}
+
+impl RigidFrame {
+    /// The frame of nodes at `x` with masses `mass` (kg).
+    pub fn of(mass: &[Real], x: &[[Real; 3]]) -> Self {
+        let mut m = 0.0;
+        let mut mx = [0.0; 3];
+        for (mi, xi) in mass.iter().zip(x) {
+            m += mi;
+            for a in 0..3 {
+                mx[a] += mi * xi[a];
+            }
+        }
+        let centre = mx.map(|s| s / m);
+        let mut inertia = Mat3::zeros();
+        for (mi, xi) in mass.iter().zip(x) {
+            add_point_inertia(&mut inertia, *mi, &sub(xi, &centre));
+        }
+        Self {
+            mass: m,
+            centre,
+            inertia,
+        }
+    }
+
+    /// The rigid motion the forces `f` at the points `x` (N, m; pairs)
+    /// give per unit time: velocity ΣF/m and ω = J_c⁻¹ Σ r × f, i.e. P(M⁻¹f)
+    /// for nodal forces (zero ω if J_c is singular).
+    pub fn response(&self, forces: impl Iterator<Item = ([Real; 3], [Real; 3])>) -> RigidMotion {
+        let (mut total, mut torque) = ([0.0; 3], [0.0; 3]);
+        for (x, f) in forces {
+            let r = sub(&x, &self.centre);
+            for a in 0..3 {
+                total[a] += f[a];
+            }
+            torque[0] += r[1] * f[2] - r[2] * f[1];
+            torque[1] += r[2] * f[0] - r[0] * f[2];
+            torque[2] += r[0] * f[1] - r[1] * f[0];
+        }
+        let det = det_mat(&self.inertia);
+        let omega = if det > 0.0 {
+            let inv = inverse_with_det(&self.inertia, det);
+            [0, 1, 2].map(|a| {
+                inv[(a, 0)] * torque[0] + inv[(a, 1)] * torque[1] + inv[(a, 2)] * torque[2]
+            })
+        } else {
+            [0.0; 3]
+        };
+        RigidMotion {
+            centre: self.centre,
+            velocity: total.map(|t| t / self.mass),
+            omega,
+            mass: self.mass,
+            angular_momentum: torque,
+        }
+    }
+}
+
+fn sub(a: &[Real; 3], b: &[Real; 3]) -> [Real; 3] {
+    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
+}
+
+/// The nodal masses the kinematic contact sees under selective mass scaling
+/// by `factor` F (`dynamics` module docs), kg, written to `out`, for nodes
+/// at `x` with stored masses `mass` (F × physical) and their `frame`.
+///
+/// Through M'⁻¹ = (1/m')(1 + (F−1)P) a contact force on node I moves it by
+/// its own share and by its share of the granule's rigid response, which the
+/// contact's one-step gap closure (force = gap × mass / Δt²) must include
+/// or it overshoots: with F comparable to the node count the overshoot
+/// exceeds 2 and the contact diverges. P_II's largest eigenvalue is at most
+/// p_I = m'_I (1/Σm' + |r_I|²/λ_min(J'_c)) (translation plus rotation about
+/// the centre of mass; exact for a sphere's inertia), and at most 1; the
+/// contact mass m'_I / (1 + (F−1) p_I) does not overshoot for a node alone.
+/// The rigid response to the other nodes' forces is the caller's to predict
+/// ([`RigidFrame::response`]). F ≤ 1: the stored masses.
+pub fn selective_contact_masses(
+    frame: &RigidFrame,
+    mass: &[Real],
+    x: &[[Real; 3]],
+    factor: Real,
+    out: &mut [Real],
+) {
+    if factor <= 1.0 {
+        out.copy_from_slice(mass);
+        return;
+    }
+    let lambda = smallest_eigenvalue(&frame.inertia);
+    let valid = lambda > 0.0 && frame.mass > 0.0;
+    for ((o, mi), xi) in out.iter_mut().zip(mass).zip(x) {
+        let r = sub(xi, &frame.centre);
+        let r2 = r[0] * r[0] + r[1] * r[1] + r[2] * r[2];
+        let p = mi * (1.0 / frame.mass + r2 / lambda);
+        // A degenerate body (λ_min ≤ 0, NaN): the bound P_II ≤ 1.
+        let p = if valid && p < 1.0 { p } else { 1.0 };
+        *o = mi / (1.0 + (factor - 1.0) * p);
     }
 }
 
@@ -111,11 +283,7 @@ pub fn damping_forces(
     let rigid = if rigid_modes {
         rigid_motion(mass, x, v)
     } else {
-        RigidMotion {
-            centre: [0.0; 3],
-            velocity: [0.0; 3],
-            omega: [0.0; 3],
-        }
+        RigidMotion::REST
     };
     for (((m, xi), vi), fi) in mass.iter().zip(x).zip(v).zip(f_d.iter_mut()) {
         let r = rigid.velocity_at(xi);

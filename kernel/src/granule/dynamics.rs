@@ -10,9 +10,24 @@
 //!
 //! Δt_n = (Δt_{n−½} + Δt_{n+½})/2. Components flagged in `fixed` (symmetry
 //! planes) keep zero velocity.
+//!
+//! **Selective mass scaling** ([`Loads::selective_mass_factor`] F > 1, an
+//! addition to physics.md §4 for quasi-static runs): the stored masses m'
+//! are F × the physical ones, and the mass matrix is
+//! M' = M'(1 − P) + (M'/F) P, with P the mass-orthogonal projection onto
+//! the six rigid modes (`damping::rigid_motion`): the deformational modes
+//! carry F× their inertia (so ω_max, and with it the stable step, is that
+//! of uniform scaling by F), the translation and spin of the granule their
+//! physical inertia. Its inverse is exact and cheap,
+//! M'⁻¹f = f/m' + (F − 1) P(f/m'), so every velocity update here adds
+//! (F − 1)× the rigid part of its increment, and the kinetic energy is
+//! ½ v·M'v = ½ Σ m'|v|² − ½ (1 − 1/F) Σ m'|Pv|². Forces with no net force
+//! or moment (element, damping) get no rigid part; gravity (a uniform
+//! field) is all rigid part, so the caller passes g/F, as with uniform
+//! scaling, and the granule falls at g.
 
 use crate::Real;
-use crate::granule::damping::damping_forces;
+use crate::granule::damping::{RigidMotion, damping_forces, rigid_motion, rigid_motion_of};
 use crate::granule::forces::{ElementFailure, ElementSettings, ForceSummary, internal_forces};
 use crate::material::Material;
 use crate::mesh::reference::ReferenceMesh;
@@ -111,6 +126,21 @@ pub struct Loads {
     pub damping_c: Real,
     /// Whether the granule has free rigid modes (false with symmetry planes).
     pub rigid_modes: bool,
+    /// Selective mass scaling F ≥ 1 (module docs): the stored masses are F ×
+    /// the physical ones and act on the deformational modes only; the rigid
+    /// modes keep the physical inertia. 1: the stored masses act on every
+    /// mode (no scaling, or uniform scaling by the caller). Ignored without
+    /// free rigid modes.
+    pub selective_mass_factor: Real,
+}
+
+impl Loads {
+    /// The factor (F − 1) by which a velocity increment's rigid part is
+    /// added again, or `None` when the masses act on every mode.
+    fn rigid_boost(&self) -> Option<Real> {
+        (self.rigid_modes && self.selective_mass_factor > 1.0)
+            .then(|| self.selective_mass_factor - 1.0)
+    }
 }
 
 /// Work of each force over one step (midpoint rule on
@@ -142,7 +172,7 @@ pub fn predict(
 ) -> Result<ForceSummary, ElementFailure> {
     let summary = internal_forces(mesh, mat, settings, b.x, b.cp_inv, b.f_int)?;
     damping_forces(b.mass, b.x, b.v, loads.damping_c, loads.rigid_modes, b.f_d);
-    advance_predictor(b, sizes, loads.gravity_m_s2);
+    advance_predictor(b, sizes, loads, false);
     Ok(summary)
 }
 
@@ -160,26 +190,64 @@ pub fn predict(
 pub fn predict_rigid(b: &mut GranuleBuffers<'_>, sizes: StepSizes, loads: &Loads) -> ForceSummary {
     b.f_int.fill([0.0; 3]);
     b.f_d.fill([0.0; 3]);
-    advance_predictor(b, sizes, loads.gravity_m_s2);
+    advance_predictor(b, sizes, loads, true);
     ForceSummary {
         min_j: 1.0,
         ..ForceSummary::default()
     }
 }
 
+/// The increment Δt_n f_a/m of velocity component `a` of node `i` for the
+/// force `force` (N), or 0 if the component is held.
+#[inline]
+fn increment(b: &GranuleBuffers<'_>, i: usize, a: usize, dt_n: Real, force: Real) -> Real {
+    if b.fixed[i] & (1 << a) != 0 {
+        0.0
+    } else {
+        dt_n * force / b.mass[i]
+    }
+}
+
+/// f_g − f_int + f_d on component `a` of node `i`, N.
+#[inline]
+fn predictor_force(b: &GranuleBuffers<'_>, i: usize, a: usize, g: Real) -> Real {
+    let f_g = if a == 2 { -g * b.mass[i] } else { 0.0 };
+    f_g - b.f_int[i][a] + b.f_d[i][a]
+}
+
 /// v* = v + Δt_n M⁻¹ (f_g − f_int + f_d) and x̃ = x + Δt v* (held components
-/// stay at rest); clears `f_c`.
-fn advance_predictor(b: &mut GranuleBuffers<'_>, sizes: StepSizes, gravity_m_s2: Real) {
-    let (dt, dt_n, g) = (sizes.dt, sizes.dt_n(), gravity_m_s2);
+/// stay at rest); clears `f_c`. `translating`: every node has the same
+/// increment (a rigid granule under gravity), which is then its own rigid
+/// part.
+fn advance_predictor(
+    b: &mut GranuleBuffers<'_>,
+    sizes: StepSizes,
+    loads: &Loads,
+    translating: bool,
+) {
+    let (dt, dt_n, g) = (sizes.dt, sizes.dt_n(), loads.gravity_m_s2);
+    let boost = loads.rigid_boost();
+    let rigid = match boost {
+        Some(_) if !translating => rigid_motion_of(b.mass, b.x, |i| {
+            core::array::from_fn(|a| increment(b, i, a, dt_n, predictor_force(b, i, a, g)))
+        }),
+        _ => RigidMotion::REST,
+    };
     for i in 0..b.x.len() {
-        let m = b.mass[i];
+        let extra = match boost {
+            Some(k) if !translating => rigid.velocity_at(&b.x[i]).map(|r| k * r),
+            _ => [0.0; 3],
+        };
         for a in 0..3 {
-            let f_g = if a == 2 { -g * m } else { 0.0 };
-            let force = f_g - b.f_int[i][a] + b.f_d[i][a];
+            let dv = increment(b, i, a, dt_n, predictor_force(b, i, a, g));
             b.v_star[i][a] = if b.fixed[i] & (1 << a) != 0 {
                 0.0
             } else {
-                b.v[i][a] + dt_n * force / m
+                match boost {
+                    None => b.v[i][a] + dv,
+                    Some(k) if translating => b.v[i][a] + (dv + k * dv),
+                    Some(_) => b.v[i][a] + (dv + extra[a]),
+                }
             };
             b.x_pred[i][a] = b.x[i][a] + dt * b.v_star[i][a];
         }
@@ -187,17 +255,31 @@ fn advance_predictor(b: &mut GranuleBuffers<'_>, sizes: StepSizes, gravity_m_s2:
     b.f_c.fill([0.0; 3]);
 }
 
-/// Second half of a step: applies the contact forces in `f_c`, advances x
-/// and v, and returns the work of every force (`gravity_m_s2` as in
-/// [`Loads`]).
-pub fn correct(b: &mut GranuleBuffers<'_>, sizes: StepSizes, gravity_m_s2: Real) -> StepWork {
+/// Second half of a step: applies the contact forces in `f_c` (with the
+/// selective mass matrix of `loads`, module docs), advances x and v, and
+/// returns the work of every force (gravity `loads.gravity_m_s2`).
+pub fn correct(b: &mut GranuleBuffers<'_>, sizes: StepSizes, loads: &Loads) -> StepWork {
     let (dt, dt_n) = (sizes.dt, sizes.dt_n());
+    let gravity_m_s2 = loads.gravity_m_s2;
+    let boost = loads.rigid_boost();
+    let rigid = match boost {
+        Some(_) => rigid_motion_of(b.mass, b.x, |i| {
+            core::array::from_fn(|a| increment(b, i, a, dt_n, b.f_c[i][a]))
+        }),
+        None => RigidMotion::REST,
+    };
     let mut w = StepWork::default();
     for i in 0..b.x.len() {
         let m = b.mass[i];
+        let extra = match boost {
+            Some(k) => rigid.velocity_at(&b.x[i]).map(|r| k * r),
+            None => [0.0; 3],
+        };
         for a in 0..3 {
             let v_new = if b.fixed[i] & (1 << a) != 0 {
                 0.0
+            } else if boost.is_some() {
+                b.v_star[i][a] + (dt_n * b.f_c[i][a] / m + extra[a])
             } else {
                 b.v_star[i][a] + dt_n * b.f_c[i][a] / m
             };
@@ -212,6 +294,11 @@ pub fn correct(b: &mut GranuleBuffers<'_>, sizes: StepSizes, gravity_m_s2: Real)
             b.x[i][a] += dt * v_new;
             w.kinetic += 0.5 * m * v_new * v_new;
         }
+    }
+    if let Some(k) = boost {
+        // ½ v·M'v: the rigid part carries m'/F, not m' (module docs).
+        let f = k + 1.0;
+        w.kinetic -= 0.5 * (1.0 - 1.0 / f) * rigid_motion(b.mass, b.x, b.v).twice_kinetic_energy();
     }
     // A pass of its own keeps the loop above as it was (folding this into
     // it doubled its cost); f64::max is maxsd, no libm call (a NaN speed

@@ -758,6 +758,7 @@ impl<'a> PlatenScene<'a> {
             gravity_m_s2: gravity,
             damping_c: self.damping_c,
             rigid_modes: self.params.symmetry == Symmetry::Full,
+            selective_mass_factor: 1.0,
         };
         let b = &mut self.buf;
         let summary = predict(
@@ -815,7 +816,7 @@ impl<'a> PlatenScene<'a> {
             Default::default()
         };
 
-        let w = correct(b, sizes, gravity);
+        let w = correct(b, sizes, &loads);
         self.window_max_speed_squared =
             math::max(self.window_max_speed_squared, w.max_speed_squared);
         let kinetic = w.kinetic;
