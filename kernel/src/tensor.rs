@@ -249,6 +249,27 @@ pub fn cauchy_from_kirchhoff(tau: &Voigt, j: Real) -> Voigt {
     scale_add_identity(tau, 1.0 / j, 0.0)
 }
 
+/// The smallest eigenvalue of the symmetric 3×3 matrix `j` (closed form,
+/// no iteration; NaN in, NaN out). Near a repeated root the closed form's
+/// acos works near ±1 and the result carries ~1e-8 relative error.
+pub fn smallest_eigenvalue(j: &Mat3) -> Real {
+    let q = (j[(0, 0)] + j[(1, 1)] + j[(2, 2)]) / 3.0;
+    let off = j[(0, 1)] * j[(0, 1)] + j[(0, 2)] * j[(0, 2)] + j[(1, 2)] * j[(1, 2)];
+    let diag = [0, 1, 2].map(|a| j[(a, a)] - q);
+    let p2 = diag[0] * diag[0] + diag[1] * diag[1] + diag[2] * diag[2] + 2.0 * off;
+    if p2 == 0.0 {
+        return q;
+    }
+    let p = math::sqrt(p2 / 6.0);
+    let mut b = *j;
+    for a in 0..3 {
+        b[(a, a)] -= q;
+    }
+    let half_det = det_mat(&(b / p)) / 2.0;
+    let phi = math::acos(half_det.clamp(-1.0, 1.0)) / 3.0;
+    q + 2.0 * p * math::cos(phi + 2.0 * core::f64::consts::FRAC_PI_3)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -263,5 +284,36 @@ mod tests {
         let inv = inverse_with_det(&m, det_mat(&m));
         assert!((inv * m - Mat3::identity()).norm() < 1e-14);
         assert!((norm(&v) - m.norm()).abs() < 1e-14);
+    }
+
+    #[test]
+    fn the_smallest_eigenvalue_of_rotated_diagonals() {
+        // R = rotation by 0.7 rad about (1, 2, 2)/3.
+        let axis = [1.0 / 3.0, 2.0 / 3.0, 2.0 / 3.0];
+        let (c, s) = (math::cos(0.7), math::sin(0.7));
+        let r = Mat3::from_fn(|a, b| {
+            let k = [
+                [0.0, -axis[2], axis[1]],
+                [axis[2], 0.0, -axis[0]],
+                [-axis[1], axis[0], 0.0],
+            ];
+            (if a == b { c } else { 0.0 }) + (1.0 - c) * axis[a] * axis[b] + s * k[a][b]
+        });
+        for (d, smallest) in [
+            ([1.0, 2.0, 5.0], 1.0),
+            ([5.0, 2.0, 1.0], 1.0),
+            ([3.0, 3.0, 7.0], 3.0),
+            ([7.0, 3.0, 3.0], 3.0),
+            ([4.0, 4.0, 4.0], 4.0),
+            ([2.0, 9.0, 5.0], 2.0),
+            ([1e-3, 1.0, 1.0], 1e-3),
+        ] {
+            let j = r * Mat3::from_diagonal(&nalgebra::Vector3::from(d)) * r.transpose();
+            let got = smallest_eigenvalue(&j);
+            // At a repeated root acos works near ±1, where it loses half the
+            // digits: ~1e-8 relative (hence the callers' margin).
+            assert!((got - smallest).abs() < 1e-7 * 9.0, "{d:?}: {got}");
+        }
+        assert!(smallest_eigenvalue(&Mat3::from_element(Real::NAN)).is_nan());
     }
 }

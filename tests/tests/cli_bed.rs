@@ -513,8 +513,9 @@ fn a_failing_run_names_granule_element_step_and_strain_and_keeps_its_outputs() {
 /// internal work like physical masses do, and hence pass the quasi-static
 /// certificate, where uniform ×10 (the granules' translation and spin ten
 /// times heavier too) fails it; the overlaps stay below 1 % of the element
-/// and P(C) moves by less than 5 % from physical masses (relative L2 over
-/// 2–30 %; the noise floor of such a change is 4–9 %, BENCHMARKS.md).
+/// and P(C) stays within the noise floor of any change of the arithmetic
+/// (relative L2 over 2–30 % below 9 %, the floor's upper end in
+/// BENCHMARKS.md; measured 3.3 %).
 #[test]
 fn selective_mass_scaling_keeps_the_bed_quasi_static_in_fewer_steps() {
     let mut args = vec!["--mass-scaling", "10"];
@@ -546,7 +547,7 @@ fn selective_mass_scaling_keeps_the_bed_quasi_static_in_fewer_steps() {
     assert!(number(&s, "max_penetration_rel_element") < 0.01, "{s}");
     let l2 = pressure_distance(&selective, &physical);
     println!("P(C) selective x10 vs physical masses: relative L2 {l2:.4}");
-    assert!(l2 < 0.05, "selective x10 moves P(C) by {l2:.4}");
+    assert!(l2 < 0.09, "selective x10 moves P(C) by {l2:.4}");
 
     let run = cli(&["bed", "--print-scene", "--selective-mass-scaling", "true"]);
     assert_eq!(run.code, 0, "{}", run.stderr);
@@ -558,4 +559,18 @@ fn selective_mass_scaling_keeps_the_bed_quasi_static_in_fewer_steps() {
     let old = DEFAULT_SCENE.replace("selective_mass_scaling = false\n", "");
     assert_ne!(old, DEFAULT_SCENE);
     assert!(!Scene::from_toml(&old).unwrap().selective_mass_scaling);
+    // It changes what the checkpoint's energy ledger means: not with --resume.
+    let run = cli(&[
+        "bed",
+        "--resume",
+        selective.to_str().unwrap(),
+        "--selective-mass-scaling",
+        "false",
+    ]);
+    assert_eq!(run.code, 2, "{}", run.stderr);
+    assert!(
+        run.stderr.contains("selective-mass-scaling"),
+        "{}",
+        run.stderr
+    );
 }

@@ -372,18 +372,37 @@ fn the_frame_response_is_the_rigid_projection() {
 /// surface node and force directions radial, tangential and oblique, the
 /// node's motion along the force under M' (its share plus the rigid
 /// response, `correct`'s arithmetic) per unit force is at most 1/m_c; and
-/// the bound is not wasteful (some direction reaches 90 % of it).
+/// the bound is not wasteful. On the sphere (isotropic inertia) some
+/// direction reaches 90 % of it; on a granule stretched to an anisotropic
+/// inertia (where the bound needs J's smallest eigenvalue, not any of the
+/// three) the bound must hold, and the three directions tried, which miss
+/// the worst one, reach 89–98 % (measured; required: half).
 #[test]
 fn a_contact_mass_bounds_the_node_s_response() {
     let mesh = OwnedReference::sphere(R, MeshLevel::new(4, 1), false).unwrap();
     let mut store = GranuleStore::new(&mesh, 1);
     store.buffers().reset(&mesh.view(), &elastic_solid());
-    for factor in [10.0, 100.0] {
+    let stretched: Vec<[Real; 3]> = mesh
+        .positions
+        .iter()
+        .map(|p| [1.3 * p[0] + 0.2 * p[1], 0.8 * p[1], 0.6 * p[2] + 0.1 * p[0]])
+        .collect();
+    for (factor, x, reach) in [
+        (10.0, &mesh.positions, 0.9),
+        (100.0, &mesh.positions, 0.9),
+        (10.0, &stretched, 0.5),
+        (100.0, &stretched, 0.5),
+    ] {
         let mass: Vec<Real> = store.mass.iter().map(|m| m * factor).collect();
-        let x = &mesh.positions;
         let frame = RigidFrame::of(&mass, x);
         let mut contact = vec![0.0; mass.len()];
-        selective_contact_masses(&frame, &mass, x, factor, &mut contact);
+        assert!(selective_contact_masses(
+            &frame,
+            &mass,
+            x,
+            factor,
+            &mut contact
+        ));
         let mut tightest: Real = 0.0;
         for i in mesh.surface_range() {
             let r = x[i];
@@ -421,7 +440,7 @@ fn a_contact_mass_bounds_the_node_s_response() {
         }
         println!("F = {factor}: the worst direction reaches {tightest:.4} of the bound");
         assert!(
-            tightest > 0.9,
+            tightest > reach,
             "F = {factor}: bound reached only to {tightest}"
         );
     }

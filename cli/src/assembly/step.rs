@@ -564,7 +564,15 @@ impl Assembly<'_> {
                 .par_iter_mut()
                 .map(|g| {
                     let frame = RigidFrame::of(&g.mass, &g.x);
-                    selective_contact_masses(&frame, &g.mass, &g.x, selective, &mut g.contact_mass);
+                    // Every buffer of a GranuleStore has one entry per node.
+                    let written = selective_contact_masses(
+                        &frame,
+                        &g.mass,
+                        &g.x,
+                        selective,
+                        &mut g.contact_mass,
+                    );
+                    debug_assert!(written);
                     frame
                 })
                 .collect();
@@ -620,10 +628,13 @@ impl Assembly<'_> {
         // a sweep and only their f_c is kept from before it; a granule the
         // last sweep put no force on keeps its x̃ (its update would add
         // zeros). With selective mass scaling the surface also moves by the
-        // granule's rigid response to Δf (M'⁻¹ exactly, as in `correct`);
-        // the interior's share of it is left to `correct`.
+        // granule's rigid response to Δf (M'⁻¹ as in `correct`, which also
+        // projects at x_n); the interior's share of it is left to `correct`.
+        // (No component is held in an assembly, so unlike `correct` the
+        // response ignores `fixed`.)
         let surface = self.mesh.surface_range();
-        let frames = self.frames.clone();
+        // Taken for the sweeps (which borrow the assembly) and put back.
+        let frames = core::mem::take(&mut self.frames);
         for sweep in 0..p.contact_sweeps {
             if sweep > 0 {
                 self.granules
@@ -704,6 +715,7 @@ impl Assembly<'_> {
                 self.contact.narrow_to_deep_pairs(p.sweep_tolerance_m);
             }
         }
+        self.frames = frames;
         for w in self.contact.work() {
             pair_normal += w.step.normal;
             constraints += w.step.constraints;

@@ -160,7 +160,7 @@ pub struct BedArgs {
     /// the outputs go to DIR. Only --strain, --stop-at-strain,
     /// --time-step-safety, --mass-scaling, --face-list-skin, -j and --quiet
     /// may be given with it.
-    #[arg(long, value_name = "DIR", conflicts_with_all = ["scene", "out", "granule_type", "granules", "mesh", "seed", "die_diameter_mm", "element", "hourglass_kappa", "rigid_until_touched", "local_sweeps"])]
+    #[arg(long, value_name = "DIR", conflicts_with_all = ["scene", "out", "granule_type", "granules", "mesh", "seed", "die_diameter_mm", "element", "hourglass_kappa", "rigid_until_touched", "local_sweeps", "selective_mass_scaling"])]
     pub resume: Option<PathBuf>,
 
     /// Write a checkpoint and stop once the strain reaches C (continue

@@ -13,7 +13,7 @@
 //! that actually happened.
 
 use crate::Real;
-use crate::tensor::{Mat3, det_mat, inverse_with_det};
+use crate::tensor::{Mat3, det_mat, inverse_with_det, smallest_eigenvalue};
 
 /// Rigid-body motion of a set of nodes: centre of mass, its velocity and
 /// the angular velocity ω = J_c⁻¹ L.
@@ -136,26 +136,6 @@ fn add_point_inertia(inertia: &mut Mat3, m: Real, r: &[Real; 3]) {
     }
 }
 
-/// The smallest eigenvalue of the symmetric 3×3 matrix `j` (closed form,
-/// no iteration; NaN in, NaN out).
-fn smallest_eigenvalue(j: &Mat3) -> Real {
-    let q = (j[(0, 0)] + j[(1, 1)] + j[(2, 2)]) / 3.0;
-    let off = j[(0, 1)] * j[(0, 1)] + j[(0, 2)] * j[(0, 2)] + j[(1, 2)] * j[(1, 2)];
-    let diag = [0, 1, 2].map(|a| j[(a, a)] - q);
-    let p2 = diag[0] * diag[0] + diag[1] * diag[1] + diag[2] * diag[2] + 2.0 * off;
-    if p2 == 0.0 {
-        return q;
-    }
-    let p = crate::math::sqrt(p2 / 6.0);
-    let mut b = *j;
-    for a in 0..3 {
-        b[(a, a)] -= q;
-    }
-    let half_det = det_mat(&(b / p)) / 2.0;
-    let phi = crate::math::acos(half_det.clamp(-1.0, 1.0)) / 3.0;
-    q + 2.0 * p * crate::math::cos(phi + 2.0 * core::f64::consts::FRAC_PI_3)
-}
-
 /// A granule's total mass, centre of mass and inertia about it: what the
 /// rigid response to a set of forces needs.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -193,7 +173,9 @@ impl RigidFrame {
 
     /// The rigid motion the forces `f` at the points `x` (N, m; pairs)
     /// give per unit time: velocity ΣF/m and ω = J_c⁻¹ Σ r × f, i.e. P(M⁻¹f)
-    /// for nodal forces (zero ω if J_c is singular).
+    /// for nodal forces (zero ω if J_c is singular). Its
+    /// `angular_momentum` holds the torque Σ r × f (a rate, N m), so
+    /// [`RigidMotion::twice_kinetic_energy`] means nothing for it.
     pub fn response(&self, forces: impl Iterator<Item = ([Real; 3], [Real; 3])>) -> RigidMotion {
         let (mut total, mut torque) = ([0.0; 3], [0.0; 3]);
         for (x, f) in forces {
@@ -241,19 +223,26 @@ fn sub(a: &[Real; 3], b: &[Real; 3]) -> [Real; 3] {
 /// the centre of mass; exact for a sphere's inertia), and at most 1; the
 /// contact mass m'_I / (1 + (F−1) p_I) does not overshoot for a node alone.
 /// The rigid response to the other nodes' forces is the caller's to predict
-/// ([`RigidFrame::response`]). F ≤ 1: the stored masses.
+/// ([`RigidFrame::response`]). F ≤ 1 (or not finite): the stored masses.
+/// Returns false, writing nothing, if the slices differ in length.
+#[must_use]
 pub fn selective_contact_masses(
     frame: &RigidFrame,
     mass: &[Real],
     x: &[[Real; 3]],
     factor: Real,
     out: &mut [Real],
-) {
-    if factor <= 1.0 {
-        out.copy_from_slice(mass);
-        return;
+) -> bool {
+    if out.len() != mass.len() || x.len() != mass.len() {
+        return false;
     }
-    let lambda = smallest_eigenvalue(&frame.inertia);
+    if !(factor > 1.0 && factor.is_finite()) {
+        out.copy_from_slice(mass);
+        return true;
+    }
+    // A hair below λ_min: near a repeated root the closed form's acos may
+    // overestimate it by ~1e-8 relative, which would under-bound p_I.
+    let lambda = smallest_eigenvalue(&frame.inertia) * (1.0 - 1e-6);
     let valid = lambda > 0.0 && frame.mass > 0.0;
     for ((o, mi), xi) in out.iter_mut().zip(mass).zip(x) {
         let r = sub(xi, &frame.centre);
@@ -263,6 +252,7 @@ pub fn selective_contact_masses(
         let p = if valid && p < 1.0 { p } else { 1.0 };
         *o = mi / (1.0 + (factor - 1.0) * p);
     }
+    true
 }
 
 /// Writes the selective damping forces f_d,I = −c m_I w_I into `f_d` (N),

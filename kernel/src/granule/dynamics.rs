@@ -130,7 +130,8 @@ pub struct Loads {
     /// the physical ones and act on the deformational modes only; the rigid
     /// modes keep the physical inertia. 1: the stored masses act on every
     /// mode (no scaling, or uniform scaling by the caller). Ignored without
-    /// free rigid modes.
+    /// free rigid modes; a factor that is not finite or not above 1 means
+    /// none.
     pub selective_mass_factor: Real,
 }
 
@@ -138,8 +139,8 @@ impl Loads {
     /// The factor (F − 1) by which a velocity increment's rigid part is
     /// added again, or `None` when the masses act on every mode.
     fn rigid_boost(&self) -> Option<Real> {
-        (self.rigid_modes && self.selective_mass_factor > 1.0)
-            .then(|| self.selective_mass_factor - 1.0)
+        let f = self.selective_mass_factor;
+        (self.rigid_modes && f > 1.0 && f.is_finite()).then_some(f - 1.0)
     }
 }
 
@@ -238,7 +239,7 @@ fn advance_predictor(
             Some(k) if !translating => rigid.velocity_at(&b.x[i]).map(|r| k * r),
             _ => [0.0; 3],
         };
-        for a in 0..3 {
+        for (a, extra) in extra.into_iter().enumerate() {
             let dv = increment(b, i, a, dt_n, predictor_force(b, i, a, g));
             b.v_star[i][a] = if b.fixed[i] & (1 << a) != 0 {
                 0.0
@@ -246,7 +247,7 @@ fn advance_predictor(
                 match boost {
                     None => b.v[i][a] + dv,
                     Some(k) if translating => b.v[i][a] + (dv + k * dv),
-                    Some(_) => b.v[i][a] + (dv + extra[a]),
+                    Some(_) => b.v[i][a] + (dv + extra),
                 }
             };
             b.x_pred[i][a] = b.x[i][a] + dt * b.v_star[i][a];
@@ -275,11 +276,11 @@ pub fn correct(b: &mut GranuleBuffers<'_>, sizes: StepSizes, loads: &Loads) -> S
             Some(k) => rigid.velocity_at(&b.x[i]).map(|r| k * r),
             None => [0.0; 3],
         };
-        for a in 0..3 {
+        for (a, extra) in extra.into_iter().enumerate() {
             let v_new = if b.fixed[i] & (1 << a) != 0 {
                 0.0
             } else if boost.is_some() {
-                b.v_star[i][a] + (dt_n * b.f_c[i][a] / m + extra[a])
+                b.v_star[i][a] + (dt_n * b.f_c[i][a] / m + extra)
             } else {
                 b.v_star[i][a] + dt_n * b.f_c[i][a] / m
             };
