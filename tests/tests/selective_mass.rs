@@ -92,18 +92,23 @@ fn run(
     }
 }
 
+/// The lumped masses of the elastic granule on `mesh`, kg.
+fn reference_masses(mesh: &OwnedReference) -> Vec<Real> {
+    let mut store = GranuleStore::new(mesh, 1);
+    store.buffers().reset(&mesh.view(), &elastic_solid());
+    store.mass
+}
+
 /// A deformational velocity field: the spheroidal shape (x, y, −2z) with
 /// its rigid part (mass-orthogonal projection) removed, amplitude `a` m/s.
 fn deformational(mesh: &OwnedReference, a: Real) -> Vec<[Real; 3]> {
-    let mat = elastic_solid();
-    let mut store = GranuleStore::new(mesh, 1);
-    store.buffers().reset(&mesh.view(), &mat);
+    let mass = reference_masses(mesh);
     let shape: Vec<[Real; 3]> = mesh
         .positions
         .iter()
         .map(|x| [a * x[0] / R, a * x[1] / R, -2.0 * a * x[2] / R])
         .collect();
-    let rigid = rigid_motion(&store.mass, &mesh.positions, &shape);
+    let rigid = rigid_motion(&mass, &mesh.positions, &shape);
     shape
         .iter()
         .zip(&mesh.positions)
@@ -332,8 +337,7 @@ fn the_kinetic_energy_balances_the_work() {
 #[test]
 fn the_frame_response_is_the_rigid_projection() {
     let mesh = OwnedReference::sphere(R, MeshLevel::new(4, 1), false).unwrap();
-    let mut store = GranuleStore::new(&mesh, 1);
-    store.buffers().reset(&mesh.view(), &elastic_solid());
+    let store_mass = reference_masses(&mesh);
     let x: Vec<[Real; 3]> = mesh
         .positions
         .iter()
@@ -350,9 +354,9 @@ fn the_frame_response_is_the_rigid_projection() {
             }
         })
         .collect();
-    let frame = RigidFrame::of(&store.mass, &x);
+    let frame = RigidFrame::of(&store_mass, &x);
     let by_frame = frame.response(x.iter().zip(&f).map(|(p, q)| (*p, *q)));
-    let projected = rigid_motion_of(&store.mass, &x, |i| f[i].map(|c| c / store.mass[i]));
+    let projected = rigid_motion_of(&store_mass, &x, |i| f[i].map(|c| c / store_mass[i]));
     for a in 0..3 {
         let (u, v) = (by_frame.velocity[a], projected.velocity[a]);
         assert!(
@@ -380,8 +384,7 @@ fn the_frame_response_is_the_rigid_projection() {
 #[test]
 fn a_contact_mass_bounds_the_node_s_response() {
     let mesh = OwnedReference::sphere(R, MeshLevel::new(4, 1), false).unwrap();
-    let mut store = GranuleStore::new(&mesh, 1);
-    store.buffers().reset(&mesh.view(), &elastic_solid());
+    let store_mass = reference_masses(&mesh);
     let stretched: Vec<[Real; 3]> = mesh
         .positions
         .iter()
@@ -393,7 +396,7 @@ fn a_contact_mass_bounds_the_node_s_response() {
         (10.0, &stretched, 0.5),
         (100.0, &stretched, 0.5),
     ] {
-        let mass: Vec<Real> = store.mass.iter().map(|m| m * factor).collect();
+        let mass: Vec<Real> = store_mass.iter().map(|m| m * factor).collect();
         let frame = RigidFrame::of(&mass, x);
         let mut contact = vec![0.0; mass.len()];
         assert!(selective_contact_masses(

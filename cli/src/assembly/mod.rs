@@ -28,7 +28,7 @@ use granbed_kernel::Real;
 use granbed_kernel::contact::broad::{Bound, GranulePair};
 use granbed_kernel::contact::pair::PairSettings;
 use granbed_kernel::contact::wall::Wall;
-use granbed_kernel::granule::damping::{RigidFrame, damping_coefficient, rigid_motion};
+use granbed_kernel::granule::damping::{RigidFrame, damping_coefficient, selective_kinetic_excess};
 use granbed_kernel::granule::forces::ElementSettings;
 use granbed_kernel::granule::quality::{WorstElement, worst_element};
 use granbed_kernel::granule::timestep::{
@@ -384,9 +384,7 @@ impl<'m> Assembly<'m> {
         if f > 1.0 {
             // ½ v·M'v: the rigid part of the motion carries m'/F.
             for g in &assembly.granules {
-                kinetic -= 0.5
-                    * (1.0 - 1.0 / f)
-                    * rigid_motion(&g.mass, &g.x, &g.v).twice_kinetic_energy();
+                kinetic -= selective_kinetic_excess(&g.mass, &g.x, &g.v, f);
             }
         }
         assembly.energies.initial_kinetic = kinetic;

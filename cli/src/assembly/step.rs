@@ -559,23 +559,24 @@ impl Assembly<'_> {
         // response in the sweeps) and its contact masses, at x_n.
         let selective = p.selective_mass_factor();
         if selective > 1.0 {
-            self.frames = self
-                .granules
+            // One frame per granule, the buffer reused from step to step.
+            self.frames
+                .resize(self.granules.len(), RigidFrame::default());
+            self.granules
                 .par_iter_mut()
-                .map(|g| {
-                    let frame = RigidFrame::of(&g.mass, &g.x);
+                .zip(self.frames.par_iter_mut())
+                .for_each(|(g, frame)| {
+                    *frame = RigidFrame::of(&g.mass, &g.x);
                     // Every buffer of a GranuleStore has one entry per node.
                     let written = selective_contact_masses(
-                        &frame,
+                        frame,
                         &g.mass,
                         &g.x,
                         selective,
                         &mut g.contact_mass,
                     );
                     debug_assert!(written);
-                    frame
-                })
-                .collect();
+                });
         }
         let predicted: Vec<Result<ForceSummary, ElementFailure>> = self
             .granules
@@ -657,20 +658,22 @@ impl Assembly<'_> {
                                     }),
                             )
                         });
-                        for ((((x, f), f0), m), xn) in g.x_pred[s.clone()]
+                        let nodes = g.x_pred[s.clone()]
                             .iter_mut()
                             .zip(&g.f_c[s.clone()])
                             .zip(before)
                             .zip(&g.mass[s.clone()])
-                            .zip(&g.x[s.clone()])
-                        {
-                            match &rigid {
-                                None => {
+                            .zip(&g.x[s.clone()]);
+                        match &rigid {
+                            None => {
+                                for ((((x, f), f0), m), _) in nodes {
                                     for a in 0..3 {
                                         x[a] += dt2 * (f[a] - f0[a]) / m;
                                     }
                                 }
-                                Some(r) => {
+                            }
+                            Some(r) => {
+                                for ((((x, f), f0), m), xn) in nodes {
                                     let u = r.velocity_at(xn);
                                     for a in 0..3 {
                                         x[a] +=

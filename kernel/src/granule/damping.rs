@@ -13,6 +13,7 @@
 //! that actually happened.
 
 use crate::Real;
+use crate::contact::quad::sub;
 use crate::tensor::{Mat3, det_mat, inverse_with_det, smallest_eigenvalue};
 
 /// Rigid-body motion of a set of nodes: centre of mass, its velocity and
@@ -108,13 +109,7 @@ pub fn rigid_motion_of(
         l[2] += mi * (r[0] * u[1] - r[1] * u[0]);
         add_point_inertia(&mut inertia, *mi, &r);
     }
-    let det = det_mat(&inertia);
-    let omega = if det > 0.0 {
-        let inv = inverse_with_det(&inertia, det);
-        [0, 1, 2].map(|a| inv[(a, 0)] * l[0] + inv[(a, 1)] * l[1] + inv[(a, 2)] * l[2])
-    } else {
-        [0.0; 3]
-    };
+    let omega = spin(&inertia, &l);
     RigidMotion {
         centre,
         velocity,
@@ -122,6 +117,29 @@ pub fn rigid_motion_of(
         mass: m,
         angular_momentum: l,
     }
+}
+
+/// ω = J⁻¹L (rad/s, or its rate for a torque), or zero if J is singular.
+fn spin(inertia: &Mat3, l: &[Real; 3]) -> [Real; 3] {
+    let det = det_mat(inertia);
+    if det > 0.0 {
+        let inv = inverse_with_det(inertia, det);
+        [0, 1, 2].map(|a| inv[(a, 0)] * l[0] + inv[(a, 1)] * l[1] + inv[(a, 2)] * l[2])
+    } else {
+        [0.0; 3]
+    }
+}
+
+/// What ½ Σ m'|v|² overcounts of the kinetic energy ½ v·M'v under selective
+/// mass scaling by `factor` (`dynamics` module docs): ½ (1 − 1/F) Σ m'|Pv|²,
+/// J, for nodes at `x` with stored masses `mass` and velocities `v`.
+pub fn selective_kinetic_excess(
+    mass: &[Real],
+    x: &[[Real; 3]],
+    v: &[[Real; 3]],
+    factor: Real,
+) -> Real {
+    0.5 * (1.0 - 1.0 / factor) * rigid_motion(mass, x, v).twice_kinetic_energy()
 }
 
 /// Adds the inertia m (|r|²1 − r⊗r) of a point mass `m` at `r` from the
@@ -137,8 +155,8 @@ fn add_point_inertia(inertia: &mut Mat3, m: Real, r: &[Real; 3]) {
 }
 
 /// A granule's total mass, centre of mass and inertia about it: what the
-/// rigid response to a set of forces needs.
-#[derive(Clone, Copy, Debug, PartialEq)]
+/// rigid response to a set of forces needs (default: all zero).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct RigidFrame {
     /// Σ m_I, kg.
     pub mass: Real,
@@ -187,15 +205,7 @@ impl RigidFrame {
             torque[1] += r[2] * f[0] - r[0] * f[2];
             torque[2] += r[0] * f[1] - r[1] * f[0];
         }
-        let det = det_mat(&self.inertia);
-        let omega = if det > 0.0 {
-            let inv = inverse_with_det(&self.inertia, det);
-            [0, 1, 2].map(|a| {
-                inv[(a, 0)] * torque[0] + inv[(a, 1)] * torque[1] + inv[(a, 2)] * torque[2]
-            })
-        } else {
-            [0.0; 3]
-        };
+        let omega = spin(&self.inertia, &torque);
         RigidMotion {
             centre: self.centre,
             velocity: total.map(|t| t / self.mass),
@@ -204,10 +214,6 @@ impl RigidFrame {
             angular_momentum: torque,
         }
     }
-}
-
-fn sub(a: &[Real; 3], b: &[Real; 3]) -> [Real; 3] {
-    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
 }
 
 /// The nodal masses the kinematic contact sees under selective mass scaling

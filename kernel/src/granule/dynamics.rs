@@ -27,7 +27,9 @@
 //! scaling, and the granule falls at g.
 
 use crate::Real;
-use crate::granule::damping::{RigidMotion, damping_forces, rigid_motion, rigid_motion_of};
+use crate::granule::damping::{
+    RigidMotion, damping_forces, rigid_motion_of, selective_kinetic_excess,
+};
 use crate::granule::forces::{ElementFailure, ElementSettings, ForceSummary, internal_forces};
 use crate::material::Material;
 use crate::mesh::reference::ReferenceMesh;
@@ -298,8 +300,7 @@ pub fn correct(b: &mut GranuleBuffers<'_>, sizes: StepSizes, loads: &Loads) -> S
     }
     if let Some(k) = boost {
         // ½ v·M'v: the rigid part carries m'/F, not m' (module docs).
-        let f = k + 1.0;
-        w.kinetic -= 0.5 * (1.0 - 1.0 / f) * rigid_motion(b.mass, b.x, b.v).twice_kinetic_energy();
+        w.kinetic -= selective_kinetic_excess(b.mass, b.x, b.v, k + 1.0);
     }
     // A pass of its own keeps the loop above as it was (folding this into
     // it doubled its cost); f64::max is maxsd, no libm call (a NaN speed
