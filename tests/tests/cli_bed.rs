@@ -237,6 +237,8 @@ fn heavy_mass_scaling_fails_the_quasi_static_certificate() {
         dir.to_str().unwrap(),
         "--mass-scaling",
         "100",
+        "--selective-mass-scaling",
+        "false",
     ];
     argv.extend_from_slice(&SMALL);
     let run = cli(&argv);
@@ -506,8 +508,9 @@ fn a_failing_run_names_granule_element_step_and_strain_and_keeps_its_outputs() {
     assert!(dir.join("compression.csv").exists());
 }
 
-/// Selective mass scaling (the scene field `selective_mass_scaling`, off by
-/// default, and its CLI override): on the CI bed, masses ×10 on the
+/// Selective mass scaling (the scene field `selective_mass_scaling`, on with
+/// `mass_scaling = 10` in the published scene, off in a scene file without
+/// the field, and its CLI override): on the CI bed, masses ×10 on the
 /// deformational modes only take under 40 % of the steps of physical masses
 /// (the stable step grows by √10), keep the kinetic energy below 1 % of the
 /// internal work like physical masses do, and hence pass the quasi-static
@@ -522,7 +525,14 @@ fn selective_mass_scaling_keeps_the_bed_quasi_static_in_fewer_steps() {
     args.extend_from_slice(&SMALL);
     let (selective, uniform) = on_and_off("selective-mass-scaling", &args);
     let physical = out_dir("physical_masses");
-    let mut argv = vec!["bed", "--quiet", "--out", physical.to_str().unwrap()];
+    let mut argv = vec![
+        "bed",
+        "--quiet",
+        "--mass-scaling",
+        "1",
+        "--out",
+        physical.to_str().unwrap(),
+    ];
     argv.extend_from_slice(&SMALL);
     let r = cli(&argv);
     assert_eq!(r.code, 0, "{}", r.stderr);
@@ -549,16 +559,22 @@ fn selective_mass_scaling_keeps_the_bed_quasi_static_in_fewer_steps() {
     println!("P(C) selective x10 vs physical masses: relative L2 {l2:.4}");
     assert!(l2 < 0.09, "selective x10 moves P(C) by {l2:.4}");
 
-    let run = cli(&["bed", "--print-scene", "--selective-mass-scaling", "true"]);
+    let run = cli(&["bed", "--print-scene", "--selective-mass-scaling", "false"]);
     assert_eq!(run.code, 0, "{}", run.stderr);
     assert!(
-        Scene::from_toml(&run.stdout)
+        !Scene::from_toml(&run.stdout)
             .unwrap()
             .selective_mass_scaling
     );
-    let old = DEFAULT_SCENE.replace("selective_mass_scaling = false\n", "");
-    assert_ne!(old, DEFAULT_SCENE);
-    assert!(!Scene::from_toml(&old).unwrap().selective_mass_scaling);
+    // The published scene's defaults are explicit: a scene file without
+    // the two fields has physical masses.
+    assert_eq!(s["scene"]["mass_scaling"], 10.0);
+    let old = DEFAULT_SCENE
+        .replace("selective_mass_scaling = true\n", "")
+        .replace("mass_scaling = 10.0\n", "");
+    assert_eq!(old.matches("mass_scaling =").count(), 0);
+    let old = Scene::from_toml(&old).unwrap();
+    assert_eq!((old.mass_scaling, old.selective_mass_scaling), (1.0, false));
     // It changes what the checkpoint's energy ledger means: not with --resume.
     let run = cli(&[
         "bed",

@@ -166,7 +166,7 @@ fn the_quick_bed_study_runs_the_bed_code_and_measures_the_spread() {
     );
     let t = Table::read(&dir.join("work_precision.csv"));
     let names = t.text("setting");
-    assert_eq!(names, ["reference", "default", "mass x10", "speed x2"]);
+    assert_eq!(names, ["reference", "default", "mass x1", "speed x2"]);
     assert!(t.num("seed").iter().all(|&s| s == 1.0));
     let error = t.num("error_curve_l2");
     let within = t.num("within_spread");
@@ -175,8 +175,11 @@ fn the_quick_bed_study_runs_the_bed_code_and_measures_the_spread() {
         error[1..].iter().all(|e| e.is_finite() && *e > 0.0),
         "{error:?}"
     );
+    // Fitted and finite; with 15 granules the fit over C ≥ 0.25 is noise
+    // (measured a from −1.2 at speed ×2 to 2.2 with physical masses), so
+    // its value is not checked here — the 125-granule study's is.
     let a = t.num("kawakita_a");
-    assert!(a.iter().all(|a| a.is_finite() && *a > 0.0), "{a:?}");
+    assert!(a.iter().all(|a| a.is_finite()), "{a:?}");
     let steps = t.num("steps");
     let close = |x: f64, want: f64, what: &str| {
         assert!(
@@ -184,9 +187,11 @@ fn the_quick_bed_study_runs_the_bed_code_and_measures_the_spread() {
             "{what}: {x}, expected {want}"
         );
     };
-    close(steps[1] / steps[2], 10f64.sqrt(), "mass scaling x10");
+    // The default scales the masses x10 (selective): physical masses take
+    // √10 times its steps, the reference at half speed twice that.
+    close(steps[2] / steps[1], 10f64.sqrt(), "mass x1 against x10");
     close(steps[1] / steps[3], 2.0, "speed x2");
-    close(steps[0] / steps[1], 2.0, "reference at half speed");
+    close(steps[0] / steps[2], 2.0, "reference at half speed");
     // The default row is `granbed-cli bed` on the same scene, bit for bit.
     let bed = common::fresh_dir("cli_study", "bed_quick_run");
     let run = cli(&[

@@ -170,12 +170,13 @@ pub struct BedArgs {
 
     /// Override: mass scaling F ≥ 1 for quasi-static runs (the stable step
     /// grows by √F; check the quasi-static certificate in summary.json).
+    /// The published scene's is 10, selective; 1 gives physical masses.
     #[arg(long, value_name = "F")]
     pub mass_scaling: Option<f64>,
 
     /// Override: the mass scaling acts on the granules' deformational modes
-    /// only, their translation and spin keep the physical inertia (true),
-    /// or on every mode (false, the default).
+    /// only, their translation and spin keep the physical inertia (true,
+    /// the published scene's), or on every mode (false).
     #[arg(long, value_name = "BOOL")]
     pub selective_mass_scaling: Option<bool>,
 

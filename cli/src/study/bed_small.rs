@@ -55,25 +55,34 @@ pub fn bed_grid(mesh: MeshLevel, quick: bool) -> (Setting, Vec<Setting>) {
         kappa: granbed_kernel::element::force::DEFAULT_HOURGLASS_KAPPA,
         safety: Scene::published().time_step_safety,
         mass_scaling: Scene::published().mass_scaling,
+        selective_mass: Scene::published().selective_mass_scaling,
         ..Setting::default_on(mesh)
     };
     let with = |name, f: &dyn Fn(&mut Setting)| base.with(name, f);
+    // Uniform mass scaling by `f`: every mode of a granule f times heavier
+    // (f = 1: the physical masses).
+    let uniform = |f: Real| {
+        move |s: &mut Setting| {
+            s.mass_scaling = f;
+            s.selective_mass = false;
+        }
+    };
     let reference = with("reference", &|s| {
         s.element = ElementKind::FBar;
         s.speed_factor = 0.5;
-        s.mass_scaling = 1.0;
+        uniform(1.0)(s);
     });
     let mut grid = vec![
         base,
-        with("mass x10", &|s| s.mass_scaling = 10.0),
+        with("mass x1", &uniform(1.0)),
         with("speed x2", &|s| s.speed_factor = 2.0),
     ];
     if !quick {
         grid.extend([
             with("speed x0.5", &|s| s.speed_factor = 0.5),
-            with("mass x1", &|s| s.mass_scaling = 1.0),
-            with("mass x4", &|s| s.mass_scaling = 4.0),
-            with("mass x100", &|s| s.mass_scaling = 100.0),
+            with("mass x4", &uniform(4.0)),
+            with("mass x10", &uniform(10.0)),
+            with("mass x100", &uniform(100.0)),
             with("selective x10", &|s| {
                 s.mass_scaling = 10.0;
                 s.selective_mass = true;
