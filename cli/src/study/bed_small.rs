@@ -83,10 +83,6 @@ pub fn bed_grid(mesh: MeshLevel, quick: bool) -> (Setting, Vec<Setting>) {
             with("mass x4", &uniform(4.0)),
             with("mass x10", &uniform(10.0)),
             with("mass x100", &uniform(100.0)),
-            with("selective x10", &|s| {
-                s.mass_scaling = 10.0;
-                s.selective_mass = true;
-            }),
             with("selective x100", &|s| {
                 s.mass_scaling = 100.0;
                 s.selective_mass = true;
