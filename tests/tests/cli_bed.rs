@@ -466,7 +466,7 @@ fn the_face_list_skin_is_a_scene_field() {
         "{}",
         run.stderr
     );
-    let old = DEFAULT_SCENE.replace("face_list_skin = 0.02\n", "");
+    let old = DEFAULT_SCENE.replace("face_list_skin = 0.05\n", "");
     assert_ne!(old, DEFAULT_SCENE);
     assert_eq!(Scene::from_toml(&old).unwrap(), Scene::published());
 }

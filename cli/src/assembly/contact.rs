@@ -170,6 +170,8 @@ pub struct ContactPhase {
     epochs: Vec<u32>,
     /// Face-list builds so far (both passes of a pair count one).
     list_builds: u64,
+    /// Anchor renewals so far (over all granules).
+    anchor_renewals: u64,
 }
 
 /// `narrow` bit: the granule is in a pair deeper than the tolerance.
@@ -232,6 +234,11 @@ impl ContactPhase {
     /// Face-list builds so far (a pair's two passes count one).
     pub fn list_builds(&self) -> u64 {
         self.list_builds
+    }
+
+    /// Anchor renewals so far (over all granules).
+    pub fn anchor_renewals(&self) -> u64 {
+        self.anchor_renewals
     }
 
     /// Candidate pairs of the current list.
@@ -501,21 +508,25 @@ impl ContactPhase {
         let forced = &self.forced;
         self.anchors.resize(granules.len(), Vec::new());
         self.epochs.resize(granules.len(), 0);
-        self.anchors
+        self.anchor_renewals += self
+            .anchors
             .par_iter_mut()
             .zip(self.epochs.par_iter_mut())
             .zip(granules.par_iter())
             .enumerate()
             .filter(|(k, _)| first || forced.get(*k).is_none_or(|&f| f))
-            .for_each(|(_, ((anchor, epoch), g))| {
+            .map(|(_, ((anchor, epoch), g))| {
                 let moved = face_lists::drift(&g.x_pred, surface.start, anchor);
                 // A NaN renews too.
-                if moved.is_nan() || moved > drift {
+                let renew = moved.is_nan() || moved > drift;
+                if renew {
                     anchor.clear();
                     anchor.extend_from_slice(&g.x_pred[surface.clone()]);
                     *epoch = epoch.wrapping_add(1);
                 }
-            });
+                u64::from(renew)
+            })
+            .sum::<u64>();
     }
 
     /// Contact counts per node for the mass sharing: pairs in list order,

@@ -164,7 +164,7 @@ impl AssemblyParams {
 
 /// The default [`AssemblyParams::face_list_skin`] (measured in
 /// BENCHMARKS.md, "Face lists").
-pub const FACE_LIST_SKIN: Real = 0.02;
+pub const FACE_LIST_SKIN: Real = 0.05;
 
 /// Where a granule starts: its mesh is rotated by `rotation` (a proper
 /// orthogonal matrix, row-major) about the mesh centre, then moved to

@@ -310,6 +310,11 @@ pub struct PhaseTimes {
     pub rigid_granule_steps: u64,
     /// Steps timed.
     pub steps: u64,
+    /// Face-list builds (a pair's two passes count one).
+    pub list_builds: u64,
+    /// Face-list anchor renewals (a granule whose x̃ left its anchor by
+    /// more than the skin).
+    pub anchor_renewals: u64,
 }
 
 impl PhaseTimes {
@@ -327,7 +332,12 @@ impl PhaseTimes {
 
     /// Sweeps per step over `steps` steps (None for none).
     pub fn sweeps_per_step(&self) -> Option<f64> {
-        (self.steps > 0).then(|| self.sweeps as f64 / self.steps as f64)
+        self.per_step(self.sweeps)
+    }
+
+    /// `count` per timed step (None for none).
+    pub fn per_step(&self, count: u64) -> Option<f64> {
+        (self.steps > 0).then(|| count as f64 / self.steps as f64)
     }
 }
 
@@ -811,6 +821,8 @@ impl Assembly<'_> {
         self.times.contact_s += contacted_at - predicted_at;
         self.times.correct_s += done_at - contacted_at;
         self.times.steps += 1;
+        self.times.list_builds = self.contact.list_builds();
+        self.times.anchor_renewals = self.contact.anchor_renewals();
         self.time += sizes.dt;
         self.steps += 1;
         self.dt_prev = sizes.dt;

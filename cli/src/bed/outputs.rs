@@ -157,6 +157,12 @@ pub struct Summary<'a> {
     pub contact_share: Option<f64>,
     /// Contact sweeps per step (of this process's segment of the run).
     pub contact_sweeps_per_step: Option<f64>,
+    /// Face-list builds per step (a pair's two passes count one; of this
+    /// process's segment of the run).
+    pub face_list_builds_per_step: Option<f64>,
+    /// Face-list anchor renewals per step, over all granules (of this
+    /// process's segment of the run).
+    pub anchor_renewals_per_step: Option<f64>,
     /// Share of the granule-steps taken as rigid bodies, without element
     /// work (of this process's segment of the run).
     pub rigid_granule_step_share: Option<f64>,
@@ -266,6 +272,8 @@ pub fn summary<'a>(scene: &'a Scene, run: &BedRun) -> Summary<'a> {
         ns_per_element_step: finite_ratio(1e9 * run.wall_time_s, run.element_steps as f64),
         contact_share: Some(run.phase_times.contact_share()).filter(|x| x.is_finite()),
         contact_sweeps_per_step: run.phase_times.sweeps_per_step().filter(|x| x.is_finite()),
+        face_list_builds_per_step: run.phase_times.per_step(run.phase_times.list_builds),
+        anchor_renewals_per_step: run.phase_times.per_step(run.phase_times.anchor_renewals),
         rigid_granule_step_share: run.phase_times.rigid_share(run.granules),
         threads: run.threads,
         min_jacobian,

@@ -18,7 +18,7 @@ pub const REPORT_FILE: &str = "report.html";
 /// The fields of `summary.json` shown first, in this order, with their
 /// meaning; any other field follows (the nested `kawakita` object is
 /// flattened to `kawakita.<field>`, the scene is shown as TOML instead).
-const FIELDS: [(&str, &str); 31] = [
+const FIELDS: [(&str, &str); 33] = [
     ("kawakita_a", "Kawakita a (limiting strain)"),
     ("kawakita_inv_b_pa", "Kawakita 1/b, Pa"),
     (
@@ -52,6 +52,14 @@ const FIELDS: [(&str, &str); 31] = [
         "share of the contact phase in the wall time",
     ),
     ("contact_sweeps_per_step", "contact sweeps per step"),
+    (
+        "face_list_builds_per_step",
+        "face-list builds per step (pairs)",
+    ),
+    (
+        "anchor_renewals_per_step",
+        "face-list anchor renewals per step (granules)",
+    ),
     (
         "rigid_granule_step_share",
         "share of granule-steps taken as rigid bodies (untouched)",

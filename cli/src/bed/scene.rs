@@ -76,7 +76,7 @@ local_sweeps = true
 # surface-face diagonal: a pair's lists are rebuilt once a node has moved this
 # far (0: try every face near the overlap every sweep). The results are the
 # same bits either way; only the speed depends on it.
-face_list_skin = 0.02
+face_list_skin = 0.05
 # Watchdogs: stop (with a checkpoint from before) when the kinetic energy
 # exceeds this multiple of all the energy put in (punch or contact work,
 # gravity, initial motion), or when a node moves faster than this multiple of
