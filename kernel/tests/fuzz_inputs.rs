@@ -248,16 +248,45 @@ proptest! {
 }
 
 /// The sieve against the projection on mesh-like faces, where it decides:
-/// a square's corners moved by up to 0.45 of its half-edge (skewed,
-/// tapered, warped), a point placed behind the face at depth h along the
-/// local normal at (ξ, η) within the edge reach. Whenever the projection
-/// finds the point within the reach (|ξ*|, |η*| ≤ 1.25) and behind the face
-/// within the window, the sieve must pass it.
+/// a square's corners moved in plane by up to 0.45 of its half-edge and out
+/// of it by up to 0.15 (tapered, warped), then stretched to an aspect ratio
+/// down to 1:5 and sheared (angles from ~35° to ~145°); a point placed
+/// behind the face at depth h along the local normal at (ξ, η) within the
+/// edge reach. Checked: the undoubled bounds of the [`QuadSieve`] docs hold
+/// for that stationary point, and whenever the projection finds the point
+/// within the reach and behind the face within the window, the sieve passes
+/// it.
 fn mesh_like_face() -> impl Strategy<Value = [[Real; 3]; 4]> {
-    proptest::array::uniform4(proptest::array::uniform3(-0.45..0.45f64)).prop_map(|d| {
-        let square = [[-1.0, -1.0], [1.0, -1.0], [1.0, 1.0], [-1.0, 1.0]];
-        core::array::from_fn(|k| [square[k][0] + d[k][0], square[k][1] + d[k][1], d[k][2]])
-    })
+    (
+        proptest::array::uniform4((-0.45..0.45f64, -0.45..0.45f64, -0.15..0.15f64)),
+        0.2..1.0f64,
+        -1.5..1.5f64,
+    )
+        .prop_map(|(d, aspect, shear)| {
+            let square = [[-1.0, -1.0], [1.0, -1.0], [1.0, 1.0], [-1.0, 1.0]];
+            core::array::from_fn(|k| {
+                let y = aspect * (square[k][1] + d[k].1);
+                [square[k][0] + d[k].0 + shear * y, y, d[k].2]
+            })
+        })
+}
+
+type V3 = [Real; 3];
+
+fn cross3(a: V3, b: V3) -> V3 {
+    [
+        a[1] * b[2] - a[2] * b[1],
+        a[2] * b[0] - a[0] * b[2],
+        a[0] * b[1] - a[1] * b[0],
+    ]
+}
+
+fn dot3(a: V3, b: V3) -> Real {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+
+fn norm3(a: V3) -> Real {
+    dot3(a, a).sqrt()
 }
 
 proptest! {
@@ -271,9 +300,7 @@ proptest! {
         window in 0.01..0.8f64,
     ) {
         prop_assume!(!folded(&q));
-        // The point behind the face at (ξ, η), `depth` of the window deep
-        // along the local normal there.
-        let w = |s: [Real; 4]| -> [Real; 3] {
+        let w = |s: [Real; 4]| -> V3 {
             core::array::from_fn(|a| 0.25 * (0..4).map(|k| s[k] * q[k][a]).sum::<Real>())
         };
         let (c, e1, e2, tw) = (
@@ -282,19 +309,44 @@ proptest! {
             w([-1.0, -1.0, 1.0, 1.0]),
             w([1.0, -1.0, 1.0, -1.0]),
         );
-        let t1: [Real; 3] = core::array::from_fn(|a| e1[a] + eta * tw[a]);
-        let t2: [Real; 3] = core::array::from_fn(|a| e2[a] + xi * tw[a]);
-        let n = [
-            t1[1] * t2[2] - t1[2] * t2[1],
-            t1[2] * t2[0] - t1[0] * t2[2],
-            t1[0] * t2[1] - t1[1] * t2[0],
-        ];
-        let len = (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt();
-        prop_assume!(len > 0.0);
+        let t1: V3 = core::array::from_fn(|a| e1[a] + eta * tw[a]);
+        let t2: V3 = core::array::from_fn(|a| e2[a] + xi * tw[a]);
+        let nl = cross3(t1, t2);
+        let nl_len = norm3(nl);
+        prop_assume!(nl_len > 0.0);
+        // The point `depth` of the window behind the face at (ξ, η), along
+        // the local normal there: a stationary point of the distance.
         let h = depth * window;
-        let p: [Real; 3] = core::array::from_fn(|a| {
-            c[a] + xi * e1[a] + eta * e2[a] + xi * eta * tw[a] - h * n[a] / len
+        let p: V3 = core::array::from_fn(|a| {
+            c[a] + xi * e1[a] + eta * e2[a] + xi * eta * tw[a] - h * nl[a] / nl_len
         });
+        // The undoubled bounds (QuadSieve docs), for R = max(|ξ|, |η|).
+        let n0 = cross3(e1, e2);
+        let len = norm3(n0);
+        let n: V3 = n0.map(|v| v / len);
+        let r = xi.abs().max(eta.abs());
+        let wn = norm3(tw);
+        let t = r * wn * (norm3(e1) + norm3(e2));
+        if t < 0.5 * len {
+            let d: V3 = core::array::from_fn(|a| p[a] - c[a]);
+            let axis1 = cross3(e2, n).map(|v| v / len);
+            let axis2 = cross3(n, e1).map(|v| v / len);
+            let tol = 1e-12;
+            for (axis, exact) in [(axis1, xi), (axis2, eta)] {
+                let bound = (r * r * wn + h * t / (len - t)) * norm3(axis);
+                prop_assert!(
+                    (dot3(d, axis) - exact).abs() <= bound + tol,
+                    "in-plane bound: {} > {bound}",
+                    (dot3(d, axis) - exact).abs()
+                );
+            }
+            let g0 = dot3(d, n);
+            prop_assert!(
+                g0 <= r * r * wn + tol && g0 >= -h - r * r * wn - tol,
+                "normal bound: g0 {g0}, h {h}, twist {}",
+                r * r * wn
+            );
+        }
         let sieve = QuadSieve::new(&q).unwrap();
         if let Some(r) = project(&p, &q)
             && r.gap <= 0.0

@@ -28,7 +28,7 @@ use crate::contact::quad::{
     QuadProjection, QuadSieve, Vec3, dot, norm, project, project_clamped, sub,
 };
 use crate::contact::surface::{Aabb, SurfaceBody};
-use crate::math::{abs, sqrt};
+use crate::math::{abs, max, sqrt};
 
 /// Settings of the granule–granule contact.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -510,11 +510,13 @@ fn closest_face<'c>(
     };
     let mut best: Option<Hit> = None;
     let mut near_outside = false;
+    // The sieve passes what projects within this reach of the face.
+    let reach = max(EDGE_REACH, settings.inside_tolerance);
     for face in candidates.clone() {
         if !face.reach.contains(&p)
             || !face
                 .sieve
-                .is_some_and(|s| s.may_touch(&p, face.window, EDGE_REACH))
+                .is_some_and(|s| s.may_touch(&p, face.window, reach))
         {
             continue;
         }

@@ -273,7 +273,9 @@ pub fn project_clamped(p: &Vec3, x: &[Vec3; 4]) -> Option<QuadProjection> {
 ///   certain while T < |e1 × e2|).
 ///
 /// Both bounds are doubled against round-off and the Newton search
-/// stopping short of the stationary point. 900 000 fuzzed faces
+/// stopping short of the stationary point — room that only a face with
+/// w ≠ 0 gets; on a parallelogram Newton is exact in one step. Callers
+/// must pass a reach no smaller than the inside tolerance they test with. 900 000 fuzzed faces
 /// (`tests/fuzz_inputs.rs`, inside the face and within the edge reach)
 /// found no rejected contact. (Session 13 replaced a constant ½ in the
 /// in-plane bound by the tilt term: on a dense bed 7 of 8 projections the
@@ -289,12 +291,13 @@ pub struct QuadSieve {
     axis2: Vec3,
     /// Unit normal of the centre plane (e1 × e2).
     normal: Vec3,
-    /// Twice the bound |ξη||w| ≤ R²|w| on how far the bilinear face leaves
-    /// its centre plane, per R², m; plus a round-off allowance (`floor`).
+    /// 2|w|: twice the bound |ξη||w| ≤ R²|w| on how far the bilinear face
+    /// leaves its centre plane, per R², m.
     warp: Real,
     /// Round-off allowance of the normal test, m.
     floor: Real,
-    /// max(|axis1|, |axis2|) |w|: the in-plane offset of the twist per R².
+    /// 2 max(|axis1|, |axis2|) |w|: twice the in-plane offset of the twist
+    /// per R².
     twist: Real,
     /// |w|(|e1| + |e2|)/|e1 × e2|: the tilt bound's T per R, relative.
     bend: Real,
@@ -338,8 +341,8 @@ impl QuadSieve {
         let r = 1.0 + reach;
         let t = r * self.bend;
         // The face may fold within the reach (N*·n ≤ 0 needs t ≥ 1): no
-        // test is safe. (Not `t >= 0.5`: a NaN passes too.)
-        if !(t < 0.5) {
+        // test is safe. (A NaN passes too.)
+        if t.is_nan() || t >= 0.5 {
             return true;
         }
         let d = sub(p, &self.centre);
@@ -349,7 +352,13 @@ impl QuadSieve {
             return false;
         }
         let tilt = t / (1.0 - t);
-        let limit = r + r * r * self.twist + 2.0 * window * tilt * self.axis_norm + 1e-9;
-        abs(dot(&d, &self.axis1)) <= limit && abs(dot(&d, &self.axis2)) <= limit
+        let lean = if tilt > 0.0 {
+            2.0 * window * tilt * self.axis_norm
+        } else {
+            0.0
+        };
+        let limit = r + r * r * self.twist + lean + 1e-9;
+        // A NaN limit passes.
+        limit.is_nan() || (abs(dot(&d, &self.axis1)) <= limit && abs(dot(&d, &self.axis2)) <= limit)
     }
 }
