@@ -210,38 +210,28 @@ proptest! {
             // And only on faces that are not folded: where the local
             // normal turns against the centre normal (a bow-tie, or a
             // concave corner) "behind the face" has no single meaning.
+            // Inside the face (a contact), and within the edge reach (the
+            // detection's use: a node just off the face starts the
+            // concave-edge search).
             if let Some(r) = project(&p, &q)
                 && one_scale
                 && !folded(&q)
-                && r.inside(0.0)
                 && r.gap <= 0.0
                 && r.gap >= -window * scale
                 && scale.is_finite()
             {
-                prop_assert!(
-                    sieve.may_touch(&p, window * scale, 0.0),
-                    "the sieve rejected a contact: p {p:?}, quad {q:?}, gap {}",
-                    r.gap
-                );
-            }
-            // The detection's use: within the edge reach (a node just off
-            // the face starts the concave-edge search).
-            if let Some(r) = project(&p, &q)
-                && one_scale
-                && !folded(&q)
-                && r.inside(0.25)
-                && r.gap <= 0.0
-                && r.gap >= -window * scale
-                && scale.is_finite()
-            {
-                prop_assert!(
-                    sieve.may_touch(&p, window * scale, 0.25),
-                    "the sieve rejected a point within the edge reach: p {p:?}, quad {q:?}, \
-                     xi {} eta {} gap {}",
-                    r.xi,
-                    r.eta,
-                    r.gap
-                );
+                for reach in [0.0, 0.25] {
+                    if r.inside(reach) {
+                        prop_assert!(
+                            sieve.may_touch(&p, window * scale, reach),
+                            "the sieve rejected a point within reach {reach}: p {p:?}, \
+                             quad {q:?}, xi {} eta {} gap {}",
+                            r.xi,
+                            r.eta,
+                            r.gap
+                        );
+                    }
+                }
             }
         }
     }

@@ -63,7 +63,7 @@ fn a_small_die_compresses_to_thirty_percent() {
             impulse[1] += walls[wall_index::LOWER].normal * asm.last().dt;
         }
     }
-    let times = *asm.times();
+    let times = asm.times();
     eprintln!(
         "phases: predict {:.2} s, contact {:.2} s, correct {:.2} s: contact share {:.1} %, {:.2} sweeps per step",
         times.predict_s,
@@ -187,7 +187,7 @@ fn small_die_phase_times_standard_mesh() {
     while scene.strain_at(asm.time()) < 0.1 {
         asm.step().unwrap();
     }
-    let t = *asm.times();
+    let t = asm.times();
     eprintln!(
         "8x2, 40 granules, 10 %: {} steps in {:.1} s; predict {:.2} s, contact {:.2} s, correct {:.2} s: contact share {:.1} %",
         asm.steps(),

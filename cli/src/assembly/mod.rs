@@ -589,9 +589,14 @@ impl<'m> Assembly<'m> {
         &self.energies
     }
 
-    /// Wall-clock time per phase so far.
-    pub fn times(&self) -> &PhaseTimes {
-        &self.times
+    /// Wall-clock time per phase so far, with the contact phase's
+    /// face-list counts.
+    pub fn times(&self) -> PhaseTimes {
+        PhaseTimes {
+            list_builds: self.contact.list_builds(),
+            anchor_renewals: self.contact.anchor_renewals(),
+            ..self.times
+        }
     }
 
     /// What the last step did.

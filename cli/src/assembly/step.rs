@@ -310,7 +310,8 @@ pub struct PhaseTimes {
     pub rigid_granule_steps: u64,
     /// Steps timed.
     pub steps: u64,
-    /// Face-list builds (a pair's two passes count one).
+    /// Face-list builds (a pair's two passes count one); filled by
+    /// `Assembly::times`.
     pub list_builds: u64,
     /// Face-list anchor renewals (a granule whose x̃ left its anchor by
     /// more than the skin).
@@ -821,8 +822,6 @@ impl Assembly<'_> {
         self.times.contact_s += contacted_at - predicted_at;
         self.times.correct_s += done_at - contacted_at;
         self.times.steps += 1;
-        self.times.list_builds = self.contact.list_builds();
-        self.times.anchor_renewals = self.contact.anchor_renewals();
         self.time += sizes.dt;
         self.steps += 1;
         self.dt_prev = sizes.dt;

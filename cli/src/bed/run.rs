@@ -499,7 +499,7 @@ pub fn run_bed(
         element_steps: steps * (scene.granules * mesh.hexes.len()) as u64,
         pour_wall_time_s,
         wall_time_s: wall(),
-        phase_times: *asm.times(),
+        phase_times: asm.times(),
         threads: rayon::current_num_threads(),
         stopped,
         error,
