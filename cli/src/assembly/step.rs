@@ -5,6 +5,7 @@ use core::fmt;
 
 use granbed_kernel::Real;
 use granbed_kernel::contact::pair::ContactError;
+use granbed_kernel::contact::rigid::RigidShift;
 use granbed_kernel::contact::wall::{PredictedNodes, WallForce, count_wall_contacts, wall_contact};
 use granbed_kernel::granule::damping::{RigidFrame, selective_contact_masses};
 use granbed_kernel::granule::dynamics::{
@@ -511,6 +512,7 @@ impl Assembly<'_> {
                     mass: &g.contact_mass,
                     x_n: &g.x,
                     x_pred: &g.x_pred,
+                    rigid_shift: RigidShift::NONE,
                 };
                 let b = contact.bounds[gi];
                 for (k, (w, total)) in walls.iter().zip(totals.iter_mut()).enumerate() {

@@ -6,9 +6,12 @@
 //! the normal force F_n = m(−g)/Δt² along the inward normal n, which closes
 //! the gap in one step. The stick trial F_t* = −m Δu_t/Δt² cancels the
 //! tangential slip Δu_t of the step; if |F_t*| > μF_n the node slips with
-//! F_t = μF_n F_t*/|F_t*|.
+//! F_t = μF_n F_t*/|F_t*|. Under selective mass scaling the body's rigid
+//! displacement from the sweep's pre-solve ([`crate::contact::rigid`])
+//! is added to the node's motion first: it closes part of the gap.
 
 use crate::Real;
+use crate::contact::rigid::{RigidContact, RigidShift};
 
 /// A rigid plane {x : n·x = d} whose inward unit normal n points into the
 /// granule's side; it moves only along n, so it has no tangential motion.
@@ -42,6 +45,10 @@ pub struct PredictedNodes<'a> {
     pub x_n: &'a [[Real; 3]],
     /// Predicted positions at t_{n+1} (x_n + Δt v*), m.
     pub x_pred: &'a [[Real; 3]],
+    /// The body's rigid displacement from the sweep's pre-solve under
+    /// selective mass scaling ([`crate::contact::rigid`]); else
+    /// [`RigidShift::NONE`].
+    pub rigid_shift: RigidShift,
 }
 
 /// A rigid wall the granule surface nodes touch (physics.md §5.5).
@@ -143,17 +150,33 @@ pub fn wall_contact(
     let (mass, x_n, x_pred) = (body.mass, body.x_n, body.x_pred);
     let inv_dt2 = 1.0 / dt_squared;
     let mut out = WallForce::default();
+    let shifted = body.rigid_shift != RigidShift::NONE;
     for i in nodes {
         let xp = x_pred[i];
         let (gap, n) = wall.gap(&xp);
         if gap >= 0.0 {
             continue;
         }
-        let m = mass[i] / Real::from(share.get(i).copied().unwrap_or(1).max(1));
+        out.min_gap = crate::math::min(out.min_gap, gap);
+        // The rigid pre-solve's displacement closes part of the gap.
+        let u = if shifted {
+            body.rigid_shift.at(&x_n[i])
+        } else {
+            [0.0; 3]
+        };
+        let gap = gap + (u[0] * n[0] + u[1] * n[1] + u[2] * n[2]);
+        if gap >= 0.0 {
+            continue;
+        }
+        let m = shared_wall_mass(mass, share, i);
         let fn_mag = m * (-gap) * inv_dt2;
         let mut f = [fn_mag * n[0], fn_mag * n[1], fn_mag * n[2]];
         if friction > 0.0 {
-            let du = [xp[0] - x_n[i][0], xp[1] - x_n[i][1], xp[2] - x_n[i][2]];
+            let du = [
+                xp[0] - x_n[i][0] + u[0],
+                xp[1] - x_n[i][1] + u[1],
+                xp[2] - x_n[i][2] + u[2],
+            ];
             let dn = du[0] * n[0] + du[1] * n[1] + du[2] * n[2];
             let mut ft = [0.0; 3];
             for a in 0..3 {
@@ -175,7 +198,43 @@ pub fn wall_contact(
         }
         out.normal += fn_mag;
         out.contacts += 1;
-        out.min_gap = crate::math::min(out.min_gap, gap);
     }
     out
+}
+
+/// Node `i`'s mass shared among its `share` contacts, m/max(1, n), kg.
+fn shared_wall_mass(mass: &[Real], share: &[u16], i: usize) -> Real {
+    mass[i] / Real::from(share.get(i).copied().unwrap_or(1).max(1))
+}
+
+/// Adds the nodes of `nodes` that penetrate `wall` on the predicted
+/// configuration to the body's rigid pre-solve (`contact::rigid`,
+/// selective mass scaling): at x_n, with the stiffness (shared mass, `share`
+/// as in [`wall_contact`]) and the closure its force will have — along the
+/// wall's normal at x̃ (−gap), and with friction (μ = `friction` > 0) as a
+/// sticking point that also cancels the tangential slip of the step.
+pub fn add_wall_contacts(
+    wall: &Wall,
+    friction: Real,
+    nodes: core::ops::Range<usize>,
+    body: &PredictedNodes<'_>,
+    share: &[u16],
+    system: &mut RigidContact,
+) {
+    for i in nodes {
+        let (xp, x) = (body.x_pred[i], body.x_n[i]);
+        let (gap, n) = wall.gap(&xp);
+        if gap >= 0.0 {
+            continue;
+        }
+        let m = shared_wall_mass(body.mass, share, i);
+        if friction > 0.0 {
+            let du = [xp[0] - x[0], xp[1] - x[1], xp[2] - x[2]];
+            let dn = du[0] * n[0] + du[1] * n[1] + du[2] * n[2];
+            let target: [Real; 3] = core::array::from_fn(|a| -gap * n[a] - (du[a] - dn * n[a]));
+            system.add_stick(&x, m, &target);
+        } else {
+            system.add(&x, &n, m, -gap);
+        }
+    }
 }

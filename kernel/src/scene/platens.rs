@@ -21,6 +21,7 @@
 use core::fmt;
 
 use crate::Real;
+use crate::contact::rigid::RigidShift;
 use crate::contact::wall::{Plane, PredictedNodes, plane_contact};
 use crate::granule::damping::damping_coefficient;
 use crate::granule::dynamics::{GranuleBuffers, Loads, StepSizes, correct, predict};
@@ -785,6 +786,7 @@ impl<'a> PlatenScene<'a> {
             mass: b.mass,
             x_n: b.x,
             x_pred: b.x_pred,
+            rigid_shift: RigidShift::NONE,
         };
         let upper = Plane {
             normal: [0.0, 0.0, -1.0],
