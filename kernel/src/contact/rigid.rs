@@ -35,18 +35,26 @@
 //! wall forces then close what the rigid displacement leaves, gap + n·u(x)
 //! ([`RigidShift::at`], `wall::wall_contact` with `PredictedNodes::rigid_shift`),
 //! with the stored masses m'. For a granule touched by walls only this is
-//! the exact one-step closure of the bilateral system, up to nodes that the
-//! rigid motion alone clears (they get no force, and the others are left a
+//! the exact one-step closure of the bilateral system — frictionless, or
+//! with every contact sticking (a contact that slips at the Coulomb cap
+//! gets less force than the system assumed) — up to nodes that the rigid
+//! motion alone clears (they get no force, and the others are left a
 //! little open): `tests/tests/selective_mass.rs`. On the 8-granule bed it
 //! gave a contact loss of 1.7 % of the punch work (physical masses 1.6 %).
 //!
 //! What stops the bed from using it: a granule's pair contacts move it too.
-//! Left out of its system, they turned the die's friction around (the
-//! stick target expects the granule to be held by the die while its
-//! neighbours push it down); solved on each side with the other side held,
-//! both sides of a pair take up the same gap and the forces stall. One
-//! solve over all granules at once, pairs as springs between two granules,
-//! is the missing piece.
+//! Left out of its system, they turned the die's friction around; solved
+//! on each side with the other side held, both sides of a pair take up the
+//! same gap and the forces stall. One solve over all granules at once
+//! (branch `wip/joint-presolve`) fixes both, but the die friction then
+//! falls to about zero, where physical masses carry 3 % of the punch force
+//! on it: the granule's rigid motion takes up the slip that a stuck node
+//! holds against with physical masses. Wall friction under the pre-solve
+//! is the open problem.
+//!
+//! Callers: `RigidContact::new` takes the centre of the frame later given
+//! to [`RigidContact::solve`]; the contacts of the system and the forces
+//! use the stored masses m'.
 
 use crate::Real;
 use crate::granule::damping::RigidFrame;
@@ -108,8 +116,9 @@ impl RigidContact {
     }
 
     /// Adds one constraint at `point` (m) that pushes this granule along
-    /// the unit `normal` with stiffness `mass` (kg: its m_eff times its
-    /// partition weight) and needs the closure `closure` (m, −gap).
+    /// the unit `normal` with stiffness `mass` (kg: the mass its force is
+    /// computed with, a wall contact's shared mass m'/n) and needs the
+    /// closure `closure` (m, −gap).
     pub fn add(&mut self, point: &[Real; 3], normal: &[Real; 3], mass: Real, closure: Real) {
         let j = self.direction(point, normal);
         for a in 0..6 {

@@ -47,7 +47,12 @@ pub struct PredictedNodes<'a> {
     pub x_pred: &'a [[Real; 3]],
     /// The body's rigid displacement from the sweep's pre-solve under
     /// selective mass scaling ([`crate::contact::rigid`]); else
-    /// [`RigidShift::NONE`].
+    /// [`RigidShift::NONE`]. With a shift, `mass` must be the stored masses
+    /// m' (the pre-solve carries the rigid response), not
+    /// `granule::damping::selective_contact_masses`, and the shift must be
+    /// the one solved from [`add_wall_contacts`] on these nodes. Only nodes
+    /// that penetrate on x̃ get a force: one that the shift would push into
+    /// the wall is left to the next sweep.
     pub rigid_shift: RigidShift,
 }
 
@@ -157,26 +162,27 @@ pub fn wall_contact(
         if gap >= 0.0 {
             continue;
         }
+        // `min_gap` is the unshifted depth, also of a node that the shift
+        // clears (which gets no force and does not count in `contacts`).
         out.min_gap = crate::math::min(out.min_gap, gap);
-        // The rigid pre-solve's displacement closes part of the gap.
-        let u = if shifted {
-            body.rigid_shift.at(&x_n[i])
-        } else {
-            [0.0; 3]
-        };
-        let gap = gap + (u[0] * n[0] + u[1] * n[1] + u[2] * n[2]);
-        if gap >= 0.0 {
-            continue;
+        let mut du = [xp[0] - x_n[i][0], xp[1] - x_n[i][1], xp[2] - x_n[i][2]];
+        let mut gap = gap;
+        if shifted {
+            // The rigid pre-solve's displacement closes part of the gap
+            // and is part of the node's motion over the step.
+            let u = body.rigid_shift.at(&x_n[i]);
+            gap += u[0] * n[0] + u[1] * n[1] + u[2] * n[2];
+            if gap >= 0.0 {
+                continue;
+            }
+            for a in 0..3 {
+                du[a] += u[a];
+            }
         }
         let m = shared_wall_mass(mass, share, i);
         let fn_mag = m * (-gap) * inv_dt2;
         let mut f = [fn_mag * n[0], fn_mag * n[1], fn_mag * n[2]];
         if friction > 0.0 {
-            let du = [
-                xp[0] - x_n[i][0] + u[0],
-                xp[1] - x_n[i][1] + u[1],
-                xp[2] - x_n[i][2] + u[2],
-            ];
             let dn = du[0] * n[0] + du[1] * n[1] + du[2] * n[2];
             let mut ft = [0.0; 3];
             for a in 0..3 {
