@@ -500,7 +500,7 @@ fn wall_pass(
         &mut contact
     ));
     let shift = if scheme == Scheme::Presolve {
-        let mut system = RigidContact::new(frame.centre);
+        let mut system = RigidContact::new(frame);
         let body = PredictedNodes {
             mass: &mass,
             x_n: x,
@@ -510,7 +510,7 @@ fn wall_pass(
         for w in walls {
             add_wall_contacts(w, friction, surface.clone(), &body, &[], &mut system);
         }
-        system.solve(&frame, factor)
+        system.solve(factor)
     } else {
         RigidShift::NONE
     };

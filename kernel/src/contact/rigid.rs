@@ -52,9 +52,8 @@
 //! holds against with physical masses. Wall friction under the pre-solve
 //! is the open problem.
 //!
-//! Callers: `RigidContact::new` takes the centre of the frame later given
-//! to [`RigidContact::solve`]; the contacts of the system and the forces
-//! use the stored masses m'.
+//! Callers: the contacts of the system and the forces use the stored
+//! masses m', those of the frame given to [`RigidContact::new`].
 
 use crate::Real;
 use crate::granule::damping::RigidFrame;
@@ -100,16 +99,17 @@ impl RigidShift {
 /// The 6×6 system of one granule's constraints in a sweep (module docs).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct RigidContact {
-    centre: [Real; 3],
+    frame: RigidFrame,
     stiffness: SMatrix<Real, 6, 6>,
     load: SVector<Real, 6>,
 }
 
 impl RigidContact {
-    /// No constraint yet; moments about `centre` (the centre of mass, m).
-    pub fn new(centre: [Real; 3]) -> Self {
+    /// No constraint yet, for the granule with `frame` (its stored masses
+    /// m' at x_n); moments about its centre of mass.
+    pub fn new(frame: RigidFrame) -> Self {
         Self {
-            centre,
+            frame,
             stiffness: SMatrix::zeros(),
             load: SVector::zeros(),
         }
@@ -144,9 +144,9 @@ impl RigidContact {
     /// j = (e, r × e) of the unit direction `e` at `point`.
     fn direction(&self, point: &[Real; 3], e: &[Real; 3]) -> SVector<Real, 6> {
         let r = [
-            point[0] - self.centre[0],
-            point[1] - self.centre[1],
-            point[2] - self.centre[2],
+            point[0] - self.frame.centre[0],
+            point[1] - self.frame.centre[1],
+            point[2] - self.frame.centre[2],
         ];
         SVector::<Real, 6>::from([
             e[0],
@@ -163,11 +163,12 @@ impl RigidContact {
         self.stiffness == SMatrix::<Real, 6, 6>::zeros()
     }
 
-    /// The rigid displacement of the granule with `frame` (its stored
-    /// masses m' at x_n) under selective mass scaling by `factor` F:
-    /// [`RigidShift::NONE`] for F ≤ 1 or not finite, for no constraint, and
-    /// if the system is not positive definite (a degenerate frame, NaN).
-    pub fn solve(&self, frame: &RigidFrame, factor: Real) -> RigidShift {
+    /// The rigid displacement of the granule under selective mass scaling
+    /// by `factor` F: [`RigidShift::NONE`] for F ≤ 1 or not finite, for no
+    /// constraint, and if the system is not positive definite (a
+    /// degenerate frame, NaN).
+    pub fn solve(&self, factor: Real) -> RigidShift {
+        let frame = &self.frame;
         if !(factor > 1.0 && factor.is_finite()) || self.is_empty() {
             return RigidShift::NONE;
         }
@@ -187,7 +188,7 @@ impl RigidContact {
             return RigidShift::NONE;
         }
         RigidShift {
-            centre: self.centre,
+            centre: frame.centre,
             translation: [u[0], u[1], u[2]],
             rotation: [u[3], u[4], u[5]],
         }
@@ -213,9 +214,9 @@ mod tests {
         // u = k c / (k + M/(F−1)) for stiffness k and total mass M.
         let frame = cube_frame();
         let (k, c, f) = (2.0, 1e-6, 5.0);
-        let mut system = RigidContact::new(frame.centre);
+        let mut system = RigidContact::new(frame);
         system.add(&[0.0, 0.0, 1.0], &[0.0, 0.0, 1.0], k, c);
-        let u = system.solve(&frame, f);
+        let u = system.solve(f);
         let want = k * c / (k + frame.mass / (f - 1.0));
         assert!((u.translation[2] - want).abs() < 1e-15 * want.abs().max(1e-30) + 1e-22);
         assert!(
@@ -230,16 +231,17 @@ mod tests {
     #[test]
     fn nothing_to_solve_or_bad_numbers_give_no_shift() {
         let frame = cube_frame();
-        let mut system = RigidContact::new(frame.centre);
-        assert_eq!(system.solve(&frame, 30.0), RigidShift::NONE);
+        let mut system = RigidContact::new(frame);
+        assert_eq!(system.solve(30.0), RigidShift::NONE);
         system.add(&[0.0, 0.0, 1.0], &[0.0, 0.0, 1.0], 1.0, 1e-6);
         for f in [1.0, 0.5, Real::NAN, Real::INFINITY] {
-            assert_eq!(system.solve(&frame, f), RigidShift::NONE, "F {f}");
+            assert_eq!(system.solve(f), RigidShift::NONE, "F {f}");
         }
-        let mut bad = RigidContact::new(frame.centre);
+        let mut bad = RigidContact::new(frame);
         bad.add(&[0.0, 0.0, 1.0], &[0.0, 0.0, 1.0], Real::NAN, 1e-6);
-        assert_eq!(bad.solve(&frame, 30.0), RigidShift::NONE);
-        let degenerate = RigidFrame::default();
-        assert_eq!(system.solve(&degenerate, 30.0), RigidShift::NONE);
+        assert_eq!(bad.solve(30.0), RigidShift::NONE);
+        let mut degenerate = RigidContact::new(RigidFrame::default());
+        degenerate.add(&[0.0, 0.0, 1.0], &[0.0, 0.0, 1.0], 1.0, 1e-6);
+        assert_eq!(degenerate.solve(30.0), RigidShift::NONE);
     }
 }
