@@ -508,17 +508,81 @@ fn a_failing_run_names_granule_element_step_and_strain_and_keeps_its_outputs() {
     assert!(dir.join("compression.csv").exists());
 }
 
-/// Selective mass scaling (the scene field `selective_mass_scaling`, on with
-/// `mass_scaling = 10` in the published scene, off in a scene file without
-/// the field, and its CLI override): on the CI bed, masses ×10 on the
-/// deformational modes only take under 40 % of the steps of physical masses
-/// (the stable step grows by √10), keep the kinetic energy below 1 % of the
-/// internal work like physical masses do, and hence pass the quasi-static
-/// certificate, where uniform ×10 (the granules' translation and spin ten
-/// times heavier too) fails it; the overlaps stay below 1 % of the element
-/// and P(C) stays within the noise floor of any change of the arithmetic
-/// (relative L2 over 2–30 % below 9 %, the floor's upper end in
-/// BENCHMARKS.md; measured 3.3 %).
+/// The bed that broke selective ×30 with physical rigid modes (BENCHMARKS.md,
+/// "Selective ×30 and the contacts' rigid coupling"): 8 C3 granules in one
+/// layer, so every contact is a wall contact and many nodes of a granule
+/// push on a punch together. A node's contact mass allows for its own
+/// response and a bounded share of the granule's rigid one; the rigid
+/// responses of many nodes add up, and how much they weigh grows with the
+/// ratio F/G of the deformational to the rigid modes' scaling. With the
+/// published scene's ratio limit (`selective_mass_ratio`), its own ×10 and
+/// ×30 (whose rigid modes it makes 3× heavier) must keep the contacts
+/// dissipative (contact loss > 0), the ledger balanced and the bed
+/// quasi-static; ×30 with physical rigid modes (an unbounded ratio) is the
+/// control that shows the check can fail (measured: the contacts inject
+/// 57 % of the punch work, residual 0.51, K/W 139 %).
+#[test]
+fn the_mass_ratio_limit_keeps_a_punched_monolayer_dissipative() {
+    let run = |name: &str, extra: &[&str]| {
+        let dir = out_dir(name);
+        let mut argv = vec!["bed", "--quiet", "-j", "1", "--seed", "1"];
+        argv.extend_from_slice(&["--out", dir.to_str().unwrap()]);
+        argv.extend_from_slice(&["--type", "C3"]);
+        argv.extend_from_slice(&common::die_4_2mm("8"));
+        argv.extend_from_slice(extra);
+        let r = cli(&argv);
+        assert_eq!(r.code, 0, "{}", r.stderr);
+        let s = summary(&dir);
+        let figures = (
+            number(&s, "contact_loss_rel"),
+            number(&s, "energy_residual_rel"),
+            number(&s["quasi_static"], "max_kinetic_to_internal"),
+        );
+        println!(
+            "{name}: F {}, ratio {}: contact loss {:.2e}, residual {:.2e}, K/W {:.2e}",
+            s["scene"]["mass_scaling"],
+            s["scene"]["selective_mass_ratio"],
+            figures.0,
+            figures.1,
+            figures.2
+        );
+        figures
+    };
+    for (name, extra) in [
+        ("monolayer_published", &[][..]),
+        ("monolayer_x30", &["--mass-scaling", "30"][..]),
+    ] {
+        let (loss, residual, kw) = run(name, extra);
+        assert!(
+            loss > 0.0,
+            "{name}: the contacts inject energy: loss {loss}"
+        );
+        assert!(residual < 1e-5, "{name}: energy residual {residual}");
+        assert!(kw < 0.02, "{name}: K/W {kw}");
+    }
+    let (loss, residual, _) = run(
+        "monolayer_x30_rigid_physical",
+        &["--mass-scaling", "30", "--selective-mass-ratio", "inf"],
+    );
+    assert!(
+        loss < 0.0 && residual > 1e-3,
+        "×30 with physical rigid modes no longer injects energy here: this test lost its \
+         control (loss {loss}, residual {residual})"
+    );
+}
+
+/// Selective mass scaling (the scene fields `selective_mass_scaling` and
+/// `selective_mass_ratio`, on with `mass_scaling = 10` and a ratio limit of 10
+/// in the published scene, off in a scene file without the fields, and their
+/// CLI overrides): on the CI bed, masses ×10 on the deformational modes only
+/// take under 40 % of the steps of physical masses (the stable step grows by
+/// √10), keep the kinetic energy below 1 % of the internal work like
+/// physical masses do, and hence pass the quasi-static certificate, where
+/// uniform ×10 (the granules' translation and spin ten times heavier too)
+/// fails it; the overlaps stay below 1 % of the element and P(C) stays
+/// within the noise floor of any change of the arithmetic (relative L2 over
+/// 2–30 % below 9 %, the floor's upper end in BENCHMARKS.md; measured
+/// 3.3 %).
 #[test]
 fn selective_mass_scaling_keeps_the_bed_quasi_static_in_fewer_steps() {
     let mut args = vec!["--mass-scaling", "10"];
@@ -566,26 +630,40 @@ fn selective_mass_scaling_keeps_the_bed_quasi_static_in_fewer_steps() {
             .unwrap()
             .selective_mass_scaling
     );
-    // The published scene's x10 is explicit (its unit test checks it): a
-    // scene file without the two fields has physical masses.
+    // The published scene's scaling is explicit (its unit test checks it):
+    // a scene file without the three fields has physical masses.
     let old = DEFAULT_SCENE
         .replace("selective_mass_scaling = true\n", "")
+        .replace("selective_mass_ratio = 10.0\n", "")
         .replace("mass_scaling = 10.0\n", "");
     assert_eq!(old.matches("mass_scaling =").count(), 0);
     let old = Scene::from_toml(&old).unwrap();
-    assert_eq!((old.mass_scaling, old.selective_mass_scaling), (1.0, false));
-    // It changes what the checkpoint's energy ledger means: not with --resume.
-    let run = cli(&[
-        "bed",
-        "--resume",
-        selective.to_str().unwrap(),
-        "--selective-mass-scaling",
-        "false",
-    ]);
-    assert_eq!(run.code, 2, "{}", run.stderr);
-    assert!(
-        run.stderr.contains("selective-mass-scaling"),
-        "{}",
-        run.stderr
+    assert_eq!(
+        (
+            old.mass_scaling,
+            old.selective_mass_scaling,
+            old.selective_mass_ratio
+        ),
+        (1.0, false, f64::INFINITY)
     );
+    // The ratio is at least 1, and named when it is not.
+    for r in ["0.5", "nan", "0"] {
+        let run = cli(&["bed", "--print-scene", "--selective-mass-ratio", r]);
+        assert_eq!(run.code, 2, "R = {r}: {}", run.stderr);
+        assert!(
+            run.stderr.contains("selective_mass_ratio") && run.stderr.contains(">= 1"),
+            "{}",
+            run.stderr
+        );
+    }
+    // They change what the checkpoint's energy ledger means: not with
+    // --resume.
+    for (flag, value) in [
+        ("--selective-mass-scaling", "false"),
+        ("--selective-mass-ratio", "inf"),
+    ] {
+        let run = cli(&["bed", "--resume", selective.to_str().unwrap(), flag, value]);
+        assert_eq!(run.code, 2, "{}", run.stderr);
+        assert!(run.stderr.contains(&flag[2..]), "{}", run.stderr);
+    }
 }

@@ -194,22 +194,9 @@ fn the_quick_bed_study_runs_the_bed_code_and_measures_the_spread() {
     close(steps[0] / steps[2], 2.0, "reference at half speed");
     // The default row is `granbed-cli bed` on the same scene, bit for bit.
     let bed = common::fresh_dir("cli_study", "bed_quick_run");
-    let run = cli(&[
-        "bed",
-        "--granules",
-        "15",
-        "--mesh",
-        "4x1",
-        "--die-diameter-mm",
-        "4.2",
-        "--strain",
-        "0.3",
-        "-j",
-        "1",
-        "--quiet",
-        "--out",
-        bed.to_str().unwrap(),
-    ]);
+    let mut argv = vec!["bed", "-j", "1", "--quiet", "--out", bed.to_str().unwrap()];
+    argv.extend_from_slice(&common::die_4_2mm("15"));
+    let run = cli(&argv);
     assert_eq!(run.code, 0, "{}", run.stderr);
     let summary: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(bed.join("summary.json")).unwrap()).unwrap();
@@ -270,24 +257,17 @@ fn the_stability_suite_writes_one_judged_row_per_run() {
     }
     // The A1 bed of seed 2 run by `bed` gives the same numbers.
     let bed_dir = dir.join("bed_a1_2");
-    let bed = cli(&[
+    let mut argv = vec![
         "bed",
-        "--type",
-        "A1",
-        "--granules",
-        "8",
-        "--mesh",
-        "4x1",
-        "--die-diameter-mm",
-        "4.2",
-        "--strain",
-        "0.3",
         "--seed",
         "2",
         "--quiet",
         "--out",
         bed_dir.to_str().unwrap(),
-    ]);
+    ];
+    argv.extend_from_slice(&["--type", "A1"]);
+    argv.extend_from_slice(&common::die_4_2mm("8"));
+    let bed = cli(&argv);
     assert_eq!(bed.code, 0, "{}", bed.stderr);
     let summary: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(bed_dir.join("summary.json")).unwrap())

@@ -76,6 +76,16 @@ pub struct AssemblyParams {
     /// granules rearrange as heavy as they are while the stable step grows
     /// by √F as with uniform scaling. false: uniform scaling.
     pub selective_mass_scaling: bool,
+    /// With selective mass scaling, the largest ratio R ≥ 1 of the
+    /// deformational modes' scaling to the rigid modes': the deformational
+    /// modes carry F × (`mass_scaling`) their physical inertia, translation
+    /// and spin G = max(1, F/R) × theirs. ∞: physical rigid modes for any
+    /// F; 1: uniform scaling. The ratio F/G is what the contacts see (the
+    /// kernel's selective factor): with F/G ≤ 10 the rigid response of many
+    /// nodes pressed on a punch together stays within what each node's
+    /// contact mass allows for (BENCHMARKS.md, "Selective ×30 with heavier
+    /// rigid modes"). Ignored with uniform scaling.
+    pub selective_mass_ratio: Real,
     /// Safety factor C on the estimate of the stable step; (0, 2]. Above
     /// 1 the step exceeds the estimated stability limit: only for testing
     /// how a run fails (the watchdog stops it).
@@ -115,13 +125,14 @@ pub struct AssemblyParams {
 }
 
 impl AssemblyParams {
-    /// The kernel's [`Loads::selective_mass_factor`]: the mass scaling if it
-    /// is selective, else 1.
+    /// The kernel's [`Loads::selective_mass_factor`]: the ratio of the
+    /// stored (deformational) masses to the rigid modes' masses,
+    /// F/G = min(F, R), if the scaling is selective, else 1.
     ///
     /// [`Loads::selective_mass_factor`]: granbed_kernel::granule::dynamics::Loads::selective_mass_factor
     pub fn selective_mass_factor(&self) -> Real {
         if self.selective_mass_scaling {
-            self.mass_scaling
+            self.mass_scaling.min(self.selective_mass_ratio)
         } else {
             1.0
         }
@@ -147,6 +158,7 @@ impl AssemblyParams {
             sweep_tolerance_m: 0.05e-6,
             mass_scaling: 1.0,
             selective_mass_scaling: false,
+            selective_mass_ratio: Real::INFINITY,
             time_step_safety: 0.9,
             max_node_speed_m_s: Real::INFINITY,
             kinetic_energy_limit: Real::INFINITY,

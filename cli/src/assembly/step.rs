@@ -159,7 +159,7 @@ impl fmt::Display for AssemblyError {
 impl core::error::Error for AssemblyError {}
 
 pub(super) fn validate(p: &AssemblyParams) -> Result<(), AssemblyError> {
-    let checks: [(bool, &'static str, Real, &'static str); 12] = [
+    let checks: [(bool, &'static str, Real, &'static str); 13] = [
         (
             (0.0..=1.0).contains(&p.face_list_skin),
             "face_list_skin",
@@ -171,6 +171,12 @@ pub(super) fn validate(p: &AssemblyParams) -> Result<(), AssemblyError> {
             "mass_scaling",
             p.mass_scaling,
             "1 <= F <= 1e6",
+        ),
+        (
+            p.selective_mass_ratio >= 1.0,
+            "selective_mass_ratio",
+            p.selective_mass_ratio,
+            ">= 1 (inf: physical rigid modes)",
         ),
         (
             (1..=50).contains(&p.contact_sweeps),

@@ -268,6 +268,7 @@ pub fn run_bed(
     params.sweep_tolerance_m = SWEEP_TOLERANCE_REL * mesh.shortest_surface_edge();
     params.mass_scaling = scene.mass_scaling;
     params.selective_mass_scaling = scene.selective_mass_scaling;
+    params.selective_mass_ratio = scene.selective_mass_ratio;
     params.time_step_safety = scene.time_step_safety;
     params.rigid_until_touched = scene.rigid_until_touched;
     params.local_sweeps = scene.local_sweeps;

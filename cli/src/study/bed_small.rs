@@ -83,6 +83,12 @@ pub fn bed_grid(mesh: MeshLevel, quick: bool) -> (Setting, Vec<Setting>) {
             with("mass x4", &uniform(4.0)),
             with("mass x10", &uniform(10.0)),
             with("mass x100", &uniform(100.0)),
+            // Selective with the published scene's ratio limit F/G ≤ 10:
+            // ×30 makes the rigid modes 3× heavier, ×100 10×.
+            with("selective x30", &|s| {
+                s.mass_scaling = 30.0;
+                s.selective_mass = true;
+            }),
             with("selective x100", &|s| {
                 s.mass_scaling = 100.0;
                 s.selective_mass = true;

@@ -138,6 +138,22 @@ pub const fn small_bed<'a>(granules: &'a str, strain: &'a str) -> [&'a str; 8] {
     ]
 }
 
+/// The stability suite's test size: `granules` coarse granules in a 4.2 mm
+/// die, pressed to 30 % (8 lie in one layer, so every contact is a wall
+/// contact: the bed that broke selective ×30).
+pub const fn die_4_2mm(granules: &str) -> [&str; 8] {
+    [
+        "--granules",
+        granules,
+        "--mesh",
+        "4x1",
+        "--die-diameter-mm",
+        "4.2",
+        "--strain",
+        "0.3",
+    ]
+}
+
 /// Asserts |actual − expected| ≤ abs + rel·|expected|, naming the quantity.
 #[track_caller]
 pub fn assert_close(what: &str, actual: f64, expected: f64, rel: f64, abs: f64) {
