@@ -558,7 +558,9 @@ fn the_mass_ratio_limit_keeps_a_punched_monolayer_dissipative() {
             "{name}: the contacts inject energy: loss {loss}"
         );
         assert!(residual < 1e-5, "{name}: energy residual {residual}");
-        assert!(kw < 0.02, "{name}: K/W {kw}");
+        // Uniform ×30 (every mode 30× heavier) stays dissipative too but
+        // leaves K/W at 1.6 %: this tells the selective scaling from it.
+        assert!(kw < 0.01, "{name}: K/W {kw}");
     }
     let (loss, residual, _) = run(
         "monolayer_x30_rigid_physical",
@@ -664,6 +666,10 @@ fn selective_mass_scaling_keeps_the_bed_quasi_static_in_fewer_steps() {
     ] {
         let run = cli(&["bed", "--resume", selective.to_str().unwrap(), flag, value]);
         assert_eq!(run.code, 2, "{}", run.stderr);
-        assert!(run.stderr.contains(&flag[2..]), "{}", run.stderr);
+        assert!(
+            run.stderr.contains("cannot be used with") && run.stderr.contains(flag),
+            "{}",
+            run.stderr
+        );
     }
 }

@@ -70,11 +70,12 @@ pub struct AssemblyParams {
     /// weight is kept (gravity is divided by F) and the damping follows
     /// the slower modes. 1 = physical masses.
     pub mass_scaling: Real,
-    /// The mass scaling acts on the granules' deformational modes only:
-    /// each granule's translation and spin keep their physical inertia
-    /// (selective mass scaling, `granbed_kernel::granule::dynamics`), so the
-    /// granules rearrange as heavy as they are while the stable step grows
-    /// by √F as with uniform scaling. false: uniform scaling.
+    /// The mass scaling acts on the granules' deformational modes: each
+    /// granule's translation and spin keep their physical inertia, or
+    /// G = max(1, F/`selective_mass_ratio`) × it (selective mass scaling,
+    /// `granbed_kernel::granule::dynamics`), so the granules rearrange as
+    /// heavy as they are, or G× so, while the stable step grows by √F as
+    /// with uniform scaling. false: uniform scaling.
     pub selective_mass_scaling: bool,
     /// With selective mass scaling, the largest ratio R ≥ 1 of the
     /// deformational modes' scaling to the rigid modes': the deformational
@@ -714,5 +715,39 @@ impl<'m> Assembly<'m> {
         let step = self.steps;
         ContactPhase::penetration(&self.granules, self.mesh, &self.params.contact)
             .map_err(|error| AssemblyError::Contact { step, error })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use granbed_kernel::granule::forces::{ElementKind, ElementSettings};
+    use granbed_kernel::material::GranuleType;
+
+    /// The kernel's factor is F/G = min(F, R) with selective scaling, 1
+    /// without.
+    #[test]
+    fn the_selective_factor_is_the_ratio_limited_scaling() {
+        let material = GranuleType::B2.params().validate().unwrap();
+        let elements = ElementSettings {
+            kind: ElementKind::OnePoint,
+            update: Default::default(),
+            hourglass_kappa: 0.05,
+        };
+        let mut p = AssemblyParams::standard(material, elements);
+        p.selective_mass_scaling = true;
+        for (f, r, factor) in [
+            (30.0, 10.0, 10.0),
+            (10.0, 10.0, 10.0),
+            (5.0, 10.0, 5.0),
+            (30.0, Real::INFINITY, 30.0),
+            (30.0, 1.0, 1.0),
+        ] {
+            p.mass_scaling = f;
+            p.selective_mass_ratio = r;
+            assert_eq!(p.selective_mass_factor(), factor, "F {f}, R {r}");
+        }
+        p.selective_mass_scaling = false;
+        assert_eq!(p.selective_mass_factor(), 1.0);
     }
 }

@@ -566,6 +566,9 @@ impl Assembly<'_> {
             dt: self.dt,
         };
         let p = self.params;
+        // g/F on the stored masses F m keeps the weight m g; with selective
+        // scaling the rigid modes carry G m, so a granule falls at g/G (at g
+        // when G = 1), as under uniform scaling by G.
         let loads = Loads {
             gravity_m_s2: p.gravity_m_s2 / p.mass_scaling,
             damping_c: self.damping_c,

@@ -176,9 +176,10 @@ pub struct BedArgs {
     #[arg(long, value_name = "F")]
     pub mass_scaling: Option<f64>,
 
-    /// Override: the mass scaling acts on the granules' deformational modes
-    /// only, their translation and spin keep the physical inertia (true,
-    /// the published scene's), or on every mode (false).
+    /// Override: the mass scaling acts on the granules' deformational modes,
+    /// their translation and spin keep the physical inertia up to the ratio
+    /// limit --selective-mass-ratio (true, the published scene's), or on
+    /// every mode (false).
     #[arg(long, value_name = "BOOL")]
     pub selective_mass_scaling: Option<bool>,
 

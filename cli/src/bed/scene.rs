@@ -481,6 +481,18 @@ impl Scene {
 mod tests {
     use super::*;
 
+    /// A scene file without the ratio has none (∞), and ∞ survives the
+    /// TOML a checkpoint stores.
+    #[test]
+    fn an_unbounded_mass_ratio_round_trips() {
+        let s = Scene {
+            selective_mass_ratio: f64::INFINITY,
+            ..Scene::published()
+        };
+        assert!(s.to_toml().contains("selective_mass_ratio = inf"));
+        assert_eq!(Scene::from_toml(&s.to_toml()).unwrap(), s);
+    }
+
     #[test]
     fn the_embedded_scene_is_the_published_one() {
         let s = Scene::published();
