@@ -4,13 +4,19 @@
 //! elastic (0.1 % from the virgin state) and plastic (the step from 19.99 %
 //! to 20 %, the state loaded there in 2000 increments, as in an explicit
 //! run), for the one-point element and the F-bar verification element.
-//! Also the memory bandwidth (STREAM triad) for the element's roofline.
+//! Also one granule's whole predictor and corrector (elements, damping,
+//! the velocity and position updates under selective mass scaling), and the
+//! memory bandwidth (STREAM triad) for the element's roofline.
 
 use core::hint::black_box;
 
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use granbed_kernel::element::batch::{ElementBatch, ElementPath, batch_count, has_avx2, regroup};
 use granbed_kernel::element::reference::{HexReference, hex_reference};
+use granbed_kernel::granule::damping::RigidFrame;
+use granbed_kernel::granule::dynamics::{
+    GranuleBuffers, Loads, StepSizes, correct, correct_in, predict, predict_in,
+};
 use granbed_kernel::granule::forces::{ElementKind, ElementSettings, internal_forces_on};
 use granbed_kernel::material::GranuleType;
 use granbed_kernel::mesh::octant::MeshView;
@@ -140,6 +146,135 @@ fn bench_elements(c: &mut Criterion) {
     group.finish();
 }
 
+/// One granule's step halves on the standard mesh, B2, selective mass
+/// scaling ×10 (the bed's default): `predict` (elements + damping +
+/// predictor) and `correct` (contact forces on the surface nodes only, as
+/// in a bed), each from the same start every iteration; `framed` is given
+/// the rigid frame, which the bed takes once per step for both halves
+/// (`predict_in`, `correct_in`). Reported per node-step (1 501 nodes).
+fn bench_granule_step(c: &mut Criterion) {
+    let m = standard_mesh();
+    let mesh = ReferenceMesh {
+        mesh: MeshView {
+            positions: &m.positions,
+            hexes: &m.hexes,
+            quads: &m.quads,
+            surface_nodes: m.surface,
+        },
+        node_quads: &m.node_quads,
+        elements: &m.elements,
+        batches: &m.batches,
+        node_volume: &m.node_volume,
+    };
+    let mat = GranuleType::B2.params().validate().unwrap();
+    let settings = ElementSettings {
+        kind: ElementKind::OnePoint,
+        update: Default::default(),
+        hourglass_kappa: 0.05,
+    };
+    let n = m.positions.len();
+    let first_surface = n - m.surface;
+    let factor = 10.0;
+    let mass: Vec<f64> = m
+        .node_volume
+        .iter()
+        .map(|v| factor * mat.density0 * v)
+        .collect();
+    // Squeezed 0.1 %, spinning slowly and swelling a little; a contact
+    // force pressing every surface node inward.
+    let x0: Vec<[f64; 3]> = m
+        .positions
+        .iter()
+        .map(|p| [p[0] + 5e-5 * p[2], p[1], p[2] * 0.999])
+        .collect();
+    let v0: Vec<[f64; 3]> = x0
+        .iter()
+        .map(|p| [0.3 * p[1] + 2.0 * p[0], -0.3 * p[0], 1e-3 + 2.0 * p[2]])
+        .collect();
+    let f_c0: Vec<[f64; 3]> = x0
+        .iter()
+        .enumerate()
+        .map(|(i, p)| {
+            if i >= first_surface {
+                p.map(|c| -1e-3 * c)
+            } else {
+                [0.0; 3]
+            }
+        })
+        .collect();
+    let loads = Loads {
+        gravity_m_s2: 9.81 / factor,
+        damping_c: 2.0e3,
+        rigid_modes: true,
+        selective_mass_factor: factor,
+    };
+    let sizes = StepSizes {
+        dt_prev: 1e-6,
+        dt: 1e-6,
+    };
+    let start = vec![VOIGT_IDENTITY; m.hexes.len()];
+    let (mut x, mut v, mut cp) = (x0.clone(), v0.clone(), start.clone());
+    let (mut v_star, mut x_pred) = (vec![[0.0; 3]; n], vec![[0.0; 3]; n]);
+    let (mut f_int, mut f_c, mut f_d) = (vec![[0.0; 3]; n], f_c0.clone(), vec![[0.0; 3]; n]);
+    let (mut masses, mut fixed) = (mass.clone(), vec![0u8; n]);
+    // The frame the bed takes once per step for both halves.
+    let frame = RigidFrame::of(&mass, &x0);
+    let mut group = c.benchmark_group("granule_step");
+    group.throughput(Throughput::Elements(n as u64));
+    for framed in [false, true] {
+        let suffix = if framed { "/framed" } else { "" };
+        group.bench_function(format!("predict_selective_x10{suffix}"), |bench| {
+            bench.iter(|| {
+                cp.copy_from_slice(&start);
+                let mut b = GranuleBuffers {
+                    x: &mut x,
+                    v: &mut v,
+                    v_star: &mut v_star,
+                    x_pred: &mut x_pred,
+                    f_int: &mut f_int,
+                    f_c: &mut f_c,
+                    f_d: &mut f_d,
+                    mass: &mut masses,
+                    fixed: &mut fixed,
+                    cp_inv: &mut cp,
+                };
+                let s = if framed {
+                    predict_in(&frame, &mesh, &mat, &settings, &mut b, sizes, &loads)
+                } else {
+                    predict(&mesh, &mat, &settings, &mut b, sizes, &loads)
+                };
+                black_box(s.unwrap().min_j)
+            })
+        });
+        group.bench_function(format!("correct_selective_x10{suffix}"), |bench| {
+            bench.iter(|| {
+                x.copy_from_slice(&x0);
+                v.copy_from_slice(&v0);
+                f_c.copy_from_slice(&f_c0);
+                let mut b = GranuleBuffers {
+                    x: &mut x,
+                    v: &mut v,
+                    v_star: &mut v_star,
+                    x_pred: &mut x_pred,
+                    f_int: &mut f_int,
+                    f_c: &mut f_c,
+                    f_d: &mut f_d,
+                    mass: &mut masses,
+                    fixed: &mut fixed,
+                    cp_inv: &mut cp,
+                };
+                let w = if framed {
+                    correct_in(&frame, &mut b, sizes, &loads)
+                } else {
+                    correct(&mut b, sizes, &loads)
+                };
+                black_box(w.kinetic)
+            })
+        });
+    }
+    group.finish();
+}
+
 /// The roofline's memory side: the STREAM triad a = b + s c over three
 /// arrays of 64 Mi doubles (1.5 GiB, beyond every cache), one thread;
 /// criterion reports the bytes moved per second (24 per element: two
@@ -164,5 +299,5 @@ fn bench_bandwidth(c: &mut Criterion) {
     g.finish();
 }
 
-criterion_group!(benches, bench_elements, bench_bandwidth);
+criterion_group!(benches, bench_elements, bench_granule_step, bench_bandwidth);
 criterion_main!(benches);

@@ -313,8 +313,8 @@ pub struct Assembly<'m> {
     /// Per granule: still a rigid body (untouched since its placement;
     /// [`AssemblyParams::rigid_until_touched`]).
     rigid: Vec<bool>,
-    /// Per granule under selective mass scaling: its rigid frame at x_n of
-    /// the current step (empty otherwise).
+    /// Per granule: its rigid frame at x_n of the current step (that of a
+    /// granule still rigid is stale unless selective mass scaling needs it).
     frames: Vec<RigidFrame>,
 }
 

@@ -9,7 +9,7 @@ use granbed_kernel::contact::rigid::RigidShift;
 use granbed_kernel::contact::wall::{PredictedNodes, WallForce, count_wall_contacts, wall_contact};
 use granbed_kernel::granule::damping::{RigidFrame, selective_contact_masses};
 use granbed_kernel::granule::dynamics::{
-    Loads, StepSizes, StepWork, correct, predict, predict_rigid,
+    Loads, StepSizes, StepWork, correct_in, predict_in, predict_rigid,
 };
 use granbed_kernel::granule::forces::{ElementFailure, ForceSummary, elastic_energy};
 use granbed_kernel::granule::quality::worst_element;
@@ -577,18 +577,21 @@ impl Assembly<'_> {
         };
         let view = self.mesh.view();
         let clock = std::time::Instant::now();
-        // Selective mass scaling: each granule's frame (for the rigid
-        // response in the sweeps) and its contact masses, at x_n.
+        // Each granule's rigid frame at x_n, taken once for the damping, the
+        // predictor and the corrector (a granule still rigid needs none
+        // unless its contact masses do) — and under selective mass scaling
+        // for the rigid response in the sweeps and the contact masses.
         let selective = p.selective_mass_factor();
-        if selective > 1.0 {
-            // One frame per granule, the buffer reused from step to step.
-            self.frames
-                .resize(self.granules.len(), RigidFrame::default());
-            self.granules
-                .par_iter_mut()
-                .zip(self.frames.par_iter_mut())
-                .for_each(|(g, frame)| {
-                    *frame = RigidFrame::of(&g.mass, &g.x);
+        self.frames
+            .resize(self.granules.len(), RigidFrame::default());
+        self.granules
+            .par_iter_mut()
+            .zip(self.frames.par_iter_mut())
+            .zip(self.rigid.par_iter())
+            .filter(|(_, rigid)| selective > 1.0 || !**rigid)
+            .for_each(|((g, frame), _)| {
+                *frame = RigidFrame::of(&g.mass, &g.x);
+                if selective > 1.0 {
                     // Every buffer of a GranuleStore has one entry per node.
                     let written = selective_contact_masses(
                         frame,
@@ -598,17 +601,20 @@ impl Assembly<'_> {
                         &mut g.contact_mass,
                     );
                     debug_assert!(written);
-                });
-        }
+                }
+            });
+        let frames = &self.frames;
         let predicted: Vec<Result<ForceSummary, ElementFailure>> = self
             .granules
             .par_iter_mut()
             .zip(self.rigid.par_iter())
-            .map(|(g, &rigid)| {
+            .zip(frames.par_iter())
+            .map(|((g, &rigid), frame)| {
                 if rigid {
                     return Ok(predict_rigid(&mut g.buffers(), sizes, &loads));
                 }
-                predict(
+                predict_in(
+                    frame,
                     &view,
                     &p.material,
                     &p.elements,
@@ -669,7 +675,8 @@ impl Assembly<'_> {
                     .for_each(|(gi, ((g, before), _))| {
                         let s = surface.clone();
                         let g = &mut *g;
-                        let rigid = frames.get(gi).map(|frame| {
+                        let rigid = (selective > 1.0).then(|| {
+                            let frame = &frames[gi];
                             frame.response(
                                 g.x[s.clone()]
                                     .iter()
@@ -749,7 +756,8 @@ impl Assembly<'_> {
         let per: Vec<StepWork> = self
             .granules
             .par_iter_mut()
-            .map(|g| correct(&mut g.buffers(), sizes, &loads))
+            .zip(self.frames.par_iter())
+            .map(|(g, frame)| correct_in(frame, &mut g.buffers(), sizes, &loads))
             .collect();
 
         let mut report = StepReport {

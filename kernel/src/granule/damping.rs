@@ -81,42 +81,7 @@ pub fn rigid_motion_of(
     x: &[[Real; 3]],
     v: impl Fn(usize) -> [Real; 3],
 ) -> RigidMotion {
-    let mut m = 0.0;
-    let mut mx = [0.0; 3];
-    let mut mv = [0.0; 3];
-    for (i, (mi, xi)) in mass.iter().zip(x).enumerate() {
-        let vi = v(i);
-        m += mi;
-        for a in 0..3 {
-            mx[a] += mi * xi[a];
-            mv[a] += mi * vi[a];
-        }
-    }
-    let centre = mx.map(|s| s / m);
-    let velocity = mv.map(|s| s / m);
-    let mut l = [0.0; 3];
-    let mut inertia = Mat3::zeros();
-    for (i, (mi, xi)) in mass.iter().zip(x).enumerate() {
-        let vi = v(i);
-        let r = [xi[0] - centre[0], xi[1] - centre[1], xi[2] - centre[2]];
-        let u = [
-            vi[0] - velocity[0],
-            vi[1] - velocity[1],
-            vi[2] - velocity[2],
-        ];
-        l[0] += mi * (r[1] * u[2] - r[2] * u[1]);
-        l[1] += mi * (r[2] * u[0] - r[0] * u[2]);
-        l[2] += mi * (r[0] * u[1] - r[1] * u[0]);
-        add_point_inertia(&mut inertia, *mi, &r);
-    }
-    let omega = spin(&inertia, &l);
-    RigidMotion {
-        centre,
-        velocity,
-        omega,
-        mass: m,
-        angular_momentum: l,
-    }
+    RigidFrame::of(mass, x).motion(mass, x, v)
 }
 
 /// ω = J⁻¹L (rad/s, or its rate for a torque), or zero if J is singular.
@@ -142,15 +107,32 @@ pub fn selective_kinetic_excess(
     0.5 * (1.0 - 1.0 / factor) * rigid_motion(mass, x, v).twice_kinetic_energy()
 }
 
-/// Adds the inertia m (|r|²1 − r⊗r) of a point mass `m` at `r` from the
-/// centre to `inertia`.
-#[inline]
-fn add_point_inertia(inertia: &mut Mat3, m: Real, r: &[Real; 3]) {
-    let r2 = r[0] * r[0] + r[1] * r[1] + r[2] * r[2];
-    for a in 0..3 {
-        for b in 0..3 {
-            inertia[(a, b)] += m * (if a == b { r2 } else { 0.0 } - r[a] * r[b]);
-        }
+/// The six distinct entries of a symmetric inertia tensor being summed:
+/// `[xx, yy, zz, xy, xz, yz]`, kg m².
+#[derive(Clone, Copy, Default)]
+struct InertiaSum([Real; 6]);
+
+impl InertiaSum {
+    /// Adds the inertia m (|r|²1 − r⊗r) of a point mass `m` at `r` from
+    /// the centre. An off-diagonal entry is m (0 − r_a r_b), and r_a r_b =
+    /// r_b r_a exactly, so the mirrored entry of a full 3×3 sum would hold
+    /// the same bits: summing six entries instead of nine changes none.
+    #[inline]
+    fn add(&mut self, m: Real, r: &[Real; 3]) {
+        let r2 = r[0] * r[0] + r[1] * r[1] + r[2] * r[2];
+        let s = &mut self.0;
+        s[0] += m * (r2 - r[0] * r[0]);
+        s[1] += m * (r2 - r[1] * r[1]);
+        s[2] += m * (r2 - r[2] * r[2]);
+        s[3] += m * (0.0 - r[0] * r[1]);
+        s[4] += m * (0.0 - r[0] * r[2]);
+        s[5] += m * (0.0 - r[1] * r[2]);
+    }
+
+    /// The full tensor.
+    fn tensor(&self) -> Mat3 {
+        let [xx, yy, zz, xy, xz, yz] = self.0;
+        Mat3::new(xx, xy, xz, xy, yy, yz, xz, yz, zz)
     }
 }
 
@@ -178,14 +160,56 @@ impl RigidFrame {
             }
         }
         let centre = mx.map(|s| s / m);
-        let mut inertia = Mat3::zeros();
+        let mut inertia = InertiaSum::default();
         for (mi, xi) in mass.iter().zip(x) {
-            add_point_inertia(&mut inertia, *mi, &sub(xi, &centre));
+            inertia.add(*mi, &sub(xi, &centre));
         }
         Self {
             mass: m,
             centre,
-            inertia,
+            inertia: inertia.tensor(),
+        }
+    }
+
+    /// The mass-orthogonal projection of the velocity field `v(I)` onto
+    /// the six rigid modes: the velocity of the centre of mass and the
+    /// angular velocity J_c⁻¹ L, with L = Σ m_I r_I × (v_I − v_c).
+    ///
+    /// `self` must be the frame of these `mass` and `x`
+    /// ([`RigidFrame::of`]); a caller that needs several projections at
+    /// one configuration (damping, predictor and corrector of a step) takes
+    /// the frame once. Two passes over the nodes, and `v` is called twice
+    /// per node: the sums run in node order, so the result has the bits of
+    /// [`rigid_motion_of`] whether the frame was taken once or each time.
+    pub fn motion(
+        &self,
+        mass: &[Real],
+        x: &[[Real; 3]],
+        v: impl Fn(usize) -> [Real; 3],
+    ) -> RigidMotion {
+        let mut mv = [0.0; 3];
+        for (i, mi) in mass.iter().enumerate() {
+            let vi = v(i);
+            for a in 0..3 {
+                mv[a] += mi * vi[a];
+            }
+        }
+        let velocity = mv.map(|s| s / self.mass);
+        let mut l = [0.0; 3];
+        for (i, (mi, xi)) in mass.iter().zip(x).enumerate() {
+            let vi = v(i);
+            let r = sub(xi, &self.centre);
+            let u = sub(&vi, &velocity);
+            l[0] += mi * (r[1] * u[2] - r[2] * u[1]);
+            l[1] += mi * (r[2] * u[0] - r[0] * u[2]);
+            l[2] += mi * (r[0] * u[1] - r[1] * u[0]);
+        }
+        RigidMotion {
+            centre: self.centre,
+            velocity,
+            omega: spin(&self.inertia, &l),
+            mass: self.mass,
+            angular_momentum: l,
         }
     }
 
@@ -276,10 +300,23 @@ pub fn damping_forces(
     rigid_modes: bool,
     f_d: &mut [[Real; 3]],
 ) {
-    let rigid = if rigid_modes {
-        rigid_motion(mass, x, v)
-    } else {
-        RigidMotion::REST
+    let frame = rigid_modes.then(|| RigidFrame::of(mass, x));
+    damping_forces_in(frame.as_ref(), mass, x, v, c, f_d);
+}
+
+/// [`damping_forces`] with the nodes' [`RigidFrame`] taken by the caller
+/// (`None`: the rigid modes are held, P = 0); the same bits.
+pub fn damping_forces_in(
+    frame: Option<&RigidFrame>,
+    mass: &[Real],
+    x: &[[Real; 3]],
+    v: &[[Real; 3]],
+    c: Real,
+    f_d: &mut [[Real; 3]],
+) {
+    let rigid = match frame {
+        Some(frame) => frame.motion(mass, x, |i| v[i]),
+        None => RigidMotion::REST,
     };
     for (((m, xi), vi), fi) in mass.iter().zip(x).zip(v).zip(f_d.iter_mut()) {
         let r = rigid.velocity_at(xi);
@@ -293,4 +330,67 @@ pub fn damping_forces(
 /// deformational frequency of a free elastic sphere (physics.md §4.4), 1/s.
 pub fn damping_coefficient(ratio: Real, shear_modulus: Real, density: Real, radius: Real) -> Real {
     2.0 * ratio * 2.5 * crate::math::sqrt(shear_modulus / density) / radius
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::rng::Rng;
+
+    /// Random masses and points (the kernel has no allocator, even here).
+    const N: usize = 500;
+
+    fn cloud(seed: u64) -> ([Real; N], [[Real; 3]; N]) {
+        let mut rng = Rng::new(seed);
+        let mass = core::array::from_fn(|_| rng.uniform(1e-10, 3e-10));
+        let x = core::array::from_fn(|_| core::array::from_fn(|_| rng.uniform(-5e-4, 6e-4)));
+        (mass, x)
+    }
+
+    /// The six-entry sum of the frame gives the bits of the full nine-entry
+    /// sum Σ m (|r|²1 − r⊗r) (the symmetry argument of `InertiaSum::add`).
+    #[test]
+    fn six_entry_inertia_has_the_bits_of_the_full_sum() {
+        for seed in 1..20 {
+            let (mass, x) = cloud(seed);
+            let frame = RigidFrame::of(&mass, &x);
+            let mut full = Mat3::zeros();
+            for (m, p) in mass.iter().zip(&x) {
+                let r = sub(p, &frame.centre);
+                let r2 = r[0] * r[0] + r[1] * r[1] + r[2] * r[2];
+                for a in 0..3 {
+                    for b in 0..3 {
+                        full[(a, b)] += m * (if a == b { r2 } else { 0.0 } - r[a] * r[b]);
+                    }
+                }
+            }
+            for (got, want) in frame.inertia.iter().zip(full.iter()) {
+                assert_eq!(got.to_bits(), want.to_bits(), "seed {seed}");
+            }
+        }
+    }
+
+    /// A rigid velocity field v_c + ω × (x − x_c) projects onto itself.
+    #[test]
+    fn motion_recovers_a_rigid_field() {
+        let (mass, x) = cloud(7);
+        let frame = RigidFrame::of(&mass, &x);
+        let (vc, omega) = ([0.01, -0.02, 0.005], [30.0, -12.0, 7.0]);
+        let field = RigidMotion {
+            centre: frame.centre,
+            velocity: vc,
+            omega,
+            ..RigidMotion::REST
+        };
+        let got = frame.motion(&mass, &x, |i| field.velocity_at(&x[i]));
+        for a in 0..3 {
+            assert!(
+                (got.velocity[a] - vc[a]).abs() < 1e-14,
+                "{:?}",
+                got.velocity
+            );
+            assert!((got.omega[a] - omega[a]).abs() < 1e-11, "{:?}", got.omega);
+        }
+        assert_eq!(got.mass.to_bits(), frame.mass.to_bits());
+    }
 }

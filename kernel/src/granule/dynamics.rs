@@ -28,7 +28,7 @@
 
 use crate::Real;
 use crate::granule::damping::{
-    RigidMotion, damping_forces, rigid_motion_of, selective_kinetic_excess,
+    RigidFrame, RigidMotion, damping_forces_in, selective_kinetic_excess,
 };
 use crate::granule::forces::{ElementFailure, ElementSettings, ForceSummary, internal_forces};
 use crate::material::Material;
@@ -173,10 +173,40 @@ pub fn predict(
     sizes: StepSizes,
     loads: &Loads,
 ) -> Result<ForceSummary, ElementFailure> {
+    let frame = own_frame(b, loads.rigid_modes);
+    predict_in(&frame, mesh, mat, settings, b, sizes, loads)
+}
+
+/// [`predict`] with the granule's [`RigidFrame`] at x_n taken by the
+/// caller, who may hand the same frame to [`correct_in`] after the
+/// contact pass (x_n does not change in between) and so take it once per
+/// step instead of three times; the bits of [`predict`]. `frame` must be
+/// `RigidFrame::of(b.mass, b.x)`; it is not read when `loads.rigid_modes`
+/// is false.
+pub fn predict_in(
+    frame: &RigidFrame,
+    mesh: &ReferenceMesh<'_>,
+    mat: &Material,
+    settings: &ElementSettings,
+    b: &mut GranuleBuffers<'_>,
+    sizes: StepSizes,
+    loads: &Loads,
+) -> Result<ForceSummary, ElementFailure> {
     let summary = internal_forces(mesh, mat, settings, b.x, b.cp_inv, b.f_int)?;
-    damping_forces(b.mass, b.x, b.v, loads.damping_c, loads.rigid_modes, b.f_d);
-    advance_predictor(b, sizes, loads, false);
+    let frame = loads.rigid_modes.then_some(frame);
+    damping_forces_in(frame, b.mass, b.x, b.v, loads.damping_c, b.f_d);
+    advance_predictor(b, sizes, loads, Motion::Deforming(frame));
     Ok(summary)
+}
+
+/// The frame of `b` at x_n if the rigid modes are free, else a zero one
+/// (not read then).
+fn own_frame(b: &GranuleBuffers<'_>, rigid_modes: bool) -> RigidFrame {
+    if rigid_modes {
+        RigidFrame::of(b.mass, b.x)
+    } else {
+        RigidFrame::default()
+    }
 }
 
 /// First half of a step for a granule that is undeformed (x_n a rigid
@@ -193,7 +223,7 @@ pub fn predict(
 pub fn predict_rigid(b: &mut GranuleBuffers<'_>, sizes: StepSizes, loads: &Loads) -> ForceSummary {
     b.f_int.fill([0.0; 3]);
     b.f_d.fill([0.0; 3]);
-    advance_predictor(b, sizes, loads, true);
+    advance_predictor(b, sizes, loads, Motion::Translating);
     ForceSummary {
         min_j: 1.0,
         ..ForceSummary::default()
@@ -218,31 +248,43 @@ fn predictor_force(b: &GranuleBuffers<'_>, i: usize, a: usize, g: Real) -> Real 
     f_g - b.f_int[i][a] + b.f_d[i][a]
 }
 
+/// How a granule moves in [`advance_predictor`].
+#[derive(Clone, Copy)]
+enum Motion<'f> {
+    /// Every node has the same increment (a rigid granule under gravity),
+    /// which is then its own rigid part.
+    Translating,
+    /// Anything else; the frame at x_n when the rigid modes are free.
+    Deforming(Option<&'f RigidFrame>),
+}
+
 /// v* = v + Δt_n M⁻¹ (f_g − f_int + f_d) and x̃ = x + Δt v* (held components
-/// stay at rest); clears `f_c`. `translating`: every node has the same
-/// increment (a rigid granule under gravity), which is then its own rigid
-/// part.
-fn advance_predictor(
-    b: &mut GranuleBuffers<'_>,
-    sizes: StepSizes,
-    loads: &Loads,
-    translating: bool,
-) {
+/// stay at rest); clears `f_c`.
+fn advance_predictor(b: &mut GranuleBuffers<'_>, sizes: StepSizes, loads: &Loads, motion: Motion) {
     let (dt, dt_n, g) = (sizes.dt, sizes.dt_n(), loads.gravity_m_s2);
     let boost = loads.rigid_boost();
-    let rigid = match boost {
-        Some(_) if !translating => rigid_motion_of(b.mass, b.x, |i| {
-            core::array::from_fn(|a| increment(b, i, a, dt_n, predictor_force(b, i, a, g)))
-        }),
-        _ => RigidMotion::REST,
+    // The increments Δt_n f/m, one division per component, kept in v*
+    // until v* is formed (the rigid projection reads each twice).
+    for i in 0..b.x.len() {
+        for a in 0..3 {
+            b.v_star[i][a] = increment(b, i, a, dt_n, predictor_force(b, i, a, g));
+        }
+    }
+    let (frame, translating) = match motion {
+        Motion::Translating => (None, true),
+        Motion::Deforming(frame) => (frame, false),
+    };
+    let rigid = match (boost, frame) {
+        (Some(_), Some(frame)) => Some(frame.motion(b.mass, b.x, |i| b.v_star[i])),
+        _ => None,
     };
     for i in 0..b.x.len() {
-        let extra = match boost {
-            Some(k) if !translating => rigid.velocity_at(&b.x[i]).map(|r| k * r),
+        let extra = match (boost, &rigid) {
+            (Some(k), Some(r)) => r.velocity_at(&b.x[i]).map(|r| k * r),
             _ => [0.0; 3],
         };
         for (a, extra) in extra.into_iter().enumerate() {
-            let dv = increment(b, i, a, dt_n, predictor_force(b, i, a, g));
+            let dv = b.v_star[i][a];
             b.v_star[i][a] = if b.fixed[i] & (1 << a) != 0 {
                 0.0
             } else {
@@ -258,16 +300,51 @@ fn advance_predictor(
     b.f_c.fill([0.0; 3]);
 }
 
+/// The velocity increment Δt_n f/m of a contact force component `force`
+/// on a node of mass `m`, with the bits of `dt_n * force / m`; a zero
+/// force (most nodes: contact acts on the surface only) skips the
+/// division, which gives the same signed zero when `dt_ok` (Δt_n > 0 and
+/// finite) and m > 0.
+#[inline]
+fn contact_increment(dt_ok: bool, dt_n: Real, force: Real, m: Real) -> Real {
+    if force == 0.0 && dt_ok && m > 0.0 {
+        force
+    } else {
+        dt_n * force / m
+    }
+}
+
 /// Second half of a step: applies the contact forces in `f_c` (with the
 /// selective mass matrix of `loads`, module docs), advances x and v, and
 /// returns the work of every force (gravity `loads.gravity_m_s2`).
 pub fn correct(b: &mut GranuleBuffers<'_>, sizes: StepSizes, loads: &Loads) -> StepWork {
+    let frame = own_frame(b, loads.rigid_boost().is_some());
+    correct_in(&frame, b, sizes, loads)
+}
+
+/// [`correct`] with the granule's [`RigidFrame`] at x_n (before this
+/// step's update) taken by the caller, as for [`predict_in`]; the bits of
+/// [`correct`]. `frame` is read only under selective mass scaling.
+pub fn correct_in(
+    frame: &RigidFrame,
+    b: &mut GranuleBuffers<'_>,
+    sizes: StepSizes,
+    loads: &Loads,
+) -> StepWork {
     let (dt, dt_n) = (sizes.dt, sizes.dt_n());
+    let dt_ok = dt_n > 0.0 && dt_n.is_finite();
     let gravity_m_s2 = loads.gravity_m_s2;
     let boost = loads.rigid_boost();
+    let held = |b: &GranuleBuffers<'_>, i: usize, a: usize| b.fixed[i] & (1 << a) != 0;
     let rigid = match boost {
-        Some(_) => rigid_motion_of(b.mass, b.x, |i| {
-            core::array::from_fn(|a| increment(b, i, a, dt_n, b.f_c[i][a]))
+        Some(_) => frame.motion(b.mass, b.x, |i| {
+            core::array::from_fn(|a| {
+                if held(b, i, a) {
+                    0.0
+                } else {
+                    contact_increment(dt_ok, dt_n, b.f_c[i][a], b.mass[i])
+                }
+            })
         }),
         None => RigidMotion::REST,
     };
@@ -279,12 +356,12 @@ pub fn correct(b: &mut GranuleBuffers<'_>, sizes: StepSizes, loads: &Loads) -> S
             None => [0.0; 3],
         };
         for (a, extra) in extra.into_iter().enumerate() {
-            let v_new = if b.fixed[i] & (1 << a) != 0 {
+            let v_new = if held(b, i, a) {
                 0.0
             } else if boost.is_some() {
-                b.v_star[i][a] + (dt_n * b.f_c[i][a] / m + extra)
+                b.v_star[i][a] + (contact_increment(dt_ok, dt_n, b.f_c[i][a], m) + extra)
             } else {
-                b.v_star[i][a] + dt_n * b.f_c[i][a] / m
+                b.v_star[i][a] + contact_increment(dt_ok, dt_n, b.f_c[i][a], m)
             };
             let dx = 0.5 * (sizes.dt_prev * b.v[i][a] + dt * v_new);
             w.internal += b.f_int[i][a] * dx;
@@ -309,4 +386,41 @@ pub fn correct(b: &mut GranuleBuffers<'_>, sizes: StepSizes, loads: &Loads) -> S
         m.max(v[0] * v[0] + v[1] * v[1] + v[2] * v[2])
     });
     w
+}
+
+#[cfg(test)]
+mod tests {
+    use super::contact_increment;
+    use crate::Real;
+
+    /// Skipping the division of a zero force gives `dt_n * f / m` to the
+    /// bit, signed zeros included; where it could not (Δt_n or m zero,
+    /// negative, infinite or NaN) the division is done.
+    #[test]
+    fn contact_increment_has_the_bits_of_the_division() {
+        let values: [Real; 9] = [
+            0.0,
+            -0.0,
+            1e-300,
+            -3.5,
+            2.0,
+            Real::INFINITY,
+            -Real::INFINITY,
+            Real::NAN,
+            5e-324,
+        ];
+        for dt_n in values {
+            let dt_ok = dt_n > 0.0 && dt_n.is_finite();
+            for force in values {
+                for m in values {
+                    let want = dt_n * force / m;
+                    let got = contact_increment(dt_ok, dt_n, force, m);
+                    assert!(
+                        got.to_bits() == want.to_bits() || (got.is_nan() && want.is_nan()),
+                        "dt {dt_n:e} f {force:e} m {m:e}: {got:e} vs {want:e}"
+                    );
+                }
+            }
+        }
+    }
 }
