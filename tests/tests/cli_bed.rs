@@ -471,6 +471,69 @@ fn the_face_list_skin_is_a_scene_field() {
     assert_eq!(Scene::from_toml(&old).unwrap(), Scene::published());
 }
 
+/// The contact-sweep tolerance is a scene field (absent: the default) with
+/// a CLI override, a bad value refused naming the field and its range; a
+/// looser one takes fewer sweeps per step on the CI bed and leaves deeper
+/// overlaps, still below itself, with the pressure curve within the noise
+/// floor used above for the local sweeps (4 %).
+#[test]
+fn the_sweep_tolerance_trades_sweeps_for_overlap() {
+    let run = cli(&["bed", "--print-scene", "--sweep-tolerance", "0.02"]);
+    assert_eq!(run.code, 0, "{}", run.stderr);
+    assert_eq!(Scene::from_toml(&run.stdout).unwrap().sweep_tolerance, 0.02);
+    for bad in ["0", "0.2", "nan"] {
+        let run = cli(&["bed", "--print-scene", "--sweep-tolerance", bad]);
+        assert_eq!(run.code, 2, "{bad}");
+        assert!(
+            run.stderr.contains("sweep_tolerance") && run.stderr.contains("0 < t <= 0.1"),
+            "{}",
+            run.stderr
+        );
+    }
+    let old = DEFAULT_SCENE.replace("sweep_tolerance = 0.005\n", "");
+    assert_ne!(old, DEFAULT_SCENE);
+    assert_eq!(Scene::from_toml(&old).unwrap(), Scene::published());
+
+    let (tight, loose) = (out_dir("sweep_tol_default"), out_dir("sweep_tol_0.02"));
+    for (dir, extra) in [
+        (&tight, &[][..]),
+        (&loose, &["--sweep-tolerance", "0.02"][..]),
+    ] {
+        let mut argv = vec!["bed", "--quiet", "--out", dir.to_str().unwrap()];
+        argv.extend_from_slice(extra);
+        argv.extend_from_slice(&SMALL);
+        let r = cli(&argv);
+        assert_eq!(r.code, 0, "{}", r.stderr);
+    }
+    let get = |dir: &Path, key: &str| number(&summary(dir), key);
+    let (sweeps_tight, sweeps_loose) = (
+        get(&tight, "contact_sweeps_per_step"),
+        get(&loose, "contact_sweeps_per_step"),
+    );
+    let (overlap_tight, overlap_loose) = (
+        get(&tight, "max_penetration_rel_element"),
+        get(&loose, "max_penetration_rel_element"),
+    );
+    let l2 = pressure_distance(&loose, &tight);
+    println!(
+        "sweeps/step {sweeps_tight:.3} -> {sweeps_loose:.3}, overlap {overlap_tight:.4} -> \
+         {overlap_loose:.4}, P(C) L2 {l2:.4}"
+    );
+    assert!(
+        sweeps_loose < sweeps_tight - 0.2,
+        "{sweeps_loose} vs {sweeps_tight}"
+    );
+    assert!(
+        overlap_loose > overlap_tight,
+        "{overlap_loose} vs {overlap_tight}"
+    );
+    assert!(overlap_loose < 0.02, "{overlap_loose}");
+    assert!(
+        l2 < 0.04,
+        "a looser sweep tolerance changes P(C) by {l2:.4}"
+    );
+}
+
 #[test]
 fn a_failing_run_names_granule_element_step_and_strain_and_keeps_its_outputs() {
     // A punch at 30 m/s crushes the coarse granules within a few steps.

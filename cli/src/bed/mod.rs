@@ -149,17 +149,23 @@ pub struct BedArgs {
     #[arg(long, value_name = "BOOL")]
     pub local_sweeps: Option<bool>,
 
+    /// Override: a further contact sweep runs while a granule–granule gap
+    /// deeper than this fraction of the element size is left (0 < t ≤ 0.1;
+    /// default 0.005). Allowed with --resume.
+    #[arg(long, value_name = "T")]
+    pub sweep_tolerance: Option<f64>,
+
     /// Override: skin of the contact search's per-node face lists as a
     /// fraction of the mean surface-face diagonal (0 ≤ s ≤ 1, 0: none;
-    /// default 0.02). Only the speed depends on it, so it may be given with
+    /// default 0.05). Only the speed depends on it, so it may be given with
     /// --resume.
     #[arg(long, value_name = "S")]
     pub face_list_skin: Option<f64>,
 
     /// Continue the run whose checkpoint is in DIR (its `checkpoint.bin`);
     /// the outputs go to DIR. Only --strain, --stop-at-strain,
-    /// --time-step-safety, --mass-scaling, --face-list-skin, -j and --quiet
-    /// may be given with it.
+    /// --time-step-safety, --mass-scaling, --sweep-tolerance,
+    /// --face-list-skin, -j and --quiet may be given with it.
     #[arg(long, value_name = "DIR", conflicts_with_all = ["scene", "out", "granule_type", "granules", "mesh", "seed", "die_diameter_mm", "element", "hourglass_kappa", "rigid_until_touched", "local_sweeps", "selective_mass_scaling", "selective_mass_ratio"])]
     pub resume: Option<PathBuf>,
 
@@ -273,6 +279,9 @@ impl BedArgs {
         }
         if let Some(s) = self.face_list_skin {
             scene.face_list_skin = s;
+        }
+        if let Some(t) = self.sweep_tolerance {
+            scene.sweep_tolerance = t;
         }
         scene.validate()?;
         Ok(scene)

@@ -22,9 +22,10 @@ use crate::assembly::{Assembly, AssemblyError, AssemblyParams, Energies};
 use crate::model::OwnedReference;
 use crate::pack::run::run_pour;
 
-/// A further contact sweep runs while the last one left a granule–granule
-/// gap deeper than this fraction of the element size (the shortest surface
-/// edge), up to the scene's `contact_sweeps`.
+/// The default of the scene's `sweep_tolerance`: a further contact sweep
+/// runs while the last one left a granule–granule gap deeper than this
+/// fraction of the element size (the shortest surface edge), up to the
+/// scene's `contact_sweeps`.
 ///
 /// **Choice, by measurement** (30 coarse B2 granules to 30 %, one thread;
 /// BENCHMARKS.md): 3 sweeps with a 0.05 µm tolerance left overlaps of
@@ -265,7 +266,7 @@ pub fn run_bed(
     let mut params = AssemblyParams::standard(material, elements);
     params.damping_ratio = scene.damping_ratio;
     params.contact_sweeps = scene.contact_sweeps;
-    params.sweep_tolerance_m = SWEEP_TOLERANCE_REL * mesh.shortest_surface_edge();
+    params.sweep_tolerance_m = scene.sweep_tolerance * mesh.shortest_surface_edge();
     params.mass_scaling = scene.mass_scaling;
     params.selective_mass_scaling = scene.selective_mass_scaling;
     params.selective_mass_ratio = scene.selective_mass_ratio;

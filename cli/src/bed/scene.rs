@@ -80,6 +80,11 @@ rigid_until_touched = true
 # Contact sweeps after the first search only the neighbourhood of the pairs
 # still deeper than the tolerance (false: every pair of a moved granule).
 local_sweeps = true
+# A further contact sweep runs (up to contact_sweeps) while a granule-granule
+# gap deeper than this fraction of the element size is left (0 < t <= 0.1).
+# 0.01 takes a quarter fewer sweeps late in a dense bed and leaves overlaps
+# of up to ~0.5 % of the element (BENCHMARKS.md).
+sweep_tolerance = 0.005
 # Skin of the contact search's per-node face lists, as a fraction of the mean
 # surface-face diagonal: a pair's lists are rebuilt once a node has moved this
 # far (0: try every face near the overlap every sweep). The results are the
@@ -170,8 +175,8 @@ pub struct Scene {
     /// Damping ratio ξ, 0 ≤ ξ ≤ 2.
     pub damping_ratio: f64,
     /// Contact sweeps per step at most, 1..=50 (a further one runs while a
-    /// gap deeper than [`super::run::SWEEP_TOLERANCE_REL`] × the element
-    /// size is left).
+    /// gap deeper than [`Self::sweep_tolerance`] × the element size is
+    /// left).
     pub contact_sweeps: u32,
     /// Mass scaling F, 1 ≤ F ≤ 1e6 (absent: 1, so a scene file written
     /// before the published scene took 10 keeps its physical masses).
@@ -197,6 +202,12 @@ pub struct Scene {
     /// Later contact sweeps search only near the deep pairs (absent: true).
     #[serde(default = "default_true")]
     pub local_sweeps: bool,
+    /// A further contact sweep runs while a granule–granule gap deeper than
+    /// this fraction of the element size (the mesh's shortest surface edge)
+    /// is left, 0 < t ≤ 0.1 (absent: [`super::run::SWEEP_TOLERANCE_REL`],
+    /// 0.005).
+    #[serde(default = "default_sweep_tolerance")]
+    pub sweep_tolerance: f64,
     /// Skin of the contact search's face lists, 0 ≤ s ≤ 1 of the mean
     /// surface-face diagonal, 0 = none (absent: the default); the same
     /// bits for any value.
@@ -213,6 +224,10 @@ pub struct Scene {
     /// Material overrides.
     #[serde(default)]
     pub material: MaterialOverrides,
+}
+
+fn default_sweep_tolerance() -> f64 {
+    super::run::SWEEP_TOLERANCE_REL
 }
 
 fn default_face_list_skin() -> f64 {
@@ -300,7 +315,13 @@ impl Scene {
         self.granule_type()?;
         self.mesh_level()?;
         self.element_kind()?;
-        let checks: [(bool, &str, f64, &str); 17] = [
+        let checks: [(bool, &str, f64, &str); 18] = [
+            (
+                self.sweep_tolerance > 0.0 && self.sweep_tolerance <= 0.1,
+                "sweep_tolerance",
+                self.sweep_tolerance,
+                "0 < t <= 0.1",
+            ),
             (
                 (0.0..=1.0).contains(&self.face_list_skin),
                 "face_list_skin",

@@ -94,6 +94,8 @@ pub fn bed_grid(mesh: MeshLevel, quick: bool) -> (Setting, Vec<Setting>) {
                 s.selective_mass = true;
             }),
             with("safety 0.7", &|s| s.safety = 0.7),
+            with("sweep tol 0.01", &|s| s.sweep_tolerance = 0.01),
+            with("sweep tol 0.02", &|s| s.sweep_tolerance = 0.02),
             with("kappa 0.02", &|s| s.kappa = 0.02),
             with("kappa 0.1", &|s| s.kappa = 0.1),
             with("fbar", &|s| s.element = ElementKind::FBar),
@@ -122,6 +124,7 @@ fn scene_for(args: &WorkPrecisionArgs, size: &Size, setting: &Setting, seed: u64
         mass_scaling: setting.mass_scaling,
         selective_mass_scaling: setting.selective_mass,
         time_step_safety: setting.safety,
+        sweep_tolerance: setting.sweep_tolerance,
         material: MaterialOverrides {
             youngs_modulus_pa: m.youngs_modulus_pa,
             poisson_ratio: m.poisson_ratio,
@@ -267,6 +270,7 @@ mod tests {
                 // The mass scaling: its factor and whether it is selective.
                 s.mass_scaling != base.mass_scaling || s.selective_mass != base.selective_mass,
                 s.speed_factor != base.speed_factor,
+                s.sweep_tolerance != base.sweep_tolerance,
             ];
             assert_eq!(
                 differs.iter().filter(|d| **d).count(),

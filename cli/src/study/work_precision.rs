@@ -43,7 +43,7 @@ pub const CSV_FILE: &str = "work_precision.csv";
 pub const SVG_FILE: &str = "work_precision.svg";
 
 /// Columns of [`CSV_FILE`].
-pub const COLUMNS: [&str; 22] = [
+pub const COLUMNS: [&str; 23] = [
     "setting",
     "seed",
     "mesh_n",
@@ -54,6 +54,7 @@ pub const COLUMNS: [&str; 22] = [
     "mass_scaling",
     "selective_mass_scaling",
     "speed_factor",
+    "sweep_tolerance",
     "steps",
     "wall_time_s",
     "sigma_est_pa",
@@ -94,6 +95,9 @@ pub struct Setting {
     pub selective_mass: bool,
     /// Platen or punch speed as a multiple of the scene's.
     pub speed_factor: Real,
+    /// Contact-sweep tolerance as a fraction of the element size (bed; a
+    /// granule between platens has no granule–granule contact).
+    pub sweep_tolerance: Real,
 }
 
 impl Setting {
@@ -108,6 +112,7 @@ impl Setting {
             mass_scaling: STANDARD_MASS_SCALING,
             selective_mass: false,
             speed_factor: 1.0,
+            sweep_tolerance: crate::bed::run::SWEEP_TOLERANCE_REL,
         }
     }
 
@@ -466,6 +471,7 @@ pub fn write_csv(path: &Path, rows: &[Row<'_>]) -> anyhow::Result<()> {
             Field::Real(s.mass_scaling),
             Field::from(s.selective_mass),
             Field::Real(s.speed_factor),
+            Field::Real(s.sweep_tolerance),
             Field::Int(r.m.steps),
             Field::Real(r.m.wall_time_s),
             opt(r.m.sigma_est_pa),
