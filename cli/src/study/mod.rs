@@ -167,6 +167,16 @@ pub struct StabilityArgs {
     #[arg(long, value_name = "R")]
     pub watchdog_speed_ratio: Option<f64>,
 
+    /// Override the beds' contact-sweep tolerance (fraction of the element
+    /// size, 0 < t ≤ 0.1; default: the published scene's).
+    #[arg(long, value_name = "T")]
+    pub sweep_tolerance: Option<f64>,
+
+    /// Override the beds' mass scaling F ≥ 1 (default: the published
+    /// scene's, selective with its ratio limit).
+    #[arg(long, value_name = "F")]
+    pub mass_scaling: Option<f64>,
+
     /// Worker threads of the bed runs (0 = all cores).
     #[arg(short = 'j', long, value_name = "N", default_value_t = 0)]
     pub threads: usize,

@@ -173,6 +173,8 @@ pub fn bed_scene(args: &StabilityArgs, granule_type: GranuleType, seed: u64) -> 
     let published = Scene::published();
     Scene {
         contact_sweeps: args.contact_sweeps.unwrap_or(published.contact_sweeps),
+        sweep_tolerance: args.sweep_tolerance.unwrap_or(published.sweep_tolerance),
+        mass_scaling: args.mass_scaling.unwrap_or(published.mass_scaling),
         watchdog_speed_ratio: args
             .watchdog_speed_ratio
             .unwrap_or(published.watchdog_speed_ratio),
@@ -458,6 +460,40 @@ impl StabilityArgs {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The suite's options as `granbed-cli study stability` parses them.
+    fn args(extra: &[&str]) -> StabilityArgs {
+        #[derive(clap::Parser)]
+        struct Wrapper {
+            #[command(flatten)]
+            args: StabilityArgs,
+        }
+        let argv = ["stability", "--out", "unused"].iter().chain(extra);
+        <Wrapper as clap::Parser>::try_parse_from(argv)
+            .unwrap()
+            .args
+    }
+
+    /// The beds are the published scene unless overridden; the mass
+    /// scaling and the sweep tolerance reach the scene.
+    #[test]
+    fn the_bed_overrides_reach_the_scene() {
+        let published = Scene::published();
+        let plain = bed_scene(&args(&[]), GranuleType::C3, 2);
+        assert_eq!(plain.mass_scaling, published.mass_scaling);
+        assert_eq!(plain.sweep_tolerance, published.sweep_tolerance);
+        assert_eq!((plain.granule_type.as_str(), plain.seed), ("C3", 2));
+        let changed = bed_scene(
+            &args(&["--mass-scaling", "30", "--sweep-tolerance", "0.01"]),
+            GranuleType::C3,
+            2,
+        );
+        assert_eq!(
+            (changed.mass_scaling, changed.sweep_tolerance),
+            (30.0, 0.01)
+        );
+        assert_eq!(changed.selective_mass_ratio, published.selective_mass_ratio);
+    }
 
     fn good() -> Record {
         Record {
