@@ -225,6 +225,10 @@ fn bench_granule_step(c: &mut Criterion) {
         let suffix = if framed { "/framed" } else { "" };
         group.bench_function(format!("predict_selective_x10{suffix}"), |bench| {
             bench.iter(|| {
+                // `correct` below moves x and v: start from x0, v0 (the
+                // configuration of `frame`) every time.
+                x.copy_from_slice(&x0);
+                v.copy_from_slice(&v0);
                 cp.copy_from_slice(&start);
                 let mut b = GranuleBuffers {
                     x: &mut x,

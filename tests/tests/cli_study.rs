@@ -293,6 +293,11 @@ fn the_stability_suite_writes_one_judged_row_per_run() {
             .unwrap();
     assert_eq!(json["all_passed"], true);
     assert_eq!(json["runs"].as_array().unwrap().len(), 6);
+    // The beds' numerical settings are recorded (the published scene's here).
+    let published = granbed_cli::bed::Scene::published();
+    assert_eq!(json["mass_scaling"], published.mass_scaling);
+    assert_eq!(json["sweep_tolerance"], published.sweep_tolerance);
+    assert_eq!(json["contact_sweeps"], published.contact_sweeps);
     for name in [
         "min_jacobian_beds.svg",
         "penetration_beds.svg",

@@ -313,8 +313,11 @@ pub struct Assembly<'m> {
     /// Per granule: still a rigid body (untouched since its placement;
     /// [`AssemblyParams::rigid_until_touched`]).
     rigid: Vec<bool>,
-    /// Per granule: its rigid frame at x_n of the current step (that of a
-    /// granule still rigid is stale unless selective mass scaling needs it).
+    /// Per granule: its rigid frame at x_n of the current step, for the
+    /// damping, predictor and corrector and the sweeps' rigid response
+    /// (a granule still rigid has none, only the zero default or an old
+    /// frame that nothing reads, unless selective mass scaling needs it;
+    /// taken out during the sweeps).
     frames: Vec<RigidFrame>,
 }
 

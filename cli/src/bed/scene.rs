@@ -51,7 +51,7 @@ hourglass_kappa = 0.05
 # Selective damping of the non-rigid modes, fraction of critical.
 damping_ratio = 0.5
 # Contact sweeps per step at most (physics.md 5.3); a further sweep runs while
-# a granule overlap deeper than 0.5 % of the element size is left.
+# a granule overlap deeper than sweep_tolerance (below) is left.
 contact_sweeps = 25
 # Mass scaling F >= 1 for quasi-static runs (1 = physical inertia; the
 # summary's quasi-static certificate says whether a run stayed quasi-static).

@@ -56,6 +56,7 @@ pub fn bed_grid(mesh: MeshLevel, quick: bool) -> (Setting, Vec<Setting>) {
         safety: Scene::published().time_step_safety,
         mass_scaling: Scene::published().mass_scaling,
         selective_mass: Scene::published().selective_mass_scaling,
+        sweep_tolerance: Scene::published().sweep_tolerance,
         ..Setting::default_on(mesh)
     };
     let with = |name, f: &dyn Fn(&mut Setting)| base.with(name, f);

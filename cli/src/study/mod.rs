@@ -172,8 +172,8 @@ pub struct StabilityArgs {
     #[arg(long, value_name = "T")]
     pub sweep_tolerance: Option<f64>,
 
-    /// Override the beds' mass scaling F ≥ 1 (default: the published
-    /// scene's, selective with its ratio limit).
+    /// Override the beds' mass scaling, 1 ≤ F ≤ 1e6 (default: the
+    /// published scene's, selective with its ratio limit).
     #[arg(long, value_name = "F")]
     pub mass_scaling: Option<f64>,
 

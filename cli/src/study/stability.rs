@@ -295,6 +295,12 @@ struct Report<'a> {
     die_diameter_mm: Real,
     bed_strain: Real,
     beds_per_type: u64,
+    /// The beds' numerical settings as run (the published scene's unless
+    /// overridden).
+    contact_sweeps: u32,
+    sweep_tolerance: Real,
+    mass_scaling: Real,
+    watchdog_speed_ratio: Real,
     granule_mesh: String,
     granule_strain: Real,
     max_residual_rel: Real,
@@ -372,6 +378,7 @@ impl StabilityArgs {
         }
         finish_file(csv.into_inner(), &path)?;
         let all_passed = records.iter().all(|r| r.passed);
+        let beds = bed_scene(self, GranuleType::B2, 1);
         write_json(
             &self.out.join(JSON_FILE),
             &Report {
@@ -380,6 +387,10 @@ impl StabilityArgs {
                 die_diameter_mm: self.die_diameter_mm,
                 bed_strain: self.strain,
                 beds_per_type: self.beds,
+                contact_sweeps: beds.contact_sweeps,
+                sweep_tolerance: beds.sweep_tolerance,
+                mass_scaling: beds.mass_scaling,
+                watchdog_speed_ratio: beds.watchdog_speed_ratio,
                 granule_mesh: self.granule_mesh.to_string(),
                 granule_strain: self.granule_strain,
                 max_residual_rel: MAX_RESIDUAL_REL,

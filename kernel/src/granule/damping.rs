@@ -391,6 +391,70 @@ mod tests {
             );
             assert!((got.omega[a] - omega[a]).abs() < 1e-11, "{:?}", got.omega);
         }
-        assert_eq!(got.mass.to_bits(), frame.mass.to_bits());
+    }
+
+    /// The projection as one fused pair of passes computed it before the
+    /// frame was taken apart (centre and mass-weighted velocity in one
+    /// pass, L and the full inertia in the second): the reference for the
+    /// bits.
+    fn fused_projection(mass: &[Real], x: &[[Real; 3]], v: &[[Real; 3]]) -> RigidMotion {
+        let (mut m, mut mx, mut mv) = (0.0, [0.0; 3], [0.0; 3]);
+        for ((mi, xi), vi) in mass.iter().zip(x).zip(v) {
+            m += mi;
+            for a in 0..3 {
+                mx[a] += mi * xi[a];
+                mv[a] += mi * vi[a];
+            }
+        }
+        let (centre, velocity) = (mx.map(|s| s / m), mv.map(|s| s / m));
+        let (mut l, mut inertia) = ([0.0; 3], Mat3::zeros());
+        for ((mi, xi), vi) in mass.iter().zip(x).zip(v) {
+            let r = [xi[0] - centre[0], xi[1] - centre[1], xi[2] - centre[2]];
+            let u = [
+                vi[0] - velocity[0],
+                vi[1] - velocity[1],
+                vi[2] - velocity[2],
+            ];
+            l[0] += mi * (r[1] * u[2] - r[2] * u[1]);
+            l[1] += mi * (r[2] * u[0] - r[0] * u[2]);
+            l[2] += mi * (r[0] * u[1] - r[1] * u[0]);
+            let r2 = r[0] * r[0] + r[1] * r[1] + r[2] * r[2];
+            for a in 0..3 {
+                for b in 0..3 {
+                    inertia[(a, b)] += mi * (if a == b { r2 } else { 0.0 } - r[a] * r[b]);
+                }
+            }
+        }
+        RigidMotion {
+            centre,
+            velocity,
+            omega: spin(&inertia, &l),
+            mass: m,
+            angular_momentum: l,
+        }
+    }
+
+    /// Frame + motion (and so `rigid_motion`) give the fused projection's
+    /// bits on random clouds and velocity fields.
+    #[test]
+    fn frame_and_motion_have_the_bits_of_the_fused_projection() {
+        for seed in 1..20 {
+            let (mass, x) = cloud(seed);
+            let mut rng = Rng::new(seed + 100);
+            let v: [[Real; 3]; N] =
+                core::array::from_fn(|_| core::array::from_fn(|_| rng.uniform(-0.1, 0.1)));
+            let want = fused_projection(&mass, &x, &v);
+            let got = rigid_motion(&mass, &x, &v);
+            let bits = |r: &RigidMotion| {
+                let mut out = [0u64; 13];
+                let all = r.centre.iter().chain(&r.velocity).chain(&r.omega);
+                for (o, c) in out.iter_mut().zip(all.chain(&r.angular_momentum)) {
+                    *o = c.to_bits();
+                }
+                out[12] = r.mass.to_bits();
+                out
+            };
+            assert_eq!(bits(&got), bits(&want), "seed {seed}");
+        }
     }
 }

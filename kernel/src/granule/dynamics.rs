@@ -234,11 +234,17 @@ pub fn predict_rigid(b: &mut GranuleBuffers<'_>, sizes: StepSizes, loads: &Loads
 /// force `force` (N), or 0 if the component is held.
 #[inline]
 fn increment(b: &GranuleBuffers<'_>, i: usize, a: usize, dt_n: Real, force: Real) -> Real {
-    if b.fixed[i] & (1 << a) != 0 {
+    if held(b, i, a) {
         0.0
     } else {
         dt_n * force / b.mass[i]
     }
+}
+
+/// Whether velocity component `a` of node `i` is held at zero.
+#[inline]
+fn held(b: &GranuleBuffers<'_>, i: usize, a: usize) -> bool {
+    b.fixed[i] & (1 << a) != 0
 }
 
 /// f_g − f_int + f_d on component `a` of node `i`, N.
@@ -260,7 +266,12 @@ enum Motion<'f> {
 
 /// v* = v + Δt_n M⁻¹ (f_g − f_int + f_d) and x̃ = x + Δt v* (held components
 /// stay at rest); clears `f_c`.
-fn advance_predictor(b: &mut GranuleBuffers<'_>, sizes: StepSizes, loads: &Loads, motion: Motion) {
+fn advance_predictor(
+    b: &mut GranuleBuffers<'_>,
+    sizes: StepSizes,
+    loads: &Loads,
+    motion: Motion<'_>,
+) {
     let (dt, dt_n, g) = (sizes.dt, sizes.dt_n(), loads.gravity_m_s2);
     let boost = loads.rigid_boost();
     // The increments Δt_n f/m, one division per component, kept in v*
@@ -285,7 +296,7 @@ fn advance_predictor(b: &mut GranuleBuffers<'_>, sizes: StepSizes, loads: &Loads
         };
         for (a, extra) in extra.into_iter().enumerate() {
             let dv = b.v_star[i][a];
-            b.v_star[i][a] = if b.fixed[i] & (1 << a) != 0 {
+            b.v_star[i][a] = if held(b, i, a) {
                 0.0
             } else {
                 match boost {
@@ -300,11 +311,18 @@ fn advance_predictor(b: &mut GranuleBuffers<'_>, sizes: StepSizes, loads: &Loads
     b.f_c.fill([0.0; 3]);
 }
 
+/// Whether a step Δt_n lets [`contact_increment`] skip the division of a
+/// zero force: Δt_n > 0 and finite.
+#[inline]
+fn division_skippable(dt_n: Real) -> bool {
+    dt_n > 0.0 && dt_n.is_finite()
+}
+
 /// The velocity increment Δt_n f/m of a contact force component `force`
 /// on a node of mass `m`, with the bits of `dt_n * force / m`; a zero
 /// force (most nodes: contact acts on the surface only) skips the
-/// division, which gives the same signed zero when `dt_ok` (Δt_n > 0 and
-/// finite) and m > 0.
+/// division, which gives the same signed zero when `dt_ok`
+/// ([`division_skippable`]) and m > 0.
 #[inline]
 fn contact_increment(dt_ok: bool, dt_n: Real, force: Real, m: Real) -> Real {
     if force == 0.0 && dt_ok && m > 0.0 {
@@ -332,10 +350,9 @@ pub fn correct_in(
     loads: &Loads,
 ) -> StepWork {
     let (dt, dt_n) = (sizes.dt, sizes.dt_n());
-    let dt_ok = dt_n > 0.0 && dt_n.is_finite();
+    let dt_ok = division_skippable(dt_n);
     let gravity_m_s2 = loads.gravity_m_s2;
     let boost = loads.rigid_boost();
-    let held = |b: &GranuleBuffers<'_>, i: usize, a: usize| b.fixed[i] & (1 << a) != 0;
     let rigid = match boost {
         Some(_) => frame.motion(b.mass, b.x, |i| {
             core::array::from_fn(|a| {
@@ -390,7 +407,7 @@ pub fn correct_in(
 
 #[cfg(test)]
 mod tests {
-    use super::contact_increment;
+    use super::{contact_increment, division_skippable};
     use crate::Real;
 
     /// Skipping the division of a zero force gives `dt_n * f / m` to the
@@ -410,7 +427,7 @@ mod tests {
             5e-324,
         ];
         for dt_n in values {
-            let dt_ok = dt_n > 0.0 && dt_n.is_finite();
+            let dt_ok = division_skippable(dt_n);
             for force in values {
                 for m in values {
                     let want = dt_n * force / m;
