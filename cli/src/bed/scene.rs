@@ -82,8 +82,8 @@ rigid_until_touched = true
 local_sweeps = true
 # A further contact sweep runs (up to contact_sweeps) while a granule-granule
 # gap deeper than this fraction of the element size is left (0 < t <= 0.1).
-# 0.01 takes a quarter fewer sweeps late in a dense bed and leaves overlaps
-# of up to ~0.5 % of the element (BENCHMARKS.md).
+# 0.01 takes a fifth to a quarter fewer sweeps in a dense bed and leaves
+# overlaps of up to ~0.6 % of the element (BENCHMARKS.md).
 sweep_tolerance = 0.005
 # Skin of the contact search's per-node face lists, as a fraction of the mean
 # surface-face diagonal: a pair's lists are rebuilt once a node has moved this
