@@ -146,6 +146,43 @@ fn bench_elements(c: &mut Criterion) {
     group.finish();
 }
 
+/// The buffers of one granule, owned (the kernel's `GranuleBuffers`
+/// borrows them).
+struct GranuleStore {
+    x: Vec<[f64; 3]>,
+    v: Vec<[f64; 3]>,
+    v_star: Vec<[f64; 3]>,
+    x_pred: Vec<[f64; 3]>,
+    f_int: Vec<[f64; 3]>,
+    f_c: Vec<[f64; 3]>,
+    f_d: Vec<[f64; 3]>,
+    mass: Vec<f64>,
+    fixed: Vec<u8>,
+    cp_inv: Vec<granbed_kernel::tensor::Voigt>,
+}
+
+impl GranuleStore {
+    /// Positions, velocities and contact forces back to the given start;
+    /// the kernel's view of the buffers.
+    fn reset(&mut self, x: &[[f64; 3]], v: &[[f64; 3]], f_c: &[[f64; 3]]) -> GranuleBuffers<'_> {
+        self.x.copy_from_slice(x);
+        self.v.copy_from_slice(v);
+        self.f_c.copy_from_slice(f_c);
+        GranuleBuffers {
+            x: &mut self.x,
+            v: &mut self.v,
+            v_star: &mut self.v_star,
+            x_pred: &mut self.x_pred,
+            f_int: &mut self.f_int,
+            f_c: &mut self.f_c,
+            f_d: &mut self.f_d,
+            mass: &mut self.mass,
+            fixed: &mut self.fixed,
+            cp_inv: &mut self.cp_inv,
+        }
+    }
+}
+
 /// One granule's step halves on the standard mesh, B2, selective mass
 /// scaling ×10 (the bed's default): `predict` (elements + damping +
 /// predictor) and `correct` (contact forces on the surface nodes only, as
@@ -213,10 +250,18 @@ fn bench_granule_step(c: &mut Criterion) {
         dt: 1e-6,
     };
     let start = vec![VOIGT_IDENTITY; m.hexes.len()];
-    let (mut x, mut v, mut cp) = (x0.clone(), v0.clone(), start.clone());
-    let (mut v_star, mut x_pred) = (vec![[0.0; 3]; n], vec![[0.0; 3]; n]);
-    let (mut f_int, mut f_c, mut f_d) = (vec![[0.0; 3]; n], f_c0.clone(), vec![[0.0; 3]; n]);
-    let (mut masses, mut fixed) = (mass.clone(), vec![0u8; n]);
+    let mut store = GranuleStore {
+        x: x0.clone(),
+        v: v0.clone(),
+        v_star: vec![[0.0; 3]; n],
+        x_pred: vec![[0.0; 3]; n],
+        f_int: vec![[0.0; 3]; n],
+        f_c: f_c0.clone(),
+        f_d: vec![[0.0; 3]; n],
+        mass: mass.clone(),
+        fixed: vec![0; n],
+        cp_inv: start.clone(),
+    };
     // The frame the bed takes once per step for both halves.
     let frame = RigidFrame::of(&mass, &x0);
     let mut group = c.benchmark_group("granule_step");
@@ -226,22 +271,10 @@ fn bench_granule_step(c: &mut Criterion) {
         group.bench_function(format!("predict_selective_x10{suffix}"), |bench| {
             bench.iter(|| {
                 // `correct` below moves x and v: start from x0, v0 (the
-                // configuration of `frame`) every time.
-                x.copy_from_slice(&x0);
-                v.copy_from_slice(&v0);
-                cp.copy_from_slice(&start);
-                let mut b = GranuleBuffers {
-                    x: &mut x,
-                    v: &mut v,
-                    v_star: &mut v_star,
-                    x_pred: &mut x_pred,
-                    f_int: &mut f_int,
-                    f_c: &mut f_c,
-                    f_d: &mut f_d,
-                    mass: &mut masses,
-                    fixed: &mut fixed,
-                    cp_inv: &mut cp,
-                };
+                // configuration of `frame`) every time, and from the virgin
+                // states (the corrector does not read them).
+                store.cp_inv.copy_from_slice(&start);
+                let mut b = store.reset(&x0, &v0, &f_c0);
                 let s = if framed {
                     predict_in(&frame, &mesh, &mat, &settings, &mut b, sizes, &loads)
                 } else {
@@ -252,21 +285,7 @@ fn bench_granule_step(c: &mut Criterion) {
         });
         group.bench_function(format!("correct_selective_x10{suffix}"), |bench| {
             bench.iter(|| {
-                x.copy_from_slice(&x0);
-                v.copy_from_slice(&v0);
-                f_c.copy_from_slice(&f_c0);
-                let mut b = GranuleBuffers {
-                    x: &mut x,
-                    v: &mut v,
-                    v_star: &mut v_star,
-                    x_pred: &mut x_pred,
-                    f_int: &mut f_int,
-                    f_c: &mut f_c,
-                    f_d: &mut f_d,
-                    mass: &mut masses,
-                    fixed: &mut fixed,
-                    cp_inv: &mut cp,
-                };
+                let mut b = store.reset(&x0, &v0, &f_c0);
                 let w = if framed {
                     correct_in(&frame, &mut b, sizes, &loads)
                 } else {

@@ -452,23 +452,48 @@ fn the_element_and_kappa_are_scene_fields() {
     assert_eq!(Scene::from_toml(&old).unwrap(), Scene::published());
 }
 
+/// A numeric scene field `field` has the CLI override `--<flag> <good>`,
+/// every value of `bad` is refused naming the field and `range`, and a
+/// scene file without the field (its published line `line` removed) reads
+/// as the published scene.
+fn a_numeric_scene_field(
+    flag: &str,
+    field: &str,
+    (good, get): (f64, fn(&Scene) -> f64),
+    bad: &[&str],
+    range: &str,
+    line: &str,
+) {
+    let option = format!("--{flag}");
+    let run = cli(&["bed", "--print-scene", &option, &good.to_string()]);
+    assert_eq!(run.code, 0, "{}", run.stderr);
+    assert_eq!(get(&Scene::from_toml(&run.stdout).unwrap()), good);
+    for value in bad {
+        let run = cli(&["bed", "--print-scene", &option, value]);
+        assert_eq!(run.code, 2, "{flag} {value}");
+        assert!(
+            run.stderr.contains(field) && run.stderr.contains(range),
+            "{}",
+            run.stderr
+        );
+    }
+    let old = DEFAULT_SCENE.replace(&format!("{line}\n"), "");
+    assert_ne!(old, DEFAULT_SCENE);
+    assert_eq!(Scene::from_toml(&old).unwrap(), Scene::published());
+}
+
 /// The face lists' skin is a scene field (absent: the default) with a CLI
 /// override; a bad value is refused naming the field and its range.
 #[test]
 fn the_face_list_skin_is_a_scene_field() {
-    let run = cli(&["bed", "--print-scene", "--face-list-skin", "0"]);
-    assert_eq!(run.code, 0, "{}", run.stderr);
-    assert_eq!(Scene::from_toml(&run.stdout).unwrap().face_list_skin, 0.0);
-    let run = cli(&["bed", "--print-scene", "--face-list-skin", "1.5"]);
-    assert_eq!(run.code, 2);
-    assert!(
-        run.stderr.contains("face_list_skin") && run.stderr.contains("0 <= s <= 1"),
-        "{}",
-        run.stderr
+    a_numeric_scene_field(
+        "face-list-skin",
+        "face_list_skin",
+        (0.0, |s| s.face_list_skin),
+        &["1.5"],
+        "0 <= s <= 1",
+        "face_list_skin = 0.05",
     );
-    let old = DEFAULT_SCENE.replace("face_list_skin = 0.05\n", "");
-    assert_ne!(old, DEFAULT_SCENE);
-    assert_eq!(Scene::from_toml(&old).unwrap(), Scene::published());
 }
 
 /// The contact-sweep tolerance is a scene field (absent: the default) with
@@ -478,21 +503,14 @@ fn the_face_list_skin_is_a_scene_field() {
 /// floor used above for the local sweeps (4 %).
 #[test]
 fn the_sweep_tolerance_trades_sweeps_for_overlap() {
-    let run = cli(&["bed", "--print-scene", "--sweep-tolerance", "0.02"]);
-    assert_eq!(run.code, 0, "{}", run.stderr);
-    assert_eq!(Scene::from_toml(&run.stdout).unwrap().sweep_tolerance, 0.02);
-    for bad in ["0", "0.2", "nan"] {
-        let run = cli(&["bed", "--print-scene", "--sweep-tolerance", bad]);
-        assert_eq!(run.code, 2, "{bad}");
-        assert!(
-            run.stderr.contains("sweep_tolerance") && run.stderr.contains("0 < t <= 0.1"),
-            "{}",
-            run.stderr
-        );
-    }
-    let old = DEFAULT_SCENE.replace("sweep_tolerance = 0.005\n", "");
-    assert_ne!(old, DEFAULT_SCENE);
-    assert_eq!(Scene::from_toml(&old).unwrap(), Scene::published());
+    a_numeric_scene_field(
+        "sweep-tolerance",
+        "sweep_tolerance",
+        (0.02, |s| s.sweep_tolerance),
+        &["0", "0.2", "nan"],
+        "0 < t <= 0.1",
+        "sweep_tolerance = 0.005",
+    );
 
     let (tight, loose) = (out_dir("sweep_tol_default"), out_dir("sweep_tol_0.02"));
     for (dir, extra) in [
