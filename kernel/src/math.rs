@@ -7,9 +7,31 @@
 use crate::Real;
 
 /// Square root (correctly rounded, IEEE 754).
+///
+/// On x86-64 through the SSE2 intrinsic, not `libm`: `libm::sqrt` is inline
+/// assembly (`sqrtsd`), which keeps its legacy SSE encoding inside the AVX2
+/// element loop, and a legacy SSE instruction after 256-bit code pays the
+/// SSE/AVX transition penalty. On one machine of this project (Xeon, model
+/// 167) that made the AVX2 element 2.8x slower than the scalar one
+/// (BENCHMARKS.md, "The AVX2 element and libm's square root"). The intrinsic
+/// is LLVM's `sqrt`, encoded `vsqrtsd` where AVX is on; both are IEEE's
+/// correctly rounded square root, so the bits are the same.
 #[inline]
 pub fn sqrt(x: Real) -> Real {
-    libm::sqrt(x)
+    #[cfg(target_arch = "x86_64")]
+    {
+        use core::arch::x86_64::{_mm_cvtsd_f64, _mm_set_sd, _mm_sqrt_pd};
+        // SAFETY: SSE2 is part of every x86-64 processor (the target's
+        // baseline); the intrinsics touch registers only.
+        #[allow(unsafe_code)]
+        unsafe {
+            _mm_cvtsd_f64(_mm_sqrt_pd(_mm_set_sd(x)))
+        }
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    {
+        libm::sqrt(x)
+    }
 }
 
 /// Cube root of any real number (negative arguments give negative roots).
@@ -67,4 +89,28 @@ pub fn max(a: Real, b: Real) -> Real {
 #[inline]
 pub fn min(a: Real, b: Real) -> Real {
     if a.is_nan() || b < a { b } else { a }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The intrinsic square root has libm's bits (both are IEEE's correctly
+    /// rounded one) on a spread of normal numbers and on the special cases.
+    #[test]
+    fn sqrt_has_libms_bits() {
+        let mut x: Real = 1.0e-310; // subnormal
+        while x < 1.0e300 {
+            for y in [x, x * 1.000_000_7, x * 3.3] {
+                assert_eq!(sqrt(y).to_bits(), libm::sqrt(y).to_bits(), "sqrt({y:e})");
+            }
+            x *= 1.37;
+        }
+        for y in [0.0, -0.0, Real::INFINITY, Real::MIN_POSITIVE, Real::MAX] {
+            assert_eq!(sqrt(y).to_bits(), libm::sqrt(y).to_bits(), "sqrt({y:e})");
+        }
+        for y in [-1.0, Real::NEG_INFINITY, Real::NAN] {
+            assert!(sqrt(y).is_nan(), "sqrt({y:e})");
+        }
+    }
 }
