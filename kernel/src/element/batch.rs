@@ -18,11 +18,14 @@
 //! time with `cpuid`, no `std` needed). All three give the same bits;
 //! [`ElementPath::fastest`] is AVX2 where available, else element by element.
 //!
-//! This is the kernel's only `unsafe` code (the workspace denies it
-//! elsewhere), allowed function by function: reading `cpuid`/`xgetbv`
-//! (`detect_avx2`), and declaring and calling the AVX2-compiled loop
-//! (`Job::batched_avx2`, [`one_point_elements`]), which is sound only once
-//! [`has_avx2`] said yes — each block says so.
+//! This is, with the SSE2 square root of [`crate::math::sqrt`], the
+//! kernel's only `unsafe` code (the workspace denies it elsewhere), allowed
+//! function by function: reading `cpuid`/`xgetbv` (`detect_avx2`), and
+//! declaring and calling the AVX2-compiled loop (`Job::batched_avx2`,
+//! [`one_point_elements`]), which is sound only once [`has_avx2`] said yes —
+//! each block says so. Nothing inside the AVX2 loop may be inline assembly
+//! of legacy SSE (as `libm::sqrt` is on x86-64): it would pay the SSE/AVX
+//! transition penalty on every call.
 
 use crate::Real;
 use crate::constitutive::update::{Trial, check_trial, plastic_return, trial};
