@@ -96,7 +96,9 @@ mod tests {
     use super::*;
 
     /// The intrinsic square root has libm's bits (both are IEEE's correctly
-    /// rounded one) on a spread of normal numbers and on the special cases.
+    /// rounded one) on a spread of normal numbers and on the special cases:
+    /// it catches a wrong lane or conversion in the intrinsic form (on
+    /// targets without it both sides are libm).
     #[test]
     fn sqrt_has_libms_bits() {
         let mut x: Real = 1.0e-310; // subnormal
