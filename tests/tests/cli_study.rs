@@ -187,9 +187,11 @@ fn the_quick_bed_study_runs_the_bed_code_and_measures_the_spread() {
             "{what}: {x}, expected {want}"
         );
     };
-    // The default scales the masses x10 (selective): physical masses take
-    // √10 times its steps, the reference at half speed twice that.
-    close(steps[2] / steps[1], 10f64.sqrt(), "mass x1 against x10");
+    // The default scales the masses by F (selective, F = 20): physical
+    // masses take √F times its steps, the reference at half speed twice
+    // that.
+    let f = granbed_cli::bed::Scene::published().mass_scaling;
+    close(steps[2] / steps[1], f.sqrt(), "mass x1 against the default");
     close(steps[1] / steps[3], 2.0, "speed x2");
     close(steps[0] / steps[2], 2.0, "reference at half speed");
     // The default row is `granbed-cli bed` on the same scene, bit for bit.

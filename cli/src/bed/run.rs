@@ -35,6 +35,11 @@ use crate::pack::run::run_pour;
 /// the gap the last one found. That bed never needs more than 10; a C3
 /// bed at 55–60 % does: with at most 10 it overlapped by 1.02 %, with 25
 /// by 0.43 % (the scene's default cap is 25).
+///
+/// This is the tolerance of a scene file without `sweep_tolerance` (from
+/// before it was a field); the published scene has 0.01 since session 18
+/// (a fifth to a quarter fewer sweeps late in a dense bed, P(C) within the
+/// noise floor; BENCHMARKS.md).
 pub const SWEEP_TOLERANCE_REL: Real = 0.005;
 
 /// One output row: averages over the interval that ends at `strain`.

@@ -85,7 +85,12 @@ pub fn bed_grid(mesh: MeshLevel, quick: bool) -> (Setting, Vec<Setting>) {
             with("mass x10", &uniform(10.0)),
             with("mass x100", &uniform(100.0)),
             // Selective with the published scene's ratio limit F/G ≤ 10:
-            // ×30 makes the rigid modes 3× heavier, ×100 10×.
+            // ×10 (the default until session 18) keeps the rigid modes
+            // physical, ×30 makes them 3× heavier, ×100 10×.
+            with("selective x10", &|s| {
+                s.mass_scaling = 10.0;
+                s.selective_mass = true;
+            }),
             with("selective x30", &|s| {
                 s.mass_scaling = 30.0;
                 s.selective_mass = true;
@@ -95,6 +100,7 @@ pub fn bed_grid(mesh: MeshLevel, quick: bool) -> (Setting, Vec<Setting>) {
                 s.selective_mass = true;
             }),
             with("safety 0.7", &|s| s.safety = 0.7),
+            with("sweep tol 0.005", &|s| s.sweep_tolerance = 0.005),
             with("sweep tol 0.01", &|s| s.sweep_tolerance = 0.01),
             with("sweep tol 0.02", &|s| s.sweep_tolerance = 0.02),
             with("kappa 0.02", &|s| s.kappa = 0.02),
