@@ -107,3 +107,35 @@ fn a_node_behind_a_face_far_from_other_faces_is_held_against_it() {
         assert!((c.gap + 0.01).abs() < 1e-12, "gap {}", c.gap);
     }
 }
+
+/// A node just below the bottom of a valley (two faces meeting at a
+/// concave edge, both facing up) projects just off each face: no face
+/// holds it, and the concave-edge search holds it against the shared edge
+/// with the faces' averaged normal (+z) and its depth below the edge.
+#[test]
+fn a_node_below_a_concave_edge_is_held_against_the_edge() {
+    let master = vec![
+        [0.0, 0.0, 0.2],
+        [1.0, 0.0, 0.0],
+        [1.0, 1.0, 0.0],
+        [0.0, 1.0, 0.2],
+        [2.0, 0.0, 0.2],
+        [2.0, 1.0, 0.2],
+    ];
+    let quads = [[0, 1, 2, 3], [1, 4, 5, 2]];
+    // Two nodes 0.005 below the edge x = 1, z = 0; the other two above
+    // face 1 (z = 0.1 where it is at 0.06).
+    let slave = [
+        [1.0, 0.5, -0.005],
+        [1.0, 0.6, -0.005],
+        [1.3, 0.6, 0.1],
+        [1.3, 0.5, 0.1],
+    ];
+    let found = constraints(&slave, &master, &quads);
+    assert_eq!(found.len(), 2, "{found:?}");
+    for c in &found {
+        assert!(c.slave < 2, "{c:?}");
+        assert!((c.gap + 0.005).abs() < 1e-12, "gap {}", c.gap);
+        assert!((c.normal[2] - 1.0).abs() < 1e-12, "normal {:?}", c.normal);
+    }
+}

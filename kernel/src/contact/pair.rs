@@ -571,6 +571,12 @@ fn closest_face<'c>(
     concave_edge(&p, candidates).filter(|h| opposing(&h.projection.normal))
 }
 
+/// Clamped projections [`concave_edge`] keeps between its two loops, so
+/// that each face is projected once (late in the default scene the second
+/// loop's were 8 % of all projections, ~4 faces per call); beyond this
+/// many the rest are projected again.
+const CONCAVE_KEPT: usize = 16;
+
 /// Relative margin by which another face's closest point must be nearer
 /// than a hit's depth to overrule it (round-off of the two projections).
 const NEARER_TOLERANCE: Real = 1e-9;
@@ -583,11 +589,16 @@ fn concave_edge<'c>(
     candidates: impl Iterator<Item = &'c CandidateFace> + Clone,
 ) -> Option<Hit> {
     let mut best: Option<(Real, u32, QuadProjection, Real)> = None;
+    // The clamped projections of the first faces, for the second loop.
+    let mut kept: heapless::Vec<Option<QuadProjection>, CONCAVE_KEPT> = heapless::Vec::new();
     for face in candidates.clone() {
         if !face.reach.contains(p) {
             continue;
         }
-        if let Some(pr) = project_clamped(p, &face.corners) {
+        let pr = project_clamped(p, &face.corners);
+        // A full list only means the second loop projects the rest again.
+        let _ = kept.push(pr);
+        if let Some(pr) = pr {
             let d = norm(&sub(p, &pr.point));
             if best.as_ref().is_none_or(|b| d < b.0) {
                 best = Some((d, face.quad, pr, face.window));
@@ -599,11 +610,16 @@ fn concave_edge<'c>(
     let tol = 1e-9 * window + 1e-15;
     let mut n = [0.0; 3];
     let mut sharing = 0;
+    let mut again = kept.iter();
     for face in candidates {
         if !face.reach.contains(p) {
             continue;
         }
-        if let Some(other) = project_clamped(p, &face.corners)
+        let other = match again.next() {
+            Some(&kept) => kept,
+            None => project_clamped(p, &face.corners),
+        };
+        if let Some(other) = other
             && abs(norm(&sub(p, &other.point)) - dist) <= tol
             && norm(&sub(&other.point, &pr.point)) <= tol
         {
