@@ -437,3 +437,29 @@ fn hourglass_stiffening_follows_the_amplitude() {
         );
     }
 }
+
+/// `hex_volume` is `hex_reference`'s volume to the bit (the time-step
+/// estimate relies on it to leave the runs unchanged) on jittered and
+/// sheared hexes, and refuses an inverted one as `hex_reference` does.
+#[test]
+fn the_hex_volume_is_the_reference_volume_to_the_bit() {
+    use granbed_kernel::element::reference::hex_volume;
+    let mut rng = Rng::new(7);
+    for _ in 0..200 {
+        let shear = rng.uniform(-0.5, 0.5);
+        let xe: HexCoords = core::array::from_fn(|i| {
+            let s = NODE_SIGNS[i];
+            [
+                1e-4 * (s[0] + shear * s[2] + rng.uniform(-0.2, 0.2)),
+                1e-4 * (s[1] + rng.uniform(-0.2, 0.2)),
+                1e-4 * (s[2] + rng.uniform(-0.2, 0.2)),
+            ]
+        });
+        let v = hex_volume(&xe).unwrap();
+        assert_eq!(v.to_bits(), hex_reference(&xe).unwrap().volume.to_bits());
+    }
+    let mut inverted: HexCoords = core::array::from_fn(|i| NODE_SIGNS[i].map(|s| 1e-4 * s));
+    inverted[6] = [-3e-4, -3e-4, -3e-4];
+    assert_eq!(hex_volume(&inverted), None);
+    assert!(hex_reference(&inverted).is_none());
+}

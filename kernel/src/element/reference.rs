@@ -35,6 +35,23 @@ pub struct HexReference {
     pub node_volume: [Real; 8],
 }
 
+/// The volume Σ_g det J_g of a hex at node positions `x` (m³, [`hex8`]
+/// order) by 2×2×2 Gauss quadrature, exact for the trilinear map — the
+/// [`HexReference::volume`] of [`hex_reference`] to the bit, without the
+/// gradients (the time-step estimate needs only this, every step). `None`
+/// if a Gauss-point Jacobian is not positive.
+pub fn hex_volume(x: &HexCoords) -> Option<Real> {
+    let mut volume = 0.0;
+    for g in hex8::gauss_points() {
+        let det = det_mat(&hex8::jacobian(x, g));
+        if det.is_nan() || det <= 0.0 {
+            return None;
+        }
+        volume += det;
+    }
+    Some(volume)
+}
+
 /// Computes the reference data of a hex with reference node positions `x`
 /// (m, [`hex8`] order) by 2×2×2 Gauss quadrature, exact for the trilinear
 /// map. Returns `None` if a Gauss-point Jacobian is not positive.

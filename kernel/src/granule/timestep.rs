@@ -4,7 +4,7 @@
 
 use crate::Real;
 use crate::element::hex8;
-use crate::element::reference::hex_reference;
+use crate::element::reference::hex_volume;
 use crate::granule::forces::{ElementSettings, internal_forces};
 use crate::material::Material;
 use crate::mesh::reference::ReferenceMesh;
@@ -16,7 +16,7 @@ pub fn min_element_length(mesh: &ReferenceMesh<'_>, x: &[[Real; 3]]) -> Option<R
     let mut min = Real::INFINITY;
     for hex in mesh.mesh.hexes {
         let xe = core::array::from_fn(|i| x[hex[i] as usize]);
-        let volume = hex_reference(&xe)?.volume;
+        let volume = hex_volume(&xe)?;
         min = crate::math::min(min, volume / hex8::max_face_area(&xe));
     }
     Some(min)
