@@ -58,9 +58,7 @@ impl SurfaceBody<'_> {
         self.node_quads[node - self.first_surface]
             .iter()
             .filter(|&&q| q != u32::MAX)
-            .map(|&q| {
-                0.25 * crate::mesh::surface::quad_area_and_flux(&self.quad_pred(q as usize)).0
-            })
+            .map(|&q| 0.25 * crate::mesh::surface::quad_area(&self.quad_pred(q as usize)))
             .sum()
     }
 
