@@ -184,7 +184,7 @@ impl GranuleStore {
 }
 
 /// One granule's step halves on the standard mesh, B2, selective mass
-/// scaling ×10 (the bed's default): `predict` (elements + damping +
+/// scaling ×10 (the bed's default until session 18, ×20 since): `predict` (elements + damping +
 /// predictor) and `correct` (contact forces on the surface nodes only, as
 /// in a bed), each from the same start every iteration; `framed` is given
 /// the rigid frame, which the bed takes once per step for both halves

@@ -115,7 +115,8 @@ fn a_small_bed_runs_end_to_end_and_is_thread_independent() {
     assert!(number(&s, "peak_memory_bytes") > 0.0);
     assert!(s["error"].is_null());
     assert_eq!(s["scene"]["mesh"], "4x1");
-    // Physical masses at 50 mm/s: quasi-static by the certificate.
+    // The published scene's selective mass scaling at 50 mm/s:
+    // quasi-static by the certificate.
     assert_eq!(s["quasi_static"]["passed"], true, "{}", s["quasi_static"]);
 }
 
@@ -253,7 +254,8 @@ fn heavy_mass_scaling_fails_the_quasi_static_certificate() {
 }
 
 /// `--rate-check` presses the same bed again at half the punch speed: the
-/// twin is in `half_speed/` with half the speed and twice the steps, the
+/// twin is in `half_speed/` with half the speed, twice the time to the
+/// final strain and about twice the steps, the
 /// change of P(C) is in the certificate, and `passed` holds all three
 /// figures to their limits.
 #[test]
@@ -295,7 +297,7 @@ fn the_rate_check_presses_the_same_bed_at_half_speed() {
         "time at half speed: {time_ratio} x"
     );
     let ratio = number(&twin, "steps") / number(&s, "steps");
-    assert!((ratio - 2.0).abs() < 0.2, "steps at half speed: {ratio} x");
+    assert!((ratio - 2.0).abs() < 0.12, "steps at half speed: {ratio} x");
     let q = &s["quasi_static"];
     let change = number(q, "rate_change_rel");
     assert!(change.is_finite() && change > 0.0, "{q}");
@@ -619,9 +621,8 @@ fn a_failing_run_names_granule_element_step_and_strain_and_keeps_its_outputs() {
 /// (rigid modes 2× heavier) and ×30 (3×) must keep the contacts
 /// dissipative (contact loss > 0), the ledger balanced and the bed
 /// quasi-static; ×30 with physical rigid modes (an unbounded ratio) is the
-/// control that shows the check can fail (measured at the published
-/// tolerance 0.01: the contacts inject 116 % of the punch work, residual
-/// 0.044, K/W 137 %; 57 % at 0.005).
+/// control that shows the check can fail (measured: the contacts inject
+/// 57 % of the punch work at tolerance 0.005, 116 % at 0.01).
 ///
 /// The sign of the loss needs the gaps closed tightly, so these runs use
 /// the contact-sweep tolerance 0.005: an overlap a step leaves (up to the
@@ -629,7 +630,7 @@ fn a_failing_run_names_granule_element_step_and_strain_and_keeps_its_outputs() {
 /// the work that made it. At the published 0.01 the loss of this bed is
 /// measured −6.3e-5 of the punch work at ×20 (−8.9e-4 at ×10, +2.6e-4 at
 /// ×30; at 0.005: +1.1e-3 at ×20), a thousandth of the control's
-/// injection; the published scene itself is held to a loss above −0.5 %.
+/// injection; the published scene itself is held to a loss above −0.2 %.
 #[test]
 fn the_mass_ratio_limit_keeps_a_punched_monolayer_dissipative() {
     let run = |name: &str, extra: &[&str]| {
@@ -676,13 +677,18 @@ fn the_mass_ratio_limit_keeps_a_punched_monolayer_dissipative() {
         assert!(kw < 0.01, "{name}: K/W {kw}");
     }
     let (loss, residual, kw) = run("monolayer_published", &[]);
+    // Twice the largest loss of either sign measured on this bed (above).
     assert!(
-        loss > -5e-3 && residual < 1e-5 && kw < 0.01,
+        loss > -2e-3 && residual < 1e-5 && kw < 0.01,
         "the published scene: loss {loss}, residual {residual}, K/W {kw}"
     );
     let (loss, residual, _) = run(
         "monolayer_x30_rigid_physical",
-        &["--mass-scaling", "30", "--selective-mass-ratio", "inf"],
+        &[
+            &tight[..],
+            &["--mass-scaling", "30", "--selective-mass-ratio", "inf"],
+        ]
+        .concat(),
     );
     assert!(
         loss < 0.0 && residual > 1e-3,
@@ -694,20 +700,19 @@ fn the_mass_ratio_limit_keeps_a_punched_monolayer_dissipative() {
 /// Selective mass scaling (the scene fields `selective_mass_scaling` and
 /// `selective_mass_ratio`, on with `mass_scaling = 20` and a ratio limit of 10
 /// in the published scene, off in a scene file without the fields, and their
-/// CLI overrides): on the CI bed, masses ×10 on the deformational modes only
-/// take under 40 % of the steps of physical masses (the stable step grows by
-/// √10), keep the kinetic energy below 1 % of the internal work like
-/// physical masses do, and hence pass the quasi-static certificate, where
-/// uniform ×10 (the granules' translation and spin ten times heavier too)
-/// fails it; the overlaps stay below 1 % of the element and P(C) stays
-/// within the noise floor of any change of the arithmetic (relative L2 over
-/// 2–30 % below 9 %, the floor's upper end in BENCHMARKS.md; measured
-/// 3.3 %).
+/// CLI overrides): on the CI bed, the published masses ×20 on the
+/// deformational modes (the rigid modes ×2) take under 30 % of the steps of
+/// physical masses (the stable step grows by √20: 0.224; measured 0.234),
+/// keep the kinetic energy below 1 % of the internal work like physical
+/// masses do (measured 0.69 % and 0.40 %), and hence pass the quasi-static
+/// certificate, where uniform ×20 (the granules' translation and spin twenty
+/// times heavier too; K/W 6.7 %) fails it; the overlaps stay below 1 % of
+/// the element and P(C) stays within the noise floor of any change of the
+/// arithmetic (relative L2 over 2–30 % below 9 %, the floor's upper end in
+/// BENCHMARKS.md; measured 3.9 %, ×10 3.1 %).
 #[test]
 fn selective_mass_scaling_keeps_the_bed_quasi_static_in_fewer_steps() {
-    let mut args = vec!["--mass-scaling", "10"];
-    args.extend_from_slice(&SMALL);
-    let (selective, uniform) = on_and_off("selective-mass-scaling", &args);
+    let (selective, uniform) = on_and_off("selective-mass-scaling", &SMALL);
     let physical = out_dir("physical_masses");
     let mut argv = vec![
         "bed",
@@ -723,10 +728,11 @@ fn selective_mass_scaling_keeps_the_bed_quasi_static_in_fewer_steps() {
 
     let (s, u, p) = (summary(&selective), summary(&uniform), summary(&physical));
     assert_eq!(s["scene"]["selective_mass_scaling"], true);
+    assert_eq!(s["scene"]["mass_scaling"], 20.0);
     let ratio = number(&s, "steps") / number(&p, "steps");
     let kw = |q: &serde_json::Value| number(&q["quasi_static"], "max_kinetic_to_internal");
     println!(
-        "steps {} selective x10, {} physical (ratio {ratio:.3}); K/W {:.4} / {:.4} / {:.4} \
+        "steps {} selective x20, {} physical (ratio {ratio:.3}); K/W {:.4} / {:.4} / {:.4} \
          (selective, uniform, physical)",
         s["steps"],
         p["steps"],
@@ -734,14 +740,14 @@ fn selective_mass_scaling_keeps_the_bed_quasi_static_in_fewer_steps() {
         kw(&u),
         kw(&p)
     );
-    assert!(ratio < 0.4, "selective x10 took {ratio:.3} of the steps");
-    assert!(kw(&s) < 0.01, "selective x10: K/W {}", kw(&s));
+    assert!(ratio < 0.3, "selective x20 took {ratio:.3} of the steps");
+    assert!(kw(&s) < 0.01, "selective x20: K/W {}", kw(&s));
     assert_eq!(s["quasi_static"]["passed"], true, "{}", s["quasi_static"]);
     assert_eq!(u["quasi_static"]["passed"], false, "{}", u["quasi_static"]);
     assert!(number(&s, "max_penetration_rel_element") < 0.01, "{s}");
     let l2 = pressure_distance(&selective, &physical);
-    println!("P(C) selective x10 vs physical masses: relative L2 {l2:.4}");
-    assert!(l2 < 0.09, "selective x10 moves P(C) by {l2:.4}");
+    println!("P(C) selective x20 vs physical masses: relative L2 {l2:.4}");
+    assert!(l2 < 0.09, "selective x20 moves P(C) by {l2:.4}");
 
     let run = cli(&["bed", "--print-scene", "--selective-mass-scaling", "false"]);
     assert_eq!(run.code, 0, "{}", run.stderr);

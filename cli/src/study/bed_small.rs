@@ -101,7 +101,6 @@ pub fn bed_grid(mesh: MeshLevel, quick: bool) -> (Setting, Vec<Setting>) {
             }),
             with("safety 0.7", &|s| s.safety = 0.7),
             with("sweep tol 0.005", &|s| s.sweep_tolerance = 0.005),
-            with("sweep tol 0.01", &|s| s.sweep_tolerance = 0.01),
             with("sweep tol 0.02", &|s| s.sweep_tolerance = 0.02),
             with("kappa 0.02", &|s| s.kappa = 0.02),
             with("kappa 0.1", &|s| s.kappa = 0.1),
