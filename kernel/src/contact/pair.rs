@@ -616,7 +616,7 @@ fn concave_edge<'c>(
             continue;
         }
         let other = match again.next() {
-            Some(&kept) => kept,
+            Some(&cached) => cached,
             None => project_clamped(p, &face.corners),
         };
         if let Some(other) = other

@@ -42,14 +42,25 @@ pub struct HexReference {
 /// if a Gauss-point Jacobian is not positive.
 pub fn hex_volume(x: &HexCoords) -> Option<Real> {
     let mut volume = 0.0;
-    for g in hex8::gauss_points() {
-        let det = det_mat(&hex8::jacobian(x, g));
-        if det.is_nan() || det <= 0.0 {
-            return None;
-        }
+    for (_, det) in gauss_jacobians(x)? {
         volume += det;
     }
     Some(volume)
+}
+
+/// The Jacobian and its determinant at each of [`hex8::gauss_points`], in
+/// their order; `None` if a determinant is not positive (or is NaN).
+fn gauss_jacobians(x: &HexCoords) -> Option<[(Mat3, Real); 8]> {
+    let mut out = [(Mat3::zeros(), 0.0); 8];
+    for (slot, g) in out.iter_mut().zip(hex8::gauss_points()) {
+        let j: Mat3 = hex8::jacobian(x, g);
+        let det = det_mat(&j);
+        if det.is_nan() || det <= 0.0 {
+            return None;
+        }
+        *slot = (j, det);
+    }
+    Some(out)
 }
 
 /// Computes the reference data of a hex with reference node positions `x`
@@ -59,12 +70,7 @@ pub fn hex_reference(x: &HexCoords) -> Option<HexReference> {
     let mut volume = 0.0;
     let mut grad_sum = [[0.0; 3]; 8];
     let mut node_volume = [0.0; 8];
-    for g in hex8::gauss_points() {
-        let j: Mat3 = hex8::jacobian(x, g);
-        let det = det_mat(&j);
-        if det.is_nan() || det <= 0.0 {
-            return None;
-        }
+    for (g, (j, det)) in hex8::gauss_points().into_iter().zip(gauss_jacobians(x)?) {
         volume += det;
         // ∇_X N = J⁻ᵀ ∇_ξ N, weighted by det J: det J · J⁻ᵀ = cof(J).
         let inv_t = inverse_with_det(&j, det).transpose();
