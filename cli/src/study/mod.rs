@@ -3,7 +3,9 @@
 //! * `work-precision` ([`work_precision`]): what each numerical setting
 //!   costs and how far it moves the answer, against a reference run;
 //! * `stability` ([`stability`]): every type in beds to 60 % and as single
-//!   granules to 70 %, with the numerics of each run judged.
+//!   granules to 70 %, with the numerics of each run judged;
+//! * `compare` ([`compare`]): the work-precision measures between two
+//!   finished bed runs.
 
 use std::path::PathBuf;
 
@@ -15,6 +17,7 @@ use crate::model::MeshLevel;
 use crate::output::Streams;
 
 pub mod bed_small;
+pub mod compare;
 pub mod stability;
 pub mod work_precision;
 
@@ -44,6 +47,12 @@ pub enum Study {
     /// an inverted element, a residual ≥ 1 % of the punch work or an
     /// overlap ≥ 1 % of the element size).
     Stability(StabilityArgs),
+    /// How far one finished bed run lies from another (the reference,
+    /// first): the relative L2 distance of P(C), the relative errors of
+    /// Kawakita's a and 1/b, and the ratios of steps, wall time and pair
+    /// searches per step, from their `compression.csv` and
+    /// `summary.json`.
+    Compare(compare::CompareArgs),
 }
 
 /// The scene of a work-precision study.
@@ -192,6 +201,7 @@ impl StudyArgs {
         match &self.study {
             Study::WorkPrecision(args) => args.run(streams),
             Study::Stability(args) => args.run(streams),
+            Study::Compare(args) => args.run(streams),
         }
     }
 }
