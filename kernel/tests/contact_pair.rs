@@ -1,17 +1,25 @@
 //! Node-to-surface detection between two bodies (`contact::pair::detect`)
-//! on hand-made surfaces: which face a node is held against.
+//! on hand-made surfaces: which face a node is held against; and the
+//! re-measure of held constraints on a moved configuration
+//! (`contact::pair::regap`).
 
 use granbed_kernel::Real;
 use granbed_kernel::contact::broad::bounding_sphere;
-use granbed_kernel::contact::pair::{CandidateFace, Constraint, PairSettings, detect};
+use granbed_kernel::contact::pair::{
+    CandidateFace, Constraint, ContactError, PairSettings, detect, regap,
+};
 use granbed_kernel::contact::surface::{Aabb, SurfaceBody, quad_bounds};
 
 type Vec3 = [Real; 3];
 
-/// Detects `slave`'s nodes (one quad, facing −z) against `master`'s quads
-/// (single pass, a margin that covers the unit-sized scene: the master's
-/// faces must lie within it of the slave's box to be tried).
-fn constraints(slave: &[Vec3], master: &[Vec3], master_quads: &[[u32; 4]]) -> Vec<Constraint> {
+/// Calls `f` with `slave` (one quad, facing −z) as body A and `master`'s
+/// quads as body B, unit masses, x_n = x̃.
+fn with_bodies<R>(
+    slave: &[Vec3],
+    master: &[Vec3],
+    master_quads: &[[u32; 4]],
+    f: impl FnOnce(&SurfaceBody<'_>, &SurfaceBody<'_>) -> R,
+) -> R {
     let slave_quads = [[0u32, 1, 2, 3]];
     let slave_node_quads = [[0u32, u32::MAX, u32::MAX, u32::MAX]; 4];
     let master_node_quads = vec![[u32::MAX; 4]; master.len()];
@@ -43,16 +51,40 @@ fn constraints(slave: &[Vec3], master: &[Vec3], master_quads: &[[u32; 4]]) -> Ve
         sphere: bounding_sphere(master, 0),
         quad_bounds: &master_boxes,
     };
-    let settings = PairSettings {
-        margin: 0.5,
-        symmetric: false,
-        ..PairSettings::standard(0.0)
-    };
-    let mut scratch = vec![CandidateFace::default(); master_quads.len()];
-    let mut out = vec![Constraint::default(); 16];
-    let n = detect(&a, &b, &settings, &mut scratch, &mut out).unwrap();
-    out.truncate(n);
-    out
+    f(&a, &b)
+}
+
+/// Detects `slave`'s nodes (one quad, facing −z) against `master`'s quads
+/// (single pass, a margin that covers the unit-sized scene: the master's
+/// faces must lie within it of the slave's box to be tried).
+fn constraints(slave: &[Vec3], master: &[Vec3], master_quads: &[[u32; 4]]) -> Vec<Constraint> {
+    with_bodies(slave, master, master_quads, |a, b| {
+        let settings = PairSettings {
+            margin: 0.5,
+            symmetric: false,
+            ..PairSettings::standard(0.0)
+        };
+        let mut scratch = vec![CandidateFace::default(); master_quads.len()];
+        let mut out = vec![Constraint::default(); 16];
+        let n = detect(a, b, &settings, &mut scratch, &mut out).unwrap();
+        out.truncate(n);
+        out
+    })
+}
+
+/// [`regap`] of `held` with `slave` (one quad) against `master`.
+fn regapped(
+    slave: &[Vec3],
+    master: &[Vec3],
+    master_quads: &[[u32; 4]],
+    held: &[Constraint],
+) -> Result<Vec<Constraint>, ContactError> {
+    with_bodies(slave, master, master_quads, |a, b| {
+        let mut out = vec![Constraint::default(); held.len()];
+        let n = regap(a, b, held, &mut out)?;
+        out.truncate(n);
+        Ok(out)
+    })
 }
 
 /// A slave quad in the plane z = `z`, corner (x, 0.5), facing −z.
@@ -138,4 +170,100 @@ fn a_node_below_a_concave_edge_is_held_against_the_edge() {
         assert!((c.gap + 0.005).abs() < 1e-12, "gap {}", c.gap);
         assert!((c.normal[2] - 1.0).abs() < 1e-12, "normal {:?}", c.normal);
     }
+}
+
+/// On a flat face the gap along the held normal is exact for any motion of
+/// the node: regap agrees with a new search wherever the node still
+/// penetrates (sliding along the face included), drops the nodes that
+/// moved out, keeps the held order, and on the unmoved configuration
+/// returns the held constraints (gaps up to round-off).
+#[test]
+fn held_constraints_are_re_measured_on_the_moved_configuration() {
+    let (master, quads) = folded_master();
+    let slave = slave_at(1.3, 0.29);
+    let held = constraints(&slave, &master, &quads);
+    assert_eq!(held.len(), 4, "{held:?}");
+    let same = regapped(&slave, &master, &quads, &held).unwrap();
+    assert_eq!(same.len(), held.len());
+    for (r, h) in same.iter().zip(&held) {
+        // The same gap up to round-off (Σ Nᵢxᵢ against the projection's
+        // own evaluation of the face).
+        assert_eq!(Constraint { gap: h.gap, ..*r }, *h);
+        assert!((r.gap - h.gap).abs() < 1e-15, "{} vs {}", r.gap, h.gap);
+    }
+
+    // Nodes 0 and 1 slide 0.05 along x and rise to 0.004 behind face 1;
+    // nodes 2 and 3 rise 0.002 above it.
+    let mut moved = slave;
+    for (k, x) in moved.iter_mut().enumerate() {
+        if k < 2 {
+            x[0] += 0.05;
+            x[2] = 0.296;
+        } else {
+            x[2] = 0.302;
+        }
+    }
+    let again = regapped(&moved, &master, &quads, &held).unwrap();
+    let fresh = constraints(&moved, &master, &quads);
+    assert_eq!(again.len(), 2, "{again:?}");
+    assert_eq!(fresh.len(), 2, "{fresh:?}");
+    for (r, f) in again.iter().zip(&fresh) {
+        assert_eq!((r.slave, r.quad), (f.slave, f.quad));
+        assert!((r.gap - f.gap).abs() < 1e-12, "{} vs {}", r.gap, f.gap);
+        assert!((r.gap + 0.004).abs() < 1e-12, "gap {}", r.gap);
+    }
+    // The held weights and normal, not the new contact point's.
+    assert_eq!(again[0].weights, held[0].weights);
+    assert_eq!(again[1].normal, held[1].normal);
+}
+
+/// A held constraint that does not fit the bodies (an id beyond their
+/// nodes or quads), or an output shorter than the held list, is an error,
+/// not a panic.
+#[test]
+fn a_held_constraint_of_other_bodies_is_an_error() {
+    let (master, quads) = folded_master();
+    let slave = slave_at(1.3, 0.29);
+    let held = constraints(&slave, &master, &quads);
+    let mut bad = held.clone();
+    bad[1].quad = 7;
+    let e = regapped(&slave, &master, &quads, &bad).unwrap_err();
+    assert!(
+        matches!(
+            e,
+            ContactError::BufferLength {
+                buffer: "master quads",
+                ..
+            }
+        ),
+        "{e:?}"
+    );
+    bad[1] = Constraint {
+        slave: 9,
+        ..held[1]
+    };
+    let e = regapped(&slave, &master, &quads, &bad).unwrap_err();
+    assert!(
+        matches!(
+            e,
+            ContactError::BufferLength {
+                buffer: "slave positions",
+                ..
+            }
+        ),
+        "{e:?}"
+    );
+    let short = with_bodies(&slave, &master, &quads, |a, b| {
+        regap(a, b, &held, &mut [Constraint::default(); 2])
+    });
+    assert!(
+        matches!(
+            short,
+            Err(ContactError::BufferLength {
+                buffer: "constraints",
+                ..
+            })
+        ),
+        "{short:?}"
+    );
 }

@@ -8,7 +8,7 @@ use granbed_kernel::contact::broad::{
 use granbed_kernel::contact::face_lists::{self, AnchorSurface, FaceLists, FaceListsMut, ReachBox};
 use granbed_kernel::contact::pair::{
     CandidateFace, Constraint, ContactError, Involvement, NodeForce, PairForce, PairSettings, Side,
-    detect, detect_listed, forces, mark_involvement,
+    detect, detect_listed, forces, mark_involvement, regap,
 };
 use granbed_kernel::contact::surface::{Aabb, SurfaceBody, quad_bounds};
 use rayon::prelude::*;
@@ -29,6 +29,11 @@ pub struct PairWork {
     pub step: PairForce,
     /// The face lists of the pair's two passes.
     lists: PairLists,
+    /// The constraints of the step's first sweep and the pair they belong
+    /// to (the list is rebuilt by index), which later sweeps re-measure
+    /// instead of searching again ([`ContactPhase::detect`]).
+    held: Vec<Constraint>,
+    held_pair: Option<GranulePair>,
 }
 
 /// A pair's face lists (pass A→B, pass B→A) and what they were built for.
@@ -113,6 +118,18 @@ struct DetectScratch {
 }
 
 impl PairWork {
+    /// After a search of pair `p`: with `keep`, holds its constraints for
+    /// the step's later sweeps; else forgets any held ones (a later sweep
+    /// that searched, or no holding).
+    fn hold(&mut self, p: GranulePair, keep: bool) {
+        self.held.clear();
+        self.held_pair = None;
+        if keep {
+            self.held.extend_from_slice(&self.constraints[..self.count]);
+            self.held_pair = Some(p);
+        }
+    }
+
     /// The constraints found in the last detection (sweep).
     pub fn constraints(&self) -> &[Constraint] {
         &self.constraints[..self.count]
@@ -158,6 +175,8 @@ pub struct ContactPhase {
     /// Per granule: bit k set if it touched wall k (mod 64) in any sweep of
     /// the step.
     pub(super) on_wall: Vec<u64>,
+    /// Pair searches so far (all sweeps; a re-measured pair is no search).
+    searches: u64,
     /// Scratch of `narrow_to_deep_pairs`, per granule: [`DEEP`] or
     /// [`NEAR_DEEP`] bits.
     narrow: Vec<u8>,
@@ -239,6 +258,11 @@ impl ContactPhase {
     /// Anchor renewals so far (over all granules).
     pub fn anchor_renewals(&self) -> u64 {
         self.anchor_renewals
+    }
+
+    /// Pair searches (detections) so far, over all sweeps.
+    pub fn searches(&self) -> u64 {
+        self.searches
     }
 
     /// Candidate pairs of the current list.
@@ -429,13 +453,17 @@ impl ContactPhase {
     ///
     /// After the first sweep of a step only pairs with a granule that the
     /// last sweep moved are searched again: the others found nothing (a
-    /// constraint would have moved both) and their x̃ is unchanged.
+    /// constraint would have moved both) and their x̃ is unchanged. With
+    /// `hold`, a later sweep does not search: it re-measures the first
+    /// sweep's constraints of the pair on the current x̃ at their contact
+    /// points ([`regap`]), keeping those still penetrating.
     pub(super) fn detect(
         &mut self,
         granules: &[GranuleStore],
         mesh: &OwnedReference,
         settings: &PairSettings,
         first: bool,
+        hold: bool,
     ) -> Result<(), ContactError> {
         let drift = self.list_drift;
         if drift > 0.0 {
@@ -449,23 +477,32 @@ impl ContactPhase {
             first_surface,
             quads: &mesh.quads,
         };
-        let builds = self
+        let (builds, searches) = self
             .pairs
             .par_iter()
             .zip(self.work.par_iter_mut())
             .try_fold(
-                || (DetectScratch::default(), 0u64),
-                |(mut scratch, mut builds), (p, w)| {
+                || (DetectScratch::default(), 0u64, 0u64),
+                |(mut scratch, mut builds, mut searches), (p, w)| {
                     let (a, b) = (p.a as usize, p.b as usize);
                     if !first && !touched[a] && !touched[b] {
                         w.count = 0;
-                        return Ok((scratch, builds));
+                        return Ok((scratch, builds, searches));
                     }
                     let body_a = body(&granules[a], mesh, (boxes[a], bounds[a], &quad_boxes[a]));
                     let body_b = body(&granules[b], mesh, (boxes[b], bounds[b], &quad_boxes[b]));
+                    if hold && !first && w.held_pair == Some(*p) {
+                        if w.constraints.len() < w.held.len() {
+                            w.constraints.resize(w.held.len(), Constraint::default());
+                        }
+                        w.count = regap(&body_a, &body_b, &w.held, &mut w.constraints)?;
+                        return Ok((scratch, builds, searches));
+                    }
+                    searches += 1;
                     if drift <= 0.0 {
                         detect_growing(&body_a, &body_b, settings, &mut scratch, w, false)?;
-                        return Ok((scratch, builds));
+                        w.hold(*p, hold && first);
+                        return Ok((scratch, builds, searches));
                     }
                     let m = settings.margin;
                     if body_a
@@ -476,7 +513,8 @@ impl ContactPhase {
                     {
                         // Both passes would stop here: nothing to list.
                         w.count = 0;
-                        return Ok((scratch, builds));
+                        w.hold(*p, hold && first);
+                        return Ok((scratch, builds, searches));
                     }
                     let key = Some((*p, epochs[a], epochs[b]));
                     if w.lists.key != key {
@@ -488,12 +526,14 @@ impl ContactPhase {
                         builds += 1;
                     }
                     detect_growing(&body_a, &body_b, settings, &mut scratch, w, true)?;
-                    Ok((scratch, builds))
+                    w.hold(*p, hold && first);
+                    Ok((scratch, builds, searches))
                 },
             )
-            .map(|r| r.map(|(_, builds)| builds))
-            .try_reduce(|| 0, |x, y| Ok(x + y))?;
+            .map(|r| r.map(|(_, builds, searches)| (builds, searches)))
+            .try_reduce(|| (0, 0), |x, y| Ok((x.0 + y.0, x.1 + y.1)))?;
         self.list_builds += builds;
+        self.searches += searches;
         Ok(())
     }
 

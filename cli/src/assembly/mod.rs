@@ -116,6 +116,10 @@ pub struct AssemblyParams {
     /// ([`ContactPhase`]`::narrow_to_deep_pairs`); false: every pair with
     /// a granule the last sweep moved.
     pub local_sweeps: bool,
+    /// Sweeps after the first re-measure the constraints the first sweep
+    /// found, at their contact points ([`granbed_kernel::contact::pair::regap`]),
+    /// instead of searching again; false: every later sweep searches.
+    pub hold_constraints: bool,
     /// Skin of the per-node face lists, as a fraction of the reference
     /// mesh's mean surface-face diagonal: a pair's lists are rebuilt once a
     /// surface node of either granule has moved this far from where they
@@ -170,6 +174,7 @@ impl AssemblyParams {
             time_step_interval: 100,
             rigid_until_touched: true,
             local_sweeps: true,
+            hold_constraints: false,
             face_list_skin: FACE_LIST_SKIN,
         }
     }
@@ -611,6 +616,7 @@ impl<'m> Assembly<'m> {
         PhaseTimes {
             list_builds: self.contact.list_builds(),
             anchor_renewals: self.contact.anchor_renewals(),
+            pair_searches: self.contact.searches(),
             ..self.times
         }
     }

@@ -323,6 +323,9 @@ pub struct PhaseTimes {
     /// Face-list anchor renewals (a granule whose x̃ left its anchor by
     /// more than the skin).
     pub anchor_renewals: u64,
+    /// Pair searches (detections) over all sweeps; filled by
+    /// `Assembly::times`.
+    pub pair_searches: u64,
 }
 
 impl PhaseTimes {
@@ -481,7 +484,7 @@ impl Assembly<'_> {
             .broad(&self.granules, mesh, p.contact.margin, first)
             .map_err(contact_error)?;
         self.contact
-            .detect(&self.granules, mesh, &p.contact, first)
+            .detect(&self.granules, mesh, &p.contact, first, p.hold_constraints)
             .map_err(contact_error)?;
         let surface = mesh.surface_range();
         if p.mass_sharing {

@@ -149,6 +149,12 @@ pub struct BedArgs {
     #[arg(long, value_name = "BOOL")]
     pub local_sweeps: Option<bool>,
 
+    /// Override: contact sweeps after the first re-measure the constraints
+    /// the step's search found at their contact points (true, the
+    /// published scene's) or search again (false). Allowed with --resume.
+    #[arg(long, value_name = "BOOL")]
+    pub hold_constraints: Option<bool>,
+
     /// Override: a further contact sweep runs while a granule–granule gap
     /// deeper than this fraction of the element size is left (0 < t ≤ 0.1;
     /// the published scene's is 0.01, 0.005 leaves half the overlap for a
@@ -166,7 +172,8 @@ pub struct BedArgs {
     /// Continue the run whose checkpoint is in DIR (its `checkpoint.bin`);
     /// the outputs go to DIR. Only --strain, --stop-at-strain,
     /// --time-step-safety, --mass-scaling, --sweep-tolerance,
-    /// --face-list-skin, -j and --quiet may be given with it.
+    /// --hold-constraints, --face-list-skin, -j and --quiet may be given
+    /// with it.
     #[arg(long, value_name = "DIR", conflicts_with_all = ["scene", "out", "granule_type", "granules", "mesh", "seed", "die_diameter_mm", "element", "hourglass_kappa", "rigid_until_touched", "local_sweeps", "selective_mass_scaling", "selective_mass_ratio"])]
     pub resume: Option<PathBuf>,
 
@@ -275,6 +282,9 @@ impl BedArgs {
         }
         if let Some(l) = self.local_sweeps {
             scene.local_sweeps = l;
+        }
+        if let Some(h) = self.hold_constraints {
+            scene.hold_constraints = h;
         }
         if let Some(c) = self.time_step_safety {
             scene.time_step_safety = c;

@@ -163,6 +163,9 @@ pub struct Summary<'a> {
     /// Face-list anchor renewals per step, over all granules (of this
     /// process's segment of the run).
     pub anchor_renewals_per_step: Option<f64>,
+    /// Pair searches (detections) per step, over all sweeps (of this
+    /// process's segment of the run).
+    pub pair_searches_per_step: Option<f64>,
     /// Share of the granule-steps taken as rigid bodies, without element
     /// work (of this process's segment of the run).
     pub rigid_granule_step_share: Option<f64>,
@@ -274,6 +277,7 @@ pub fn summary<'a>(scene: &'a Scene, run: &BedRun) -> Summary<'a> {
         contact_sweeps_per_step: run.phase_times.sweeps_per_step().filter(|x| x.is_finite()),
         face_list_builds_per_step: run.phase_times.per_step(run.phase_times.list_builds),
         anchor_renewals_per_step: run.phase_times.per_step(run.phase_times.anchor_renewals),
+        pair_searches_per_step: run.phase_times.per_step(run.phase_times.pair_searches),
         rigid_granule_step_share: run.phase_times.rigid_share(run.granules),
         threads: run.threads,
         min_jacobian,

@@ -18,7 +18,7 @@ pub const REPORT_FILE: &str = "report.html";
 /// The fields of `summary.json` shown first, in this order, with their
 /// meaning; any other field follows (the nested `kawakita` object is
 /// flattened to `kawakita.<field>`, the scene is shown as TOML instead).
-const FIELDS: [(&str, &str); 33] = [
+const FIELDS: [(&str, &str); 34] = [
     ("kawakita_a", "Kawakita a (limiting strain)"),
     ("kawakita_inv_b_pa", "Kawakita 1/b, Pa"),
     (
@@ -59,6 +59,10 @@ const FIELDS: [(&str, &str); 33] = [
     (
         "anchor_renewals_per_step",
         "face-list anchor renewals per step (granules)",
+    ),
+    (
+        "pair_searches_per_step",
+        "pair searches per step (all sweeps)",
     ),
     (
         "rigid_granule_step_share",

@@ -81,6 +81,12 @@ rigid_until_touched = true
 # Contact sweeps after the first search only the neighbourhood of the pairs
 # still deeper than the tolerance (false: every pair of a moved granule).
 local_sweeps = true
+# Contact sweeps after the first correct the contacts the step's search found,
+# re-measuring each gap at its contact point, instead of searching again: a
+# third of the searches in a dense bed, the pressure within 1.3 % of
+# searching every sweep (BENCHMARKS.md). false (the value of scene files
+# without this field): every later sweep searches.
+hold_constraints = true
 # A further contact sweep runs (up to contact_sweeps) while a granule-granule
 # gap deeper than this fraction of the element size is left (0 < t <= 0.1).
 # The default 0.01 takes a fifth to a quarter fewer sweeps in a dense bed
@@ -204,6 +210,11 @@ pub struct Scene {
     /// Later contact sweeps search only near the deep pairs (absent: true).
     #[serde(default = "default_true")]
     pub local_sweeps: bool,
+    /// Later contact sweeps re-measure the first sweep's constraints
+    /// instead of searching (absent: false, as before the field; the
+    /// published scene's is true).
+    #[serde(default)]
+    pub hold_constraints: bool,
     /// A further contact sweep runs while a granule–granule gap deeper than
     /// this fraction of the element size (the mesh's shortest surface edge)
     /// is left, 0 < t ≤ 0.1 (absent: [`super::run::SWEEP_TOLERANCE_REL`],
@@ -533,15 +544,17 @@ mod tests {
         // (BENCHMARKS.md, "Selective x20 and sweep tolerance 0.01 become
         // the bed's default"), the rigid modes physical up to F = 10 and
         // F/10 times heavier beyond ("Selective x30 with heavier rigid
-        // modes").
+        // modes"), later sweeps on the held constraints ("Later sweeps
+        // re-measure the held constraints").
         assert_eq!(
             (
                 s.mass_scaling,
                 s.selective_mass_scaling,
                 s.selective_mass_ratio,
-                s.sweep_tolerance
+                s.sweep_tolerance,
+                s.hold_constraints
             ),
-            (20.0, true, 10.0, 0.01)
+            (20.0, true, 10.0, 0.01, true)
         );
         // The TOML written back parses to the same scene.
         assert_eq!(Scene::from_toml(&s.to_toml()).unwrap(), s);

@@ -818,6 +818,72 @@ fn kinematic_force(
     }
 }
 
+/// Re-measures `held` — constraints [`detect`] found between `a` and `b`
+/// on an earlier x̃ of the same step — on the bodies' current x̃, at their
+/// contact points: the gap n·(x̃_s − Σ Nᵢ x̃ᵢ) with each constraint's held
+/// weights Nᵢ and normal n. The constraints still penetrating (g < 0) are
+/// written to `out` in their order (so a subsequence keeps [`detect`]'s
+/// order, which [`forces`] relies on), with the new gap. Returns how many.
+///
+/// **Choice (physics.md §5.3 leaves the later Jacobi sweeps open):** a
+/// later sweep of a step corrects the contacts the step's search found
+/// rather than searching again. The gap is first-order exact in the
+/// corrections (it leaves out how far the closest point slides, and the
+/// turn of the normal); a node that a correction pushes into a face
+/// without a held constraint is found by the next step's search. A NaN
+/// gap is no penetration (the search on the next step reports it).
+pub fn regap(
+    a: &SurfaceBody<'_>,
+    b: &SurfaceBody<'_>,
+    held: &[Constraint],
+    out: &mut [Constraint],
+) -> Result<usize, ContactError> {
+    if out.len() < held.len() {
+        return Err(ContactError::BufferLength {
+            buffer: "constraints",
+            expected: held.len(),
+            got: out.len(),
+        });
+    }
+    let mut k = 0;
+    for c in held {
+        let (slave, master) = match c.side {
+            Side::A => (a, b),
+            Side::B => (b, a),
+        };
+        // A constraint of other bodies: its ids lie outside these.
+        let short = |buffer, id: u32, got| ContactError::BufferLength {
+            buffer,
+            expected: id as usize + 1,
+            got,
+        };
+        let p = slave
+            .x_pred
+            .get(c.slave as usize)
+            .ok_or_else(|| short("slave positions", c.slave, slave.x_pred.len()))?;
+        let quad = master
+            .quads
+            .get(c.quad as usize)
+            .ok_or_else(|| short("master quads", c.quad, master.quads.len()))?;
+        let mut d = *p;
+        for (&id, &wi) in quad.iter().zip(&c.weights) {
+            let x = master
+                .x_pred
+                .get(id as usize)
+                .ok_or_else(|| short("master positions", id, master.x_pred.len()))?;
+            for (dk, xk) in d.iter_mut().zip(x) {
+                *dk -= wi * xk;
+            }
+        }
+        let gap = dot(&c.normal, &d);
+        if gap < 0.0 {
+            out[k] = Constraint { gap, ..*c };
+            k += 1;
+        }
+    }
+    Ok(k)
+}
+
 /// Shared mass m/max(1, n) of node `i` (`share` empty: no sharing).
 fn shared_mass(body: &SurfaceBody<'_>, share: &[u16], i: usize) -> Real {
     let n = share.get(i).copied().unwrap_or(1).max(1);
