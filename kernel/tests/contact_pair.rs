@@ -6,7 +6,7 @@
 use granbed_kernel::Real;
 use granbed_kernel::contact::broad::bounding_sphere;
 use granbed_kernel::contact::pair::{
-    CandidateFace, Constraint, ContactError, PairSettings, detect, regap,
+    CandidateFace, Constraint, ContactError, NodeForce, PairSettings, detect, forces, regap,
 };
 use granbed_kernel::contact::surface::{Aabb, SurfaceBody, quad_bounds};
 
@@ -266,4 +266,35 @@ fn a_held_constraint_of_other_bodies_is_an_error() {
         ),
         "{short:?}"
     );
+}
+
+/// The contact area is estimated only when asked for: a slave quad of
+/// 0.1 × 0.1 wholly behind a face (single pass, weight 1) has the area of
+/// the quad, its four nodes' quarter shares; without it the area is 0 and
+/// the forces are the same bits.
+#[test]
+fn the_contact_area_is_the_slave_nodes_tributary_area_when_asked_for() {
+    let (master, quads) = folded_master();
+    let slave = slave_at(1.3, 0.29);
+    let held = constraints(&slave, &master, &quads);
+    assert_eq!(held.len(), 4);
+    let run = |contact_area| {
+        with_bodies(&slave, &master, &quads, |a, b| {
+            let settings = PairSettings {
+                symmetric: false,
+                contact_area,
+                ..PairSettings::standard(0.1)
+            };
+            let mut out = vec![NodeForce::default(); 5 * held.len()];
+            let (k, total) = forces((a, &[]), (b, &[]), &held, &settings, 1e-8, &mut out).unwrap();
+            out.truncate(k);
+            (out, total)
+        })
+    };
+    let ((with, t_with), (without, t_without)) = (run(true), run(false));
+    assert!((t_with.area - 0.01).abs() < 1e-15, "area {}", t_with.area);
+    assert_eq!(t_without.area, 0.0);
+    assert_eq!(with, without);
+    assert_eq!(t_with.normal, t_without.normal);
+    assert!(t_with.normal > 0.0);
 }

@@ -46,11 +46,16 @@ pub struct PairSettings {
     /// passes see the spot, see [`forces`]) or a single pass with A's nodes
     /// as slaves (weight 1).
     pub symmetric: bool,
+    /// Also estimate the contact area ([`PairForce::area`]): each
+    /// constraint then evaluates its slave node's tributary area, which no
+    /// force needs (false: the area is 0; the forces are the same bits).
+    pub contact_area: bool,
 }
 
 impl PairSettings {
     /// physics.md's choices: μ = `friction`, inside tolerance 1e-6, window
-    /// 0.25 × face diagonal, 20 µm margin, symmetric two-pass.
+    /// 0.25 × face diagonal, 20 µm margin, symmetric two-pass; no contact
+    /// area.
     pub fn standard(friction: Real) -> Self {
         Self {
             friction,
@@ -58,6 +63,7 @@ impl PairSettings {
             window_fraction: 0.25,
             margin: 20e-6,
             symmetric: true,
+            contact_area: false,
         }
     }
 }
@@ -166,7 +172,7 @@ pub struct PairForce {
     pub slipping: usize,
     /// Contact area estimate, m²: Σ w × the slave node's tributary area
     /// (a quarter of its quads' areas), so a spot both passes see counts
-    /// once.
+    /// once; 0 unless [`PairSettings::contact_area`].
     pub area: Real,
     /// Most negative predicted gap, m (0 if none).
     pub min_gap: Real,
@@ -973,7 +979,9 @@ pub fn forces(
             total.friction_on_a[a] += sign * f_t[a];
         }
         total.normal += f_n;
-        total.area += w * slave.node_area(s);
+        if settings.contact_area {
+            total.area += w * slave.node_area(s);
+        }
         total.constraints += 1;
         if c.gap < total.min_gap {
             total.min_gap = c.gap;
