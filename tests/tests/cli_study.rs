@@ -314,3 +314,98 @@ fn the_stability_suite_writes_one_judged_row_per_run() {
         assert!(lines >= 2, "{name}: {lines} curves");
     }
 }
+
+/// `study compare` on two runs of the published scene kept as fixtures
+/// (selective ×20 against ×10, sweep tolerances 0.01 and 0.005): a run
+/// against itself is at zero distance with ratios 1; the two differ by a
+/// few per cent in P(C) (the work-precision study's measure, here
+/// recomputed from the two tables), and the steps ratio is that of the
+/// summaries. A directory without the files is an error naming the file.
+#[test]
+fn study_compare_measures_two_finished_runs() {
+    let fixtures = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../fixtures/bed-default");
+    let run_dir = |name: &str, suffix: &str| {
+        let dir = common::fresh_dir("cli_study", name);
+        std::fs::create_dir_all(&dir).unwrap();
+        for (from, to) in [
+            ("compression", "compression.csv"),
+            ("summary", "summary.json"),
+        ] {
+            let ext = if from == "summary" { "json" } else { "csv" };
+            std::fs::copy(
+                fixtures.join(format!("{from}_{suffix}.{ext}")),
+                dir.join(to),
+            )
+            .unwrap();
+        }
+        dir
+    };
+    let (x20, x10) = (
+        run_dir("compare_x20", "x20_tol01"),
+        run_dir("compare_x10", "x10"),
+    );
+    let compare = |a: &std::path::Path, b: &std::path::Path| {
+        let run = cli(&["study", "compare", a.to_str().unwrap(), b.to_str().unwrap()]);
+        assert_eq!(run.code, 0, "{}", run.stderr);
+        // "<what>: <number>" per line.
+        let value = |what: &str| -> f64 {
+            let line = run
+                .stdout
+                .lines()
+                .find(|l| l.starts_with(what))
+                .unwrap_or_else(|| panic!("no `{what}` in {}", run.stdout));
+            line.rsplit(": ").next().unwrap().parse().unwrap()
+        };
+        (value("P(C) relative L2"), value("steps, run / reference"))
+    };
+    assert_eq!(compare(&x20, &x20), (0.0, 1.0));
+
+    let (l2, steps) = compare(&x10, &x20);
+    // The same distance from the tables: both have rows every 0.5 % strain.
+    let (a, b) = (
+        Table::read(&x20.join("compression.csv")),
+        Table::read(&x10.join("compression.csv")),
+    );
+    let (c, p, q) = (
+        b.num("strain"),
+        a.num("upper_pressure_pa"),
+        b.num("upper_pressure_pa"),
+    );
+    let (mut num, mut den) = (0.0, 0.0);
+    for ((c, x), y) in c.iter().zip(&p).zip(&q) {
+        if (0.02 - 1e-9..=0.3 + 1e-4).contains(c) {
+            num += (x - y) * (x - y);
+            den += y * y;
+        }
+    }
+    let expected = (num / den).sqrt();
+    println!("x20 against x10: P(C) L2 {l2} (tables: {expected:.4}), steps {steps}");
+    assert!(l2 > 0.005 && l2 < 0.1, "{l2}");
+    assert!(
+        (l2 - expected).abs() < 0.1 * expected + 1e-3,
+        "{l2} vs {expected}"
+    );
+    let steps_of = |dir: &std::path::Path| {
+        let text = std::fs::read_to_string(dir.join("summary.json")).unwrap();
+        let v: serde_json::Value = serde_json::from_str(&text).unwrap();
+        v["steps"].as_f64().unwrap()
+    };
+    assert!(
+        (steps - steps_of(&x20) / steps_of(&x10)).abs() < 1e-4,
+        "{steps}"
+    );
+
+    let empty = common::fresh_dir("cli_study", "compare_empty");
+    std::fs::create_dir_all(&empty).unwrap();
+    let run = cli(&[
+        "study",
+        "compare",
+        x10.to_str().unwrap(),
+        empty.to_str().unwrap(),
+    ]);
+    assert_ne!(run.code, 0);
+    assert!(run.stderr.contains("compression.csv"), "{}", run.stderr);
+    let run = cli(&["study", "compare", "--window", "0.3,0.1", "a", "b"]);
+    assert_eq!(run.code, 2);
+    assert!(run.stderr.contains("--window"), "{}", run.stderr);
+}

@@ -57,6 +57,7 @@ pub fn bed_grid(mesh: MeshLevel, quick: bool) -> (Setting, Vec<Setting>) {
         mass_scaling: Scene::published().mass_scaling,
         selective_mass: Scene::published().selective_mass_scaling,
         sweep_tolerance: Scene::published().sweep_tolerance,
+        hold_constraints: Scene::published().hold_constraints,
         ..Setting::default_on(mesh)
     };
     let with = |name, f: &dyn Fn(&mut Setting)| base.with(name, f);
@@ -102,6 +103,8 @@ pub fn bed_grid(mesh: MeshLevel, quick: bool) -> (Setting, Vec<Setting>) {
             with("safety 0.7", &|s| s.safety = 0.7),
             with("sweep tol 0.005", &|s| s.sweep_tolerance = 0.005),
             with("sweep tol 0.02", &|s| s.sweep_tolerance = 0.02),
+            // The published scene before session 19: every sweep searches.
+            with("search sweeps", &|s| s.hold_constraints = false),
             with("kappa 0.02", &|s| s.kappa = 0.02),
             with("kappa 0.1", &|s| s.kappa = 0.1),
             with("fbar", &|s| s.element = ElementKind::FBar),
@@ -131,6 +134,7 @@ fn scene_for(args: &WorkPrecisionArgs, size: &Size, setting: &Setting, seed: u64
         selective_mass_scaling: setting.selective_mass,
         time_step_safety: setting.safety,
         sweep_tolerance: setting.sweep_tolerance,
+        hold_constraints: setting.hold_constraints,
         material: MaterialOverrides {
             youngs_modulus_pa: m.youngs_modulus_pa,
             poisson_ratio: m.poisson_ratio,
@@ -277,6 +281,7 @@ mod tests {
                 s.mass_scaling != base.mass_scaling || s.selective_mass != base.selective_mass,
                 s.speed_factor != base.speed_factor,
                 s.sweep_tolerance != base.sweep_tolerance,
+                s.hold_constraints != base.hold_constraints,
             ];
             assert_eq!(
                 differs.iter().filter(|d| **d).count(),

@@ -43,7 +43,7 @@ pub const CSV_FILE: &str = "work_precision.csv";
 pub const SVG_FILE: &str = "work_precision.svg";
 
 /// Columns of [`CSV_FILE`].
-pub const COLUMNS: [&str; 23] = [
+pub const COLUMNS: [&str; 24] = [
     "setting",
     "seed",
     "mesh_n",
@@ -55,6 +55,7 @@ pub const COLUMNS: [&str; 23] = [
     "selective_mass_scaling",
     "speed_factor",
     "sweep_tolerance",
+    "hold_constraints",
     "steps",
     "wall_time_s",
     "sigma_est_pa",
@@ -98,6 +99,9 @@ pub struct Setting {
     /// Contact-sweep tolerance as a fraction of the element size (bed; a
     /// granule between platens has no granule–granule contact).
     pub sweep_tolerance: Real,
+    /// Later contact sweeps re-measure the held constraints instead of
+    /// searching (bed; the scene's `hold_constraints`).
+    pub hold_constraints: bool,
 }
 
 impl Setting {
@@ -113,6 +117,7 @@ impl Setting {
             selective_mass: false,
             speed_factor: 1.0,
             sweep_tolerance: crate::bed::run::SWEEP_TOLERANCE_REL,
+            hold_constraints: false,
         }
     }
 
@@ -472,6 +477,7 @@ pub fn write_csv(path: &Path, rows: &[Row<'_>]) -> anyhow::Result<()> {
             Field::from(s.selective_mass),
             Field::Real(s.speed_factor),
             Field::Real(s.sweep_tolerance),
+            Field::from(s.hold_constraints),
             Field::Int(r.m.steps),
             Field::Real(r.m.wall_time_s),
             opt(r.m.sigma_est_pa),
