@@ -444,8 +444,8 @@ fn local_contact_sweeps_compress_like_full_sweeps() {
 /// overlaps below 1 % of the element, no more than a quarter sweep per
 /// step more; and they search each pair about once a step (the other
 /// run searches it in every sweep that moved it: here more than twice).
-/// Off, the run is the old one; the switch is a scene field (absent:
-/// off, as before the field) with a CLI override.
+/// The switch is a scene field (absent: off, every later sweep searches,
+/// as before the field) with a CLI override.
 #[test]
 fn held_constraints_compress_like_searching_every_sweep() {
     let (on, off) = on_and_off("hold-constraints", &SMALL);

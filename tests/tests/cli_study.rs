@@ -327,16 +327,9 @@ fn study_compare_measures_two_finished_runs() {
     let run_dir = |name: &str, suffix: &str| {
         let dir = common::fresh_dir("cli_study", name);
         std::fs::create_dir_all(&dir).unwrap();
-        for (from, to) in [
-            ("compression", "compression.csv"),
-            ("summary", "summary.json"),
-        ] {
-            let ext = if from == "summary" { "json" } else { "csv" };
-            std::fs::copy(
-                fixtures.join(format!("{from}_{suffix}.{ext}")),
-                dir.join(to),
-            )
-            .unwrap();
+        for (stem, ext) in [("compression", "csv"), ("summary", "json")] {
+            let from = fixtures.join(format!("{stem}_{suffix}.{ext}"));
+            std::fs::copy(from, dir.join(format!("{stem}.{ext}"))).unwrap();
         }
         dir
     };

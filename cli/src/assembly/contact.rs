@@ -454,9 +454,11 @@ impl ContactPhase {
     /// After the first sweep of a step only pairs with a granule that the
     /// last sweep moved are searched again: the others found nothing (a
     /// constraint would have moved both) and their x̃ is unchanged. With
-    /// `hold`, a later sweep does not search: it re-measures the first
-    /// sweep's constraints of the pair on the current x̃ at their contact
-    /// points ([`regap`]), keeping those still penetrating.
+    /// `hold`, a later sweep does not search a pair the step's first sweep
+    /// searched: it re-measures that sweep's constraints of the pair on the
+    /// current x̃ at their contact points ([`regap`]), keeping those still
+    /// penetrating (a pair held with none stays without any for the step).
+    /// Only a pair new to the list (a rebuild within the step) is searched.
     pub(super) fn detect(
         &mut self,
         granules: &[GranuleStore],
@@ -476,6 +478,41 @@ impl ContactPhase {
             x: &anchors[g],
             first_surface,
             quads: &mesh.quads,
+        };
+        // Searches pair `p` into `w`; returns the face-list builds (0 or 1).
+        let search = |p: &GranulePair,
+                      (body_a, body_b): (&SurfaceBody<'_>, &SurfaceBody<'_>),
+                      scratch: &mut DetectScratch,
+                      w: &mut PairWork|
+         -> Result<u64, ContactError> {
+            if drift <= 0.0 {
+                detect_growing(body_a, body_b, settings, scratch, w, false)?;
+                return Ok(0);
+            }
+            let m = settings.margin;
+            if body_a
+                .bounds
+                .expanded(m)
+                .intersect(&body_b.bounds.expanded(m))
+                .is_empty()
+            {
+                // Both passes would stop here: nothing to list.
+                w.count = 0;
+                return Ok(0);
+            }
+            let (a, b) = (p.a as usize, p.b as usize);
+            let key = Some((*p, epochs[a], epochs[b]));
+            let mut builds = 0;
+            if w.lists.key != key {
+                let (ab, ba) = w.lists.pass.split_at_mut(1);
+                let f = settings.window_fraction;
+                ab[0].build(&anchor(a), &anchor(b), f, drift, &mut scratch.reach)?;
+                ba[0].build(&anchor(b), &anchor(a), f, drift, &mut scratch.reach)?;
+                w.lists.key = key;
+                builds = 1;
+            }
+            detect_growing(body_a, body_b, settings, scratch, w, true)?;
+            Ok(builds)
         };
         let (builds, searches) = self
             .pairs
@@ -499,33 +536,9 @@ impl ContactPhase {
                         return Ok((scratch, builds, searches));
                     }
                     searches += 1;
-                    if drift <= 0.0 {
-                        detect_growing(&body_a, &body_b, settings, &mut scratch, w, false)?;
-                        w.hold(*p, hold && first);
-                        return Ok((scratch, builds, searches));
-                    }
-                    let m = settings.margin;
-                    if body_a
-                        .bounds
-                        .expanded(m)
-                        .intersect(&body_b.bounds.expanded(m))
-                        .is_empty()
-                    {
-                        // Both passes would stop here: nothing to list.
-                        w.count = 0;
-                        w.hold(*p, hold && first);
-                        return Ok((scratch, builds, searches));
-                    }
-                    let key = Some((*p, epochs[a], epochs[b]));
-                    if w.lists.key != key {
-                        let (ab, ba) = w.lists.pass.split_at_mut(1);
-                        let f = settings.window_fraction;
-                        ab[0].build(&anchor(a), &anchor(b), f, drift, &mut scratch.reach)?;
-                        ba[0].build(&anchor(b), &anchor(a), f, drift, &mut scratch.reach)?;
-                        w.lists.key = key;
-                        builds += 1;
-                    }
-                    detect_growing(&body_a, &body_b, settings, &mut scratch, w, true)?;
+                    builds += search(p, (&body_a, &body_b), &mut scratch, w)?;
+                    // Every search, and only a search, renews what is held
+                    // (the first sweep searches every pair).
                     w.hold(*p, hold && first);
                     Ok((scratch, builds, searches))
                 },

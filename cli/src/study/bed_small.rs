@@ -69,9 +69,11 @@ pub fn bed_grid(mesh: MeshLevel, quick: bool) -> (Setting, Vec<Setting>) {
             s.selective_mass = false;
         }
     };
+    // The most exact of each: later sweeps search too.
     let reference = with("reference", &|s| {
         s.element = ElementKind::FBar;
         s.speed_factor = 0.5;
+        s.hold_constraints = false;
         uniform(1.0)(s);
     });
     let mut grid = vec![

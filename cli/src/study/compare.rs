@@ -13,7 +13,7 @@ use clap::Args;
 use granbed_kernel::Real;
 use serde_json::Value;
 
-use super::work_precision::curve_error;
+use super::work_precision::{curve_error, relative_error};
 use crate::output::Streams;
 
 /// Options of `granbed-cli study compare`.
@@ -125,16 +125,14 @@ pub struct Comparison {
     pub steps: Real,
     /// Compression wall time of the run over the reference's.
     pub wall_time: Real,
-    /// Pair searches per step of the run over the reference's.
+    /// Pair searches per step of the run over the reference's (a resumed
+    /// run's summary counts its last segment only).
     pub pair_searches: Real,
 }
 
 /// Compares `run` with `reference` over the strain `window`.
 pub fn compare(reference: &RunRecord, run: &RunRecord, window: [Real; 2]) -> Comparison {
-    let rel = |key: &str| match (run.number(key), reference.number(key)) {
-        (Some(x), Some(r)) if r != 0.0 => (x - r).abs() / r.abs(),
-        _ => Real::NAN,
-    };
+    let rel = |key: &str| relative_error(run.number(key), reference.number(key));
     let ratio = |key: &str| match (run.number(key), reference.number(key)) {
         (Some(x), Some(r)) if r != 0.0 => x / r,
         _ => Real::NAN,
@@ -157,7 +155,14 @@ impl CompareArgs {
         let c = compare(&reference, &run, self.window);
         let [from, to] = self.window;
         let out = &mut streams.stdout;
-        writeln!(out, "P(C) relative L2, C = {from}..{to}: {:.4}", c.curve)?;
+        if c.curve.is_nan() {
+            writeln!(
+                out,
+                "P(C) relative L2, C = {from}..{to}: NaN (a run does not cover the window)"
+            )?;
+        } else {
+            writeln!(out, "P(C) relative L2, C = {from}..{to}: {:.4}", c.curve)?;
+        }
         writeln!(out, "Kawakita a, relative error: {:.4}", c.kawakita_a)?;
         writeln!(out, "Kawakita 1/b, relative error: {:.4}", c.kawakita_inv_b)?;
         writeln!(out, "steps, run / reference: {:.4}", c.steps)?;

@@ -305,13 +305,18 @@ pub struct Errors {
     pub kawakita_inv_b: Real,
 }
 
+/// |x − r|/|r| (NaN if either is missing; ∞ for r = 0 and x ≠ 0).
+pub fn relative_error(x: Option<Real>, r: Option<Real>) -> Real {
+    match (x, r) {
+        (Some(x), Some(r)) => (x - r).abs() / r.abs(),
+        _ => Real::NAN,
+    }
+}
+
 impl Errors {
     /// The errors of `m` against `reference`.
     pub fn of(m: &Measured, reference: &Measured) -> Self {
-        let rel = |x: Option<Real>, r: Option<Real>| match (x, r) {
-            (Some(x), Some(r)) => (x - r).abs() / r.abs(),
-            _ => Real::NAN,
-        };
+        let rel = relative_error;
         let (a, inv_b) = (m.kawakita.map(|k| k.0), m.kawakita.map(|k| k.1));
         let (ra, rinv_b) = (
             reference.kawakita.map(|k| k.0),

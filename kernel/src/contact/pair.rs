@@ -837,7 +837,8 @@ fn kinematic_force(
 /// corrections (it leaves out how far the closest point slides, and the
 /// turn of the normal); a node that a correction pushes into a face
 /// without a held constraint is found by the next step's search. A NaN
-/// gap is no penetration (the search on the next step reports it).
+/// gap is no penetration here (the driver's checks of the motion report
+/// a non-finite state).
 pub fn regap(
     a: &SurfaceBody<'_>,
     b: &SurfaceBody<'_>,
@@ -860,7 +861,7 @@ pub fn regap(
         // A constraint of other bodies: its ids lie outside these.
         let short = |buffer, id: u32, got| ContactError::BufferLength {
             buffer,
-            expected: id as usize + 1,
+            expected: (id as usize).saturating_add(1),
             got,
         };
         let p = slave
