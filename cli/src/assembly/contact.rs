@@ -25,7 +25,8 @@ pub struct PairWork {
     /// What the last force pass (sweep) did.
     pub result: PairForce,
     /// What every sweep of the last step did together: forces summed,
-    /// constraint counts of the first sweep, the smallest gap.
+    /// constraint counts and contact area of the first sweep, the smallest
+    /// gap.
     pub step: PairForce,
     /// The face lists of the pair's two passes.
     lists: PairLists,
@@ -675,7 +676,6 @@ impl ContactPhase {
                 } else {
                     let t = &mut w.step;
                     t.normal += result.normal;
-                    t.area += result.area;
                     for a in 0..3 {
                         t.friction_on_a[a] += result.friction_on_a[a];
                         t.total_on_a[a] += result.total_on_a[a];
