@@ -18,7 +18,6 @@
 
 use crate::Real;
 use crate::constitutive::elastic;
-use crate::lanes::{Lanes, Num};
 use crate::math;
 
 /// Newton iterations before the bisection fallback takes over.
@@ -48,26 +47,23 @@ pub enum ReturnMethod {
     Bisection,
 }
 
-/// The trial-state scalars and coefficients that define the corrector, for
-/// one point (`T` = [`Real`]) or one point per lane (`T` = [`Lanes`]): the
-/// residual, its Jacobian and the Newton step are written once over
-/// [`Num`], so every lane gets the scalar bits.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub struct ReturnMapSystem<T = Real> {
+/// The trial-state scalars and coefficients that define the corrector.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ReturnMapSystem {
     /// θtr = μ tr b^e,tr, Pa (> 0).
-    pub theta_tr: T,
+    pub theta_tr: Real,
     /// Trial elastic volume ratio J^e,tr (> 0).
-    pub je_tr: T,
+    pub je_tr: Real,
     /// βtr = ‖dev τtr‖, Pa (≥ 0).
-    pub beta_tr: T,
+    pub beta_tr: Real,
     /// Yield-surface coefficient a1 ≥ 0.
-    pub a1: T,
+    pub a1: Real,
     /// Yield scale (2/3) a2 σy², Pa² (> 0).
-    pub yield_scale: T,
+    pub yield_scale: Real,
     /// Lamé λ, Pa.
-    pub lambda: T,
+    pub lambda: Real,
     /// Shear modulus μ, Pa.
-    pub mu: T,
+    pub mu: Real,
 }
 
 /// A solution (or best iterate) of the corrector.
@@ -85,191 +81,65 @@ pub struct ReturnSolution {
     pub residual: Real,
 }
 
-impl<T: Num> ReturnMapSystem<T> {
+impl ReturnMapSystem {
     /// θ(ε) = θtr/(1+ε), Pa.
-    #[inline(always)]
-    pub fn theta(&self, eps: T) -> T {
-        self.theta_tr / (T::splat(1.0) + eps)
+    #[inline]
+    pub fn theta(&self, eps: Real) -> Real {
+        self.theta_tr / (1.0 + eps)
     }
 
     /// J^e(ε) = (1 − 1.5ε) J^e,tr (backward-Euler update of J^p).
-    #[inline(always)]
-    pub fn je(&self, eps: T) -> T {
-        (T::splat(1.0) - T::splat(1.5) * eps) * self.je_tr
+    #[inline]
+    pub fn je(&self, eps: Real) -> Real {
+        (1.0 - 1.5 * eps) * self.je_tr
     }
 
     /// α(ε) = θ(ε) + h(J^e(ε)) = tr τ, Pa.
-    #[inline(always)]
-    pub fn alpha(&self, eps: T) -> T {
+    #[inline]
+    pub fn alpha(&self, eps: Real) -> Real {
         self.theta(eps) + elastic::h_lame(self.lambda, self.mu, self.je(eps))
     }
 
     /// dα/dε, Pa.
-    #[inline(always)]
-    pub fn dalpha(&self, eps: T) -> T {
-        -self.theta(eps) / (T::splat(1.0) + eps)
-            - T::splat(4.5)
-                * self.lambda
-                * (T::splat(2.0) * self.je(eps) - T::splat(1.0))
-                * self.je_tr
+    #[inline]
+    pub fn dalpha(&self, eps: Real) -> Real {
+        -self.theta(eps) / (1.0 + eps) - 4.5 * self.lambda * (2.0 * self.je(eps) - 1.0) * self.je_tr
     }
 
     /// β = βtr/(1+ε+δ), Pa.
-    #[inline(always)]
-    pub fn beta(&self, eps: T, delta: T) -> T {
-        self.beta_tr / (T::splat(1.0) + eps + delta)
+    #[inline]
+    pub fn beta(&self, eps: Real, delta: Real) -> Real {
+        self.beta_tr / (1.0 + eps + delta)
     }
 
     /// Residuals [R1, R2] (both dimensionless; see the module docs).
-    #[inline(always)]
-    pub fn residual(&self, eps: T, delta: T) -> [T; 2] {
+    pub fn residual(&self, eps: Real, delta: Real) -> [Real; 2] {
         let alpha = self.alpha(eps);
         let beta = self.beta(eps, delta);
         [
             (self.a1 * alpha * delta - eps * self.theta(eps)) / self.theta_tr,
-            (beta * beta + (self.a1 / T::splat(3.0)) * alpha * alpha - self.yield_scale)
-                / self.yield_scale,
+            (beta * beta + (self.a1 / 3.0) * alpha * alpha - self.yield_scale) / self.yield_scale,
         ]
     }
 
     /// Jacobian `[[∂R1/∂ε, ∂R1/∂δ], [∂R2/∂ε, ∂R2/∂δ]]` of [`Self::residual`].
-    #[inline(always)]
-    pub fn jacobian(&self, eps: T, delta: T) -> [[T; 2]; 2] {
+    pub fn jacobian(&self, eps: Real, delta: Real) -> [[Real; 2]; 2] {
         let alpha = self.alpha(eps);
         let dalpha = self.dalpha(eps);
         let beta = self.beta(eps, delta);
-        let d_beta2 = -T::splat(2.0) * beta * beta / (T::splat(1.0) + eps + delta);
+        let d_beta2 = -2.0 * beta * beta / (1.0 + eps + delta);
         [
             [
-                (self.a1 * dalpha * delta - self.theta(eps) / (T::splat(1.0) + eps))
-                    / self.theta_tr,
+                (self.a1 * dalpha * delta - self.theta(eps) / (1.0 + eps)) / self.theta_tr,
                 self.a1 * alpha / self.theta_tr,
             ],
             [
-                (d_beta2 + T::splat(2.0 / 3.0) * self.a1 * alpha * dalpha) / self.yield_scale,
+                (d_beta2 + (2.0 / 3.0) * self.a1 * alpha * dalpha) / self.yield_scale,
                 d_beta2 / self.yield_scale,
             ],
         ]
     }
 
-    /// The full Newton step (Δε, Δδ) = −J⁻¹R at (ε, δ), before damping.
-    #[inline(always)]
-    pub fn newton_step(&self, eps: T, delta: T) -> (T, T) {
-        let r = self.residual(eps, delta);
-        let j = self.jacobian(eps, delta);
-        let det = j[0][0] * j[1][1] - j[0][1] * j[1][0];
-        let de = -(j[1][1] * r[0] - j[0][1] * r[1]) / det;
-        let dd = -(j[0][0] * r[1] - j[1][0] * r[0]) / det;
-        (de, dd)
-    }
-}
-
-impl<const W: usize> ReturnMapSystem<Lanes<W>> {
-    /// The systems of `W` points side by side.
-    pub fn from_lanes(lanes: &[ReturnMapSystem; W]) -> Self {
-        let pick = |f: fn(&ReturnMapSystem) -> Real| Lanes::from_fn(|l| f(&lanes[l]));
-        Self {
-            theta_tr: pick(|s| s.theta_tr),
-            je_tr: pick(|s| s.je_tr),
-            beta_tr: pick(|s| s.beta_tr),
-            a1: pick(|s| s.a1),
-            yield_scale: pick(|s| s.yield_scale),
-            lambda: pick(|s| s.lambda),
-            mu: pick(|s| s.mu),
-        }
-    }
-
-    /// The damped Newton of [`ReturnMapSystem::solve`] in every lane with
-    /// `active[l]`, side by side: the residuals, Jacobians and steps of all
-    /// lanes at once, the damping and the convergence test lane by lane.
-    /// Lane `l` of the result is the solution [`ReturnMapSystem::solve`]
-    /// returns for lane `l`'s system, to the bit, when that Newton
-    /// converges; `None` where it does not (or the lane is inactive), for
-    /// the caller to solve that lane alone (bisection fallback, radial
-    /// return). Inactive lanes must hold finite values (any lane's copy).
-    pub fn newton(&self, active: [bool; W]) -> [Option<ReturnSolution>; W] {
-        let mut out = [None; W];
-        let mut eps = [0.0; W];
-        let mut delta = [0.0; W];
-        let mut live = active;
-        for l in 0..W {
-            if live[l] {
-                delta[l] = self.lane(l).delta_start();
-            }
-        }
-        for it in 1..=MAX_NEWTON_ITERATIONS {
-            if !live.contains(&true) {
-                break;
-            }
-            let (de, dd) = self.newton_step(Lanes(eps), Lanes(delta));
-            for l in 0..W {
-                if !live[l] {
-                    continue;
-                }
-                match damped_update(eps[l], delta[l], de.0[l], dd.0[l]) {
-                    NewtonUpdate::Failed => live[l] = false,
-                    NewtonUpdate::Moved(e, d) => (eps[l], delta[l]) = (e, d),
-                    NewtonUpdate::Converged(e, d) => {
-                        live[l] = false;
-                        out[l] = Some(self.lane(l).newton_solution(e, d, it));
-                    }
-                }
-            }
-        }
-        out
-    }
-
-    /// The system of lane `l`.
-    #[inline(always)]
-    pub fn lane(&self, l: usize) -> ReturnMapSystem {
-        ReturnMapSystem {
-            theta_tr: self.theta_tr.0[l],
-            je_tr: self.je_tr.0[l],
-            beta_tr: self.beta_tr.0[l],
-            a1: self.a1.0[l],
-            yield_scale: self.yield_scale.0[l],
-            lambda: self.lambda.0[l],
-            mu: self.mu.0[l],
-        }
-    }
-}
-
-/// What one damped Newton update did.
-enum NewtonUpdate {
-    /// The step was not finite: Newton failed at the current iterate.
-    Failed,
-    /// The new iterate (ε, δ), not yet converged.
-    Moved(Real, Real),
-    /// The new iterate (ε, δ), converged.
-    Converged(Real, Real),
-}
-
-/// Applies the Newton step (`de`, `dd`) at (`eps`, `delta`), halved until
-/// the iterate is feasible, and tests convergence.
-#[inline(always)]
-fn damped_update(eps: Real, delta: Real, de: Real, dd: Real) -> NewtonUpdate {
-    if !(de.is_finite() && dd.is_finite()) {
-        return NewtonUpdate::Failed;
-    }
-    let mut t = 1.0;
-    let mut halvings = 0;
-    while !ReturnMapSystem::feasible(eps + t * de, delta + t * dd) && halvings < MAX_HALVINGS {
-        t *= 0.5;
-        halvings += 1;
-    }
-    let eps = eps + t * de;
-    let delta = math::max(delta + t * dd, 0.0);
-    let converged = t == 1.0
-        && math::abs(de) < NEWTON_STEP_TOL * (1.0 + math::abs(eps))
-        && math::abs(dd) < NEWTON_STEP_TOL * (1.0 + delta);
-    if converged {
-        NewtonUpdate::Converged(eps, delta)
-    } else {
-        NewtonUpdate::Moved(eps, delta)
-    }
-}
-
-impl ReturnMapSystem {
     /// Solves the corrector: radial return for a1 = 0, otherwise damped
     /// Newton with the bisection fallback. `Err` carries the best iterate
     /// when neither reaches |R2| ≤ [`FALLBACK_RESIDUAL_MAX`].
@@ -319,29 +189,41 @@ impl ReturnMapSystem {
         1.0 + eps >= STEP_FLOOR && 1.0 - 1.5 * eps >= STEP_FLOOR && delta >= 0.0
     }
 
-    /// A converged Newton iterate as a solution.
-    fn newton_solution(&self, eps: Real, delta: Real, iterations: u32) -> ReturnSolution {
-        ReturnSolution {
-            eps,
-            delta,
-            iterations,
-            method: ReturnMethod::Newton,
-            residual: self.residual(eps, delta)[1],
-        }
-    }
-
     /// Damped Newton from (0, δ0); `Err` holds the last iterate.
     fn newton(&self) -> Result<ReturnSolution, ReturnSolution> {
         let (mut eps, mut delta) = (0.0, self.delta_start());
+        let sol = |eps, delta, iterations, method| ReturnSolution {
+            eps,
+            delta,
+            iterations,
+            method,
+            residual: self.residual(eps, delta)[1],
+        };
         for it in 1..=MAX_NEWTON_ITERATIONS {
-            let (de, dd) = self.newton_step(eps, delta);
-            match damped_update(eps, delta, de, dd) {
-                NewtonUpdate::Failed => return Err(self.newton_solution(eps, delta, it)),
-                NewtonUpdate::Moved(e, d) => (eps, delta) = (e, d),
-                NewtonUpdate::Converged(e, d) => return Ok(self.newton_solution(e, d, it)),
+            let r = self.residual(eps, delta);
+            let j = self.jacobian(eps, delta);
+            let det = j[0][0] * j[1][1] - j[0][1] * j[1][0];
+            let de = -(j[1][1] * r[0] - j[0][1] * r[1]) / det;
+            let dd = -(j[0][0] * r[1] - j[1][0] * r[0]) / det;
+            if !(de.is_finite() && dd.is_finite()) {
+                return Err(sol(eps, delta, it, ReturnMethod::Newton));
+            }
+            let mut t = 1.0;
+            let mut halvings = 0;
+            while !Self::feasible(eps + t * de, delta + t * dd) && halvings < MAX_HALVINGS {
+                t *= 0.5;
+                halvings += 1;
+            }
+            eps += t * de;
+            delta = math::max(delta + t * dd, 0.0);
+            let converged = t == 1.0
+                && math::abs(de) < NEWTON_STEP_TOL * (1.0 + math::abs(eps))
+                && math::abs(dd) < NEWTON_STEP_TOL * (1.0 + delta);
+            if converged {
+                return Ok(sol(eps, delta, it, ReturnMethod::Newton));
             }
         }
-        Err(self.newton_solution(eps, delta, MAX_NEWTON_ITERATIONS))
+        Err(sol(eps, delta, MAX_NEWTON_ITERATIONS, ReturnMethod::Newton))
     }
 
     /// δ(ε) = εθ/(a1 α): the δ that satisfies R1 = 0 exactly.

@@ -10,7 +10,7 @@
 use core::fmt;
 
 use crate::constitutive::elastic;
-use crate::constitutive::return_map::{ReturnMapSystem, ReturnMethod, ReturnSolution};
+use crate::constitutive::return_map::{ReturnMapSystem, ReturnMethod};
 use crate::constitutive::yield_surface::{self, YieldCoefficients};
 use crate::lanes::{Lanes, Num};
 use crate::material::Material;
@@ -328,50 +328,23 @@ pub fn plastic_return(
     opts: &UpdateOptions,
     F: &Rows<Real>,
     t: &Trial<Real>,
-    info: UpdateInfo,
+    mut info: UpdateInfo,
     scale: Real,
 ) -> Result<(PointUpdate, Voigt), UpdateError> {
-    let system = return_system(mat, t, &info, scale);
-    let sol = system.solve().map_err(|best| UpdateError::NoConvergence {
-        residual: math::abs(best.residual),
-        iterations: best.iterations,
-    })?;
-    returned_state(mat, opts, F, t, info, &system, &sol)
-}
-
-/// The corrector's system of a trial state `t` that yields ([`check_trial`]'s
-/// `info` and `scale`).
-#[inline(always)]
-pub fn return_system(
-    mat: &Material,
-    t: &Trial<Real>,
-    info: &UpdateInfo,
-    scale: Real,
-) -> ReturnMapSystem {
-    ReturnMapSystem {
+    let mu = mat.mu;
+    let system = ReturnMapSystem {
         theta_tr: t.theta,
         je_tr: t.je,
         beta_tr: t.beta,
         a1: info.coefficients.a1,
         yield_scale: scale,
         lambda: mat.lambda,
-        mu: mat.mu,
-    }
-}
-
-/// The end of [`plastic_return`] once its `system` is solved (`sol`): the
-/// returned stress, the volume fix and the new C_p⁻¹.
-#[allow(non_snake_case)]
-pub fn returned_state(
-    mat: &Material,
-    opts: &UpdateOptions,
-    F: &Rows<Real>,
-    t: &Trial<Real>,
-    mut info: UpdateInfo,
-    system: &ReturnMapSystem,
-    sol: &ReturnSolution,
-) -> Result<(PointUpdate, Voigt), UpdateError> {
-    let mu = mat.mu;
+        mu,
+    };
+    let sol = system.solve().map_err(|best| UpdateError::NoConvergence {
+        residual: math::abs(best.residual),
+        iterations: best.iterations,
+    })?;
     let theta = system.theta(sol.eps);
     let je = system.je(sol.eps);
     let alpha = system.alpha(sol.eps);

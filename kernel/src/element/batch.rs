@@ -7,11 +7,8 @@
 //! as the scalar element ([`mean_gradient_rows`], [`trial`],
 //! [`nodal_forces`] are generic over [`Num`]), so every lane gets exactly the
 //! scalar result. Per lane, in scalar code: the input checks and the yield
-//! test ([`check_trial`]). The lanes that yield run the corrector's Newton
-//! iterations side by side ([`ReturnMapSystem::newton`], the scalar bits
-//! again), then, lane by lane, the rest of the plastic corrector
-//! ([`returned_state`]; the radial return and Newton's rare failures by the
-//! scalar [`ReturnMapSystem::solve`]). A batch in which any lane fails is evaluated again
+//! test ([`check_trial`]) and, for a lane that yields, the plastic corrector
+//! ([`plastic_return`]). A batch in which any lane fails is evaluated again
 //! element by element by [`hex_forces`], so errors, and the states left
 //! behind, are those of the scalar loop.
 //!
@@ -31,8 +28,7 @@
 //! transition penalty on every call.
 
 use crate::Real;
-use crate::constitutive::return_map::ReturnMapSystem;
-use crate::constitutive::update::{check_trial, return_system, returned_state, trial};
+use crate::constitutive::update::{Trial, check_trial, plastic_return, trial};
 use crate::constitutive::yield_surface::YieldCoefficients;
 use crate::constitutive::{UpdateError, UpdateInfo, UpdateOptions, elastic};
 use crate::element::force::{
@@ -375,76 +371,38 @@ impl Job<'_> {
         let F = mean_gradient_rows(&g.b0, &x);
         let t = trial(self.mat, &F, &c);
         let mut tau = elastic::kirchhoff(self.mat, &t.b, t.je);
-        // Per lane: the checks and the yield test; then the correctors'
-        // Newton iterations side by side; then, per lane, the rest of the
-        // corrector.
+        // Per lane: the checks and, if it yields, the corrector.
         let mut info = [UNSET; W];
         let mut new_state: [Option<Voigt>; W] = [None; W];
         let mut dissipation = [0.0; W];
-        let mut lane_f = [[[0.0; 3]; 3]; W];
-        let mut lane_t = [t.lane(0); W];
-        let mut scales: [Option<Real>; W] = [None; W];
-        let mut systems = [ReturnMapSystem::default(); W];
         for l in 0..W {
-            for (row, f_row) in lane_f[l].iter_mut().zip(&F) {
+            let mut lane_f = [[0.0; 3]; 3];
+            for (row, f_row) in lane_f.iter_mut().zip(&F) {
                 for (v, fv) in row.iter_mut().zip(f_row) {
                     *v = fv.0[l];
                 }
             }
-            lane_t[l] = t.lane(l);
-            let Ok(check) = check_trial(self.mat, self.opts, &lane_f[l], &lane_t[l]) else {
+            let lane_t: Trial<Real> = t.lane(l);
+            let Ok(check) = check_trial(self.mat, self.opts, &lane_f, &lane_t) else {
                 return false;
             };
             info[l] = check.info;
             // V0 × 0 as the scalar element computes it (−0 or NaN for a
             // malformed volume, like the scalar path).
             dissipation[l] = g.volume.0[l] * 0.0;
-            scales[l] = check.plastic_scale;
-            // A lane that does not yield keeps a finite dummy system (its
-            // own trial state at scale 1) and takes no part in Newton.
-            systems[l] = return_system(
-                self.mat,
-                &lane_t[l],
-                &info[l],
-                check.plastic_scale.unwrap_or(1.0),
-            );
-        }
-        let newton = scales.map(|s| s.is_some());
-        let mut solved = [None; W];
-        if newton.contains(&true) {
-            let active = core::array::from_fn(|l| newton[l] && systems[l].a1 != 0.0);
-            solved = ReturnMapSystem::from_lanes(&systems).newton(active);
-        }
-        for l in 0..W {
-            if scales[l].is_none() {
-                continue;
+            if let Some(scale) = check.plastic_scale {
+                let Ok((up, cp)) =
+                    plastic_return(self.mat, self.opts, &lane_f, &lane_t, check.info, scale)
+                else {
+                    return false;
+                };
+                for (tk, uk) in tau.iter_mut().zip(up.tau) {
+                    tk.0[l] = uk;
+                }
+                info[l] = up.info;
+                new_state[l] = Some(cp);
+                dissipation[l] = g.volume.0[l] * up.dissipation_density();
             }
-            let sol = match solved[l] {
-                Some(sol) => sol,
-                // Radial return, or a Newton that failed: alone, as the
-                // scalar element solves it.
-                None => match systems[l].solve() {
-                    Ok(sol) => sol,
-                    Err(_) => return false,
-                },
-            };
-            let Ok((up, cp)) = returned_state(
-                self.mat,
-                self.opts,
-                &lane_f[l],
-                &lane_t[l],
-                info[l],
-                &systems[l],
-                &sol,
-            ) else {
-                return false;
-            };
-            for (tk, uk) in tau.iter_mut().zip(up.tau) {
-                tk.0[l] = uk;
-            }
-            info[l] = up.info;
-            new_state[l] = Some(cp);
-            dissipation[l] = g.volume.0[l] * up.dissipation_density();
         }
         let j = det_rows(&F);
         let geometry = ElementGeometry {
