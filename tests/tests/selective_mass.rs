@@ -332,6 +332,48 @@ fn the_kinetic_energy_balances_the_work() {
     );
 }
 
+/// Under selective scaling the corrector hands back the rigid frame of the
+/// positions it moved the granule to, with the bits of `RigidFrame::of` on
+/// them (a driver reuses it for the next step instead of taking it again);
+/// without selective scaling it takes none.
+#[test]
+fn the_corrector_hands_back_the_frame_of_its_new_positions() {
+    let mesh = OwnedReference::sphere(R, MeshLevel::new(4, 1), false).unwrap();
+    let wobble = deformational(&mesh, 2e-3);
+    let v0 = field(&mesh, wobble);
+    let node = mesh.positions.len() - 1;
+    for selective in [F, 1.0] {
+        let how = Run {
+            mass_factor: F,
+            selective,
+            gravity: 9.81,
+            rigid_predictor: false,
+        };
+        let (mut steps, mut moved) = (0, false);
+        let mut last: Option<RigidFrame> = None;
+        run(
+            &mesh,
+            &how,
+            &v0,
+            50,
+            &mut |_, b| b.f_c[node] = [3e-5, 1e-5, -2e-5],
+            &mut |b, _, w| {
+                steps += 1;
+                if selective > 1.0 {
+                    let want = RigidFrame::of(b.mass, b.x);
+                    assert_eq!(w.next_frame, Some(want), "step {steps}");
+                    moved |= last.is_some_and(|f| f.centre != want.centre);
+                    last = Some(want);
+                } else {
+                    assert_eq!(w.next_frame, None, "step {steps}");
+                }
+            },
+        );
+        assert_eq!(steps, 50);
+        assert!(selective == 1.0 || moved, "the granule must move");
+    }
+}
+
 /// `RigidFrame::response` is the rigid projection of M⁻¹f that `correct`
 /// applies (`rigid_motion_of`), computed from the forces alone: the same
 /// translation and spin to round-off, for forces on surface nodes of a

@@ -324,6 +324,11 @@ pub struct Assembly<'m> {
     /// frame that nothing reads, unless selective mass scaling needs it;
     /// taken out during the sweeps).
     frames: Vec<RigidFrame>,
+    /// Per granule: whether `frames` already holds the frame of its
+    /// current x and masses — the corrector's frame at x_{n+1}
+    /// (`StepWork::next_frame`), which the next step then does not take
+    /// again. Cleared wherever the positions change outside a step.
+    frames_current: Vec<bool>,
 }
 
 impl<'m> Assembly<'m> {
@@ -394,6 +399,7 @@ impl<'m> Assembly<'m> {
                 .collect(),
             rigid: vec![params.rigid_until_touched; placements.len()],
             frames: Vec::new(),
+            frames_current: Vec::new(),
         };
         let mut kinetic: Real = assembly
             .granules
@@ -551,6 +557,7 @@ impl<'m> Assembly<'m> {
             return Err(mismatch);
         }
         self.contact.restore_broad(&state.pairs, &state.built);
+        self.frames_current.clear();
         self.time = state.time;
         self.steps = state.steps;
         [self.dt, self.dt_prev] = state.dt;
@@ -582,6 +589,7 @@ impl<'m> Assembly<'m> {
     /// writes need not be a rigid motion.
     pub fn granules_mut(&mut self) -> &mut [GranuleStore] {
         self.rigid.fill(false);
+        self.frames_current.clear();
         &mut self.granules
     }
 

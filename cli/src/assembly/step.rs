@@ -584,16 +584,22 @@ impl Assembly<'_> {
         // predictor and the corrector (a granule still rigid needs none
         // unless its contact masses do) — and under selective mass scaling
         // for the rigid response in the sweeps and the contact masses.
+        // A frame the last corrector took at these positions is reused (the
+        // same bits as taking it again).
         let selective = p.selective_mass_factor();
         self.frames
             .resize(self.granules.len(), RigidFrame::default());
+        self.frames_current.resize(self.granules.len(), false);
         self.granules
             .par_iter_mut()
             .zip(self.frames.par_iter_mut())
             .zip(self.rigid.par_iter())
-            .filter(|(_, rigid)| selective > 1.0 || !**rigid)
-            .for_each(|((g, frame), _)| {
-                *frame = RigidFrame::of(&g.mass, &g.x);
+            .zip(self.frames_current.par_iter())
+            .filter(|((_, rigid), _)| selective > 1.0 || !**rigid)
+            .for_each(|(((g, frame), _), &current)| {
+                if !current {
+                    *frame = RigidFrame::of(&g.mass, &g.x);
+                }
                 if selective > 1.0 {
                     // Every buffer of a GranuleStore has one entry per node.
                     let written = selective_contact_masses(
@@ -762,6 +768,17 @@ impl Assembly<'_> {
             .zip(self.frames.par_iter())
             .map(|(g, frame)| correct_in(frame, &mut g.buffers(), sizes, &loads))
             .collect();
+        for ((frame, current), w) in self
+            .frames
+            .iter_mut()
+            .zip(&mut self.frames_current)
+            .zip(&per)
+        {
+            if let Some(next) = w.next_frame {
+                *frame = next;
+            }
+            *current = w.next_frame.is_some();
+        }
 
         let mut report = StepReport {
             dt: sizes.dt,

@@ -104,7 +104,19 @@ pub fn selective_kinetic_excess(
     v: &[[Real; 3]],
     factor: Real,
 ) -> Real {
-    0.5 * (1.0 - 1.0 / factor) * rigid_motion(mass, x, v).twice_kinetic_energy()
+    selective_kinetic_excess_in(&RigidFrame::of(mass, x), mass, x, v, factor)
+}
+
+/// [`selective_kinetic_excess`] with the frame of `mass` and `x`
+/// ([`RigidFrame::of`]) taken by the caller; the same bits.
+pub fn selective_kinetic_excess_in(
+    frame: &RigidFrame,
+    mass: &[Real],
+    x: &[[Real; 3]],
+    v: &[[Real; 3]],
+    factor: Real,
+) -> Real {
+    0.5 * (1.0 - 1.0 / factor) * frame.motion(mass, x, |i| v[i]).twice_kinetic_energy()
 }
 
 /// The six distinct entries of a symmetric inertia tensor being summed:

@@ -28,7 +28,7 @@
 
 use crate::Real;
 use crate::granule::damping::{
-    RigidFrame, RigidMotion, damping_forces_in, selective_kinetic_excess,
+    RigidFrame, RigidMotion, damping_forces_in, selective_kinetic_excess_in,
 };
 use crate::granule::forces::{ElementFailure, ElementSettings, ForceSummary, internal_forces};
 use crate::material::Material;
@@ -162,6 +162,12 @@ pub struct StepWork {
     pub kinetic: Real,
     /// Largest nodal |v_{n+½}|², m²/s² (for a driver's runaway watchdog).
     pub max_speed_squared: Real,
+    /// The granule's rigid frame at x_{n+1} when the corrector took it
+    /// (under selective mass scaling, for the kinetic energy): the bits of
+    /// [`RigidFrame::of`] on the new positions, so a driver may hand it to
+    /// the next step's [`predict_in`] and [`correct_in`] instead of taking
+    /// it again, while the positions and masses stay as they are.
+    pub next_frame: Option<RigidFrame>,
 }
 
 /// First half of a step: forces at x_n, damping, v*, x̃; clears `f_c`.
@@ -230,28 +236,11 @@ pub fn predict_rigid(b: &mut GranuleBuffers<'_>, sizes: StepSizes, loads: &Loads
     }
 }
 
-/// The increment Δt_n f_a/m of velocity component `a` of node `i` for the
-/// force `force` (N), or 0 if the component is held.
+/// Whether velocity component `a` of a node with `fixed` bits is held at
+/// zero.
 #[inline]
-fn increment(b: &GranuleBuffers<'_>, i: usize, a: usize, dt_n: Real, force: Real) -> Real {
-    if held(b, i, a) {
-        0.0
-    } else {
-        dt_n * force / b.mass[i]
-    }
-}
-
-/// Whether velocity component `a` of node `i` is held at zero.
-#[inline]
-fn held(b: &GranuleBuffers<'_>, i: usize, a: usize) -> bool {
-    b.fixed[i] & (1 << a) != 0
-}
-
-/// f_g − f_int + f_d on component `a` of node `i`, N.
-#[inline]
-fn predictor_force(b: &GranuleBuffers<'_>, i: usize, a: usize, g: Real) -> Real {
-    let f_g = if a == 2 { -g * b.mass[i] } else { 0.0 };
-    f_g - b.f_int[i][a] + b.f_d[i][a]
+fn held(fixed: u8, a: usize) -> bool {
+    fixed & (1 << a) != 0
 }
 
 /// How a granule moves in [`advance_predictor`].
@@ -274,11 +263,24 @@ fn advance_predictor(
 ) {
     let (dt, dt_n, g) = (sizes.dt, sizes.dt_n(), loads.gravity_m_s2);
     let boost = loads.rigid_boost();
-    // The increments Δt_n f/m, one division per component, kept in v*
-    // until v* is formed (the rigid projection reads each twice).
-    for i in 0..b.x.len() {
+    // Buffers cut to the node count, so the loops index without bounds
+    // checks (callers check the lengths with `GranuleBuffers::wrong_length`).
+    let n = b.x.len();
+    let (mass, fixed, x, v) = (&b.mass[..n], &b.fixed[..n], &b.x[..n], &b.v[..n]);
+    let (f_int, f_d) = (&b.f_int[..n], &b.f_d[..n]);
+    let (v_star, x_pred) = (&mut b.v_star[..n], &mut b.x_pred[..n]);
+    // The increments Δt_n (f_g − f_int + f_d)/m, one division per
+    // component, kept in v* until v* is formed (the rigid projection reads
+    // each twice).
+    for i in 0..n {
         for a in 0..3 {
-            b.v_star[i][a] = increment(b, i, a, dt_n, predictor_force(b, i, a, g));
+            let f_g = if a == 2 { -g * mass[i] } else { 0.0 };
+            let force = f_g - f_int[i][a] + f_d[i][a];
+            v_star[i][a] = if held(fixed[i], a) {
+                0.0
+            } else {
+                dt_n * force / mass[i]
+            };
         }
     }
     let (frame, translating) = match motion {
@@ -286,26 +288,29 @@ fn advance_predictor(
         Motion::Deforming(frame) => (frame, false),
     };
     let rigid = match (boost, frame) {
-        (Some(_), Some(frame)) => Some(frame.motion(b.mass, b.x, |i| b.v_star[i])),
+        (Some(_), Some(frame)) => {
+            let increments: &[[Real; 3]] = v_star;
+            Some(frame.motion(mass, x, |i| increments[i]))
+        }
         _ => None,
     };
-    for i in 0..b.x.len() {
+    for i in 0..n {
         let extra = match (boost, &rigid) {
-            (Some(k), Some(r)) => r.velocity_at(&b.x[i]).map(|r| k * r),
+            (Some(k), Some(r)) => r.velocity_at(&x[i]).map(|r| k * r),
             _ => [0.0; 3],
         };
         for (a, extra) in extra.into_iter().enumerate() {
-            let dv = b.v_star[i][a];
-            b.v_star[i][a] = if held(b, i, a) {
+            let dv = v_star[i][a];
+            v_star[i][a] = if held(fixed[i], a) {
                 0.0
             } else {
                 match boost {
-                    None => b.v[i][a] + dv,
-                    Some(k) if translating => b.v[i][a] + (dv + k * dv),
-                    Some(_) => b.v[i][a] + (dv + extra),
+                    None => v[i][a] + dv,
+                    Some(k) if translating => v[i][a] + (dv + k * dv),
+                    Some(_) => v[i][a] + (dv + extra),
                 }
             };
-            b.x_pred[i][a] = b.x[i][a] + dt * b.v_star[i][a];
+            x_pred[i][a] = x[i][a] + dt * v_star[i][a];
         }
     }
     b.f_c.fill([0.0; 3]);
@@ -353,48 +358,57 @@ pub fn correct_in(
     let dt_ok = division_skippable(dt_n);
     let gravity_m_s2 = loads.gravity_m_s2;
     let boost = loads.rigid_boost();
+    // Every buffer cut to the node count up front, so the loops below
+    // index without bounds checks (the same bits). Callers check the
+    // lengths with `GranuleBuffers::wrong_length`.
+    let n = b.x.len();
+    let (mass, fixed, f_c) = (&b.mass[..n], &b.fixed[..n], &b.f_c[..n]);
     let rigid = match boost {
-        Some(_) => frame.motion(b.mass, b.x, |i| {
+        Some(_) => frame.motion(mass, &b.x[..n], |i| {
             core::array::from_fn(|a| {
-                if held(b, i, a) {
+                if held(fixed[i], a) {
                     0.0
                 } else {
-                    contact_increment(dt_ok, dt_n, b.f_c[i][a], b.mass[i])
+                    contact_increment(dt_ok, dt_n, f_c[i][a], mass[i])
                 }
             })
         }),
         None => RigidMotion::REST,
     };
+    let (v_star, f_int, f_d) = (&b.v_star[..n], &b.f_int[..n], &b.f_d[..n]);
+    let (x, v) = (&mut b.x[..n], &mut b.v[..n]);
     let mut w = StepWork::default();
-    for i in 0..b.x.len() {
-        let m = b.mass[i];
+    for i in 0..n {
+        let m = mass[i];
         let extra = match boost {
-            Some(k) => rigid.velocity_at(&b.x[i]).map(|r| k * r),
+            Some(k) => rigid.velocity_at(&x[i]).map(|r| k * r),
             None => [0.0; 3],
         };
         for (a, extra) in extra.into_iter().enumerate() {
-            let v_new = if held(b, i, a) {
+            let v_new = if held(fixed[i], a) {
                 0.0
             } else if boost.is_some() {
-                b.v_star[i][a] + (contact_increment(dt_ok, dt_n, b.f_c[i][a], m) + extra)
+                v_star[i][a] + (contact_increment(dt_ok, dt_n, f_c[i][a], m) + extra)
             } else {
-                b.v_star[i][a] + contact_increment(dt_ok, dt_n, b.f_c[i][a], m)
+                v_star[i][a] + contact_increment(dt_ok, dt_n, f_c[i][a], m)
             };
-            let dx = 0.5 * (sizes.dt_prev * b.v[i][a] + dt * v_new);
-            w.internal += b.f_int[i][a] * dx;
-            w.contact += b.f_c[i][a] * dx;
-            w.damping -= b.f_d[i][a] * dx;
+            let dx = 0.5 * (sizes.dt_prev * v[i][a] + dt * v_new);
+            w.internal += f_int[i][a] * dx;
+            w.contact += f_c[i][a] * dx;
+            w.damping -= f_d[i][a] * dx;
             if a == 2 {
                 w.gravity -= gravity_m_s2 * m * dx;
             }
-            b.v[i][a] = v_new;
-            b.x[i][a] += dt * v_new;
+            v[i][a] = v_new;
+            x[i][a] += dt * v_new;
             w.kinetic += 0.5 * m * v_new * v_new;
         }
     }
     if let Some(k) = boost {
         // ½ v·M'v: the rigid part carries m'/F, not m' (module docs).
-        w.kinetic -= selective_kinetic_excess(b.mass, b.x, b.v, k + 1.0);
+        let next = RigidFrame::of(b.mass, b.x);
+        w.kinetic -= selective_kinetic_excess_in(&next, b.mass, b.x, b.v, k + 1.0);
+        w.next_frame = Some(next);
     }
     // A pass of its own keeps the loop above as it was (folding this into
     // it doubled its cost); f64::max is maxsd, no libm call (a NaN speed
