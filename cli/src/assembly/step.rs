@@ -585,7 +585,8 @@ impl Assembly<'_> {
         // unless its contact masses do) — and under selective mass scaling
         // for the rigid response in the sweeps and the contact masses.
         // A frame the last corrector took at these positions is reused (the
-        // same bits as taking it again).
+        // same bits as taking it again); the mark is consumed here, so a
+        // step that fails before its corrector leaves none behind.
         let selective = p.selective_mass_factor();
         self.frames
             .resize(self.granules.len(), RigidFrame::default());
@@ -594,10 +595,10 @@ impl Assembly<'_> {
             .par_iter_mut()
             .zip(self.frames.par_iter_mut())
             .zip(self.rigid.par_iter())
-            .zip(self.frames_current.par_iter())
+            .zip(self.frames_current.par_iter_mut())
             .filter(|((_, rigid), _)| selective > 1.0 || !**rigid)
-            .for_each(|(((g, frame), _), &current)| {
-                if !current {
+            .for_each(|(((g, frame), _), current)| {
+                if !core::mem::take(current) {
                     *frame = RigidFrame::of(&g.mass, &g.x);
                 }
                 if selective > 1.0 {
