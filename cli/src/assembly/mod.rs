@@ -327,7 +327,9 @@ pub struct Assembly<'m> {
     /// Per granule: whether `frames` already holds the frame of its
     /// current x and masses — the corrector's frame at x_{n+1}
     /// (`StepWork::next_frame`), which the next step then does not take
-    /// again. Cleared wherever the positions change outside a step.
+    /// again. Set by the corrector (only under selective mass scaling),
+    /// consumed at the start of every step, and cleared wherever the
+    /// positions change outside a step (`restore`, `granules_mut`).
     frames_current: Vec<bool>,
 }
 
@@ -527,6 +529,8 @@ impl<'m> Assembly<'m> {
         if state.granules.len() != self.granules.len() || !built_ok {
             return Err(mismatch);
         }
+        // Before any position changes (a later check may fail half-way).
+        self.frames_current.clear();
         for ((((g, mode), control), rigid), s) in self
             .granules
             .iter_mut()
@@ -557,7 +561,6 @@ impl<'m> Assembly<'m> {
             return Err(mismatch);
         }
         self.contact.restore_broad(&state.pairs, &state.built);
-        self.frames_current.clear();
         self.time = state.time;
         self.steps = state.steps;
         [self.dt, self.dt_prev] = state.dt;

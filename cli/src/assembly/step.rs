@@ -586,7 +586,9 @@ impl Assembly<'_> {
         // for the rigid response in the sweeps and the contact masses.
         // A frame the last corrector took at these positions is reused (the
         // same bits as taking it again); the mark is consumed here, so a
-        // step that fails before its corrector leaves none behind.
+        // step that fails before its corrector leaves none behind. (Marks
+        // are set only under selective scaling, where the filter below
+        // keeps every granule, so every mark is consumed.)
         let selective = p.selective_mass_factor();
         self.frames
             .resize(self.granules.len(), RigidFrame::default());

@@ -147,7 +147,9 @@ impl Loads {
 }
 
 /// Work of each force over one step (midpoint rule on
-/// ½(Δx_{n−½} + Δx_{n+½})), J, and the kinetic energy at n+½.
+/// ½(Δx_{n−½} + Δx_{n+½})), J, the kinetic energy at n+½, the largest
+/// nodal speed and, under selective mass scaling, the rigid frame at
+/// x_{n+1}.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct StepWork {
     /// Work of the internal + hourglass forces (energy taken up by the body).
@@ -347,7 +349,8 @@ pub fn correct(b: &mut GranuleBuffers<'_>, sizes: StepSizes, loads: &Loads) -> S
 
 /// [`correct`] with the granule's [`RigidFrame`] at x_n (before this
 /// step's update) taken by the caller, as for [`predict_in`]; the bits of
-/// [`correct`]. `frame` is read only under selective mass scaling.
+/// [`correct`]. `frame` is read only under selective mass scaling, where
+/// the returned [`StepWork::next_frame`] is the frame at x_{n+1}.
 pub fn correct_in(
     frame: &RigidFrame,
     b: &mut GranuleBuffers<'_>,
