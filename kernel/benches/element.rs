@@ -276,7 +276,7 @@ fn bench_granule_step(c: &mut Criterion) {
                 store.cp_inv.copy_from_slice(&start);
                 let mut b = store.reset(&x0, &v0, &f_c0);
                 let s = if framed {
-                    predict_in(&frame, &mesh, &mat, &settings, &mut b, sizes, &loads)
+                    predict_in(&frame, None, &mesh, &mat, &settings, &mut b, sizes, &loads)
                 } else {
                     predict(&mesh, &mat, &settings, &mut b, sizes, &loads)
                 };

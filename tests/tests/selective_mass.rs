@@ -334,7 +334,9 @@ fn the_kinetic_energy_balances_the_work() {
 
 /// Under selective scaling the corrector hands back the rigid frame of the
 /// positions it moved the granule to, with the bits of `RigidFrame::of` on
-/// them (a driver reuses it for the next step instead of taking it again);
+/// them, and the rigid part of its new velocities in that frame, with the
+/// bits of `motion` (a driver reuses both for the next step instead of
+/// taking them again);
 /// without selective scaling it takes none.
 #[test]
 fn the_corrector_hands_back_the_frame_of_its_new_positions() {
@@ -362,10 +364,13 @@ fn the_corrector_hands_back_the_frame_of_its_new_positions() {
                 if selective > 1.0 {
                     let want = RigidFrame::of(b.mass, b.x);
                     assert_eq!(w.next_frame, Some(want), "step {steps}");
+                    let motion = want.motion(b.mass, b.x, |i| b.v[i]);
+                    assert_eq!(w.next_motion, Some(motion), "step {steps}");
                     moved |= last.is_some_and(|f| f.centre != want.centre);
                     last = Some(want);
                 } else {
                     assert_eq!(w.next_frame, None, "step {steps}");
+                    assert_eq!(w.next_motion, None, "step {steps}");
                 }
             },
         );

@@ -28,7 +28,9 @@ use granbed_kernel::Real;
 use granbed_kernel::contact::broad::{Bound, GranulePair};
 use granbed_kernel::contact::pair::PairSettings;
 use granbed_kernel::contact::wall::Wall;
-use granbed_kernel::granule::damping::{RigidFrame, damping_coefficient, selective_kinetic_excess};
+use granbed_kernel::granule::damping::{
+    RigidFrame, RigidMotion, damping_coefficient, selective_kinetic_excess,
+};
 use granbed_kernel::granule::forces::ElementSettings;
 use granbed_kernel::granule::quality::{WorstElement, worst_element};
 use granbed_kernel::granule::timestep::{
@@ -324,13 +326,16 @@ pub struct Assembly<'m> {
     /// frame that nothing reads, unless selective mass scaling needs it;
     /// taken out during the sweeps).
     frames: Vec<RigidFrame>,
-    /// Per granule: whether `frames` already holds the frame of its
+    /// Per granule: `Some` when `frames` already holds the frame of its
     /// current x and masses — the corrector's frame at x_{n+1}
     /// (`StepWork::next_frame`), which the next step then does not take
-    /// again. Set by the corrector (only under selective mass scaling),
-    /// consumed at the start of every step, and cleared wherever the
-    /// positions change outside a step (`restore`, `granules_mut`).
-    frames_current: Vec<bool>,
+    /// again — holding the rigid part of its current v in that frame
+    /// (`StepWork::next_motion`), which the next step's damping then does
+    /// not take again. Set by the corrector (only under selective mass
+    /// scaling), consumed at the start of every step, and cleared wherever
+    /// the positions or velocities change outside a step (`restore`,
+    /// `granules_mut`).
+    frame_motions: Vec<Option<RigidMotion>>,
 }
 
 impl<'m> Assembly<'m> {
@@ -401,7 +406,7 @@ impl<'m> Assembly<'m> {
                 .collect(),
             rigid: vec![params.rigid_until_touched; placements.len()],
             frames: Vec::new(),
-            frames_current: Vec::new(),
+            frame_motions: Vec::new(),
         };
         let mut kinetic: Real = assembly
             .granules
@@ -530,7 +535,7 @@ impl<'m> Assembly<'m> {
             return Err(mismatch);
         }
         // Before any position changes (a later check may fail half-way).
-        self.frames_current.clear();
+        self.frame_motions.clear();
         for ((((g, mode), control), rigid), s) in self
             .granules
             .iter_mut()
@@ -592,7 +597,7 @@ impl<'m> Assembly<'m> {
     /// writes need not be a rigid motion.
     pub fn granules_mut(&mut self) -> &mut [GranuleStore] {
         self.rigid.fill(false);
-        self.frames_current.clear();
+        self.frame_motions.clear();
         &mut self.granules
     }
 

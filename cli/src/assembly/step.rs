@@ -584,49 +584,46 @@ impl Assembly<'_> {
         // predictor and the corrector (a granule still rigid needs none
         // unless its contact masses do) — and under selective mass scaling
         // for the rigid response in the sweeps and the contact masses.
-        // A frame the last corrector took at these positions is reused (the
-        // same bits as taking it again); the mark is consumed here, so a
-        // step that fails before its corrector leaves none behind. (Marks
-        // are set only under selective scaling, where the filter below
-        // keeps every granule, so every mark is consumed.)
+        // A frame the last corrector took at these positions is reused with
+        // the rigid part of v it took in it (the same bits as taking both
+        // again); the mark is consumed here, so a step that fails before
+        // its corrector leaves none behind. (Marks are set only under
+        // selective scaling, where every granule takes a frame, so every
+        // mark is consumed.)
         let selective = p.selective_mass_factor();
         self.frames
             .resize(self.granules.len(), RigidFrame::default());
-        self.frames_current.resize(self.granules.len(), false);
-        self.granules
-            .par_iter_mut()
-            .zip(self.frames.par_iter_mut())
-            .zip(self.rigid.par_iter())
-            .zip(self.frames_current.par_iter_mut())
-            .filter(|((_, rigid), _)| selective > 1.0 || !**rigid)
-            .for_each(|(((g, frame), _), current)| {
-                if !core::mem::take(current) {
-                    *frame = RigidFrame::of(&g.mass, &g.x);
-                }
-                if selective > 1.0 {
-                    // Every buffer of a GranuleStore has one entry per node.
-                    let written = selective_contact_masses(
-                        frame,
-                        &g.mass,
-                        &g.x,
-                        selective,
-                        &mut g.contact_mass,
-                    );
-                    debug_assert!(written);
-                }
-            });
-        let frames = &self.frames;
+        self.frame_motions.resize(self.granules.len(), None);
         let predicted: Vec<Result<ForceSummary, ElementFailure>> = self
             .granules
             .par_iter_mut()
+            .zip(self.frames.par_iter_mut())
             .zip(self.rigid.par_iter())
-            .zip(frames.par_iter())
-            .map(|((g, &rigid), frame)| {
+            .zip(self.frame_motions.par_iter_mut())
+            .map(|(((g, frame), &rigid), current)| {
+                let velocity_motion = current.take();
+                if selective > 1.0 || !rigid {
+                    if velocity_motion.is_none() {
+                        *frame = RigidFrame::of(&g.mass, &g.x);
+                    }
+                    if selective > 1.0 {
+                        // Every buffer of a GranuleStore has one entry per node.
+                        let written = selective_contact_masses(
+                            frame,
+                            &g.mass,
+                            &g.x,
+                            selective,
+                            &mut g.contact_mass,
+                        );
+                        debug_assert!(written);
+                    }
+                }
                 if rigid {
                     return Ok(predict_rigid(&mut g.buffers(), sizes, &loads));
                 }
                 predict_in(
                     frame,
+                    velocity_motion.as_ref(),
                     &view,
                     &p.material,
                     &p.elements,
@@ -774,13 +771,13 @@ impl Assembly<'_> {
         for ((frame, current), w) in self
             .frames
             .iter_mut()
-            .zip(&mut self.frames_current)
+            .zip(&mut self.frame_motions)
             .zip(&per)
         {
             if let Some(next) = w.next_frame {
                 *frame = next;
             }
-            *current = w.next_frame.is_some();
+            *current = w.next_frame.and(w.next_motion);
         }
 
         let mut report = StepReport {

@@ -104,19 +104,86 @@ pub fn selective_kinetic_excess(
     v: &[[Real; 3]],
     factor: Real,
 ) -> Real {
-    selective_kinetic_excess_in(&RigidFrame::of(mass, x), mass, x, v, factor)
+    selective_excess_of(&rigid_motion(mass, x, v), factor)
 }
 
-/// [`selective_kinetic_excess`] with the frame of `mass` and `x`
-/// ([`RigidFrame::of`]) taken by the caller; the same bits.
-pub fn selective_kinetic_excess_in(
-    frame: &RigidFrame,
-    mass: &[Real],
-    x: &[[Real; 3]],
-    v: &[[Real; 3]],
-    factor: Real,
-) -> Real {
-    0.5 * (1.0 - 1.0 / factor) * frame.motion(mass, x, |i| v[i]).twice_kinetic_energy()
+/// ½ (1 − 1/F) Σ m'|Pv|² from the rigid `motion` Pv ([`RigidFrame::motion`]
+/// of the velocities), J: [`selective_kinetic_excess`] for a caller that
+/// has the motion.
+pub fn selective_excess_of(motion: &RigidMotion, factor: Real) -> Real {
+    0.5 * (1.0 - 1.0 / factor) * motion.twice_kinetic_energy()
+}
+
+/// The sums Σ m_I, Σ m_I x_I and Σ m_I v_I of a granule's nodes, added node
+/// by node in node order: the first passes of [`RigidFrame::of`] and of
+/// [`RigidFrame::motion`], for a caller whose own node loop produces x and
+/// v (the corrector), so that [`MomentSums::frame_and_motion`] needs one
+/// more pass instead of four. The same bits as those two functions.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct MomentSums {
+    /// Σ m_I, kg.
+    mass: Real,
+    /// Σ m_I x_I, kg m.
+    mx: [Real; 3],
+    /// Σ m_I v_I, kg m/s.
+    mv: [Real; 3],
+}
+
+impl MomentSums {
+    /// Adds node mass `m` (kg) at `x` (m) with velocity `v` (m/s).
+    #[inline(always)]
+    pub fn add(&mut self, m: Real, x: &[Real; 3], v: &[Real; 3]) {
+        self.mass += m;
+        for a in 0..3 {
+            self.mx[a] += m * x[a];
+            self.mv[a] += m * v[a];
+        }
+    }
+
+    /// The frame of the nodes `mass`, `x` and the rigid motion of their
+    /// velocities `v` — the bits of `RigidFrame::of(mass, x)` and of its
+    /// `motion(mass, x, |i| v[i])` — when `self` holds exactly the sums of
+    /// these nodes ([`MomentSums::add`] in node order). One pass for the
+    /// inertia and the angular momentum.
+    pub fn frame_and_motion(
+        &self,
+        mass: &[Real],
+        x: &[[Real; 3]],
+        v: &[[Real; 3]],
+    ) -> (RigidFrame, RigidMotion) {
+        let m = self.mass;
+        let centre = self.mx.map(|s| s / m);
+        let velocity = self.mv.map(|s| s / m);
+        let mut inertia = InertiaSum::default();
+        let mut l = [0.0; 3];
+        for ((mi, xi), vi) in mass.iter().zip(x).zip(v) {
+            let r = sub(xi, &centre);
+            inertia.add(*mi, &r);
+            add_angular_momentum(&mut l, *mi, &r, &sub(vi, &velocity));
+        }
+        let frame = RigidFrame {
+            mass: m,
+            centre,
+            inertia: inertia.tensor(),
+        };
+        let motion = RigidMotion {
+            centre,
+            velocity,
+            omega: spin(&frame.inertia, &l),
+            mass: m,
+            angular_momentum: l,
+        };
+        (frame, motion)
+    }
+}
+
+/// l += m r × u: one node's angular momentum about the centre (r its
+/// offset, u its velocity relative to the centre's).
+#[inline(always)]
+fn add_angular_momentum(l: &mut [Real; 3], m: Real, r: &[Real; 3], u: &[Real; 3]) {
+    l[0] += m * (r[1] * u[2] - r[2] * u[1]);
+    l[1] += m * (r[2] * u[0] - r[0] * u[2]);
+    l[2] += m * (r[0] * u[1] - r[1] * u[0]);
 }
 
 /// The six distinct entries of a symmetric inertia tensor being summed:
@@ -210,11 +277,7 @@ impl RigidFrame {
         let mut l = [0.0; 3];
         for (i, (mi, xi)) in mass.iter().zip(x).enumerate() {
             let vi = v(i);
-            let r = sub(xi, &self.centre);
-            let u = sub(&vi, &velocity);
-            l[0] += mi * (r[1] * u[2] - r[2] * u[1]);
-            l[1] += mi * (r[2] * u[0] - r[0] * u[2]);
-            l[2] += mi * (r[0] * u[1] - r[1] * u[0]);
+            add_angular_momentum(&mut l, *mi, &sub(xi, &self.centre), &sub(&vi, &velocity));
         }
         RigidMotion {
             centre: self.centre,
@@ -330,6 +393,20 @@ pub fn damping_forces_in(
         Some(frame) => frame.motion(mass, x, |i| v[i]),
         None => RigidMotion::REST,
     };
+    damping_forces_of(&rigid, mass, x, v, c, f_d);
+}
+
+/// [`damping_forces_in`] with the rigid part of `v` taken by the caller:
+/// `rigid` is the frame's `motion(mass, x, |i| v[i])`, or
+/// [`RigidMotion::REST`] when the rigid modes are held; the same bits.
+pub fn damping_forces_of(
+    rigid: &RigidMotion,
+    mass: &[Real],
+    x: &[[Real; 3]],
+    v: &[[Real; 3]],
+    c: Real,
+    f_d: &mut [[Real; 3]],
+) {
     for (((m, xi), vi), fi) in mass.iter().zip(x).zip(v).zip(f_d.iter_mut()) {
         let r = rigid.velocity_at(xi);
         for a in 0..3 {
@@ -457,16 +534,56 @@ mod tests {
                 core::array::from_fn(|_| core::array::from_fn(|_| rng.uniform(-0.1, 0.1)));
             let want = fused_projection(&mass, &x, &v);
             let got = rigid_motion(&mass, &x, &v);
-            let bits = |r: &RigidMotion| {
-                let mut out = [0u64; 13];
-                let all = r.centre.iter().chain(&r.velocity).chain(&r.omega);
-                for (o, c) in out.iter_mut().zip(all.chain(&r.angular_momentum)) {
+            assert_eq!(motion_bits(&got), motion_bits(&want), "seed {seed}");
+        }
+    }
+
+    /// Every field of a rigid motion, as bits.
+    fn motion_bits(r: &RigidMotion) -> [u64; 13] {
+        let mut out = [r.mass.to_bits(); 13];
+        let all = r.centre.iter().chain(&r.velocity).chain(&r.omega);
+        for (o, c) in out[1..].iter_mut().zip(all.chain(&r.angular_momentum)) {
+            *o = c.to_bits();
+        }
+        out
+    }
+
+    /// The sums added node by node and one more pass give the frame and
+    /// the motion of `RigidFrame::of` and `motion`, to the bit.
+    #[test]
+    fn moment_sums_give_the_frame_and_motion_of_the_separate_passes() {
+        for seed in 1..20 {
+            let (mass, x) = cloud(seed);
+            let mut rng = Rng::new(seed + 200);
+            let v: [[Real; 3]; N] =
+                core::array::from_fn(|_| core::array::from_fn(|_| rng.uniform(-0.1, 0.1)));
+            let mut sums = MomentSums::default();
+            for ((m, xi), vi) in mass.iter().zip(&x).zip(&v) {
+                sums.add(*m, xi, vi);
+            }
+            let (frame, motion) = sums.frame_and_motion(&mass, &x, &v);
+            let want_frame = RigidFrame::of(&mass, &x);
+            let want_motion = want_frame.motion(&mass, &x, |i| v[i]);
+            let frame_bits = |f: &RigidFrame| {
+                let mut out = [f.mass.to_bits(); 13];
+                for (o, c) in out[1..]
+                    .iter_mut()
+                    .zip(f.centre.iter().chain(f.inertia.iter()))
+                {
                     *o = c.to_bits();
                 }
-                out[12] = r.mass.to_bits();
                 out
             };
-            assert_eq!(bits(&got), bits(&want), "seed {seed}");
+            assert_eq!(frame_bits(&frame), frame_bits(&want_frame), "seed {seed}");
+            assert_eq!(
+                motion_bits(&motion),
+                motion_bits(&want_motion),
+                "seed {seed}"
+            );
+            assert_eq!(
+                selective_excess_of(&motion, 20.0).to_bits(),
+                selective_kinetic_excess(&mass, &x, &v, 20.0).to_bits()
+            );
         }
     }
 }

@@ -28,7 +28,7 @@
 
 use crate::Real;
 use crate::granule::damping::{
-    RigidFrame, RigidMotion, damping_forces_in, selective_kinetic_excess_in,
+    MomentSums, RigidFrame, RigidMotion, damping_forces_of, selective_excess_of,
 };
 use crate::granule::forces::{ElementFailure, ElementSettings, ForceSummary, internal_forces};
 use crate::material::Material;
@@ -170,6 +170,11 @@ pub struct StepWork {
     /// the next step's [`predict_in`] and [`correct_in`] instead of taking
     /// it again, while the positions and masses stay as they are.
     pub next_frame: Option<RigidFrame>,
+    /// With `next_frame`, the rigid part of the new velocities v_{n+½} in
+    /// it: the bits of `next_frame.motion(mass, x, |i| v[i])` on the new
+    /// positions, which is the projection the next step's damping takes
+    /// ([`predict_in`]'s `velocity_motion`).
+    pub next_motion: Option<RigidMotion>,
 }
 
 /// First half of a step: forces at x_n, damping, v*, x̃; clears `f_c`.
@@ -182,7 +187,7 @@ pub fn predict(
     loads: &Loads,
 ) -> Result<ForceSummary, ElementFailure> {
     let frame = own_frame(b, loads.rigid_modes);
-    predict_in(&frame, mesh, mat, settings, b, sizes, loads)
+    predict_in(&frame, None, mesh, mat, settings, b, sizes, loads)
 }
 
 /// [`predict`] with the granule's [`RigidFrame`] at x_n taken by the
@@ -190,9 +195,14 @@ pub fn predict(
 /// contact pass (x_n does not change in between) and so take it once per
 /// step instead of three times; the bits of [`predict`]. `frame` must be
 /// `RigidFrame::of(b.mass, b.x)`; it is not read when `loads.rigid_modes`
-/// is false.
+/// is false. `velocity_motion`, if given, must be
+/// `frame.motion(b.mass, b.x, |i| b.v[i])`, the rigid part of v_{n−½} that
+/// the damping leaves undamped (the last corrector's
+/// [`StepWork::next_motion`]); `None` takes it here.
+#[allow(clippy::too_many_arguments)]
 pub fn predict_in(
     frame: &RigidFrame,
+    velocity_motion: Option<&RigidMotion>,
     mesh: &ReferenceMesh<'_>,
     mat: &Material,
     settings: &ElementSettings,
@@ -202,7 +212,12 @@ pub fn predict_in(
 ) -> Result<ForceSummary, ElementFailure> {
     let summary = internal_forces(mesh, mat, settings, b.x, b.cp_inv, b.f_int)?;
     let frame = loads.rigid_modes.then_some(frame);
-    damping_forces_in(frame, b.mass, b.x, b.v, loads.damping_c, b.f_d);
+    let rigid = match (frame, velocity_motion) {
+        (None, _) => RigidMotion::REST,
+        (Some(_), Some(motion)) => *motion,
+        (Some(frame), None) => frame.motion(b.mass, b.x, |i| b.v[i]),
+    };
+    damping_forces_of(&rigid, b.mass, b.x, b.v, loads.damping_c, b.f_d);
     advance_predictor(b, sizes, loads, Motion::Deforming(frame));
     Ok(summary)
 }
@@ -381,6 +396,9 @@ pub fn correct_in(
     let (v_star, f_int, f_d) = (&b.v_star[..n], &b.f_int[..n], &b.f_d[..n]);
     let (x, v) = (&mut b.x[..n], &mut b.v[..n]);
     let mut w = StepWork::default();
+    // Under selective scaling, the sums of the frame at x_{n+1} and of the
+    // rigid part of v_{n+½}, added as the loop makes them.
+    let mut sums = MomentSums::default();
     for i in 0..n {
         let m = mass[i];
         let extra = match boost {
@@ -406,12 +424,17 @@ pub fn correct_in(
             x[i][a] += dt * v_new;
             w.kinetic += 0.5 * m * v_new * v_new;
         }
+        if boost.is_some() {
+            sums.add(m, &x[i], &v[i]);
+        }
     }
     if let Some(k) = boost {
-        // ½ v·M'v: the rigid part carries m'/F, not m' (module docs).
-        let next = RigidFrame::of(b.mass, b.x);
-        w.kinetic -= selective_kinetic_excess_in(&next, b.mass, b.x, b.v, k + 1.0);
+        // ½ v·M'v: the rigid part carries m'/F, not m' (module docs). The
+        // frame and motion have the bits of RigidFrame::of and its motion.
+        let (next, motion) = sums.frame_and_motion(mass, x, v);
+        w.kinetic -= selective_excess_of(&motion, k + 1.0);
         w.next_frame = Some(next);
+        w.next_motion = Some(motion);
     }
     // A pass of its own keeps the loop above as it was (folding this into
     // it doubled its cost); f64::max is maxsd, no libm call (a NaN speed
