@@ -529,13 +529,17 @@ mod tests {
     fn frame_and_motion_have_the_bits_of_the_fused_projection() {
         for seed in 1..20 {
             let (mass, x) = cloud(seed);
-            let mut rng = Rng::new(seed + 100);
-            let v: [[Real; 3]; N] =
-                core::array::from_fn(|_| core::array::from_fn(|_| rng.uniform(-0.1, 0.1)));
+            let v = velocities(seed + 100);
             let want = fused_projection(&mass, &x, &v);
             let got = rigid_motion(&mass, &x, &v);
             assert_eq!(motion_bits(&got), motion_bits(&want), "seed {seed}");
         }
+    }
+
+    /// A random velocity field on the cloud's nodes, m/s.
+    fn velocities(seed: u64) -> [[Real; 3]; N] {
+        let mut rng = Rng::new(seed);
+        core::array::from_fn(|_| core::array::from_fn(|_| rng.uniform(-0.1, 0.1)))
     }
 
     /// Every field of a rigid motion, as bits.
@@ -554,9 +558,7 @@ mod tests {
     fn moment_sums_give_the_frame_and_motion_of_the_separate_passes() {
         for seed in 1..20 {
             let (mass, x) = cloud(seed);
-            let mut rng = Rng::new(seed + 200);
-            let v: [[Real; 3]; N] =
-                core::array::from_fn(|_| core::array::from_fn(|_| rng.uniform(-0.1, 0.1)));
+            let v = velocities(seed + 200);
             let mut sums = MomentSums::default();
             for ((m, xi), vi) in mass.iter().zip(&x).zip(&v) {
                 sums.add(*m, xi, vi);
