@@ -28,7 +28,7 @@
 
 use crate::Real;
 use crate::granule::damping::{
-    MomentSums, RigidFrame, RigidMotion, damping_forces_of, selective_excess_of,
+    MomentSums, RigidFrame, RigidMotion, damping_forces_in, damping_forces_of, selective_excess_of,
 };
 use crate::granule::forces::{ElementFailure, ElementSettings, ForceSummary, internal_forces};
 use crate::material::Material;
@@ -212,12 +212,12 @@ pub fn predict_in(
 ) -> Result<ForceSummary, ElementFailure> {
     let summary = internal_forces(mesh, mat, settings, b.x, b.cp_inv, b.f_int)?;
     let frame = loads.rigid_modes.then_some(frame);
-    let rigid = match (frame, velocity_motion) {
-        (None, _) => RigidMotion::REST,
-        (Some(_), Some(motion)) => *motion,
-        (Some(frame), None) => frame.motion(b.mass, b.x, |i| b.v[i]),
-    };
-    damping_forces_of(&rigid, b.mass, b.x, b.v, loads.damping_c, b.f_d);
+    match (frame, velocity_motion) {
+        (Some(_), Some(motion)) => {
+            damping_forces_of(motion, b.mass, b.x, b.v, loads.damping_c, b.f_d)
+        }
+        _ => damping_forces_in(frame, b.mass, b.x, b.v, loads.damping_c, b.f_d),
+    }
     advance_predictor(b, sizes, loads, Motion::Deforming(frame));
     Ok(summary)
 }
