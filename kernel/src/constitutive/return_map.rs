@@ -122,22 +122,48 @@ impl ReturnMapSystem {
         ]
     }
 
-    /// Jacobian `[[∂R1/∂ε, ∂R1/∂δ], [∂R2/∂ε, ∂R2/∂δ]]` of [`Self::residual`].
+    /// Jacobian `[[∂R1/∂ε, ∂R1/∂δ], [∂R2/∂ε, ∂R2/∂δ]]` of [`Self::residual`]:
+    /// the rows of [`Self::linearise`]'s Jacobian divided by θtr and by
+    /// (2/3)a2σy².
     pub fn jacobian(&self, eps: Real, delta: Real) -> [[Real; 2]; 2] {
-        let alpha = self.alpha(eps);
-        let dalpha = self.dalpha(eps);
-        let beta = self.beta(eps, delta);
-        let d_beta2 = -2.0 * beta * beta / (1.0 + eps + delta);
-        [
+        let (_, j) = self.linearise(eps, delta);
+        let row = [1.0 / self.theta_tr, 1.0 / self.yield_scale];
+        core::array::from_fn(|i| [j[i][0] * row[i], j[i][1] * row[i]])
+    }
+
+    /// The residual and Jacobian that Newton iterates on: R1 multiplied by
+    /// θtr (Pa) and R2 by (2/3)a2σy² (Pa²), i.e. without the normalising
+    /// divisions. A Newton step is the same for any scaling of the rows, and
+    /// the step is Newton's convergence test, so only round-off changes; the
+    /// normalised [`Self::residual`] stays what is reported.
+    ///
+    /// Three divisions per call, two of them in sequence (1/(1+ε), then
+    /// 1/det J in [`Self::newton`]): the corrector is bound by their latency
+    /// (BENCHMARKS.md, session 23), where the normalised pair took about ten.
+    #[inline(always)]
+    fn linearise(&self, eps: Real, delta: Real) -> ([Real; 2], [[Real; 2]; 2]) {
+        let inv_e = 1.0 / (1.0 + eps);
+        let inv_ed = 1.0 / (1.0 + eps + delta);
+        let theta = self.theta_tr * inv_e;
+        let je = self.je(eps);
+        let alpha = theta + elastic::h_lame(self.lambda, self.mu, je);
+        // dθ/dε = −θ/(1+ε); d(εθ)/dε = θ/(1+ε).
+        let theta_e = theta * inv_e;
+        let dalpha = -theta_e - 4.5 * self.lambda * (2.0 * je - 1.0) * self.je_tr;
+        let beta = self.beta_tr * inv_ed;
+        let beta2 = beta * beta;
+        let d_beta2 = -2.0 * beta2 * inv_ed;
+        let a1_alpha = self.a1 * alpha;
+        (
             [
-                (self.a1 * dalpha * delta - self.theta(eps) / (1.0 + eps)) / self.theta_tr,
-                self.a1 * alpha / self.theta_tr,
+                a1_alpha * delta - eps * theta,
+                beta2 + (self.a1 / 3.0) * alpha * alpha - self.yield_scale,
             ],
             [
-                (d_beta2 + (2.0 / 3.0) * self.a1 * alpha * dalpha) / self.yield_scale,
-                d_beta2 / self.yield_scale,
+                [self.a1 * dalpha * delta - theta_e, a1_alpha],
+                [d_beta2 + (2.0 / 3.0) * a1_alpha * dalpha, d_beta2],
             ],
-        ]
+        )
     }
 
     /// Solves the corrector: radial return for a1 = 0, otherwise damped
@@ -200,11 +226,10 @@ impl ReturnMapSystem {
             residual: self.residual(eps, delta)[1],
         };
         for it in 1..=MAX_NEWTON_ITERATIONS {
-            let r = self.residual(eps, delta);
-            let j = self.jacobian(eps, delta);
-            let det = j[0][0] * j[1][1] - j[0][1] * j[1][0];
-            let de = -(j[1][1] * r[0] - j[0][1] * r[1]) / det;
-            let dd = -(j[0][0] * r[1] - j[1][0] * r[0]) / det;
+            let (r, j) = self.linearise(eps, delta);
+            let inv_det = 1.0 / (j[0][0] * j[1][1] - j[0][1] * j[1][0]);
+            let de = -(j[1][1] * r[0] - j[0][1] * r[1]) * inv_det;
+            let dd = -(j[0][0] * r[1] - j[1][0] * r[0]) * inv_det;
             if !(de.is_finite() && dd.is_finite()) {
                 return Err(sol(eps, delta, it, ReturnMethod::Newton));
             }
