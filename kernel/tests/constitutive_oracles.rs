@@ -10,6 +10,7 @@ use common::{Rng, a1_a2, assert_close, material, material_with, normalised_phi};
 use granbed_kernel::Real;
 use granbed_kernel::constitutive::elastic;
 use granbed_kernel::constitutive::return_map::ReturnMapSystem;
+use granbed_kernel::constitutive::update::spherical_part_for_volume;
 use granbed_kernel::constitutive::{UpdateOptions, update_point};
 use granbed_kernel::material::{GranuleType, MaterialParams};
 use granbed_kernel::material_point::{LoadPath, MaterialPoint};
@@ -422,6 +423,41 @@ fn c7_jacobian_matches_finite_differences() {
         checked += 1;
     }
     assert_eq!(checked, 500);
+}
+
+/// The volume fix's cubic (physics.md §1.6): s with det(k n + s 1) = (J^e)²
+/// for a unit deviator n, against a bisection of the same cubic to the
+/// last bit, from starts off by up to 1 % (the corrector's start θ/(3μ) is
+/// off by O(k²)). Tolerance 4 ulp of s: the root is where f changes sign
+/// under f64 round-off, which the two methods find to within a few ulp. A
+/// Newton stopped on its step size alone, |Δs| ≤ 1e-6|s|, leaves errors up
+/// to 2e-13 here and fails.
+#[test]
+fn volume_fix_cubic_is_solved_to_round_off() {
+    let mut rng = Rng::new(9);
+    for _ in 0..20_000 {
+        let k = rng.uniform(1e-6, 0.3);
+        let d = deviator(&voigt_from_mat(
+            &(rng.matrix(1.0) + rng.matrix(1.0).transpose()),
+        ));
+        let n = d.map(|x| x / norm(&d));
+        let je = rng.uniform(0.7, 1.3);
+        let target = je * je;
+        let cubic = |s: Real| s * s * s - 0.5 * k * k * s + k * k * k * det(&n) - target;
+        let root0 = target.cbrt();
+        let (mut lo, mut hi) = (0.5 * root0, 1.5 * root0);
+        assert!(cubic(lo) < 0.0 && cubic(hi) > 0.0, "bracket");
+        loop {
+            let mid = 0.5 * (lo + hi);
+            if mid == lo || mid == hi {
+                break;
+            }
+            if cubic(mid) < 0.0 { lo = mid } else { hi = mid }
+        }
+        let s0 = root0 * (1.0 + rng.uniform(-0.01, 0.01));
+        let s = spherical_part_for_volume(k, det(&n), je, s0);
+        assert_close("s", s, lo, 0.0, 4.0 * Real::EPSILON * lo);
+    }
 }
 
 /// The stored state carries the returned deviator exactly: b^e = F C_p⁻¹ Fᵀ

@@ -345,6 +345,10 @@ pub fn plastic_return(
         residual: math::abs(best.residual),
         iterations: best.iterations,
     })?;
+    // 1/μ does not wait for the corrector, so the divisions by μ below
+    // become multiplications off the chain of dependent divisions that
+    // bounds this function (the Newton's, then the cubic's).
+    let inv_mu = 1.0 / mu;
     let theta = system.theta(sol.eps);
     let je = system.je(sol.eps);
     let alpha = system.alpha(sol.eps);
@@ -358,11 +362,12 @@ pub fn plastic_return(
     let tau = tensor::scale_add_identity(&n, beta, alpha / 3.0);
 
     // New elastic left Cauchy–Green tensor b^e = k n + s 1 (§1.4, §1.6).
-    let k = beta / mu;
+    let k = beta * inv_mu;
+    let s_literal = theta * (inv_mu / 3.0);
     let s = if opts.volume_fix {
-        spherical_part_for_volume(k, tensor::det(&n), je, theta / (3.0 * mu))
+        spherical_part_for_volume(k, tensor::det(&n), je, s_literal)
     } else {
-        theta / (3.0 * mu)
+        s_literal
     };
     let be = tensor::scale_add_identity(&n, k, s);
     let f_inv = tensor::inverse_rows_with_det(F, t.j);
@@ -384,8 +389,15 @@ pub fn plastic_return(
 
 /// The spherical coefficient `s` of b^e = k n + s 1 with det b^e = (J^e)²,
 /// where `n` is a unit deviator with determinant `det_n` (physics.md §1.6):
-/// the root of s³ − (k²/2)s + k³ det n − (J^e)² = 0 reached by Newton from
-/// `s0`. For k = 0 the root is (J^e)^{2/3}.
+/// the root of f(s) = s³ − (k²/2)s + k³ det n − (J^e)² = 0 reached by Newton
+/// from `s0`. For k = 0 the root is (J^e)^{2/3}.
+///
+/// Newton stops after the step Δs whose successor it predicts below
+/// 10⁻¹⁶|s|: the error left after a step is |f''/(2f')| Δs² =
+/// 3|s| Δs²/|f'|, so the test is 3Δs² ≤ 10⁻¹⁶|f'| (no division). The
+/// earlier test |Δs| ≤ 10⁻¹⁶|s| lay below one ulp of s ≈ 1, so it needed a
+/// step of exactly zero: every call ran one step of round-off more, and
+/// 0.7 % ran all 20 (BENCHMARKS.md, session 24).
 pub fn spherical_part_for_volume(k: Real, det_n: Real, je: Real, s0: Real) -> Real {
     let target = je * je;
     if k == 0.0 {
@@ -394,7 +406,7 @@ pub fn spherical_part_for_volume(k: Real, det_n: Real, je: Real, s0: Real) -> Re
     let c1 = 0.5 * k * k;
     let c0 = k * k * k * det_n - target;
     let mut s = s0;
-    for _ in 0..20 {
+    for _ in 0..VOLUME_NEWTON_ITERATIONS {
         let f = s * s * s - c1 * s + c0;
         let df = 3.0 * s * s - c1;
         let ds = f / df;
@@ -402,9 +414,12 @@ pub fn spherical_part_for_volume(k: Real, det_n: Real, je: Real, s0: Real) -> Re
             break;
         }
         s -= ds;
-        if math::abs(ds) <= 1.0e-16 * math::abs(s) {
+        if 3.0 * ds * ds <= 1.0e-16 * math::abs(df) {
             break;
         }
     }
     s
 }
+
+/// Newton steps of [`spherical_part_for_volume`] at most.
+const VOLUME_NEWTON_ITERATIONS: u32 = 20;
