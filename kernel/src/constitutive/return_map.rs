@@ -123,8 +123,8 @@ impl ReturnMapSystem {
     }
 
     /// Jacobian `[[∂R1/∂ε, ∂R1/∂δ], [∂R2/∂ε, ∂R2/∂δ]]` of [`Self::residual`]:
-    /// the rows of [`Self::linearise`]'s Jacobian divided by θtr and by
-    /// (2/3)a2σy².
+    /// the rows of the Jacobian Newton iterates on (without the normalising
+    /// divisions, see `linearise`) divided by θtr and by (2/3)a2σy².
     pub fn jacobian(&self, eps: Real, delta: Real) -> [[Real; 2]; 2] {
         let (_, j) = self.linearise(eps, delta);
         let row = [1.0 / self.theta_tr, 1.0 / self.yield_scale];
