@@ -256,11 +256,12 @@ impl RigidFrame {
     /// L is summed as Σ m r × v, which is Σ m r × (v − v_c) because
     /// Σ m r = 0 about the centre of mass (but for the rounding of the
     /// centre, of the order of the rounding of r = x − x_c that either
-    /// form has), so v_c is not needed inside the loop. A node whose velocity is exactly zero adds nothing and is
-    /// skipped (most nodes of a contact increment): the sums start at +0
-    /// and adding ±0 leaves any of them unchanged, so the bits are those of
-    /// the full sum. The sums run in node order, so the result has the bits
-    /// of [`rigid_motion_of`] whether the frame was taken once or each time.
+    /// form has), so v_c is not needed inside the loop. A node whose
+    /// velocity is exactly zero adds nothing and is skipped (most nodes of
+    /// a contact increment): the sums start at +0 and adding ±0 leaves any
+    /// of them unchanged, so the bits are those of the full sum. The sums
+    /// run in node order, so the result has the bits of [`rigid_motion_of`]
+    /// whether the frame was taken once or each time.
     pub fn motion(
         &self,
         mass: &[Real],
