@@ -100,12 +100,6 @@ impl ReturnMapSystem {
         self.theta(eps) + elastic::h_lame(self.lambda, self.mu, self.je(eps))
     }
 
-    /// dα/dε, Pa.
-    #[inline]
-    pub fn dalpha(&self, eps: Real) -> Real {
-        -self.theta(eps) / (1.0 + eps) - 4.5 * self.lambda * (2.0 * self.je(eps) - 1.0) * self.je_tr
-    }
-
     /// β = βtr/(1+ε+δ), Pa.
     #[inline]
     pub fn beta(&self, eps: Real, delta: Real) -> Real {
@@ -147,7 +141,8 @@ impl ReturnMapSystem {
         let theta = self.theta_tr * inv_e;
         let je = self.je(eps);
         let alpha = theta + elastic::h_lame(self.lambda, self.mu, je);
-        // dθ/dε = −θ/(1+ε); d(εθ)/dε = θ/(1+ε).
+        // dθ/dε = −θ/(1+ε); d(εθ)/dε = θ/(1+ε); dα/dε = dθ/dε + h'(J^e) dJ^e/dε
+        // with dJ^e/dε = −1.5 J^e,tr.
         let theta_e = theta * inv_e;
         let dalpha = -theta_e - 4.5 * self.lambda * (2.0 * je - 1.0) * self.je_tr;
         let beta = self.beta_tr * inv_ed;
