@@ -8,9 +8,10 @@ use granbed_kernel::contact::broad::{
 use granbed_kernel::contact::face_lists::{self, AnchorSurface, FaceLists, FaceListsMut, ReachBox};
 use granbed_kernel::contact::pair::{
     CandidateFace, Constraint, ContactError, Involvement, NodeForce, PairForce, PairSettings, Side,
-    detect, detect_listed, forces, mark_involvement, regap,
+    detect, detect_listed, forces, mark_side, regap,
 };
 use granbed_kernel::contact::surface::{Aabb, SurfaceBody, quad_bounds};
+use granbed_kernel::contact::wall::{Wall, count_wall_contacts};
 use rayon::prelude::*;
 
 use crate::model::{GranuleStore, OwnedReference};
@@ -155,6 +156,13 @@ pub struct ContactPhase {
     boxes: Vec<Aabb>,
     /// Per granule, the box of every surface quad on x̃.
     quad_boxes: Vec<Vec<Aabb>>,
+    /// Per granule: its x̃ moved since its boxes and anchor were last
+    /// brought up to date (a sweep that did not search); the next search
+    /// takes them first ([`Self::refresh_surfaces`]).
+    stale: Vec<bool>,
+    /// Some pair of the list holds nothing of this step's first sweep (the
+    /// list was rebuilt in a later sweep): the later sweeps search.
+    unheld: bool,
     /// Per granule and node: contacts this step (mass sharing).
     pub(super) share: Vec<Vec<u16>>,
     tag: Vec<Vec<u32>>,
@@ -276,9 +284,11 @@ impl ContactPhase {
         &self.work
     }
 
-    /// Granules whose bounding sphere, box or quad boxes (as the last sweep
-    /// left them) differ from those of their x̃ now: always empty, since a
-    /// sweep skips only granules whose x̃ did not move. For tests.
+    /// Granules whose bounding sphere (as the last sweep left it) differs
+    /// from that of their x̃ now, or whose box or quad boxes differ while
+    /// they are not marked stale or a search is due (a stale granule's are
+    /// taken before the next search): always empty, since a sweep skips
+    /// only granules whose x̃ did not move. For tests.
     pub fn stale_boxes(&self, granules: &[GranuleStore], mesh: &OwnedReference) -> Vec<usize> {
         let first = mesh.surface_range().start;
         let mut quads = vec![Aabb::EMPTY; mesh.quads.len()];
@@ -286,9 +296,12 @@ impl ContactPhase {
             .filter(|&g| {
                 let x = &granules[g].x_pred;
                 quad_bounds(x, &mesh.quads, &mut quads);
+                // Stale boxes are allowed only while no search is due.
+                let stale = self.stale.get(g) == Some(&true) && !self.unheld;
                 self.bounds.get(g) != Some(&bounding_sphere(x, first))
-                    || self.boxes.get(g) != Some(&Aabb::of_surface(x, first))
-                    || self.quad_boxes.get(g) != Some(&quads)
+                    || !stale
+                        && (self.boxes.get(g) != Some(&Aabb::of_surface(x, first))
+                            || self.quad_boxes.get(g) != Some(&quads))
             })
             .collect()
     }
@@ -391,11 +404,12 @@ impl ContactPhase {
         n
     }
 
-    /// Bounding spheres and boxes of every granule's predicted surface,
-    /// then the candidate list, rebuilt if a granule drifted half the margin.
+    /// Bounding spheres of every granule's predicted surface, then the
+    /// candidate list, rebuilt if a granule drifted half the margin.
     /// After the first sweep of a step (`first_sweep` false) only the
-    /// granules the last sweep moved (`forced`) get new boxes: the others'
-    /// x̃ and so their boxes are unchanged.
+    /// granules the last sweep moved (`forced`) get new spheres: the
+    /// others' x̃ and so their spheres are unchanged. (The boxes the search
+    /// needs are [`Self::detect`]'s to take.)
     pub(super) fn broad(
         &mut self,
         granules: &[GranuleStore],
@@ -405,23 +419,17 @@ impl ContactPhase {
     ) -> Result<(), ContactError> {
         let first = mesh.surface_range().start;
         let moved = |g: usize| first_sweep || self.forced.get(g).is_none_or(|&f| f);
+        if first_sweep {
+            self.unheld = false;
+        }
         // In place: this runs every sweep of every step.
         self.bounds.resize(granules.len(), Bound::default());
-        self.boxes.resize(granules.len(), Aabb::EMPTY);
-        self.quad_boxes
-            .resize(granules.len(), vec![Aabb::EMPTY; mesh.quads.len()]);
         self.bounds
             .par_iter_mut()
-            .zip(self.boxes.par_iter_mut())
-            .zip(self.quad_boxes.par_iter_mut())
             .zip(granules.par_iter())
             .enumerate()
             .filter(|(g, _)| moved(*g))
-            .for_each(|(_, (((b, a), quads), g))| {
-                *b = bounding_sphere(&g.x_pred, first);
-                *a = Aabb::of_surface(&g.x_pred, first);
-                quad_bounds(&g.x_pred, &mesh.quads, quads);
-            });
+            .for_each(|(_, (b, g))| *b = bounding_sphere(&g.x_pred, first));
         if !self.built.is_empty() && !needs_rebuild(&self.built, &self.bounds, margin) {
             return Ok(());
         }
@@ -446,6 +454,9 @@ impl ContactPhase {
         self.index_pairs();
         self.built.clone_from(&self.bounds);
         self.rebuilds += 1;
+        // The pairs' places in the list moved: what the first sweep held
+        // no longer matches them, so later sweeps of this step search.
+        self.unheld |= !first_sweep;
         Ok(())
     }
 
@@ -469,9 +480,7 @@ impl ContactPhase {
         hold: bool,
     ) -> Result<(), ContactError> {
         let drift = self.list_drift;
-        if drift > 0.0 {
-            self.renew_anchors(granules, mesh, first);
-        }
+        self.refresh_surfaces(granules, mesh, first, !hold || first || self.unheld);
         let (boxes, bounds, quad_boxes) = (&self.boxes, &self.bounds, &self.quad_boxes);
         let (touched, anchors, epochs) = (&self.touched, &self.anchors, &self.epochs);
         let first_surface = mesh.surface_range().start;
@@ -551,25 +560,59 @@ impl ContactPhase {
         Ok(())
     }
 
-    /// Renews the anchor of every granule whose x̃ has left it by more than
-    /// the face-list drift (or holds a NaN, or has none yet): its surface
-    /// x̃ becomes the anchor and its epoch advances, so its pairs rebuild
-    /// their lists. After the first sweep only granules the last sweep
-    /// moved are checked.
-    fn renew_anchors(&mut self, granules: &[GranuleStore], mesh: &OwnedReference, first: bool) {
+    /// Brings what a search reads up to date with x̃: each granule's
+    /// surface box and quad boxes and, with face lists, its anchor — renewed
+    /// when x̃ has left it by more than the face-list drift (or holds a NaN,
+    /// or has none yet): its surface x̃ becomes the anchor and its epoch
+    /// advances, so its pairs rebuild their lists. The first sweep of a step
+    /// takes every granule; a later one only those the last sweep moved
+    /// (`forced`), or marked stale since. A sweep that will not search
+    /// (`searching` false: every pair re-measures what it holds) only marks
+    /// the moved granules stale, so the work is done once, before the next
+    /// search.
+    fn refresh_surfaces(
+        &mut self,
+        granules: &[GranuleStore],
+        mesh: &OwnedReference,
+        first: bool,
+        searching: bool,
+    ) {
         let surface = mesh.surface_range();
         let drift = self.list_drift;
         let forced = &self.forced;
-        self.anchors.resize(granules.len(), Vec::new());
-        self.epochs.resize(granules.len(), 0);
+        let n = granules.len();
+        self.stale.resize(n, true);
+        self.boxes.resize(n, Aabb::EMPTY);
+        self.quad_boxes
+            .resize(n, vec![Aabb::EMPTY; mesh.quads.len()]);
+        // (Without face lists the anchors stay empty and unread.)
+        self.anchors.resize(n, Vec::new());
+        self.epochs.resize(n, 0);
+        let face_lists = drift > 0.0;
         self.anchor_renewals += self
-            .anchors
+            .stale
             .par_iter_mut()
-            .zip(self.epochs.par_iter_mut())
+            .zip(self.boxes.par_iter_mut())
+            .zip(self.quad_boxes.par_iter_mut())
             .zip(granules.par_iter())
+            .zip(self.anchors.par_iter_mut())
+            .zip(self.epochs.par_iter_mut())
             .enumerate()
-            .filter(|(k, _)| first || forced.get(*k).is_none_or(|&f| f))
-            .map(|(_, ((anchor, epoch), g))| {
+            .map(|(k, (((((stale, aabb), quads), g), anchor), epoch))| {
+                let moved = first || forced.get(k).is_none_or(|&f| f);
+                if !searching {
+                    *stale |= moved;
+                    return 0;
+                }
+                if !(moved || *stale) {
+                    return 0;
+                }
+                *stale = false;
+                *aabb = Aabb::of_surface(&g.x_pred, surface.start);
+                quad_bounds(&g.x_pred, &mesh.quads, quads);
+                if !face_lists {
+                    return 0;
+                }
                 let moved = face_lists::drift(&g.x_pred, surface.start, anchor);
                 // A NaN renews too.
                 let renew = moved.is_nan() || moved > drift;
@@ -583,51 +626,40 @@ impl ContactPhase {
             .sum::<u64>();
     }
 
-    /// Contact counts per node for the mass sharing: pairs in list order,
-    /// then every granule's wall contacts (`walls` adds them).
-    pub(super) fn count_pairs(&mut self, granules: &[GranuleStore], mesh: &OwnedReference) {
+    /// Contact counts per node for the mass sharing, granules in parallel:
+    /// each granule's pairs in list order ([`mark_side`]: a node counts
+    /// once per pair it takes part in), then its contacts with `walls`
+    /// (one per wall). The counts are those of one pass over the pairs.
+    pub(super) fn count_contacts(
+        &mut self,
+        granules: &[GranuleStore],
+        mesh: &OwnedReference,
+        walls: &[Wall],
+    ) {
         // Contacts involve surface nodes only: the other entries stay 0 and
         // u32::MAX from `new`.
         let surface = mesh.surface_range();
+        let (pairs_of, work, bounds) = (&self.by_granule, &self.work, &self.bounds);
         self.share
             .par_iter_mut()
             .zip(self.tag.par_iter_mut())
-            .for_each(|(s, t)| {
-                s[surface.clone()].fill(0);
-                t[surface.clone()].fill(u32::MAX);
+            .zip(granules.par_iter())
+            .enumerate()
+            .for_each(|(g, ((count, tag), store))| {
+                count[surface.clone()].fill(0);
+                tag[surface.clone()].fill(u32::MAX);
+                let mut inv = Involvement { tag, count };
+                for &(k, side) in &pairs_of[g] {
+                    let w = &work[k as usize];
+                    if w.count > 0 {
+                        mark_side(w.constraints(), side, &mesh.quads, &mut inv, k);
+                    }
+                }
+                let b = bounds[g];
+                for w in walls.iter().filter(|w| w.may_touch(&b.centre, b.radius)) {
+                    count_wall_contacts(w, surface.clone(), &store.x_pred, inv.count);
+                }
             });
-        for (k, (p, w)) in self.pairs.iter().zip(&self.work).enumerate() {
-            if w.count == 0 {
-                continue;
-            }
-            let (a, b) = (p.a as usize, p.b as usize);
-            let (lo, hi) = self.share.split_at_mut(b);
-            let (tlo, thi) = self.tag.split_at_mut(b);
-            let mut inv_a = Involvement {
-                tag: &mut tlo[a],
-                count: &mut lo[a],
-            };
-            let mut inv_b = Involvement {
-                tag: &mut thi[0],
-                count: &mut hi[0],
-            };
-            let body_a = body(
-                &granules[a],
-                mesh,
-                (self.boxes[a], self.bounds[a], &self.quad_boxes[a]),
-            );
-            let body_b = body(
-                &granules[b],
-                mesh,
-                (self.boxes[b], self.bounds[b], &self.quad_boxes[b]),
-            );
-            mark_involvement(
-                w.constraints(),
-                (&body_a, &mut inv_a),
-                (&body_b, &mut inv_b),
-                k as u32,
-            );
-        }
     }
 
     /// The forces of every pair (in parallel) into the pairs' own lists.
@@ -816,5 +848,144 @@ fn detect_growing(
             }
             Err(e) => return Err(e),
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::model::MeshLevel;
+
+    const R: Real = 0.5e-3;
+
+    /// Granules of `mesh` translated to `centres`, at rest (x = x̃).
+    fn granules_at(mesh: &OwnedReference, centres: &[[Real; 3]]) -> Vec<GranuleStore> {
+        centres
+            .iter()
+            .map(|c| {
+                let mut g = GranuleStore::new(mesh, 1);
+                for (x, x0) in g.x.iter_mut().zip(&mesh.positions) {
+                    *x = core::array::from_fn(|a| c[a] + x0[a]);
+                }
+                g.x_pred.clone_from(&g.x);
+                g
+            })
+            .collect()
+    }
+
+    fn phase(granules: &[GranuleStore], mesh: &OwnedReference) -> ContactPhase {
+        ContactPhase::new(granules, mesh)
+            .with_face_lists(super::super::FACE_LIST_SKIN * mesh.mean_face_diagonal())
+    }
+
+    /// The constraints of pair (a, b), if it is a candidate.
+    fn pair_constraints(p: &ContactPhase, a: u32, b: u32) -> Option<Vec<Constraint>> {
+        let k = p.pairs.iter().position(|q| (q.a, q.b) == (a, b))?;
+        Some(p.work[k].constraints().to_vec())
+    }
+
+    /// A held sweep leaves the boxes and anchor of a granule it moved for
+    /// the next search to take. When the list is rebuilt within the step,
+    /// the new pair is searched, and on the moved granule's current boxes
+    /// and anchor: it finds what a first sweep on the same x̃ finds.
+    #[test]
+    fn a_pair_new_in_a_later_sweep_is_searched_on_current_boxes() {
+        let mesh = OwnedReference::sphere(R, MeshLevel::new(4, 1), false).unwrap();
+        let settings = PairSettings::standard(0.1);
+        let overlap = 0.02 * R;
+        // A at the origin touching B; C far away, to be moved onto A.
+        let start = [
+            [0.0; 3],
+            [2.0 * R - overlap, 0.0, 0.0],
+            [0.0, 10.0 * R, 0.0],
+        ];
+        let mut granules = granules_at(&mesh, &start);
+        let mut p = phase(&granules, &mesh);
+        p.broad(&granules, &mesh, settings.margin, true).unwrap();
+        p.detect(&granules, &mesh, &settings, true, true).unwrap();
+        assert!(
+            pair_constraints(&p, 0, 2).is_none(),
+            "C is no candidate yet"
+        );
+        let held = pair_constraints(&p, 0, 1).unwrap();
+        assert!(!held.is_empty(), "A and B touch");
+
+        // A later sweep that moves B a little (no rebuild, no search):
+        // B's boxes are left stale.
+        let shift = |g: &mut GranuleStore, d: [Real; 3]| {
+            for x in &mut g.x_pred {
+                for a in 0..3 {
+                    x[a] += d[a];
+                }
+            }
+        };
+        p.forced = vec![false, true, false];
+        p.touched.clone_from(&p.forced);
+        shift(&mut granules[1], [-1e-3 * settings.margin, 0.0, 0.0]);
+        p.broad(&granules, &mesh, settings.margin, false).unwrap();
+        p.detect(&granules, &mesh, &settings, false, true).unwrap();
+        assert!(p.stale[1], "a held sweep takes no boxes");
+        assert!(p.stale_boxes(&granules, &mesh).is_empty());
+
+        // The next moves C onto A from below: the list is rebuilt, the new
+        // pair (A, C) searched, and B's boxes taken as well.
+        p.forced = vec![false, false, true];
+        p.touched.clone_from(&p.forced);
+        let to = [0.0, -(2.0 * R - overlap), 0.0];
+        let now = granules[2].x_pred[0][1] - mesh.positions[0][1];
+        shift(&mut granules[2], [0.0, to[1] - now, 0.0]);
+        p.broad(&granules, &mesh, settings.margin, false).unwrap();
+        p.detect(&granules, &mesh, &settings, false, true).unwrap();
+        let found = pair_constraints(&p, 0, 2).expect("(A, C) is a candidate");
+
+        let mut fresh = phase(&granules, &mesh);
+        fresh
+            .broad(&granules, &mesh, settings.margin, true)
+            .unwrap();
+        fresh
+            .detect(&granules, &mesh, &settings, true, true)
+            .unwrap();
+        let expected = pair_constraints(&fresh, 0, 2).unwrap();
+        assert!(!expected.is_empty(), "A and C touch");
+        assert_eq!(found, expected, "the new pair was not searched on C's x̃");
+        assert!(p.stale_boxes(&granules, &mesh).is_empty());
+
+        // The mass sharing's counts, granule by granule, against their
+        // definition: per node, the pairs it takes part in as a slave or as
+        // a master corner of non-zero weight.
+        p.count_contacts(&granules, &mesh, &[]);
+        let mut expected = vec![vec![0u16; mesh.positions.len()]; granules.len()];
+        for (q, w) in p.pairs.iter().zip(&p.work) {
+            for (g, side) in [(q.a as usize, Side::A), (q.b as usize, Side::B)] {
+                let mut nodes: Vec<usize> = w
+                    .constraints()
+                    .iter()
+                    .flat_map(|c| {
+                        let corners = mesh.quads[c.quad as usize]
+                            .iter()
+                            .zip(c.weights)
+                            .filter(|(_, wt)| *wt != 0.0)
+                            .map(|(&i, _)| i as usize);
+                        let own: Vec<usize> = if c.side == side {
+                            vec![c.slave as usize]
+                        } else {
+                            corners.collect()
+                        };
+                        own
+                    })
+                    .collect();
+                nodes.sort_unstable();
+                nodes.dedup();
+                for i in nodes {
+                    expected[g][i] += 1;
+                }
+            }
+        }
+        // (The last sweep moved C only, so only (A, C) holds constraints.)
+        assert!(
+            [0, 2].iter().all(|&g| expected[g].iter().any(|&n| n > 0)),
+            "A or C without contacts"
+        );
+        assert_eq!(p.share, expected);
     }
 }

@@ -6,7 +6,7 @@ use core::fmt;
 use granbed_kernel::Real;
 use granbed_kernel::contact::pair::ContactError;
 use granbed_kernel::contact::rigid::RigidShift;
-use granbed_kernel::contact::wall::{PredictedNodes, WallForce, count_wall_contacts, wall_contact};
+use granbed_kernel::contact::wall::{PredictedNodes, WallForce, wall_contact};
 use granbed_kernel::granule::damping::{RigidFrame, selective_contact_masses};
 use granbed_kernel::granule::dynamics::{
     Loads, StepSizes, StepWork, correct_in, predict_in, predict_rigid,
@@ -488,17 +488,7 @@ impl Assembly<'_> {
             .map_err(contact_error)?;
         let surface = mesh.surface_range();
         if p.mass_sharing {
-            self.contact.count_pairs(&self.granules, mesh);
-            self.contact
-                .share
-                .par_iter_mut()
-                .zip(self.granules.par_iter())
-                .zip(self.contact.bounds.par_iter())
-                .for_each(|((share, g), b)| {
-                    for w in walls.iter().filter(|w| w.may_touch(&b.centre, b.radius)) {
-                        count_wall_contacts(w, surface.clone(), &g.x_pred, share);
-                    }
-                });
+            self.contact.count_contacts(&self.granules, mesh, walls);
         }
         self.contact
             .forces(&self.granules, mesh, &p.contact, dt2, p.mass_sharing, first)

@@ -667,7 +667,7 @@ impl Involvement<'_> {
 
 /// Counts, once per pair (tag `tag`, unique within the step), every node of
 /// A and B that takes part in one of `constraints` as a slave or as a
-/// master corner with a non-zero weight.
+/// master corner with a non-zero weight: [`mark_side`] for A, then for B.
 pub fn mark_involvement(
     constraints: &[Constraint],
     a: (&SurfaceBody<'_>, &mut Involvement<'_>),
@@ -676,25 +676,33 @@ pub fn mark_involvement(
 ) {
     let (body_a, inv_a) = a;
     let (body_b, inv_b) = b;
-    for c in constraints {
-        match c.side {
-            Side::A => mark_constraint(c, inv_a, body_b.quads, inv_b, tag),
-            Side::B => mark_constraint(c, inv_b, body_a.quads, inv_a, tag),
-        }
-    }
+    mark_side(constraints, Side::A, body_a.quads, inv_a, tag);
+    mark_side(constraints, Side::B, body_b.quads, inv_b, tag);
 }
 
-fn mark_constraint(
-    c: &Constraint,
-    slave: &mut Involvement<'_>,
-    master_quads: &[[u32; 4]],
-    master: &mut Involvement<'_>,
+/// The half of [`mark_involvement`] that concerns one body of the pair:
+/// counts, once per pair (tag `tag`), every node of the body on `side`
+/// (its surface quads `quads`) that is the slave of one of `constraints`
+/// or a corner with a non-zero weight of the master face of one. A node's
+/// count does not depend on the other body, so a driver may count each
+/// granule over its own pairs, granules in parallel, and get the counts
+/// of a pass over the pairs.
+pub fn mark_side(
+    constraints: &[Constraint],
+    side: Side,
+    quads: &[[u32; 4]],
+    inv: &mut Involvement<'_>,
     tag: u32,
 ) {
-    slave.mark(c.slave as usize, tag);
-    for (id, w) in master_quads[c.quad as usize].iter().zip(c.weights) {
-        if w != 0.0 {
-            master.mark(*id as usize, tag);
+    for c in constraints {
+        if c.side == side {
+            inv.mark(c.slave as usize, tag);
+        } else {
+            for (id, w) in quads[c.quad as usize].iter().zip(c.weights) {
+                if w != 0.0 {
+                    inv.mark(*id as usize, tag);
+                }
+            }
         }
     }
 }
