@@ -280,7 +280,9 @@ pub struct GranuleStore {
     /// The masses the kinematic contact sees, kg: `mass`, or under selective
     /// mass scaling the effective nodal masses of
     /// [`granbed_kernel::granule::damping::selective_contact_masses`]
-    /// (set by the owner of the contact phase).
+    /// (set by the owner of the contact phase; the assembly sets them on
+    /// the surface nodes only, which are all that contact touches, and
+    /// leaves the interior at `mass`).
     pub contact_mass: Vec<Real>,
     /// Per node, bit a = velocity component a held at zero.
     pub fixed: Vec<u8>,

@@ -584,6 +584,7 @@ impl Assembly<'_> {
         self.frames
             .resize(self.granules.len(), RigidFrame::default());
         self.frame_motions.resize(self.granules.len(), None);
+        let contact_nodes = self.mesh.surface_range();
         let predicted: Vec<Result<ForceSummary, ElementFailure>> = self
             .granules
             .par_iter_mut()
@@ -597,13 +598,16 @@ impl Assembly<'_> {
                         *frame = RigidFrame::of(&g.mass, &g.x);
                     }
                     if selective > 1.0 {
-                        // Every buffer of a GranuleStore has one entry per node.
+                        // Contact touches surface nodes only, so only
+                        // theirs are taken (every buffer of a GranuleStore
+                        // has one entry per node).
+                        let s = contact_nodes.clone();
                         let written = selective_contact_masses(
                             frame,
-                            &g.mass,
-                            &g.x,
+                            &g.mass[s.clone()],
+                            &g.x[s.clone()],
                             selective,
-                            &mut g.contact_mass,
+                            &mut g.contact_mass[s],
                         );
                         debug_assert!(written);
                     }
