@@ -11,7 +11,7 @@
 
 use crate::Real;
 use crate::contact::pair::ContactError;
-use crate::contact::quad::{Vec3, norm, sub};
+use crate::contact::quad::{Vec3, dot, norm, sub};
 
 /// A granule's bounding sphere: centroid of its surface nodes and the
 /// largest distance of a surface node from it.
@@ -38,10 +38,17 @@ pub fn bounding_sphere(x: &[Vec3], first_surface: usize) -> Bound {
     }
     let inv = 1.0 / surface.len() as Real;
     let centre = c.map(|v| v * inv);
-    let radius = surface
-        .iter()
-        .fold(0.0, |r, p| crate::math::max(r, norm(&sub(p, &centre))));
-    Bound { centre, radius }
+    // max |p − c| as √(max |p − c|²): a correctly rounded square root is
+    // monotone, so this is the same number with one root instead of one
+    // per node.
+    let radius_squared = surface.iter().fold(0.0, |r, p| {
+        let d = sub(p, &centre);
+        crate::math::max(r, dot(&d, &d))
+    });
+    Bound {
+        centre,
+        radius: crate::math::sqrt(radius_squared),
+    }
 }
 
 /// A candidate pair of granules, a < b.
@@ -205,5 +212,31 @@ impl CellGrid {
     fn neighbours(&self, c: [usize; 3]) -> impl Iterator<Item = [usize; 3]> + '_ {
         let range = move |a: usize| c[a].saturating_sub(1)..=(c[a] + 1).min(self.dims[a] - 1);
         range(2).flat_map(move |z| range(1).flat_map(move |y| range(0).map(move |x| [x, y, z])))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::rng::Rng;
+
+    /// The radius is the largest node distance, taken as one root of the
+    /// largest squared distance: the bits of the largest root.
+    #[test]
+    fn the_radius_is_the_largest_distance_to_the_bit() {
+        let mut rng = Rng::new(7);
+        let mut x = [[0.0; 3]; 64];
+        for cloud in 0..2000 {
+            let scale = 10f64.powi(cloud % 9 - 6);
+            for p in &mut x {
+                *p = core::array::from_fn(|_| scale * rng.uniform(-1.0, 1.0));
+            }
+            let first = cloud as usize % 8;
+            let b = bounding_sphere(&x, first);
+            let largest = x[first..]
+                .iter()
+                .fold(0.0, |r, p| crate::math::max(r, norm(&sub(p, &b.centre))));
+            assert_eq!(b.radius.to_bits(), largest.to_bits(), "cloud {cloud}");
+        }
     }
 }
