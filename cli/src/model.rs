@@ -281,8 +281,8 @@ pub struct GranuleStore {
     /// mass scaling the effective nodal masses of
     /// [`granbed_kernel::granule::damping::selective_contact_masses`]
     /// (set by the owner of the contact phase; the assembly sets them on
-    /// the surface nodes only, which are all that contact touches, and
-    /// leaves the interior at `mass`).
+    /// the surface nodes only, which are all that contact touches: the
+    /// interior entries are not kept up to date and nothing reads them).
     pub contact_mass: Vec<Real>,
     /// Per node, bit a = velocity component a held at zero.
     pub fixed: Vec<u8>,

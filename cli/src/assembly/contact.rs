@@ -153,8 +153,10 @@ pub struct ContactPhase {
     built: Vec<Bound>,
     /// Per granule, the bounding sphere of its surface on the last x̃.
     pub(super) bounds: Vec<Bound>,
+    /// Per granule, the box of its surface on x̃ as of its last refresh
+    /// (current unless `stale`; [`Self::refresh_surfaces`]).
     boxes: Vec<Aabb>,
-    /// Per granule, the box of every surface quad on x̃.
+    /// Per granule, the box of every surface quad on x̃, as `boxes`.
     quad_boxes: Vec<Vec<Aabb>>,
     /// Per granule: its x̃ moved since its boxes and anchor were last
     /// brought up to date (a sweep that did not search); the next search
@@ -288,7 +290,8 @@ impl ContactPhase {
     /// from that of their x̃ now, or whose box or quad boxes differ while
     /// they are not marked stale or a search is due (a stale granule's are
     /// taken before the next search): always empty, since a sweep skips
-    /// only granules whose x̃ did not move. For tests.
+    /// only granules whose x̃ did not move, and a sweep that searches
+    /// nothing defers the boxes of those it moved, marked stale. For tests.
     pub fn stale_boxes(&self, granules: &[GranuleStore], mesh: &OwnedReference) -> Vec<usize> {
         let first = mesh.surface_range().start;
         let mut quads = vec![Aabb::EMPTY; mesh.quads.len()];
@@ -483,6 +486,7 @@ impl ContactPhase {
         self.refresh_surfaces(granules, mesh, first, !hold || first || self.unheld);
         let (boxes, bounds, quad_boxes) = (&self.boxes, &self.bounds, &self.quad_boxes);
         let (touched, anchors, epochs) = (&self.touched, &self.anchors, &self.epochs);
+        let stale = &self.stale;
         let first_surface = mesh.surface_range().start;
         let anchor = |g: usize| AnchorSurface {
             x: &anchors[g],
@@ -545,6 +549,7 @@ impl ContactPhase {
                         w.count = regap(&body_a, &body_b, &w.held, &mut w.constraints)?;
                         return Ok((scratch, builds, searches));
                     }
+                    debug_assert!(!stale[a] && !stale[b], "pair {p:?} searched on stale boxes");
                     searches += 1;
                     builds += search(p, (&body_a, &body_b), &mut scratch, w)?;
                     // Every search, and only a search, renews what is held
@@ -663,7 +668,8 @@ impl ContactPhase {
     }
 
     /// The forces of every pair (in parallel) into the pairs' own lists.
-    /// `sharing` selects the counts of [`Self::count_pairs`] (else none).
+    /// `sharing` selects the counts of [`Self::count_contacts`] (else
+    /// none). (The bodies' boxes may be stale here: the forces read none.)
     /// `first` marks the first sweep of a step (which resets the step's
     /// per-pair totals).
     pub(super) fn forces(
@@ -987,5 +993,65 @@ mod tests {
             "A or C without contacts"
         );
         assert_eq!(p.share, expected);
+    }
+
+    /// The mass sharing's counts, granule by granule, equal a pass over
+    /// the pairs in list order with `mark_involvement`, on a cluster where
+    /// nodes of A take part in two pairs (B and C touch A side by side).
+    #[test]
+    fn the_counts_per_granule_are_those_of_a_pass_over_the_pairs() {
+        let mesh = OwnedReference::sphere(R, MeshLevel::new(4, 1), false).unwrap();
+        let settings = PairSettings::standard(0.1);
+        let d = 2.0 * R - 0.04 * R;
+        let t = 1f64.to_radians();
+        let centres = [
+            [0.0; 3],
+            [d * t.cos(), d * t.sin(), 0.0],
+            [d * t.cos(), -d * t.sin(), 0.0],
+        ];
+        let granules = granules_at(&mesh, &centres);
+        let mut p = phase(&granules, &mesh);
+        p.broad(&granules, &mesh, settings.margin, true).unwrap();
+        p.detect(&granules, &mesh, &settings, true, true).unwrap();
+        p.count_contacts(&granules, &mesh, &[]);
+
+        let nodes = mesh.positions.len();
+        let mut count = vec![vec![0u16; nodes]; granules.len()];
+        let mut tag = vec![vec![u32::MAX; nodes]; granules.len()];
+        for (k, (q, w)) in p.pairs.iter().zip(&p.work).enumerate() {
+            let (a, b) = (q.a as usize, q.b as usize);
+            let (count_lo, count_hi) = count.split_at_mut(b);
+            let (tag_lo, tag_hi) = tag.split_at_mut(b);
+            let body_of = |g: usize| {
+                body(
+                    &granules[g],
+                    &mesh,
+                    (p.boxes[g], p.bounds[g], &p.quad_boxes[g]),
+                )
+            };
+            granbed_kernel::contact::pair::mark_involvement(
+                w.constraints(),
+                (
+                    &body_of(a),
+                    &mut Involvement {
+                        tag: &mut tag_lo[a],
+                        count: &mut count_lo[a],
+                    },
+                ),
+                (
+                    &body_of(b),
+                    &mut Involvement {
+                        tag: &mut tag_hi[0],
+                        count: &mut count_hi[0],
+                    },
+                ),
+                k as u32,
+            );
+        }
+        assert!(
+            count[0].iter().any(|&n| n >= 2),
+            "no node of A in two pairs"
+        );
+        assert_eq!(p.share, count);
     }
 }

@@ -10,7 +10,8 @@
 //! broad     bounding spheres of x̃; rebuild the candidate pairs when a granule
 //!           drifted half the margin (contact::broad)
 //! detect    every candidate pair in parallel: constraints on x̃ (contact::pair)
-//! share     contact counts per node, pairs in list order, then walls
+//! share     contact counts per node, granules in parallel: each over its
+//!           pairs in list order, then walls
 //! forces    every pair in parallel, into the pair's own force list
 //! gather    every granule in parallel: its pairs' forces in pair order, then
 //!           its wall forces in wall order → f_c

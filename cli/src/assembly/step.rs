@@ -584,7 +584,7 @@ impl Assembly<'_> {
         self.frames
             .resize(self.granules.len(), RigidFrame::default());
         self.frame_motions.resize(self.granules.len(), None);
-        let contact_nodes = self.mesh.surface_range();
+        let surface = self.mesh.surface_range();
         let predicted: Vec<Result<ForceSummary, ElementFailure>> = self
             .granules
             .par_iter_mut()
@@ -601,7 +601,7 @@ impl Assembly<'_> {
                         // Contact touches surface nodes only, so only
                         // theirs are taken (every buffer of a GranuleStore
                         // has one entry per node).
-                        let s = contact_nodes.clone();
+                        let s = surface.clone();
                         let written = selective_contact_masses(
                             frame,
                             &g.mass[s.clone()],
@@ -663,8 +663,7 @@ impl Assembly<'_> {
         // granule's rigid response to Δf (M'⁻¹ as in `correct`, which also
         // projects at x_n); the interior's share of it is left to `correct`.
         // (No component is held in an assembly, so unlike `correct` the
-        // response ignores `fixed`.)
-        let surface = self.mesh.surface_range();
+        // response ignores `fixed`.) `surface` is the range taken above.
         // Taken for the sweeps (which borrow the assembly) and put back.
         let frames = core::mem::take(&mut self.frames);
         for sweep in 0..p.contact_sweeps {

@@ -649,7 +649,8 @@ fn concave_edge<'c>(
 
 /// Per-node contact counts of one body for the mass sharing of §5.3.
 pub struct Involvement<'a> {
-    /// Last pair tag that counted the node (the driver resets it each step).
+    /// Last pair tag that counted the node (the driver resets it before
+    /// each count).
     pub tag: &'a mut [u32],
     /// Contacts the node takes part in this step.
     pub count: &'a mut [u16],

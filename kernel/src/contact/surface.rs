@@ -34,7 +34,9 @@ pub struct SurfaceBody<'a> {
     /// ([`crate::contact::broad::bounding_sphere`]).
     pub sphere: Bound,
     /// Box of each quad's predicted corners ([`quad_bounds`]), one per quad:
-    /// computed once per sweep and shared by all the body's pairs.
+    /// computed once per configuration searched and shared by all the
+    /// body's pairs. Only the detection reads this and `bounds`; the forces
+    /// and [`crate::contact::pair::regap`] do not.
     pub quad_bounds: &'a [Aabb],
 }
 
