@@ -484,3 +484,66 @@ fn e3_exactly_six_zero_modes_with_hourglass_control() {
         count(&without)
     );
 }
+
+/// Variable mass scaling's step: multiplying every mass of a granule by k
+/// and telling its policy (`TimeStepControl::scale_masses`) gives the step
+/// a fresh power iteration finds on the heavier granule, √k × the old one
+/// (M → kM scales every ω² by 1/k); the element estimate does not see the
+/// masses and refuses.
+#[test]
+fn heavier_masses_lengthen_the_global_step_by_the_square_root() {
+    use granbed_kernel::granule::timestep::{
+        Linearisation, PowerIterationBuffers, TimeStepControl, TimeStepMethod, power_start,
+    };
+    let mesh = OwnedReference::sphere(R, MeshLevel::STANDARD, false).unwrap();
+    let view = mesh.view();
+    let mat = elastic_solid();
+    let mut store = GranuleStore::new(&mesh, 1);
+    store.buffers().reset(&view, &mat);
+    let n = mesh.positions.len();
+    let method = TimeStepMethod::Global {
+        power_interval: 10,
+        power_iterations: 30,
+    };
+    let estimate = |control: &mut TimeStepControl, mass: &[Real]| {
+        let mut mode = vec![[0.0; 3]; n];
+        power_start(&mut mode);
+        let (mut xp, mut fp, mut fm) = (vec![[0.0; 3]; n], vec![[0.0; 3]; n], vec![[0.0; 3]; n]);
+        let mut cp = store.cp_inv.clone();
+        let at = Linearisation {
+            mass,
+            x: &store.x,
+            cp_inv: &store.cp_inv,
+        };
+        let mut pb = PowerIterationBuffers {
+            mode: &mut mode,
+            x_pert: &mut xp,
+            f_plus: &mut fp,
+            f_minus: &mut fm,
+            cp_scratch: &mut cp,
+        };
+        control
+            .estimate(&view, &mat, &settings(0.05), &at, &mut pb)
+            .unwrap()
+    };
+    let k = 2.5;
+    let heavy: Vec<Real> = store.mass.iter().map(|m| k * m).collect();
+    let mut control = TimeStepControl::new(method, 0.9);
+    let light = estimate(&mut control, &store.mass);
+    assert!(control.scale_masses(k));
+    // The next re-estimate is not a power iteration: it takes the scaled memory.
+    let scaled = estimate(&mut control, &heavy);
+    let fresh = estimate(&mut TimeStepControl::new(method, 0.9), &heavy);
+    println!("light {light:e} s, scaled {scaled:e} s, fresh on the heavy masses {fresh:e} s");
+    assert!(
+        (scaled / (light * k.sqrt()) - 1.0).abs() < 1e-12,
+        "scaled {scaled:e} against √k × {light:e}"
+    );
+    assert!(
+        (scaled / fresh - 1.0).abs() < 2e-3,
+        "scaled {scaled:e}, fresh {fresh:e}"
+    );
+    let mut element = TimeStepControl::new(TimeStepMethod::Element, 0.9);
+    assert!(!element.scale_masses(k));
+    assert!(!control.scale_masses(Real::NAN) && !control.scale_masses(0.0));
+}

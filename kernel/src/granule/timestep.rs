@@ -193,6 +193,22 @@ impl TimeStepControl {
         (self.since_power, self.global_dt, self.global_length) = memory;
     }
 
+    /// Tells the policy that every mass of its granule was multiplied by
+    /// `factor` (variable mass scaling): M → kM scales every eigenvalue
+    /// ω² of M⁻¹K by 1/k and leaves the modes as they are, so the
+    /// remembered 2/ω_max grows by √k and the power iteration's warm start
+    /// stays a mode. Returns false, changing nothing, for the element
+    /// estimate (which does not see the masses) or a factor that is not
+    /// finite and positive.
+    pub fn scale_masses(&mut self, factor: Real) -> bool {
+        let global = matches!(self.method, TimeStepMethod::Global { .. });
+        let usable = factor > 0.0 && factor.is_finite();
+        if global && usable {
+            self.global_dt *= crate::math::sqrt(factor);
+        }
+        global && usable
+    }
+
     /// A policy with safety factor `safety` (0 < C ≤ 1).
     pub fn new(method: TimeStepMethod, safety: Real) -> Self {
         Self {
