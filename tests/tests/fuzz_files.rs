@@ -201,45 +201,108 @@ fn a_wrong_version_is_named() {
     assert!(e.contains("format version 99"), "{e}");
 }
 
-/// A version 2 checkpoint (before the per-granule flags word) still reads,
-/// with every granule deformable. The version 2 bytes are made from this
-/// build's own: two checkpoints of one state that differ only in the
-/// granules' rigid flags differ only in the flags words, which are cut out.
-#[test]
-fn a_version_2_checkpoint_reads_with_every_granule_deformable() {
-    let (dir, _) = base_checkpoint();
-    let mut ck = read(dir).unwrap();
-    let with_flags = |rigid: bool, ck: &mut Checkpoint| {
-        for g in &mut ck.state.granules {
-            g.rigid = rigid;
-        }
-        let d = common::fresh_dir("fuzz_files", &format!("flags_{rigid}"));
+/// The 8-byte words at which the checkpoints of `ck` before and after
+/// `edit` differ (their offsets in the file), with the unedited bytes.
+/// Each edited word must differ in its lowest byte (the first, little
+/// endian), where the word is taken to start: see [`flip`].
+fn edited_words(ck: &Checkpoint, edit: impl Fn(&mut Checkpoint)) -> (Vec<usize>, Vec<u8>) {
+    let bytes = |ck: &Checkpoint, name: &str| {
+        let d = common::fresh_dir("fuzz_files", name);
         std::fs::create_dir_all(&d).unwrap();
         ck.write(&d).unwrap();
         std::fs::read(d.join(FILE_NAME)).unwrap()
     };
-    let (on, off) = (with_flags(true, &mut ck), with_flags(false, &mut ck));
-    assert_eq!(on.len(), off.len());
-    let words: Vec<usize> = (36..on.len()).filter(|&k| on[k] != off[k]).collect();
-    assert_eq!(
-        words.len(),
-        ck.state.granules.len(),
-        "one flags word per granule"
-    );
+    let before = bytes(ck, "edit_before");
+    let mut edited = ck.clone();
+    edit(&mut edited);
+    let after = bytes(&edited, "edit_after");
+    assert_eq!(before.len(), after.len());
+    let mut words: Vec<usize> = Vec::new();
+    for k in (36..before.len()).filter(|&k| before[k] != after[k]) {
+        // A word starts on the first differing byte not inside the last.
+        if words.last().is_none_or(|&w| k >= w + 8) {
+            words.push(k);
+        }
+    }
+    (words, before)
+}
+
+/// `x` with its sign and lowest mantissa bit flipped: it differs from `x`
+/// in the first and the last byte of its word.
+fn flip(x: f64) -> f64 {
+    f64::from_bits(x.to_bits() ^ (1 << 63 | 1))
+}
+
+/// `bytes` (a checkpoint file) with the 8-byte words at `cut` removed,
+/// relabelled `version` under a fresh length and checksum.
+fn older(bytes: &[u8], cut: &[usize], version: u32) -> Vec<u8> {
     let mut payload = Vec::new();
     let mut from = 36;
-    for &k in &words {
-        payload.extend_from_slice(&off[from..k]);
+    for &k in cut {
+        payload.extend_from_slice(&bytes[from..k]);
         from = k + 8;
     }
-    payload.extend_from_slice(&off[from..]);
-    let mut v2 = off[..16].to_vec();
-    v2.extend_from_slice(&2u32.to_le_bytes());
-    v2.extend_from_slice(&(payload.len() as u64).to_le_bytes());
-    v2.extend_from_slice(&fnv1a(&payload).to_le_bytes());
-    v2.extend_from_slice(&payload);
+    payload.extend_from_slice(&bytes[from..]);
+    let mut b = bytes[..16].to_vec();
+    b.extend_from_slice(&version.to_le_bytes());
+    b.extend_from_slice(&(payload.len() as u64).to_le_bytes());
+    b.extend_from_slice(&fnv1a(&payload).to_le_bytes());
+    b.extend_from_slice(&payload);
+    b
+}
+
+/// Checkpoints of older formats still read: version 3 (before the mass
+/// factors and the undeformed step) with every factor 1 and no undeformed
+/// step (the resuming run keeps its own), version 2 (before the
+/// per-granule flags word as well) with every granule deformable too. The
+/// older bytes are made from this build's own: two checkpoints of one
+/// state that differ only in a field differ only in its words, which are
+/// cut out.
+#[test]
+fn version_2_and_3_checkpoints_read_with_the_fields_they_lack_at_their_defaults() {
+    let (dir, _) = base_checkpoint();
+    let mut ck = read(dir).unwrap();
+    for g in &mut ck.state.granules {
+        (g.rigid, g.mass_factor) = (false, 1.0);
+    }
+    let granules = ck.state.granules.len();
+    let (flags, _) = edited_words(&ck, |c| {
+        c.state.granules.iter_mut().for_each(|g| g.rigid = true)
+    });
+    let (factors, _) = edited_words(&ck, |c| {
+        c.state
+            .granules
+            .iter_mut()
+            .for_each(|g| g.mass_factor = flip(1.0))
+    });
+    let (step, bytes) = edited_words(&ck, |c| {
+        c.state.undeformed_step = flip(c.state.undeformed_step)
+    });
+    assert_eq!(
+        (flags.len(), factors.len(), step.len()),
+        (granules, granules, 1)
+    );
+    // Each factor follows its granule's flags word.
+    assert!(flags.iter().zip(&factors).all(|(f, k)| *k == f + 8));
+    let mut expected = ck.clone();
+    expected.state.undeformed_step = 0.0;
+
+    let v3_cut: Vec<usize> = step.iter().chain(&factors).copied().collect();
+    let v3 = older(&bytes, &v3_cut, 3);
+    let old = read(&write_checkpoint("version3", &v3)).expect("a version 3 checkpoint reads");
+    assert_eq!(
+        old, expected,
+        "version 3 reads as the same state, factors 1"
+    );
+
+    let mut v2_cut: Vec<usize> = v3_cut.iter().chain(&flags).copied().collect();
+    v2_cut.sort_unstable();
+    let mut v2 = older(&bytes, &v2_cut, 2);
     let old = read(&write_checkpoint("version2", &v2)).expect("a version 2 checkpoint reads");
-    assert_eq!(old, ck, "version 2 reads as the same state, all deformable");
+    assert_eq!(
+        old, expected,
+        "version 2 reads as the same state, all deformable"
+    );
     // The same bytes labelled version 3 lack the flags: refused.
     v2[16..20].copy_from_slice(&3u32.to_le_bytes());
     read(&write_checkpoint("version2as3", &v2)).expect_err("flags missing");

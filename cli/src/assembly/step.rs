@@ -13,10 +13,10 @@ use granbed_kernel::granule::dynamics::{
 };
 use granbed_kernel::granule::forces::{ElementFailure, ForceSummary, elastic_energy};
 use granbed_kernel::granule::quality::worst_element;
-use granbed_kernel::granule::timestep::{Linearisation, PowerIterationBuffers};
+use granbed_kernel::granule::timestep::{Linearisation, PowerIterationBuffers, TimeStepMethod};
 use rayon::prelude::*;
 
-use super::{Assembly, AssemblyParams};
+use super::{Assembly, AssemblyParams, granule_kinetic, set_masses};
 
 /// Why an assembly cannot be set up or stopped.
 #[derive(Clone, Debug, PartialEq)]
@@ -159,7 +159,8 @@ impl fmt::Display for AssemblyError {
 impl core::error::Error for AssemblyError {}
 
 pub(super) fn validate(p: &AssemblyParams) -> Result<(), AssemblyError> {
-    let checks: [(bool, &'static str, Real, &'static str); 13] = [
+    let global = matches!(p.time_step_method, TimeStepMethod::Global { .. });
+    let checks: [(bool, &'static str, Real, &'static str); 15] = [
         (
             (0.0..=1.0).contains(&p.face_list_skin),
             "face_list_skin",
@@ -227,6 +228,19 @@ pub(super) fn validate(p: &AssemblyParams) -> Result<(), AssemblyError> {
             "0 < C <= 2 (and an interval >= 1)",
         ),
         (
+            p.time_step_floor == 0.0
+                || (p.time_step_floor > 0.0 && p.time_step_floor <= 1.0 && global),
+            "time_step_floor",
+            p.time_step_floor,
+            "0 (off) or 0 < r <= 1, with the global time-step method",
+        ),
+        (
+            p.max_mass_factor >= 1.0 && p.max_mass_factor.is_finite(),
+            "max_mass_factor",
+            p.max_mass_factor,
+            ">= 1 and finite",
+        ),
+        (
             p.max_node_speed_m_s > 0.0,
             "max_node_speed_m_s",
             p.max_node_speed_m_s,
@@ -252,7 +266,7 @@ pub(super) fn validate(p: &AssemblyParams) -> Result<(), AssemblyError> {
 /// Energy ledger of the whole assembly since the start, J.
 ///
 /// Central differences balance exactly:
-/// `kinetic − initial_kinetic + internal_work + damping = contact_work +
+/// `kinetic − supplied_kinetic + internal_work + damping = contact_work +
 /// gravity_work` to round-off ([`Energies::residual`]). `punch_work` is what the moving
 /// walls put in (Σ F_n v Δt); kinematic contact can only take energy out,
 /// so `contact_work ≤ punch_work` ([`Energies::contact_loss`] ≥ 0).
@@ -270,8 +284,11 @@ pub struct Energies {
     pub gravity_work: Real,
     /// Kinetic energy at n+½.
     pub kinetic: Real,
-    /// Kinetic energy of the initial velocities.
-    pub initial_kinetic: Real,
+    /// Kinetic energy not put in by a force: that of the initial
+    /// velocities, plus what raising a moving granule's masses added
+    /// (variable mass scaling, [`AssemblyParams::time_step_floor`], which
+    /// keeps the velocities: (k − 1) × the granule's kinetic energy).
+    pub supplied_kinetic: Real,
     /// Plastic dissipation.
     pub plastic: Real,
     /// Hourglass energy (current).
@@ -283,7 +300,7 @@ pub struct Energies {
 impl Energies {
     /// ΔK + internal + damping − contact − gravity (round-off).
     pub fn residual(&self) -> Real {
-        self.kinetic - self.initial_kinetic + self.internal_work + self.damping
+        self.kinetic - self.supplied_kinetic + self.internal_work + self.damping
             - self.contact_work
             - self.gravity_work
     }
@@ -371,6 +388,20 @@ pub struct StepReport {
     pub max_node_speed_m_s: Real,
 }
 
+/// A granule's loads when variable mass scaling has put k on its masses:
+/// gravity g/k keeps its weight, damping c/√k its damping ratio (c = 2ξω₁
+/// and ω₁ falls by √k). k = 1: `loads` as they are.
+fn loads_for_mass_factor(loads: &Loads, k: Real) -> Loads {
+    if k == 1.0 {
+        return *loads;
+    }
+    Loads {
+        gravity_m_s2: loads.gravity_m_s2 / k,
+        damping_c: loads.damping_c / k.sqrt(),
+        ..*loads
+    }
+}
+
 /// Adds the forces of `w` to `total`; the contact count is summed
 /// (`sum_contacts`, over granules) or the larger is kept (over sweeps of
 /// one granule, which see the same nodes again).
@@ -421,10 +452,10 @@ impl Assembly<'_> {
                 },
             )
             .collect();
-        let mut dt = Real::INFINITY;
+        let mut steps = Vec::with_capacity(per.len());
         for (g, d) in per.into_iter().enumerate() {
             match d {
-                Some(d) if d > 0.0 && d.is_finite() => dt = dt.min(d),
+                Some(d) if d > 0.0 && d.is_finite() => steps.push(d),
                 _ => {
                     let step = self.steps;
                     return Err(match worst_element(&view, &self.granules[g].x) {
@@ -442,6 +473,14 @@ impl Assembly<'_> {
                 }
             }
         }
+        if self.undeformed_step == 0.0 {
+            // The first estimate, in `Assembly::new`: every granule is the
+            // undeformed reference, placed.
+            self.undeformed_step = steps.iter().copied().fold(Real::INFINITY, Real::min);
+        } else if p.time_step_floor > 0.0 {
+            self.lift_to_floor(&mut steps);
+        }
+        let dt = steps.iter().copied().fold(Real::INFINITY, Real::min);
         if !dt.is_finite() {
             return Ok(1.0);
         }
@@ -449,6 +488,43 @@ impl Assembly<'_> {
         // differences to Ω² < 4 − 2cΔt (Ω = ω_max Δt): scale by
         // √(1 − cΔt/2). Without it a regular hex cube diverged at C = 0.85.
         Ok(dt * (1.0 - 0.5 * self.damping_c * dt).max(0.25).sqrt())
+    }
+
+    /// Variable mass scaling ([`AssemblyParams::time_step_floor`]): gives
+    /// each granule whose step in `steps` lies below the floor the least
+    /// factor on its masses that lifts it there (at most
+    /// `max_mass_factor`), and its new step. The velocities are kept; the
+    /// kinetic energy the heavier masses give them is booked as supplied.
+    /// Granules in index order, so the ledger's sums are the same for any
+    /// thread count.
+    pub(super) fn lift_to_floor(&mut self, steps: &mut [Real]) {
+        let p = self.params;
+        let floor = p.time_step_floor * self.undeformed_step;
+        let selective = p.selective_mass_factor();
+        for (g, d) in steps.iter_mut().enumerate() {
+            let old = self.mass_factors[g];
+            if *d >= floor || old >= p.max_mass_factor {
+                continue;
+            }
+            let lift = floor / *d;
+            let k = (old * lift * lift).min(p.max_mass_factor);
+            if k <= old {
+                continue;
+            }
+            let granule = &mut self.granules[g];
+            let before = granule_kinetic(granule, selective);
+            set_masses(granule, &self.base_mass, k);
+            let added = granule_kinetic(granule, selective) - before;
+            self.energies.supplied_kinetic += added;
+            self.energies.kinetic += added;
+            self.time_steps[g].scale_masses(k / old);
+            self.mass_factors[g] = k;
+            // The rigid frame the last corrector left holds the old masses.
+            if let Some(current) = self.frame_motions.get_mut(g) {
+                *current = None;
+            }
+            *d *= (k / old).sqrt();
+        }
     }
 
     /// Elastic energy Ψ of every granule (summed in order), stored in the
@@ -591,7 +667,9 @@ impl Assembly<'_> {
             .zip(self.frames.par_iter_mut())
             .zip(self.rigid.par_iter())
             .zip(self.frame_motions.par_iter_mut())
-            .map(|(((g, frame), &rigid), current)| {
+            .zip(self.mass_factors.par_iter())
+            .map(|((((g, frame), &rigid), current), &k)| {
+                let loads = loads_for_mass_factor(&loads, k);
                 let velocity_motion = current.take();
                 if selective > 1.0 || !rigid {
                     if velocity_motion.is_none() {
@@ -759,7 +837,15 @@ impl Assembly<'_> {
             .granules
             .par_iter_mut()
             .zip(self.frames.par_iter())
-            .map(|(g, frame)| correct_in(frame, &mut g.buffers(), sizes, &loads))
+            .zip(self.mass_factors.par_iter())
+            .map(|((g, frame), &k)| {
+                correct_in(
+                    frame,
+                    &mut g.buffers(),
+                    sizes,
+                    &loads_for_mass_factor(&loads, k),
+                )
+            })
             .collect();
         for ((frame, current), w) in self
             .frames
@@ -810,7 +896,7 @@ impl Assembly<'_> {
         e.kinetic = kinetic;
         // Contact work counts where it exceeds the punch work: the release
         // of the overlaps a packing starts with.
-        let supplied = e.punch_work.max(e.contact_work) + e.gravity_work + e.initial_kinetic;
+        let supplied = e.punch_work.max(e.contact_work) + e.gravity_work + e.supplied_kinetic;
         if kinetic > p.kinetic_energy_limit * supplied.max(0.0) && kinetic > 0.0 {
             let granule = per
                 .iter()

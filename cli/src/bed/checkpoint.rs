@@ -30,7 +30,13 @@ pub const FILE_NAME: &str = "checkpoint.bin";
 /// 3: each granule gained a flags word (bit 0: still a rigid body). Version
 /// 2 files are read with every granule deformable, which continues them
 /// with the same motion up to round-off (not bit for bit).
-pub const VERSION: u32 = 3;
+///
+/// 4: the energies are followed by the undeformed granule's stable step
+/// (f64, the time-step floor's reference), and each granule gained, after
+/// its flags, the factor variable mass scaling put on its masses (f64).
+/// Version 2 and 3 files are read with factor 1, which they were written
+/// with (bit for bit), and the resuming run's own undeformed step.
+pub const VERSION: u32 = 4;
 /// The oldest version read.
 const OLDEST_VERSION: u32 = 2;
 /// Granule flag: still a rigid body.
@@ -157,7 +163,7 @@ fn energies_to(e: &Energies) -> [f64; 10] {
         e.damping,
         e.gravity_work,
         e.kinetic,
-        e.initial_kinetic,
+        e.supplied_kinetic,
         e.plastic,
         e.hourglass,
         e.elastic,
@@ -172,7 +178,7 @@ fn energies_from(v: [f64; 10]) -> Energies {
         damping: v[3],
         gravity_work: v[4],
         kinetic: v[5],
-        initial_kinetic: v[6],
+        supplied_kinetic: v[6],
         plastic: v[7],
         hourglass: v[8],
         elastic: v[9],
@@ -267,6 +273,7 @@ impl Checkpoint {
         e.vecs(&p.samples.iter().map(sample_to).collect::<Vec<_>>());
         e.f64s(&[s.time, f64::from_bits(s.steps), s.dt[0], s.dt[1]]);
         e.f64s(&energies_to(&s.energies));
+        e.f64(s.undeformed_step);
         e.u64(s.granules.len() as u64);
         for g in &s.granules {
             e.vecs(&g.x);
@@ -278,6 +285,7 @@ impl Checkpoint {
             e.f64(dt);
             e.f64(length);
             e.u64(if g.rigid { FLAG_RIGID } else { 0 });
+            e.f64(g.mass_factor);
         }
         e.u64(s.pairs.len() as u64);
         for pair in &s.pairs {
@@ -316,6 +324,10 @@ impl Checkpoint {
         let energies = energies_from(
             <[f64; 10]>::try_from(d.f64s()?).map_err(|_| anyhow::anyhow!("bad energies"))?,
         );
+        let undeformed_step = match version {
+            2 | 3 => 0.0,
+            _ => d.f64()?,
+        };
         let n = d.len(24)?;
         let granules = (0..n)
             .map(|_| {
@@ -336,6 +348,10 @@ impl Checkpoint {
                             FLAG_RIGID => true,
                             other => bail!("unknown granule flags {other:#x}"),
                         },
+                    },
+                    mass_factor: match version {
+                        2 | 3 => 1.0,
+                        _ => d.f64()?,
                     },
                 })
             })
@@ -388,6 +404,7 @@ impl Checkpoint {
                 steps: t[1].to_bits(),
                 dt: [t[2], t[3]],
                 energies,
+                undeformed_step,
                 granules,
                 pairs,
                 built,
