@@ -844,3 +844,93 @@ fn selective_mass_scaling_keeps_the_bed_quasi_static_in_fewer_steps() {
         );
     }
 }
+
+/// Variable mass scaling (`--time-step-floor`, scene `time_step_floor`) on
+/// the CI bed: the granules whose stable step fell below the floor are
+/// given heavier masses (reported in the summary, at most the largest
+/// factor), so the bed takes fewer steps; the pressure curve stays within
+/// the 4 % noise floor of the tests above, the ledger closes and the
+/// certificate passes; the run is the same bits on 1 and 2 threads and
+/// through a checkpoint that holds raised masses. The floor is a scene
+/// field (absent: 0, off) with a CLI override whose bad values are named.
+#[test]
+fn the_time_step_floor_lifts_the_granules_that_set_the_step() {
+    let floor = ["--time-step-floor", "0.95"];
+    let run = |dir: &Path, extra: &[&str]| {
+        let mut argv = vec!["bed", "--quiet", "--out", dir.to_str().unwrap()];
+        argv.extend_from_slice(extra);
+        argv.extend_from_slice(&SMALL);
+        let r = cli(&argv);
+        assert_eq!(r.code, 0, "bed {extra:?} failed:\n{}", r.stderr);
+    };
+    let (off, one, two, parts) = (
+        out_dir("floor_off"),
+        out_dir("floor_j1"),
+        out_dir("floor_j2"),
+        out_dir("floor_parts"),
+    );
+    run(&off, &["-j", "2"]);
+    run(&one, &[&floor[..], &["-j", "1"]].concat());
+    run(&two, &[&floor[..], &["-j", "2"]].concat());
+    run(
+        &parts,
+        &[&floor[..], &["-j", "2", "--stop-at-strain", "0.2"]].concat(),
+    );
+    let factors: Vec<f64> = granbed_cli::bed::checkpoint::Checkpoint::read(&parts)
+        .unwrap()
+        .state
+        .granules
+        .iter()
+        .map(|g| g.mass_factor)
+        .collect();
+    assert!(
+        factors.iter().any(|&k| k > 1.0),
+        "no granule is heavier at the stop: {factors:?}"
+    );
+    let r = cli(&["bed", "--resume", parts.to_str().unwrap(), "--quiet"]);
+    assert_eq!(r.code, 0, "{}", r.stderr);
+    let csv = |dir: &Path| std::fs::read(dir.join("compression.csv")).unwrap();
+    assert!(csv(&one) == csv(&two), "1 and 2 threads differ");
+    assert!(csv(&two) == csv(&parts), "stop + resume differs");
+
+    let (s_off, s_on) = (summary(&off), summary(&two));
+    let added = &s_on["added_mass"];
+    let (scaled, max_factor, rel) = (
+        number(added, "granules_scaled"),
+        number(added, "max_factor"),
+        number(added, "added_mass_rel"),
+    );
+    println!(
+        "floor 0.95: {scaled} granules heavier, at most x{max_factor:.3}, +{:.1} % mass; steps {} against {}",
+        100.0 * rel,
+        number(&s_on, "steps"),
+        number(&s_off, "steps")
+    );
+    assert!(scaled >= 1.0 && max_factor > 1.0 && max_factor <= 4.0 && rel > 0.0);
+    assert_eq!(number(&s_off["added_mass"], "granules_scaled"), 0.0);
+    assert!(number(&s_on, "steps") < number(&s_off, "steps"));
+    let l2 = pressure_distance(&two, &off);
+    println!("P(C) with the floor against without: relative L2 {l2:.4}");
+    assert!(l2 < 0.04, "the floor changes P(C) by {l2:.4}");
+    assert!(number(&s_on, "energy_residual_rel") < 1e-4);
+    assert_eq!(s_on["quasi_static"]["passed"], true);
+
+    let r = cli(&["bed", "--print-scene", "--time-step-floor", "0.9"]);
+    assert_eq!(r.code, 0, "{}", r.stderr);
+    assert_eq!(Scene::from_toml(&r.stdout).unwrap().time_step_floor, 0.9);
+    let old = DEFAULT_SCENE
+        .lines()
+        .filter(|l| !l.starts_with("time_step_floor") && !l.starts_with("max_mass_factor"))
+        .collect::<Vec<_>>()
+        .join("\n");
+    let old = Scene::from_toml(&old).unwrap();
+    assert_eq!((old.time_step_floor, old.max_mass_factor), (0.0, 4.0));
+    for (flag, value, field) in [
+        ("--time-step-floor", "1.5", "time_step_floor"),
+        ("--max-mass-factor", "0.5", "max_mass_factor"),
+    ] {
+        let r = cli(&["bed", "--print-scene", flag, value]);
+        assert_eq!(r.code, 2, "{flag} {value}: {}", r.stderr);
+        assert!(r.stderr.contains(field), "{}", r.stderr);
+    }
+}

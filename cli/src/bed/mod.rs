@@ -172,8 +172,8 @@ pub struct BedArgs {
     /// Continue the run whose checkpoint is in DIR (its `checkpoint.bin`);
     /// the outputs go to DIR. Only --strain, --stop-at-strain,
     /// --time-step-safety, --mass-scaling, --sweep-tolerance,
-    /// --hold-constraints, --face-list-skin, -j and --quiet may be given
-    /// with it.
+    /// --hold-constraints, --face-list-skin, --time-step-floor,
+    /// --max-mass-factor, -j and --quiet may be given with it.
     #[arg(long, value_name = "DIR", conflicts_with_all = ["scene", "out", "granule_type", "granules", "mesh", "seed", "die_diameter_mm", "element", "hourglass_kappa", "rigid_until_touched", "local_sweeps", "selective_mass_scaling", "selective_mass_ratio"])]
     pub resume: Option<PathBuf>,
 
@@ -212,6 +212,20 @@ pub struct BedArgs {
     /// --resume, e.g. to continue a run that failed with a smaller step.
     #[arg(long, value_name = "C")]
     pub time_step_safety: Option<f64>,
+
+    /// Override: variable mass scaling — a granule whose stable step falls
+    /// below this fraction R of the undeformed granule's is given the
+    /// least factor on its masses that lifts it back (at most
+    /// --max-mass-factor); 0 < R ≤ 1, 0: off (the published scene's). The
+    /// summary reports the granules scaled and the mass added. Allowed
+    /// with --resume (masses already added stay).
+    #[arg(long, value_name = "R")]
+    pub time_step_floor: Option<f64>,
+
+    /// Override: the largest factor K ≥ 1 variable mass scaling puts on a
+    /// granule's masses (default 4).
+    #[arg(long, value_name = "K")]
+    pub max_mass_factor: Option<f64>,
 
     /// The quasi-static certificate's rate check: after the run, press the
     /// same bed again at half the punch speed (into DIR/half_speed; about
@@ -288,6 +302,12 @@ impl BedArgs {
         }
         if let Some(c) = self.time_step_safety {
             scene.time_step_safety = c;
+        }
+        if let Some(r) = self.time_step_floor {
+            scene.time_step_floor = r;
+        }
+        if let Some(k) = self.max_mass_factor {
+            scene.max_mass_factor = k;
         }
         if let Some(s) = self.face_list_skin {
             scene.face_list_skin = s;

@@ -193,6 +193,8 @@ pub struct Summary<'a> {
     pub peak_memory_bytes: Option<u64>,
     /// The quasi-static certificate.
     pub quasi_static: QuasiStatic,
+    /// What variable mass scaling did (scene `time_step_floor`).
+    pub added_mass: super::run::AddedMass,
     /// The error that stopped the run early, if any.
     pub error: Option<String>,
 }
@@ -305,6 +307,7 @@ pub fn summary<'a>(scene: &'a Scene, run: &BedRun) -> Summary<'a> {
         contact_loss_rel: finite_ratio(e.contact_loss(), e.punch_work),
         peak_memory_bytes: peak_memory_bytes(),
         quasi_static: quasi_static(&run.samples, run.rate_change_rel),
+        added_mass: run.added_mass,
         error: run.error.as_ref().map(|e| e.to_string()),
     }
 }

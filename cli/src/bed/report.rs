@@ -18,7 +18,7 @@ pub const REPORT_FILE: &str = "report.html";
 /// The fields of `summary.json` shown first, in this order, with their
 /// meaning; any other field follows (the nested `kawakita` object is
 /// flattened to `kawakita.<field>`, the scene is shown as TOML instead).
-const FIELDS: [(&str, &str); 34] = [
+const FIELDS: [(&str, &str); 38] = [
     ("kawakita_a", "Kawakita a (limiting strain)"),
     ("kawakita_inv_b_pa", "Kawakita 1/b, Pa"),
     (
@@ -76,6 +76,22 @@ const FIELDS: [(&str, &str); 34] = [
     ),
     ("contact_loss_rel", "contact losses / punch work"),
     ("peak_memory_bytes", "peak resident memory, bytes"),
+    (
+        "added_mass.granules_scaled",
+        "granules given heavier masses (variable mass scaling)",
+    ),
+    (
+        "added_mass.max_factor",
+        "largest factor on a granule's masses",
+    ),
+    (
+        "added_mass.added_mass_rel",
+        "mass added / the bed's mass before it",
+    ),
+    (
+        "added_mass.undeformed_step_s",
+        "stable step of the undeformed granule, s",
+    ),
     ("error", "error that stopped the run early"),
     ("version", "granbed version"),
     // Shown in the fields above already.

@@ -130,6 +130,36 @@ pub struct BedRun {
     /// change of P(C) when the same bed is pressed at half the punch speed
     /// (None: not checked).
     pub rate_change_rel: Option<Real>,
+    /// What variable mass scaling did (scene `time_step_floor`).
+    pub added_mass: AddedMass,
+}
+
+/// What variable mass scaling ([`crate::assembly::AssemblyParams::time_step_floor`])
+/// did to a run, at its end.
+#[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize)]
+pub struct AddedMass {
+    /// The undeformed granule's stable step, s (what the floor is a
+    /// fraction of; before the damping's reduction).
+    pub undeformed_step_s: Real,
+    /// Granules whose masses were raised.
+    pub granules_scaled: usize,
+    /// The largest factor put on a granule's masses (1: none).
+    pub max_factor: Real,
+    /// Mass added, as a fraction of the bed's mass before it.
+    pub added_mass_rel: Real,
+}
+
+impl AddedMass {
+    /// What `asm` holds now.
+    pub fn of(asm: &Assembly<'_>) -> Self {
+        let k = asm.mass_factors();
+        Self {
+            undeformed_step_s: asm.undeformed_step(),
+            granules_scaled: k.iter().filter(|&&k| k > 1.0).count(),
+            max_factor: k.iter().copied().fold(1.0, Real::max),
+            added_mass_rel: asm.added_mass_fraction(),
+        }
+    }
 }
 
 /// The time-averaging window of the samples (integrals over the open
@@ -276,6 +306,8 @@ pub fn run_bed(
     params.selective_mass_scaling = scene.selective_mass_scaling;
     params.selective_mass_ratio = scene.selective_mass_ratio;
     params.time_step_safety = scene.time_step_safety;
+    params.time_step_floor = scene.time_step_floor;
+    params.max_mass_factor = scene.max_mass_factor;
     params.rigid_until_touched = scene.rigid_until_touched;
     params.local_sweeps = scene.local_sweeps;
     params.hold_constraints = scene.hold_constraints;
@@ -513,5 +545,6 @@ pub fn run_bed(
         error,
         checkpoint_strain,
         rate_change_rel: None,
+        added_mass: AddedMass::of(&asm),
     })
 }

@@ -74,6 +74,14 @@ selective_mass_ratio = 10.0
 # Safety factor on the stable time step 2/omega_max (0 < C <= 2; above 1 the
 # run is unstable, which only tests the failure handling).
 time_step_safety = 0.9
+# Variable mass scaling (0 = off; 0 < r <= 1): a granule whose stable step
+# falls below this fraction of the undeformed granule's is given k times its
+# masses, the least k that lifts it back (the step grows by sqrt(k)), at most
+# max_mass_factor; masses never go back down. A few strongly pressed granules
+# then no longer set the step of the whole bed. The summary reports the
+# granules scaled and the mass added.
+time_step_floor = 0.0
+max_mass_factor = 4.0
 # Granules move as rigid bodies (no element work) from their placement until
 # their first contact: the same motion up to round-off, cheaper while the bed
 # settles onto its granules and walls. false: finite-element bodies from t = 0.
@@ -204,6 +212,15 @@ pub struct Scene {
     /// unstable, for testing the failure handling).
     #[serde(default = "default_time_step_safety")]
     pub time_step_safety: f64,
+    /// Variable mass scaling: the fraction of the undeformed granule's
+    /// stable step below which a granule is given heavier masses
+    /// (`AssemblyParams::time_step_floor`; absent: 0, off).
+    #[serde(default)]
+    pub time_step_floor: f64,
+    /// The largest factor variable mass scaling puts on a granule's
+    /// masses, ≥ 1 (absent: 4).
+    #[serde(default = "default_max_mass_factor")]
+    pub max_mass_factor: f64,
     /// Granules are rigid bodies until first touched (absent: true).
     #[serde(default = "default_true")]
     pub rigid_until_touched: bool,
@@ -281,6 +298,10 @@ fn default_time_step_safety() -> f64 {
     0.9
 }
 
+fn default_max_mass_factor() -> f64 {
+    4.0
+}
+
 fn default_true() -> bool {
     true
 }
@@ -329,7 +350,7 @@ impl Scene {
         self.granule_type()?;
         self.mesh_level()?;
         self.element_kind()?;
-        let checks: [(bool, &str, f64, &str); 18] = [
+        let checks: [(bool, &str, f64, &str); 20] = [
             (
                 self.sweep_tolerance > 0.0 && self.sweep_tolerance <= 0.1,
                 "sweep_tolerance",
@@ -377,6 +398,18 @@ impl Scene {
                 "selective_mass_ratio",
                 self.selective_mass_ratio,
                 ">= 1 (inf: physical rigid modes)",
+            ),
+            (
+                (0.0..=1.0).contains(&self.time_step_floor),
+                "time_step_floor",
+                self.time_step_floor,
+                "0 <= r <= 1 (0: off)",
+            ),
+            (
+                (1.0..=1e6).contains(&self.max_mass_factor),
+                "max_mass_factor",
+                self.max_mass_factor,
+                "1 <= k <= 1e6",
             ),
             (
                 self.checkpoint_interval_minutes > 0.0,

@@ -186,6 +186,11 @@ pub struct StabilityArgs {
     #[arg(long, value_name = "F")]
     pub mass_scaling: Option<f64>,
 
+    /// Override the beds' time-step floor of variable mass scaling,
+    /// 0 ≤ r ≤ 1 (0: off; default: the published scene's).
+    #[arg(long, value_name = "R")]
+    pub time_step_floor: Option<f64>,
+
     /// Worker threads of the bed runs (0 = all cores).
     #[arg(short = 'j', long, value_name = "N", default_value_t = 0)]
     pub threads: usize,

@@ -175,6 +175,7 @@ pub fn bed_scene(args: &StabilityArgs, granule_type: GranuleType, seed: u64) -> 
         contact_sweeps: args.contact_sweeps.unwrap_or(published.contact_sweeps),
         sweep_tolerance: args.sweep_tolerance.unwrap_or(published.sweep_tolerance),
         mass_scaling: args.mass_scaling.unwrap_or(published.mass_scaling),
+        time_step_floor: args.time_step_floor.unwrap_or(published.time_step_floor),
         watchdog_speed_ratio: args
             .watchdog_speed_ratio
             .unwrap_or(published.watchdog_speed_ratio),
@@ -300,6 +301,7 @@ struct Report<'a> {
     contact_sweeps: u32,
     sweep_tolerance: Real,
     mass_scaling: Real,
+    time_step_floor: Real,
     watchdog_speed_ratio: Real,
     granule_mesh: String,
     granule_strain: Real,
@@ -390,6 +392,7 @@ impl StabilityArgs {
                 contact_sweeps: beds.contact_sweeps,
                 sweep_tolerance: beds.sweep_tolerance,
                 mass_scaling: beds.mass_scaling,
+                time_step_floor: beds.time_step_floor,
                 watchdog_speed_ratio: beds.watchdog_speed_ratio,
                 granule_mesh: self.granule_mesh.to_string(),
                 granule_strain: self.granule_strain,
@@ -493,15 +496,27 @@ mod tests {
         let plain = bed_scene(&args(&[]), GranuleType::C3, 2);
         assert_eq!(plain.mass_scaling, published.mass_scaling);
         assert_eq!(plain.sweep_tolerance, published.sweep_tolerance);
+        assert_eq!(plain.time_step_floor, published.time_step_floor);
         assert_eq!((plain.granule_type.as_str(), plain.seed), ("C3", 2));
         let changed = bed_scene(
-            &args(&["--mass-scaling", "30", "--sweep-tolerance", "0.01"]),
+            &args(&[
+                "--mass-scaling",
+                "30",
+                "--sweep-tolerance",
+                "0.01",
+                "--time-step-floor",
+                "0.9",
+            ]),
             GranuleType::C3,
             2,
         );
         assert_eq!(
-            (changed.mass_scaling, changed.sweep_tolerance),
-            (30.0, 0.01)
+            (
+                changed.mass_scaling,
+                changed.sweep_tolerance,
+                changed.time_step_floor
+            ),
+            (30.0, 0.01, 0.9)
         );
         assert_eq!(changed.selective_mass_ratio, published.selective_mass_ratio);
     }
@@ -601,6 +616,7 @@ mod tests {
             stopped: false,
             error: None,
             checkpoint_strain: None,
+            added_mass: Default::default(),
         };
         let (a, b) = (run([1.0, 0.8, 0.9]), run([1.0, 0.9, 0.7]));
         let w = worst(&[&a, &b], |s| s.min_jacobian, true);
