@@ -58,15 +58,17 @@ pub fn bed_grid(mesh: MeshLevel, quick: bool) -> (Setting, Vec<Setting>) {
         selective_mass: Scene::published().selective_mass_scaling,
         sweep_tolerance: Scene::published().sweep_tolerance,
         hold_constraints: Scene::published().hold_constraints,
+        time_step_floor: Scene::published().time_step_floor,
         ..Setting::default_on(mesh)
     };
     let with = |name, f: &dyn Fn(&mut Setting)| base.with(name, f);
     // Uniform mass scaling by `f`: every mode of a granule f times heavier
-    // (f = 1: the physical masses).
+    // and no variable scaling on top (f = 1: the physical masses).
     let uniform = |f: Real| {
         move |s: &mut Setting| {
             s.mass_scaling = f;
             s.selective_mass = false;
+            s.time_step_floor = 0.0;
         }
     };
     // The most exact of each: later sweeps search too.
@@ -102,6 +104,9 @@ pub fn bed_grid(mesh: MeshLevel, quick: bool) -> (Setting, Vec<Setting>) {
                 s.mass_scaling = 100.0;
                 s.selective_mass = true;
             }),
+            // Variable mass scaling off: the published scene before
+            // session 27.
+            with("floor off", &|s| s.time_step_floor = 0.0),
             with("safety 0.7", &|s| s.safety = 0.7),
             with("sweep tol 0.005", &|s| s.sweep_tolerance = 0.005),
             with("sweep tol 0.02", &|s| s.sweep_tolerance = 0.02),
@@ -137,6 +142,7 @@ fn scene_for(args: &WorkPrecisionArgs, size: &Size, setting: &Setting, seed: u64
         time_step_safety: setting.safety,
         sweep_tolerance: setting.sweep_tolerance,
         hold_constraints: setting.hold_constraints,
+        time_step_floor: setting.time_step_floor,
         material: MaterialOverrides {
             youngs_modulus_pa: m.youngs_modulus_pa,
             poisson_ratio: m.poisson_ratio,
@@ -279,8 +285,11 @@ mod tests {
                 s.element != base.element,
                 s.kappa != base.kappa,
                 s.safety != base.safety,
-                // The mass scaling: its factor and whether it is selective.
-                s.mass_scaling != base.mass_scaling || s.selective_mass != base.selective_mass,
+                // The mass scaling: its factor, whether it is selective and
+                // its variable part.
+                s.mass_scaling != base.mass_scaling
+                    || s.selective_mass != base.selective_mass
+                    || s.time_step_floor != base.time_step_floor,
                 s.speed_factor != base.speed_factor,
                 s.sweep_tolerance != base.sweep_tolerance,
                 s.hold_constraints != base.hold_constraints,

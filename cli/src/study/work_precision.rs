@@ -43,7 +43,7 @@ pub const CSV_FILE: &str = "work_precision.csv";
 pub const SVG_FILE: &str = "work_precision.svg";
 
 /// Columns of [`CSV_FILE`].
-pub const COLUMNS: [&str; 24] = [
+pub const COLUMNS: [&str; 25] = [
     "setting",
     "seed",
     "mesh_n",
@@ -56,6 +56,7 @@ pub const COLUMNS: [&str; 24] = [
     "speed_factor",
     "sweep_tolerance",
     "hold_constraints",
+    "time_step_floor",
     "steps",
     "wall_time_s",
     "sigma_est_pa",
@@ -102,6 +103,9 @@ pub struct Setting {
     /// Later contact sweeps re-measure the held constraints instead of
     /// searching (bed; the scene's `hold_constraints`).
     pub hold_constraints: bool,
+    /// Variable mass scaling's floor on the granules' steps (bed; the
+    /// scene's `time_step_floor`, 0 = off).
+    pub time_step_floor: Real,
 }
 
 impl Setting {
@@ -118,6 +122,7 @@ impl Setting {
             speed_factor: 1.0,
             sweep_tolerance: crate::bed::run::SWEEP_TOLERANCE_REL,
             hold_constraints: false,
+            time_step_floor: 0.0,
         }
     }
 
@@ -483,6 +488,7 @@ pub fn write_csv(path: &Path, rows: &[Row<'_>]) -> anyhow::Result<()> {
             Field::Real(s.speed_factor),
             Field::Real(s.sweep_tolerance),
             Field::from(s.hold_constraints),
+            Field::Real(s.time_step_floor),
             Field::Int(r.m.steps),
             Field::Real(r.m.wall_time_s),
             opt(r.m.sigma_est_pa),
