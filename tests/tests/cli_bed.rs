@@ -869,7 +869,7 @@ fn the_time_step_floor_lifts_the_granules_that_set_the_step() {
         out_dir("floor_j2"),
         out_dir("floor_parts"),
     );
-    run(&off, &["-j", "2"]);
+    run(&off, &["-j", "2", "--time-step-floor", "0"]);
     run(&one, &[&floor[..], &["-j", "1"]].concat());
     run(&two, &[&floor[..], &["-j", "2"]].concat());
     run(

@@ -503,7 +503,7 @@ mod tests {
                 "--mass-scaling",
                 "30",
                 "--sweep-tolerance",
-                "0.01",
+                "0.02",
                 "--time-step-floor",
                 "0.9",
             ]),
@@ -516,7 +516,7 @@ mod tests {
                 changed.sweep_tolerance,
                 changed.time_step_floor
             ),
-            (30.0, 0.01, 0.9)
+            (30.0, 0.02, 0.9)
         );
         assert_eq!(changed.selective_mass_ratio, published.selective_mass_ratio);
     }
