@@ -15,6 +15,14 @@ fn out_dir(name: &str) -> PathBuf {
     common::fresh_dir("cli_bed", name)
 }
 
+/// The granules' states in the checkpoint of the run in `dir`.
+fn checkpoint_granules(dir: &Path) -> Vec<granbed_cli::assembly::GranuleState> {
+    granbed_cli::bed::checkpoint::Checkpoint::read(dir)
+        .unwrap()
+        .state
+        .granules
+}
+
 /// The CI bed of these tests: 30 coarse granules to 30 %.
 const SMALL: [&str; 8] = common::small_bed("30", "0.3");
 
@@ -178,10 +186,7 @@ fn a_stopped_run_resumes_to_the_same_bits() {
     run(&[&["--out", parts_s, "--stop-at-strain", "0.01"][..], &args].concat());
     // The checkpoint must carry granules still rigid (untouched) and
     // others already deformable, or the flag's round trip goes untested.
-    let rigid: Vec<bool> = granbed_cli::bed::checkpoint::Checkpoint::read(&parts)
-        .unwrap()
-        .state
-        .granules
+    let rigid: Vec<bool> = checkpoint_granules(&parts)
         .iter()
         .map(|g| g.rigid)
         .collect();
@@ -876,10 +881,7 @@ fn the_time_step_floor_lifts_the_granules_that_set_the_step() {
         &parts,
         &[&floor[..], &["-j", "2", "--stop-at-strain", "0.2"]].concat(),
     );
-    let factors: Vec<f64> = granbed_cli::bed::checkpoint::Checkpoint::read(&parts)
-        .unwrap()
-        .state
-        .granules
+    let factors: Vec<f64> = checkpoint_granules(&parts)
         .iter()
         .map(|g| g.mass_factor)
         .collect();

@@ -329,12 +329,45 @@ fn the_rigid_predictor_is_the_element_predictor_for_an_untouched_granule() {
     assert!(dv < 1e-9 * 0.03, "velocities differ by {dv:e} m/s");
 }
 
+/// Owned scratch of a power iteration: the start mode and the buffers
+/// `PowerIterationBuffers` borrows (one entry per node, `states` C_p⁻¹).
+struct PowerScratch {
+    mode: Vec<[Real; 3]>,
+    x_pert: Vec<[Real; 3]>,
+    f_plus: Vec<[Real; 3]>,
+    f_minus: Vec<[Real; 3]>,
+    cp_scratch: Vec<[Real; 6]>,
+}
+
+impl PowerScratch {
+    fn new(mode: Vec<[Real; 3]>, states: usize) -> Self {
+        let n = mode.len();
+        Self {
+            mode,
+            x_pert: vec![[0.0; 3]; n],
+            f_plus: vec![[0.0; 3]; n],
+            f_minus: vec![[0.0; 3]; n],
+            cp_scratch: vec![[0.0; 6]; states],
+        }
+    }
+
+    fn buffers(&mut self) -> granbed_kernel::granule::timestep::PowerIterationBuffers<'_> {
+        granbed_kernel::granule::timestep::PowerIterationBuffers {
+            mode: &mut self.mode,
+            x_pert: &mut self.x_pert,
+            f_plus: &mut self.f_plus,
+            f_minus: &mut self.f_minus,
+            cp_scratch: &mut self.cp_scratch,
+        }
+    }
+}
+
 /// T1 (physics.md §4.2): the element estimate 0.9·min L_e/c_d is 1.48 µs and
 /// the global limit 2/ω_max (power iteration, κ = 0.05) 2.17 µs at ρ = 1500;
 /// an undamped run at 0.95·2/ω_max stays bounded, at 1.1·2/ω_max it diverges.
 #[test]
 fn t1_time_step_estimates_and_the_stability_limit() {
-    use granbed_kernel::granule::timestep::{Linearisation, PowerIterationBuffers, max_frequency};
+    use granbed_kernel::granule::timestep::{Linearisation, max_frequency};
     let mesh = OwnedReference::sphere(R, MeshLevel::STANDARD, false).unwrap();
     let view = mesh.view();
     let mat = elastic_solid();
@@ -356,22 +389,22 @@ fn t1_time_step_estimates_and_the_stability_limit() {
         rng ^= rng << 17;
         (rng >> 11) as Real / (1u64 << 53) as Real - 0.5
     };
-    let mut mode: Vec<[Real; 3]> = (0..n).map(|_| [random(), random(), random()]).collect();
-    let (mut xp, mut fp, mut fm) = (vec![[0.0; 3]; n], vec![[0.0; 3]; n], vec![[0.0; 3]; n]);
-    let mut cp = b.cp_inv.to_vec();
+    let mode: Vec<[Real; 3]> = (0..n).map(|_| [random(), random(), random()]).collect();
+    let mut scratch = PowerScratch::new(mode, b.cp_inv.len());
     let at = Linearisation {
         mass: b.mass,
         x: b.x,
         cp_inv: b.cp_inv,
     };
-    let mut pb = PowerIterationBuffers {
-        mode: &mut mode,
-        x_pert: &mut xp,
-        f_plus: &mut fp,
-        f_minus: &mut fm,
-        cp_scratch: &mut cp,
-    };
-    let omega = max_frequency(&view, &mat, &settings(0.05), &at, &mut pb, 300).unwrap();
+    let omega = max_frequency(
+        &view,
+        &mat,
+        &settings(0.05),
+        &at,
+        &mut scratch.buffers(),
+        300,
+    )
+    .unwrap();
     let dt_crit = 2.0 / omega;
     println!(
         "element estimate {dt_element:.4e} s, 2/omega_max {dt_crit:.4e} s (ratio {:.3})",
@@ -493,7 +526,7 @@ fn e3_exactly_six_zero_modes_with_hourglass_control() {
 #[test]
 fn heavier_masses_lengthen_the_global_step_by_the_square_root() {
     use granbed_kernel::granule::timestep::{
-        Linearisation, PowerIterationBuffers, TimeStepControl, TimeStepMethod, power_start,
+        Linearisation, TimeStepControl, TimeStepMethod, power_start,
     };
     let mesh = OwnedReference::sphere(R, MeshLevel::STANDARD, false).unwrap();
     let view = mesh.view();
@@ -508,22 +541,14 @@ fn heavier_masses_lengthen_the_global_step_by_the_square_root() {
     let estimate = |control: &mut TimeStepControl, mass: &[Real]| {
         let mut mode = vec![[0.0; 3]; n];
         power_start(&mut mode);
-        let (mut xp, mut fp, mut fm) = (vec![[0.0; 3]; n], vec![[0.0; 3]; n], vec![[0.0; 3]; n]);
-        let mut cp = store.cp_inv.clone();
+        let mut scratch = PowerScratch::new(mode, store.cp_inv.len());
         let at = Linearisation {
             mass,
             x: &store.x,
             cp_inv: &store.cp_inv,
         };
-        let mut pb = PowerIterationBuffers {
-            mode: &mut mode,
-            x_pert: &mut xp,
-            f_plus: &mut fp,
-            f_minus: &mut fm,
-            cp_scratch: &mut cp,
-        };
         control
-            .estimate(&view, &mat, &settings(0.05), &at, &mut pb)
+            .estimate(&view, &mat, &settings(0.05), &at, &mut scratch.buffers())
             .unwrap()
     };
     let k = 2.5;

@@ -859,17 +859,22 @@ mod tests {
     use granbed_kernel::granule::forces::{ElementKind, ElementSettings};
     use granbed_kernel::material::GranuleType;
 
-    /// The kernel's factor is F/G = min(F, R) with selective scaling, 1
-    /// without.
-    #[test]
-    fn the_selective_factor_is_the_ratio_limited_scaling() {
+    /// The standard parameters for B2 granules of one-point elements.
+    fn b2_one_point() -> AssemblyParams {
         let material = GranuleType::B2.params().validate().unwrap();
         let elements = ElementSettings {
             kind: ElementKind::OnePoint,
             update: Default::default(),
             hourglass_kappa: 0.05,
         };
-        let mut p = AssemblyParams::standard(material, elements);
+        AssemblyParams::standard(material, elements)
+    }
+
+    /// The kernel's factor is F/G = min(F, R) with selective scaling, 1
+    /// without.
+    #[test]
+    fn the_selective_factor_is_the_ratio_limited_scaling() {
+        let mut p = b2_one_point();
         p.selective_mass_scaling = true;
         for (f, r, factor) in [
             (30.0, 10.0, 10.0),
@@ -899,13 +904,7 @@ mod tests {
     #[test]
     fn a_lifted_granule_is_heavier_keeps_its_weight_and_the_ledger_closes() {
         use crate::model::MeshLevel;
-        let material = GranuleType::B2.params().validate().unwrap();
-        let elements = ElementSettings {
-            kind: ElementKind::OnePoint,
-            update: Default::default(),
-            hourglass_kappa: 0.05,
-        };
-        let mut p = AssemblyParams::standard(material, elements);
+        let mut p = b2_one_point();
         p.mass_scaling = 20.0;
         p.selective_mass_scaling = true;
         p.selective_mass_ratio = 10.0;
