@@ -13,6 +13,10 @@ use serde::Serialize;
 pub struct QuasiStatic {
     /// Largest kinetic / internal work ratio over the second half.
     pub max_kinetic_to_internal: Option<Real>,
+    /// The same with the kinetic energy relative to the compression the
+    /// punches impose: a diagnostic, not judged (`null`: nothing imposed,
+    /// as between platens, or not recorded).
+    pub max_relative_kinetic_to_internal: Option<Real>,
     /// Mean |F_in − F_out| / F_in over the loaded samples of the second
     /// half (`null` where not measured: an octant granule).
     pub force_imbalance_rel: Option<Real>,
@@ -27,6 +31,7 @@ impl From<Certificate> for QuasiStatic {
     fn from(c: Certificate) -> Self {
         Self {
             max_kinetic_to_internal: c.max_kinetic_to_internal,
+            max_relative_kinetic_to_internal: c.max_relative_kinetic_to_internal,
             force_imbalance_rel: c.force_imbalance_rel,
             rate_change_rel: c.rate_change_rel,
             passed: c.passed,

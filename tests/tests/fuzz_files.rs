@@ -251,15 +251,16 @@ fn older(bytes: &[u8], cut: &[usize], version: u32) -> Vec<u8> {
     b
 }
 
-/// Checkpoints of older formats still read: version 3 (before the mass
-/// factors and the undeformed step) with every factor 1 and no undeformed
-/// step (the resuming run keeps its own), version 2 (before the
-/// per-granule flags word as well) with every granule deformable too. The
-/// older bytes are made from this build's own: two checkpoints of one
-/// state that differ only in a field differ only in its words, which are
-/// cut out.
+/// Checkpoints of older formats still read: version 4 (before the
+/// samples' kinetic energy relative to the imposed compression) with that
+/// energy NaN (not recorded), version 3 (before the mass factors and the
+/// undeformed step as well) with every factor 1 and no undeformed step
+/// (the resuming run keeps its own), version 2 (before the per-granule
+/// flags word as well) with every granule deformable too. The older bytes
+/// are made from this build's own: two checkpoints of one state that
+/// differ only in a field differ only in its words, which are cut out.
 #[test]
-fn version_2_and_3_checkpoints_read_with_the_fields_they_lack_at_their_defaults() {
+fn versions_2_to_4_checkpoints_read_with_the_fields_they_lack_at_their_defaults() {
     let (dir, _) = base_checkpoint();
     let mut ck = read(dir).unwrap();
     for g in &mut ck.state.granules {
@@ -275,32 +276,63 @@ fn version_2_and_3_checkpoints_read_with_the_fields_they_lack_at_their_defaults(
             .iter_mut()
             .for_each(|g| g.mass_factor = flip(1.0))
     });
-    let (step, bytes) = edited_words(&ck, |c| {
+    let (step, _) = edited_words(&ck, |c| {
         c.state.undeformed_step = flip(c.state.undeformed_step)
     });
+    let (relative, bytes) = edited_words(&ck, |c| {
+        c.progress
+            .samples
+            .iter_mut()
+            .for_each(|s| s.kinetic_relative_j = flip(s.kinetic_relative_j))
+    });
     assert_eq!(
-        (flags.len(), factors.len(), step.len()),
-        (granules, granules, 1)
+        (flags.len(), factors.len(), step.len(), relative.len()),
+        (granules, granules, 1, ck.progress.samples.len())
     );
+    assert!(!relative.is_empty(), "the base checkpoint has no samples");
     // Each factor follows its granule's flags word.
     assert!(flags.iter().zip(&factors).all(|(f, k)| *k == f + 8));
+    // An older file's state, its relative kinetic energies checked NaN and
+    // then set to this build's, so that the rest compares bit for bit.
+    let read_older = |name: &str, bytes: &[u8], version: u32| {
+        let mut old = read(&write_checkpoint(name, bytes))
+            .unwrap_or_else(|e| panic!("a version {version} checkpoint reads: {e}"));
+        assert_eq!(old.progress.samples.len(), ck.progress.samples.len());
+        for (o, s) in old.progress.samples.iter_mut().zip(&ck.progress.samples) {
+            assert!(
+                o.kinetic_relative_j.is_nan(),
+                "version {version}: not recorded"
+            );
+            o.kinetic_relative_j = s.kinetic_relative_j;
+        }
+        old
+    };
+    let cut_of = |parts: &[&Vec<usize>]| {
+        let mut cut: Vec<usize> = parts.iter().flat_map(|p| p.iter().copied()).collect();
+        cut.sort_unstable();
+        cut
+    };
+
+    let v4 = older(&bytes, &relative, 4);
+    assert_eq!(
+        read_older("version4", &v4, 4),
+        ck,
+        "version 4 reads as the same state"
+    );
+
     let mut expected = ck.clone();
     expected.state.undeformed_step = 0.0;
-
-    let v3_cut: Vec<usize> = step.iter().chain(&factors).copied().collect();
-    let v3 = older(&bytes, &v3_cut, 3);
-    let old = read(&write_checkpoint("version3", &v3)).expect("a version 3 checkpoint reads");
+    let v3 = older(&bytes, &cut_of(&[&relative, &step, &factors]), 3);
     assert_eq!(
-        old, expected,
+        read_older("version3", &v3, 3),
+        expected,
         "version 3 reads as the same state, factors 1"
     );
 
-    let mut v2_cut: Vec<usize> = v3_cut.iter().chain(&flags).copied().collect();
-    v2_cut.sort_unstable();
-    let mut v2 = older(&bytes, &v2_cut, 2);
-    let old = read(&write_checkpoint("version2", &v2)).expect("a version 2 checkpoint reads");
+    let mut v2 = older(&bytes, &cut_of(&[&relative, &step, &factors, &flags]), 2);
     assert_eq!(
-        old, expected,
+        read_older("version2", &v2, 2),
+        expected,
         "version 2 reads as the same state, all deformable"
     );
     // The same bytes labelled version 3 lack the flags: refused.

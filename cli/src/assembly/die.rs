@@ -6,6 +6,7 @@
 //! pre-settled).
 
 use granbed_kernel::Real;
+use granbed_kernel::analysis::quasi_static::ImposedCompression;
 use granbed_kernel::contact::wall::{Plane, Wall};
 use granbed_kernel::rng::Rng;
 
@@ -66,6 +67,18 @@ impl DieScene {
             }),
             WallSpec::moving(upper, self.punch_speed_m_s, Real::INFINITY),
         ]
+    }
+
+    /// The affine compression the punches impose at time `t`: the lower
+    /// punch at rest at z = 0, the upper one at H0 − v t moving down at v
+    /// (the walls of [`Self::walls`]).
+    pub fn imposed_at(&self, t: Real) -> ImposedCompression {
+        ImposedCompression {
+            lower_z_m: 0.0,
+            lower_velocity_m_s: 0.0,
+            upper_z_m: self.bed_height_m - self.punch_speed_m_s * t,
+            upper_velocity_m_s: -self.punch_speed_m_s,
+        }
     }
 
     /// Axial strain (punch travel / H0) at time `t`.

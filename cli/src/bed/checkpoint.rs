@@ -36,7 +36,11 @@ pub const FILE_NAME: &str = "checkpoint.bin";
 /// its flags, the factor variable mass scaling put on its masses (f64).
 /// Version 2 and 3 files are read with factor 1, which they were written
 /// with (bit for bit), and the resuming run's own undeformed step.
-pub const VERSION: u32 = 4;
+///
+/// 5: samples gained the kinetic energy relative to the imposed
+/// compression (after the smallest Gauss-point Jacobian). Older files read
+/// it as NaN (not recorded), which the certificate's diagnostic skips.
+pub const VERSION: u32 = 5;
 /// The oldest version read.
 const OLDEST_VERSION: u32 = 2;
 /// Granule flag: still a rigid body.
@@ -185,8 +189,11 @@ fn energies_from(v: [f64; 10]) -> Energies {
     }
 }
 
-/// Floats per sample: 18 fields, then the 10 energies.
-const SAMPLE_FLOATS: usize = 28;
+/// Floats per sample: 19 fields, then the 10 energies.
+const SAMPLE_FLOATS: usize = 29;
+/// Floats per sample before version 5 (without the relative kinetic
+/// energy, the last of the fields).
+const SAMPLE_FLOATS_V4: usize = 28;
 /// Floats of the averaging window.
 const WINDOW_FLOATS: usize = 8;
 
@@ -211,6 +218,7 @@ fn sample_to(s: &BedSample) -> [f64; SAMPLE_FLOATS] {
         s.max_node_speed_m_s,
         s.penetration_m,
         s.min_gauss_jacobian,
+        s.kinetic_relative_j,
     ];
     core::array::from_fn(|i| {
         if i < head.len() {
@@ -241,6 +249,7 @@ fn sample_from(v: [f64; SAMPLE_FLOATS]) -> BedSample {
         max_node_speed_m_s: v[15],
         penetration_m: v[16],
         min_gauss_jacobian: v[17],
+        kinetic_relative_j: v[18],
         energies: energies_from(core::array::from_fn(|i| v[SAMPLE_FLOATS - 10 + i])),
     }
 }
@@ -315,11 +324,27 @@ impl Checkpoint {
         let snapshots_done = d.u64()? as usize;
         let w = <[f64; WINDOW_FLOATS]>::try_from(d.f64s()?)
             .map_err(|_| anyhow::anyhow!("bad window"))?;
-        let samples = d
-            .vecs::<SAMPLE_FLOATS>()?
-            .into_iter()
-            .map(sample_from)
-            .collect();
+        let samples = match version {
+            2..=4 => d
+                .vecs::<SAMPLE_FLOATS_V4>()?
+                .into_iter()
+                .map(|v| {
+                    // The relative kinetic energy, not recorded, goes in
+                    // as NaN before the energies.
+                    let fields = SAMPLE_FLOATS_V4 - 10;
+                    sample_from(core::array::from_fn(|i| match i {
+                        i if i < fields => v[i],
+                        i if i == fields => f64::NAN,
+                        i => v[i - 1],
+                    }))
+                })
+                .collect(),
+            _ => d
+                .vecs::<SAMPLE_FLOATS>()?
+                .into_iter()
+                .map(sample_from)
+                .collect(),
+        };
         let t = <[f64; 4]>::try_from(d.f64s()?).map_err(|_| anyhow::anyhow!("bad time"))?;
         let energies = energies_from(
             <[f64; 10]>::try_from(d.f64s()?).map_err(|_| anyhow::anyhow!("bad energies"))?,

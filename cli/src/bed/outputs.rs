@@ -18,7 +18,7 @@ use crate::progress::{StrainBar, draw_target, steps_per_second};
 use crate::quasi_static::QuasiStatic;
 
 /// Columns of `compression.csv`, in order.
-pub const COMPRESSION_COLUMNS: [&str; 27] = [
+pub const COMPRESSION_COLUMNS: [&str; 28] = [
     "time_s",
     "strain",
     "upper_pressure_pa",
@@ -44,11 +44,12 @@ pub const COMPRESSION_COLUMNS: [&str; 27] = [
     "hourglass_j",
     "damping_j",
     "kinetic_j",
+    "kinetic_relative_j",
     "contact_loss_j",
     "energy_residual_j",
 ];
 
-fn row(s: &BedSample) -> [Field; 27] {
+fn row(s: &BedSample) -> [Field; 28] {
     let e = &s.energies;
     [
         s.time_s.into(),
@@ -76,6 +77,7 @@ fn row(s: &BedSample) -> [Field; 27] {
         e.hourglass.into(),
         e.damping.into(),
         e.kinetic.into(),
+        s.kinetic_relative_j.into(),
         e.contact_loss().into(),
         e.residual().into(),
     ]
@@ -104,6 +106,10 @@ pub fn quasi_static(samples: &[BedSample], rate_change_rel: Option<Real>) -> Qua
             internal_work_j: s.energies.internal_work,
             force_in_n: s.upper_force_n,
             force_out_n: Some(s.lower_force_n + s.die_friction_z_n),
+            kinetic_relative_j: s
+                .kinetic_relative_j
+                .is_finite()
+                .then_some(s.kinetic_relative_j),
         })
         .collect();
     crate::quasi_static::judge(&loads, rate_change_rel)
@@ -341,9 +347,10 @@ pub fn summary_line(scene: &Scene, run: &BedRun) -> String {
         String::new()
     } else {
         format!(
-            "; NOT quasi-static (kinetic/internal up to {}, force imbalance {}, change at half \
-             speed {})",
+            "; NOT quasi-static (kinetic/internal up to {} (relative to the imposed \
+             compression {}), force imbalance {}, change at half speed {})",
             fmt(q.max_kinetic_to_internal, 1.0),
+            fmt(q.max_relative_kinetic_to_internal, 1.0),
             fmt(q.force_imbalance_rel, 1.0),
             fmt(q.rate_change_rel, 1.0)
         )

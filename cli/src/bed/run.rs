@@ -88,6 +88,10 @@ pub struct BedSample {
     pub steps: u64,
     /// Energy ledger so far (elastic energy at this instant).
     pub energies: Energies,
+    /// Kinetic energy at this instant relative to the compression the
+    /// punches impose ([`Assembly::kinetic_relative_to`]), J; NaN where not
+    /// recorded (checkpoints before version 5).
+    pub kinetic_relative_j: Real,
 }
 
 /// What a run produced. A run stopped by a kernel error keeps the samples
@@ -404,6 +408,7 @@ pub fn run_bed(
             penetration_m: asm.penetration().map_or(Real::NAN, |g| -g),
             steps: asm.steps(),
             energies: *asm.energies(),
+            kinetic_relative_j: asm.kinetic_relative_to(&die.imposed_at(asm.time())),
         }
     };
     let mut snapshots: Vec<Real> = scene.snapshot_strains.clone();

@@ -428,6 +428,8 @@ impl PlatenSample {
             internal_work_j: self.energy.internal_work,
             force_in_n: self.force_upper_n,
             force_out_n: (symmetry == Symmetry::Full).then_some(self.force_lower_n),
+            // Between platens nothing is imposed but the platens themselves.
+            kinetic_relative_j: None,
         }
     }
 
