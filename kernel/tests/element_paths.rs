@@ -13,6 +13,7 @@ use granbed_kernel::constitutive::UpdateError;
 use granbed_kernel::element::batch::{
     BATCH, ElementBatch, ElementPath, batch_count, has_avx2, one_point_elements, regroup,
 };
+use granbed_kernel::element::force::HexForces;
 use granbed_kernel::element::reference::{HexReference, hex_reference};
 use granbed_kernel::material::GranuleType;
 use granbed_kernel::mesh::sphere::SphereMeshParams;
@@ -28,7 +29,7 @@ const PATHS: [(ElementPath, bool); 4] = [
 ];
 
 /// Everything an element hands to the loop, as bits.
-fn bits(e: usize, out: &granbed_kernel::element::force::HexForces) -> Vec<u64> {
+fn bits(e: usize, out: &HexForces) -> Vec<u64> {
     let mut v = vec![e as u64];
     v.extend(out.f.iter().flatten().map(|x| x.to_bits()));
     v.extend(out.tau.iter().map(|x| x.to_bits()));
@@ -86,7 +87,7 @@ fn run(
         &batches,
         x,
         cp,
-        &mut |e, _, out| {
+        &mut |e: usize, _: &[u32; 8], out: &HexForces| {
             plastic += usize::from(out.info.plastic);
             outputs.push(bits(e, out));
         },
@@ -280,7 +281,7 @@ fn regrouped_data_of_the_wrong_length_or_mesh_are_ignored() {
             batches,
             &x,
             &mut cp,
-            &mut |e, _, o| out.push(bits(e, o)),
+            &mut |e: usize, _: &[u32; 8], o: &HexForces| out.push(bits(e, o)),
         )
         .unwrap();
         outputs.push(out);

@@ -244,14 +244,32 @@ pub struct TrialCheck {
 /// Checks the input of an update: a finite `f`, J > 0, a valid stored state
 /// and a finite η; then evaluates the yield function at the trial state.
 #[inline(always)]
-#[allow(clippy::neg_cmp_op_on_partial_ord)] // NaN must fail the test
 pub fn check_trial(
     mat: &Material,
     opts: &UpdateOptions,
     f: &Rows<Real>,
     t: &Trial<Real>,
 ) -> Result<TrialCheck, UpdateError> {
-    if !f.iter().flatten().all(|x| x.is_finite()) {
+    check_input(f.iter().flatten().all(|x| x.is_finite()), t)?;
+    let coefficients = yield_surface::coefficients(&mat.params, t.eta);
+    let scale = yield_surface::yield_scale(&coefficients, mat.params.yield_stress_pa);
+    let phi_tr = yield_surface::yield_function_of(coefficients.a1, scale, t.beta, t.alpha);
+    Ok(judge_trial(
+        opts,
+        t,
+        coefficients,
+        scale,
+        phi_tr,
+        phi_tr / scale,
+    ))
+}
+
+/// The input checks of [`check_trial`]: F finite (`f_finite`), J > 0, a
+/// valid stored state and a finite η.
+#[inline(always)]
+#[allow(clippy::neg_cmp_op_on_partial_ord)] // NaN must fail the test
+pub fn check_input(f_finite: bool, t: &Trial<Real>) -> Result<(), UpdateError> {
+    if !f_finite {
         return Err(UpdateError::NonFinite);
     }
     if t.j.is_nan() || t.j <= 0.0 {
@@ -266,16 +284,35 @@ pub fn check_trial(
         // flat, for the update as good as inverted (found by fuzzing).
         return Err(UpdateError::InvertedDeformation { j: t.j });
     }
-    let coefficients = yield_surface::coefficients(&mat.params, t.eta);
-    let sy = mat.params.yield_stress_pa;
-    let scale = yield_surface::yield_scale(&coefficients, sy);
-    let phi_tr = yield_surface::yield_function(&coefficients, sy, t.beta, t.alpha);
-    Ok(TrialCheck {
-        info: UpdateInfo::elastic(t.eta, t.je, coefficients, phi_tr / scale),
-        // Not `φ > tol`: a NaN φ (overflowed trial state) must go to the
-        // corrector, which reports it, never pass as elastic (fuzzing).
-        plastic_scale: (!(phi_tr <= opts.yield_tolerance * scale)).then_some(scale),
-    })
+    Ok(())
+}
+
+/// [`check_trial`]'s verdict from the yield coefficients at η, the scale
+/// (2/3)a2σy², the trial φ and φ/scale (computed by the caller, so that an
+/// element batch can take them for all its lanes at once).
+#[inline(always)]
+pub fn judge_trial(
+    opts: &UpdateOptions,
+    t: &Trial<Real>,
+    coefficients: YieldCoefficients,
+    scale: Real,
+    phi_tr: Real,
+    residual: Real,
+) -> TrialCheck {
+    TrialCheck {
+        info: UpdateInfo::elastic(t.eta, t.je, coefficients, residual),
+        plastic_scale: yields(opts, phi_tr, scale).then_some(scale),
+    }
+}
+
+/// Whether a trial state with yield function `phi_tr` and scale
+/// (2/3)a2σy² `scale` yields: not `φ ≤ tol·scale`. Not `φ > tol·scale`: a
+/// NaN φ (overflowed trial state) must go to the corrector, which reports
+/// it, never pass as elastic (fuzzing).
+#[inline(always)]
+#[allow(clippy::neg_cmp_op_on_partial_ord)] // NaN must fail the test
+pub fn yields(opts: &UpdateOptions, phi_tr: Real, scale: Real) -> bool {
+    !(phi_tr <= opts.yield_tolerance * scale)
 }
 
 /// Updates one integration point to the end-of-step deformation gradient.

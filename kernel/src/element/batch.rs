@@ -6,9 +6,13 @@
 //! nodal forces and the hourglass forces once for all lanes — the same code
 //! as the scalar element ([`mean_gradient_rows`], [`trial`],
 //! [`nodal_forces`] are generic over [`Num`]), so every lane gets exactly the
-//! scalar result. Per lane, in scalar code: the input checks and the yield
-//! test ([`check_trial`]) and, for a lane that yields, the plastic corrector
-//! ([`plastic_return`]). A batch in which any lane fails is evaluated again
+//! scalar result. The yield test of [`check_trial`] runs in lanes too (its
+//! pieces, [`yield_surface::porous_formula`],
+//! [`yield_surface::yield_function_of`], are generic), all but the branches
+//! of η ≥ 1 and the a2 clamp. Per lane, in scalar code: those branches, the
+//! input checks ([`check_input`]) and, for a lane that yields
+//! ([`yields`]), the plastic corrector ([`plastic_return`]). The element's
+//! results go to a [`Sink`] the loop is generic over, compiled into it. A batch in which any lane fails is evaluated again
 //! element by element by [`hex_forces`], so errors, and the states left
 //! behind, are those of the scalar loop.
 //!
@@ -28,8 +32,10 @@
 //! transition penalty on every call.
 
 use crate::Real;
-use crate::constitutive::update::{Trial, check_trial, plastic_return, trial};
-use crate::constitutive::yield_surface::YieldCoefficients;
+#[cfg(doc)]
+use crate::constitutive::update::check_trial;
+use crate::constitutive::update::{Trial, check_input, plastic_return, trial, yields};
+use crate::constitutive::yield_surface::{self, YieldCoefficients};
 use crate::constitutive::{UpdateError, UpdateInfo, UpdateOptions, elastic};
 use crate::element::force::{
     ElementGeometry, HexForces, hex_forces, mean_gradient_rows, nodal_forces,
@@ -110,6 +116,27 @@ fn detect_avx2() -> bool {
 
 /// One element's results as the element loop consumes them.
 pub type ElementOutput = HexForces;
+
+/// What the element loop hands each element's result to, in element
+/// order. Any closure `|element, &hex, &output|` is one (with its
+/// parameter types written out, `|e: usize, hex: &[u32; 8], out:
+/// &ElementOutput|`, as the compiler does not infer them through the
+/// trait); the loop is
+/// generic over it so that a sink whose `element` is `#[inline(always)]`
+/// is compiled into the batch loop (an indirect call per element, with the
+/// output copied through memory, was 10 % of the elastic element:
+/// BENCHMARKS.md).
+pub trait Sink {
+    /// Takes the result `out` of element `element` with node ids `hex`.
+    fn element(&mut self, element: usize, hex: &[u32; 8], out: &ElementOutput);
+}
+
+impl<S: FnMut(usize, &[u32; 8], &ElementOutput)> Sink for S {
+    #[inline(always)]
+    fn element(&mut self, element: usize, hex: &[u32; 8], out: &ElementOutput) {
+        self(element, hex, out)
+    }
+}
 
 /// The reference data of [`BATCH`] consecutive elements regrouped into
 /// lanes (lane l = element l of the batch; structure of arrays), so that a
@@ -198,7 +225,7 @@ pub fn regroup(elements: &[HexReference], out: &mut [ElementBatch]) -> Result<()
 /// Lengths: `refs` and `cp_inv` as `hexes`; node ids index `x`.
 #[allow(clippy::too_many_arguments)]
 #[allow(unsafe_code)]
-pub fn one_point_elements(
+pub fn one_point_elements<S: Sink>(
     path: ElementPath,
     mat: &Material,
     opts: &UpdateOptions,
@@ -208,7 +235,7 @@ pub fn one_point_elements(
     batches: &[ElementBatch],
     x: &[[Real; 3]],
     cp_inv: &mut [Voigt],
-    sink: &mut dyn FnMut(usize, &[u32; 8], &ElementOutput),
+    sink: &mut S,
 ) -> Result<(), (usize, UpdateError)> {
     let job = Job {
         mat,
@@ -254,7 +281,9 @@ fn regrouped_from(batches: &[ElementBatch], refs: &[HexReference]) -> bool {
         && (batches.is_empty() || (lanes_match(0) && lanes_match(batches.len() - 1)))
 }
 
-/// Placeholder diagnostics, overwritten for every lane before use.
+/// Placeholder diagnostics: each lane's starts from these elastic fields
+/// (not plastic, no iterations) and gets its η, J^e, coefficients and
+/// residual written over them.
 const UNSET: UpdateInfo = UpdateInfo::elastic(
     0.0,
     0.0,
@@ -279,11 +308,11 @@ struct Job<'a> {
 
 impl Job<'_> {
     /// Elements `first..first + cp_inv.len()` one by one.
-    fn scalar(
+    fn scalar<S: Sink>(
         &self,
         first: usize,
         cp_inv: &mut [Voigt],
-        sink: &mut dyn FnMut(usize, &[u32; 8], &ElementOutput),
+        sink: &mut S,
     ) -> Result<(), (usize, UpdateError)> {
         for (k, c) in cp_inv.iter_mut().enumerate() {
             let e = first + k;
@@ -291,7 +320,7 @@ impl Job<'_> {
             let xe = core::array::from_fn(|i| self.x[hex[i] as usize]);
             let out = hex_forces(self.mat, self.opts, self.kappa, &self.refs[e], &xe, c)
                 .map_err(|error| (e, error))?;
-            sink(e, hex, &out);
+            sink.element(e, hex, &out);
         }
         Ok(())
     }
@@ -301,20 +330,20 @@ impl Job<'_> {
     #[allow(unsafe_code)]
     /// # Safety
     /// The processor must support AVX2 ([`has_avx2`]).
-    unsafe fn batched_avx2(
+    unsafe fn batched_avx2<S: Sink>(
         &self,
         cp_inv: &mut [Voigt],
-        sink: &mut dyn FnMut(usize, &[u32; 8], &ElementOutput),
+        sink: &mut S,
     ) -> Result<(), (usize, UpdateError)> {
         self.batched(cp_inv, sink)
     }
 
     /// All elements in batches of [`BATCH`], the remainder one by one.
     #[inline(always)]
-    fn batched(
+    fn batched<S: Sink>(
         &self,
         cp_inv: &mut [Voigt],
-        sink: &mut dyn FnMut(usize, &[u32; 8], &ElementOutput),
+        sink: &mut S,
     ) -> Result<(), (usize, UpdateError)> {
         let full = batch_count(cp_inv.len()) * BATCH;
         let (head, tail) = cp_inv.split_at_mut(full);
@@ -334,12 +363,7 @@ impl Job<'_> {
     /// `array::from_fn` were left out of line and copied through memory.
     #[allow(non_snake_case)]
     #[inline(always)]
-    fn batch(
-        &self,
-        b: usize,
-        cp_inv: &mut [Voigt; BATCH],
-        sink: &mut dyn FnMut(usize, &[u32; 8], &ElementOutput),
-    ) -> bool {
+    fn batch<S: Sink>(&self, b: usize, cp_inv: &mut [Voigt; BATCH], sink: &mut S) -> bool {
         const W: usize = BATCH;
         let first = b * W;
         let hexes = &self.hexes[first..first + W];
@@ -371,28 +395,50 @@ impl Job<'_> {
         let F = mean_gradient_rows(&g.b0, &x);
         let t = trial(self.mat, &F, &c);
         let mut tau = elastic::kirchhoff(self.mat, &t.b, t.je);
+        // The yield test of `check_trial` for all lanes at once: the
+        // porous coefficients' formula, then per lane η ≥ 1 and the clamp,
+        // then the scale, φ and φ/scale (the scalar bits).
+        let params = &self.mat.params;
+        let (a1_formula, a2_formula) = yield_surface::porous_formula(params, t.eta);
+        let mut coefficients = [UNSET.coefficients; W];
+        let (mut a1, mut a2) = (zero, zero);
+        for (l, cl) in coefficients.iter_mut().enumerate() {
+            *cl = yield_surface::coefficients_from(t.eta.0[l], a1_formula.0[l], a2_formula.0[l]);
+            (a1.0[l], a2.0[l]) = (cl.a1, cl.a2);
+        }
+        let scale = yield_surface::yield_scale_of(a2, params.yield_stress_pa);
+        let phi = yield_surface::yield_function_of(a1, scale, t.beta, t.alpha);
+        let residual = phi / scale;
         // Per lane: the checks and, if it yields, the corrector.
         let mut info = [UNSET; W];
         let mut new_state: [Option<Voigt>; W] = [None; W];
         let mut dissipation = [0.0; W];
         for l in 0..W {
-            let mut lane_f = [[0.0; 3]; 3];
-            for (row, f_row) in lane_f.iter_mut().zip(&F) {
-                for (v, fv) in row.iter_mut().zip(f_row) {
-                    *v = fv.0[l];
-                }
-            }
+            let finite = F.iter().flatten().all(|v| v.0[l].is_finite());
             let lane_t: Trial<Real> = t.lane(l);
-            let Ok(check) = check_trial(self.mat, self.opts, &lane_f, &lane_t) else {
+            if check_input(finite, &lane_t).is_err() {
                 return false;
-            };
-            info[l] = check.info;
+            }
+            // `judge_trial`'s elastic diagnostics, written field by field
+            // into the placeholder (building the struct and copying it in
+            // stalled on store forwarding: BENCHMARKS.md).
+            let i = &mut info[l];
+            (i.eta, i.je) = (lane_t.eta, lane_t.je);
+            i.coefficients = coefficients[l];
+            i.residual = residual.0[l];
             // V0 × 0 as the scalar element computes it (−0 or NaN for a
             // malformed volume, like the scalar path).
             dissipation[l] = g.volume.0[l] * 0.0;
-            if let Some(scale) = check.plastic_scale {
+            if yields(self.opts, phi.0[l], scale.0[l]) {
+                let scale = scale.0[l];
+                let mut lane_f = [[0.0; 3]; 3];
+                for (row, f_row) in lane_f.iter_mut().zip(&F) {
+                    for (v, fv) in row.iter_mut().zip(f_row) {
+                        *v = fv.0[l];
+                    }
+                }
                 let Ok((up, cp)) =
-                    plastic_return(self.mat, self.opts, &lane_f, &lane_t, check.info, scale)
+                    plastic_return(self.mat, self.opts, &lane_f, &lane_t, info[l], scale)
                 else {
                     return false;
                 };
@@ -433,7 +479,7 @@ impl Job<'_> {
             for (o, tk) in out.tau.iter_mut().zip(&tau) {
                 *o = tk.0[l];
             }
-            sink(first + l, &self.hexes[first + l], &out);
+            sink.element(first + l, &self.hexes[first + l], &out);
         }
         true
     }

@@ -6,7 +6,7 @@ use core::fmt;
 
 use crate::Real;
 use crate::constitutive::{UpdateError, UpdateOptions};
-use crate::element::batch::{ElementPath, one_point_elements};
+use crate::element::batch::{ElementPath, Sink, one_point_elements};
 use crate::element::fbar::{fbar_elastic_energy, fbar_forces};
 use crate::element::force::HexForces;
 use crate::material::Material;
@@ -113,27 +113,9 @@ pub fn internal_forces_on(
         min_j: Real::INFINITY,
         ..ForceSummary::default()
     };
-    let mut scatter = |hex: &[u32; 8], fe: &[[Real; 3]; 8]| {
-        for (id, fe) in hex.iter().zip(fe.iter()) {
-            let fi = &mut f[*id as usize];
-            fi[0] += fe[0];
-            fi[1] += fe[1];
-            fi[2] += fe[2];
-        }
-    };
     match settings.kind {
         ElementKind::OnePoint => {
-            let mut sink = |_: usize, hex: &[u32; 8], out: &HexForces| {
-                scatter(hex, &out.f);
-                s.hourglass_energy += out.hourglass_energy;
-                s.plastic_dissipation += out.plastic_dissipation;
-                s.min_j = crate::math::min(s.min_j, out.j);
-                if out.info.plastic {
-                    s.plastic_elements += 1;
-                    s.max_iterations = s.max_iterations.max(out.info.iterations);
-                }
-                s.a2_clamped += usize::from(out.info.coefficients.a2_clamped);
-            };
+            let mut sink = Assemble { f, summary: &mut s };
             one_point_elements(
                 path,
                 mat,
@@ -155,7 +137,7 @@ pub fn internal_forces_on(
                 let xe = core::array::from_fn(|i| x[hex[i] as usize]);
                 let out = fbar_forces(mat, &settings.update, &xr, &xe, c)
                     .map_err(|error| ElementFailure { element, error })?;
-                scatter(hex, &out.f);
+                scatter(f, hex, &out.f);
                 s.plastic_dissipation += out.plastic_dissipation;
                 s.min_j = crate::math::min(s.min_j, out.min_j);
                 if out.plastic_points > 0 {
@@ -167,6 +149,42 @@ pub fn internal_forces_on(
         }
     }
     Ok(s)
+}
+
+/// Adds an element's nodal forces `fe` to the granule's `f` at its nodes
+/// `hex`.
+#[inline(always)]
+fn scatter(f: &mut [[Real; 3]], hex: &[u32; 8], fe: &[[Real; 3]; 8]) {
+    for (id, fe) in hex.iter().zip(fe.iter()) {
+        let fi = &mut f[*id as usize];
+        fi[0] += fe[0];
+        fi[1] += fe[1];
+        fi[2] += fe[2];
+    }
+}
+
+/// The one-point element loop's sink: each element's forces into the
+/// granule's `f`, its energies and diagnostics into `summary`, in element
+/// order.
+struct Assemble<'a> {
+    f: &'a mut [[Real; 3]],
+    summary: &'a mut ForceSummary,
+}
+
+impl Sink for Assemble<'_> {
+    #[inline(always)]
+    fn element(&mut self, _: usize, hex: &[u32; 8], out: &HexForces) {
+        let s = &mut *self.summary;
+        scatter(self.f, hex, &out.f);
+        s.hourglass_energy += out.hourglass_energy;
+        s.plastic_dissipation += out.plastic_dissipation;
+        s.min_j = crate::math::min(s.min_j, out.j);
+        if out.info.plastic {
+            s.plastic_elements += 1;
+            s.max_iterations = s.max_iterations.max(out.info.iterations);
+        }
+        s.a2_clamped += usize::from(out.info.coefficients.a2_clamped);
+    }
 }
 
 /// Stored elastic energy Σ ∫ψ(b^e, J^e) dV0 of a granule, J, with
