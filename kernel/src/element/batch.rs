@@ -378,18 +378,19 @@ impl Job<'_> {
             }
         };
         let zero = Lanes::<W>::splat(0.0);
+        // Each lane vector is made whole from its W scalars (written lane
+        // by lane into memory and read back as one vector, it stalled on
+        // store forwarding: BENCHMARKS.md).
         let mut x = [[zero; 3]; 8];
+        for (i, xi) in x.iter_mut().enumerate() {
+            let p: [&[Real; 3]; W] = core::array::from_fn(|l| &self.x[hexes[l][i] as usize]);
+            for (a, xia) in xi.iter_mut().enumerate() {
+                *xia = Lanes(core::array::from_fn(|l| p[l][a]));
+            }
+        }
         let mut c = [zero; 6];
-        for (l, hex) in hexes.iter().enumerate() {
-            for (xi, &node) in x.iter_mut().zip(hex) {
-                let p = &self.x[node as usize];
-                for (xia, &pa) in xi.iter_mut().zip(p) {
-                    xia.0[l] = pa;
-                }
-            }
-            for (ck, &v) in c.iter_mut().zip(&cp_inv[l]) {
-                ck.0[l] = v;
-            }
+        for (k, ck) in c.iter_mut().enumerate() {
+            *ck = Lanes(core::array::from_fn(|l| cp_inv[l][k]));
         }
 
         let F = mean_gradient_rows(&g.b0, &x);
