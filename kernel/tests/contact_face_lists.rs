@@ -9,7 +9,7 @@ use common::{Rng, sphere_mesh};
 use granbed_kernel::Real;
 use granbed_kernel::contact::broad::bounding_sphere;
 use granbed_kernel::contact::face_lists::{
-    AnchorSurface, FaceLists, FaceListsMut, ReachBox, build, drift,
+    AnchorSurface, FaceLists, FaceListsMut, ReachBox, build, drift, face_diagonal,
 };
 use granbed_kernel::contact::pair::{
     CandidateFace, Constraint, PairSettings, detect, detect_listed,
@@ -324,4 +324,58 @@ fn a_small_face_that_overrules_a_hit_on_a_large_one_is_listed() {
     let (full, listed) = full_and_listed((&a, &b), &settings, anchors, 1e-3);
     assert!(full.is_empty(), "the full pass holds no node: {full:?}");
     assert!(listed.is_empty(), "the listed pass holds {listed:?}");
+}
+
+/// The lists are their definition (module docs): node p lists face q
+/// exactly when q's anchor box grown by τ = (f·G + (2 + 2f)·d)(1 + 10⁻⁶)
+/// holds p, G the master's largest face diagonal — checked against every
+/// node × face of granules pressed together, side by side with a gap and
+/// far apart, so that the prefilters of `build` (faces whose reach misses
+/// the slave's box, nodes outside every remaining reach) leave out only
+/// faces and nodes that list nothing.
+#[test]
+fn the_lists_are_every_face_whose_grown_box_holds_the_node() {
+    let d = 30e-6;
+    let mut listed = 0;
+    for (seed, overlap) in [(1, 40e-6), (2, 0.0), (3, -60e-6), (4, -0.6e-3), (5, 25e-6)] {
+        let s = scene(seed, overlap, 0.0);
+        let surface = |b: usize| AnchorSurface {
+            x: &s.anchor[b][s.first..],
+            first_surface: s.first,
+            quads: &s.mesh.quads,
+        };
+        for (slave, master) in [(surface(0), surface(1)), (surface(1), surface(0))] {
+            let lists = build_lists(&slave, &master, d);
+            let corners = |q: &[u32; 4]| q.map(|id| master.x[id as usize - s.first]);
+            let largest = master
+                .quads
+                .iter()
+                .map(|q| face_diagonal(&corners(q)))
+                .fold(0.0, Real::max);
+            let tau = (0.25 * largest + (2.0 + 2.0 * 0.25) * d) * (1.0 + 1e-6);
+            let mut want = Lists::default();
+            for (i, p) in slave.x.iter().enumerate() {
+                let start = want.faces.len() as u32;
+                for (q, quad) in master.quads.iter().enumerate() {
+                    if Aabb::of_points(&corners(quad)).expanded(tau).contains(p) {
+                        want.faces.push(q as u32);
+                    }
+                }
+                if want.faces.len() as u32 > start {
+                    want.nodes.push((s.first + i) as u32);
+                    want.starts.push(start);
+                }
+            }
+            want.starts.push(want.faces.len() as u32);
+            want.used = want.faces.clone();
+            want.used.sort_unstable();
+            want.used.dedup();
+            assert_eq!(lists.nodes, want.nodes, "seed {seed}: nodes");
+            assert_eq!(lists.starts, want.starts, "seed {seed}: starts");
+            assert_eq!(lists.faces, want.faces, "seed {seed}: faces");
+            assert_eq!(lists.used, want.used, "seed {seed}: used");
+            listed += lists.faces.len();
+        }
+    }
+    assert!(listed > 100, "the scenes list faces: {listed}");
 }
