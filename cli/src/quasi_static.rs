@@ -14,8 +14,10 @@ pub struct QuasiStatic {
     /// Largest kinetic / internal work ratio over the second half.
     pub max_kinetic_to_internal: Option<Real>,
     /// The same with the kinetic energy relative to the compression the
-    /// punches impose: a diagnostic, not judged (`null`: nothing imposed,
-    /// as between platens, or not recorded).
+    /// punches impose: a diagnostic, not judged, over the judged samples
+    /// that recorded it (`null`: nothing imposed, as between platens, or
+    /// none recorded; a run resumed from a checkpoint before format 5 has
+    /// it for the samples after the resume only).
     pub max_relative_kinetic_to_internal: Option<Real>,
     /// Mean |F_in − F_out| / F_in over the loaded samples of the second
     /// half (`null` where not measured: an octant granule).

@@ -11,7 +11,7 @@ use common::{Rng, material, sphere_mesh};
 use granbed_kernel::Real;
 use granbed_kernel::constitutive::UpdateError;
 use granbed_kernel::element::batch::{
-    BATCH, ElementBatch, ElementPath, batch_count, has_avx2, one_point_elements, regroup,
+    BATCH, ElementBatch, ElementPath, batch_count, has_avx2, one_point_elements, regroup, sink,
 };
 use granbed_kernel::element::force::HexForces;
 use granbed_kernel::element::reference::{HexReference, hex_reference};
@@ -87,10 +87,10 @@ fn run(
         &batches,
         x,
         cp,
-        &mut |e: usize, _: &[u32; 8], out: &HexForces| {
+        &mut sink(|e, _, out| {
             plastic += usize::from(out.info.plastic);
             outputs.push(bits(e, out));
-        },
+        }),
     );
     Pass {
         result,
@@ -289,4 +289,67 @@ fn regrouped_data_of_the_wrong_length_or_mesh_are_ignored() {
     assert_eq!(outputs[0].len(), count);
     assert_eq!(outputs[0], outputs[1]);
     assert_eq!(outputs[0], outputs[2]);
+}
+
+/// Lanes whose relative density is past 1 (von Mises, radial return),
+/// just below it, or so low that a2 is clamped give the scalar bits on
+/// every path: the yield test's branches run per lane after the batch's
+/// arithmetic. B2 (η0 = 0.8) in a radial field ramped over 40 steps, which
+/// shrinks the core by 0.9 (J ≈ 0.73, η ≈ 1.1) and stretches the shell by
+/// up to 1.65 (J ≈ 4.5, η below η_c = 0.2).
+#[test]
+fn lanes_past_eta_one_or_with_a_clamped_a2_give_the_scalar_bits() {
+    let mesh = sphere_mesh(&SphereMeshParams::standard());
+    let count = mesh.hexes.len();
+    let hexes = &mesh.hexes[..];
+    let refs: Vec<HexReference> = (0..count)
+        .map(|e| hex_reference(&mesh.hex_coords(e)).unwrap())
+        .collect();
+    let radius = 0.5e-3;
+    let mut states: Vec<Vec<Voigt>> = PATHS.iter().map(|_| vec![VOIGT_IDENTITY; count]).collect();
+    // Which lanes the field made: η from the outputs' bits (`bits`'s order).
+    let eta = |o: &Vec<u64>| Real::from_bits(o[1 + 24 + 6 + 6]);
+    let clamped = |o: &Vec<u64>| o[1 + 24 + 6 + 11] == 1;
+    let (mut von_mises, mut near_one, mut clamp, mut mixed) = (0, 0, 0, 0);
+    let steps = 40;
+    for step in 1..=steps {
+        let ramp = step as Real / steps as Real;
+        let x: Vec<[Real; 3]> = mesh
+            .positions
+            .iter()
+            .map(|p| {
+                let r = (p[0] * p[0] + p[1] * p[1] + p[2] * p[2]).sqrt() / radius;
+                let t = ((r - 0.25) / 0.6).clamp(0.0, 1.0);
+                let s = 0.9 + 0.75 * t * t * (3.0 - 2.0 * t);
+                p.map(|c| c * (1.0 + ramp * (s - 1.0)))
+            })
+            .collect();
+        let passes: Vec<Pass> = PATHS
+            .iter()
+            .zip(states.iter_mut())
+            .map(|(&path, cp)| run(path, hexes, &refs, &x, cp))
+            .collect();
+        let scalar = &passes[0];
+        assert!(scalar.result.is_ok(), "step {step}: {:?}", scalar.result);
+        for (path, pass) in PATHS.iter().zip(&passes).skip(1) {
+            assert_eq!(pass.result, scalar.result, "{path:?}, step {step}");
+            assert_eq!(pass.outputs, scalar.outputs, "{path:?}, step {step}");
+        }
+        von_mises += scalar.outputs.iter().filter(|o| eta(o) >= 1.0).count();
+        near_one += scalar
+            .outputs
+            .iter()
+            .filter(|o| (0.95..1.0).contains(&eta(o)))
+            .count();
+        clamp += scalar.outputs.iter().filter(|o| clamped(o)).count();
+        mixed += scalar
+            .outputs
+            .chunks(BATCH)
+            .filter(|b| b.iter().any(|o| eta(o) >= 1.0) && b.iter().any(|o| eta(o) < 1.0))
+            .count();
+    }
+    assert!(
+        von_mises > 0 && near_one > 0 && clamp > 0 && mixed > 0,
+        "lanes past 1: {von_mises}, just below 1: {near_one}, clamped: {clamp}, batches across 1: {mixed}"
+    );
 }

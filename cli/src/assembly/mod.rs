@@ -806,12 +806,8 @@ impl<'m> Assembly<'m> {
     /// or, under selective mass scaling, Σ m/F). Granules in parallel, the
     /// shares summed in granule order.
     pub fn kinetic_relative_to(&self, field: &ImposedCompression) -> Real {
-        let selective = self.params.selective_mass_factor();
-        let fraction = if selective > 1.0 {
-            1.0 / selective
-        } else {
-            1.0
-        };
+        // F/G ≥ 1, and 1 without selective scaling.
+        let fraction = 1.0 / self.params.selective_mass_factor();
         let shares: Vec<Real> = self
             .granules
             .par_iter()
@@ -917,15 +913,16 @@ mod tests {
         assert_eq!(p.selective_mass_factor(), 1.0);
     }
 
-    /// Three granules stacked in a die pressed at 0.05 m/s, each translating
-    /// with the imposed field at its centre, have no kinetic energy relative
-    /// to it (to round-off of K); a rattle of one granule and a spin of
-    /// another leave exactly their own kinetic energies — with physical
-    /// masses and under selective scaling, whose translation carries Σ m/F.
     /// A node velocity, m/s, by granule, position and the imposed field's
     /// axial velocity at the granule's centre.
     type VelocityField<'a> = &'a dyn Fn(usize, &[Real; 3], Real) -> [Real; 3];
 
+    /// Three granules stacked in a die pressed at 0.05 m/s, each translating
+    /// with the imposed field at its centre, have no kinetic energy relative
+    /// to it (to round-off of K); a rattle of one granule and a spin of
+    /// another leave exactly their own kinetic energies — under uniform
+    /// scaling ×20 and under selective scaling, whose translation carries
+    /// Σ m/(F/G). The field's upper face is the upper punch's wall.
     #[test]
     fn the_relative_kinetic_energy_is_what_moves_against_the_imposed_compression() {
         use crate::assembly::die::DieScene;
@@ -934,6 +931,13 @@ mod tests {
         let centres = [[0.0, 0.0, 0.6e-3], [0.0, 0.0, 1.7e-3], [0.0, 0.0, 2.8e-3]];
         let die = DieScene::new(&centres, 0.5e-3, 2e-3, 0.05);
         let field = die.imposed_at(4e-3);
+        let Wall::Plane(upper) = die.walls()[2].at(4e-3) else {
+            panic!("the third wall is the upper punch");
+        };
+        assert_eq!(
+            -upper.offset, field.upper_z_m,
+            "the field's upper face is the punch"
+        );
         let placements = centres.map(Placement::at);
         for selective in [false, true] {
             let mut p = b2_one_point();

@@ -106,10 +106,8 @@ pub fn quasi_static(samples: &[BedSample], rate_change_rel: Option<Real>) -> Qua
             internal_work_j: s.energies.internal_work,
             force_in_n: s.upper_force_n,
             force_out_n: Some(s.lower_force_n + s.die_friction_z_n),
-            kinetic_relative_j: s
-                .kinetic_relative_j
-                .is_finite()
-                .then_some(s.kinetic_relative_j),
+            // NaN: not recorded (a sample of a checkpoint before format 5).
+            kinetic_relative_j: (!s.kinetic_relative_j.is_nan()).then_some(s.kinetic_relative_j),
         })
         .collect();
     crate::quasi_static::judge(&loads, rate_change_rel)

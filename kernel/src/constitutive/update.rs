@@ -252,22 +252,18 @@ pub fn check_trial(
 ) -> Result<TrialCheck, UpdateError> {
     check_input(f.iter().flatten().all(|x| x.is_finite()), t)?;
     let coefficients = yield_surface::coefficients(&mat.params, t.eta);
-    let scale = yield_surface::yield_scale(&coefficients, mat.params.yield_stress_pa);
-    let phi_tr = yield_surface::yield_function_of(coefficients.a1, scale, t.beta, t.alpha);
-    Ok(judge_trial(
-        opts,
-        t,
-        coefficients,
-        scale,
-        phi_tr,
-        phi_tr / scale,
-    ))
+    let sy = mat.params.yield_stress_pa;
+    let scale = yield_surface::yield_scale(&coefficients, sy);
+    let phi_tr = yield_surface::yield_function(&coefficients, sy, t.beta, t.alpha);
+    Ok(TrialCheck {
+        info: UpdateInfo::elastic(t.eta, t.je, coefficients, phi_tr / scale),
+        plastic_scale: yields(opts, phi_tr, scale).then_some(scale),
+    })
 }
 
 /// The input checks of [`check_trial`]: F finite (`f_finite`), J > 0, a
-/// valid stored state and a finite η.
+/// valid stored state and a finite η (a NaN J or det C_p⁻¹ fails).
 #[inline(always)]
-#[allow(clippy::neg_cmp_op_on_partial_ord)] // NaN must fail the test
 pub fn check_input(f_finite: bool, t: &Trial<Real>) -> Result<(), UpdateError> {
     if !f_finite {
         return Err(UpdateError::NonFinite);
@@ -285,24 +281,6 @@ pub fn check_input(f_finite: bool, t: &Trial<Real>) -> Result<(), UpdateError> {
         return Err(UpdateError::InvertedDeformation { j: t.j });
     }
     Ok(())
-}
-
-/// [`check_trial`]'s verdict from the yield coefficients at η, the scale
-/// (2/3)a2σy², the trial φ and φ/scale (computed by the caller, so that an
-/// element batch can take them for all its lanes at once).
-#[inline(always)]
-pub fn judge_trial(
-    opts: &UpdateOptions,
-    t: &Trial<Real>,
-    coefficients: YieldCoefficients,
-    scale: Real,
-    phi_tr: Real,
-    residual: Real,
-) -> TrialCheck {
-    TrialCheck {
-        info: UpdateInfo::elastic(t.eta, t.je, coefficients, residual),
-        plastic_scale: yields(opts, phi_tr, scale).then_some(scale),
-    }
 }
 
 /// Whether a trial state with yield function `phi_tr` and scale

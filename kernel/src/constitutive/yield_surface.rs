@@ -92,3 +92,64 @@ pub fn yield_scale_of<T: Num>(a2: T, yield_stress: Real) -> T {
 pub fn yield_function_of<T: Num>(a1: T, scale: T, beta: T, alpha: T) -> T {
     beta * beta + (a1 / T::splat(3.0)) * alpha * alpha - scale
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::lanes::Lanes;
+    use crate::material::GranuleType;
+
+    /// The pieces an element batch evaluates in lanes give each lane the
+    /// bits of the scalar [`coefficients`], [`yield_scale`] and
+    /// [`yield_function`]: lanes past η = 1 (von Mises), just below it,
+    /// porous, at and below η_c (a2 clamped), and NaN, side by side.
+    #[test]
+    fn lanes_give_the_scalar_coefficients_scale_and_yield_function() {
+        let params = GranuleType::B1.params();
+        let etas = [
+            1.3,
+            1.0,
+            1.0 - 1e-12,
+            0.999,
+            0.8,
+            0.6,
+            params.eta_c,
+            0.1,
+            Real::NAN,
+            0.35,
+            2.0,
+            0.2001,
+        ];
+        let (beta, alpha) = (7.0e3, -2.0e4);
+        let mut seen = (false, false, false);
+        for chunk in etas.chunks_exact(4) {
+            let eta = Lanes::<4>(core::array::from_fn(|l| chunk[l]));
+            let (a1_formula, a2_formula) = porous_formula(&params, eta);
+            let c: [YieldCoefficients; 4] = core::array::from_fn(|l| {
+                coefficients_from(eta.0[l], a1_formula.0[l], a2_formula.0[l])
+            });
+            let a1 = Lanes::<4>(core::array::from_fn(|l| c[l].a1));
+            let a2 = Lanes::<4>(core::array::from_fn(|l| c[l].a2));
+            let scale = yield_scale_of(a2, params.yield_stress_pa);
+            let phi =
+                yield_function_of(a1, scale, Lanes::<4>::splat(beta), Lanes::<4>::splat(alpha));
+            for l in 0..4 {
+                let want = coefficients(&params, eta.0[l]);
+                let bits = |c: &YieldCoefficients| (c.a1.to_bits(), c.a2.to_bits(), c.a2_clamped);
+                assert_eq!(bits(&c[l]), bits(&want), "η {}", eta.0[l]);
+                let s = yield_scale(&want, params.yield_stress_pa);
+                assert_eq!(scale.0[l].to_bits(), s.to_bits(), "η {}", eta.0[l]);
+                let f = yield_function(&want, params.yield_stress_pa, beta, alpha);
+                assert_eq!(phi.0[l].to_bits(), f.to_bits(), "η {}", eta.0[l]);
+                seen.0 |= eta.0[l] >= 1.0;
+                seen.1 |= want.a2_clamped;
+                seen.2 |= want.a1 > 0.0 && !want.a2_clamped;
+            }
+        }
+        assert_eq!(
+            seen,
+            (true, true, true),
+            "von Mises, clamped and porous lanes"
+        );
+    }
+}

@@ -118,24 +118,30 @@ fn detect_avx2() -> bool {
 pub type ElementOutput = HexForces;
 
 /// What the element loop hands each element's result to, in element
-/// order. Any closure `|element, &hex, &output|` is one (with its
-/// parameter types written out, `|e: usize, hex: &[u32; 8], out:
-/// &ElementOutput|`, as the compiler does not infer them through the
-/// trait); the loop is
-/// generic over it so that a sink whose `element` is `#[inline(always)]`
-/// is compiled into the batch loop (an indirect call per element, with the
-/// output copied through memory, was 10 % of the elastic element:
-/// BENCHMARKS.md).
+/// order. The loop is generic over it so that a sink whose `element` is
+/// `#[inline(always)]` is compiled into the batch loop (an indirect call
+/// per element, with the output copied through memory, was 10 % of the
+/// elastic element: BENCHMARKS.md, session 28). Any closure
+/// `|element, &hex, &output|` is one — wrap it in [`sink`] for the
+/// compiler to infer its parameter types — and so is a
+/// `&mut dyn FnMut(usize, &[u32; 8], &ElementOutput)`.
 pub trait Sink {
     /// Takes the result `out` of element `element` with node ids `hex`.
     fn element(&mut self, element: usize, hex: &[u32; 8], out: &ElementOutput);
 }
 
-impl<S: FnMut(usize, &[u32; 8], &ElementOutput)> Sink for S {
+impl<S: FnMut(usize, &[u32; 8], &ElementOutput) + ?Sized> Sink for S {
     #[inline(always)]
     fn element(&mut self, element: usize, hex: &[u32; 8], out: &ElementOutput) {
         self(element, hex, out)
     }
+}
+
+/// `f` as it is: a closure passed through here gets its parameter types
+/// from the [`Sink`] shape, `one_point_elements(…, &mut sink(|e, hex, out|
+/// …))`.
+pub fn sink<F: FnMut(usize, &[u32; 8], &ElementOutput)>(f: F) -> F {
+    f
 }
 
 /// The reference data of [`BATCH`] consecutive elements regrouped into
@@ -211,7 +217,7 @@ pub fn regroup(elements: &[HexReference], out: &mut [ElementBatch]) -> Result<()
 
 /// Evaluates the one-point elements `hexes` (with their reference data
 /// `refs` and states `cp_inv`, one per element) at node positions `x`, and
-/// hands each element's result to `sink(element, &hex, &output)` in element
+/// hands each element's result to `sink` ([`Sink::element`]) in element
 /// order. Stops at the first element whose update fails and returns its
 /// index with the error; the states of the elements before it are updated,
 /// the failing one's and those after it are not (as an element-by-element
@@ -225,7 +231,7 @@ pub fn regroup(elements: &[HexReference], out: &mut [ElementBatch]) -> Result<()
 /// Lengths: `refs` and `cp_inv` as `hexes`; node ids index `x`.
 #[allow(clippy::too_many_arguments)]
 #[allow(unsafe_code)]
-pub fn one_point_elements<S: Sink>(
+pub fn one_point_elements<S: Sink + ?Sized>(
     path: ElementPath,
     mat: &Material,
     opts: &UpdateOptions,
@@ -308,7 +314,7 @@ struct Job<'a> {
 
 impl Job<'_> {
     /// Elements `first..first + cp_inv.len()` one by one.
-    fn scalar<S: Sink>(
+    fn scalar<S: Sink + ?Sized>(
         &self,
         first: usize,
         cp_inv: &mut [Voigt],
@@ -330,7 +336,7 @@ impl Job<'_> {
     #[allow(unsafe_code)]
     /// # Safety
     /// The processor must support AVX2 ([`has_avx2`]).
-    unsafe fn batched_avx2<S: Sink>(
+    unsafe fn batched_avx2<S: Sink + ?Sized>(
         &self,
         cp_inv: &mut [Voigt],
         sink: &mut S,
@@ -340,7 +346,7 @@ impl Job<'_> {
 
     /// All elements in batches of [`BATCH`], the remainder one by one.
     #[inline(always)]
-    fn batched<S: Sink>(
+    fn batched<S: Sink + ?Sized>(
         &self,
         cp_inv: &mut [Voigt],
         sink: &mut S,
@@ -359,11 +365,12 @@ impl Job<'_> {
     /// Batch `b` (elements `b·BATCH…`) side by side: updates the states and
     /// hands the outputs to `sink`, in element order. Returns `false`,
     /// having changed nothing, if any lane fails (the caller redoes the
-    /// batch element by element). Plain loops throughout: `array::map` and
-    /// `array::from_fn` were left out of line and copied through memory.
+    /// batch element by element). Plain loops, but for `core::array::from_fn`
+    /// making one lane vector from its scalars: `array::map` and `from_fn`
+    /// over whole structs were left out of line and copied through memory.
     #[allow(non_snake_case)]
     #[inline(always)]
-    fn batch<S: Sink>(&self, b: usize, cp_inv: &mut [Voigt; BATCH], sink: &mut S) -> bool {
+    fn batch<S: Sink + ?Sized>(&self, b: usize, cp_inv: &mut [Voigt; BATCH], sink: &mut S) -> bool {
         const W: usize = BATCH;
         let first = b * W;
         let hexes = &self.hexes[first..first + W];
@@ -401,12 +408,11 @@ impl Job<'_> {
         // then the scale, φ and φ/scale (the scalar bits).
         let params = &self.mat.params;
         let (a1_formula, a2_formula) = yield_surface::porous_formula(params, t.eta);
-        let mut coefficients = [UNSET.coefficients; W];
-        let (mut a1, mut a2) = (zero, zero);
-        for (l, cl) in coefficients.iter_mut().enumerate() {
-            *cl = yield_surface::coefficients_from(t.eta.0[l], a1_formula.0[l], a2_formula.0[l]);
-            (a1.0[l], a2.0[l]) = (cl.a1, cl.a2);
-        }
+        let coefficients: [YieldCoefficients; W] = core::array::from_fn(|l| {
+            yield_surface::coefficients_from(t.eta.0[l], a1_formula.0[l], a2_formula.0[l])
+        });
+        let a1 = Lanes(core::array::from_fn(|l| coefficients[l].a1));
+        let a2 = Lanes(core::array::from_fn(|l| coefficients[l].a2));
         let scale = yield_surface::yield_scale_of(a2, params.yield_stress_pa);
         let phi = yield_surface::yield_function_of(a1, scale, t.beta, t.alpha);
         let residual = phi / scale;
@@ -420,7 +426,7 @@ impl Job<'_> {
             if check_input(finite, &lane_t).is_err() {
                 return false;
             }
-            // `judge_trial`'s elastic diagnostics, written field by field
+            // `check_trial`'s elastic diagnostics, written field by field
             // into the placeholder (building the struct and copying it in
             // stalled on store forwarding: BENCHMARKS.md).
             let i = &mut info[l];
