@@ -99,6 +99,42 @@ fn run(
     }
 }
 
+/// One step of every path at positions `x` from its own `states` (one per
+/// entry of [`PATHS`]): checks that each path succeeds and hands over,
+/// element by element, and stores the scalar path's bits; returns the
+/// scalar pass.
+fn every_path_alike(
+    step: usize,
+    hexes: &[[u32; 8]],
+    refs: &[HexReference],
+    x: &[[Real; 3]],
+    states: &mut [Vec<Voigt>],
+) -> Pass {
+    let mut passes: Vec<Pass> = PATHS
+        .iter()
+        .zip(states.iter_mut())
+        .map(|(&path, cp)| run(path, hexes, refs, x, cp))
+        .collect();
+    let scalar = &passes[0];
+    assert!(scalar.result.is_ok(), "step {step}: {:?}", scalar.result);
+    for (path, pass) in PATHS.iter().zip(&passes).skip(1) {
+        assert_eq!(pass.result, scalar.result, "{path:?}, step {step}");
+        assert_eq!(pass.outputs.len(), hexes.len(), "{path:?}, step {step}");
+        for (a, b) in pass.outputs.iter().zip(&scalar.outputs) {
+            assert_eq!(a, b, "{path:?}, step {step}, element {}", b[0]);
+        }
+    }
+    for cp in &states[1..] {
+        let same = cp
+            .iter()
+            .flatten()
+            .zip(states[0].iter().flatten())
+            .all(|(a, b)| a.to_bits() == b.to_bits());
+        assert!(same, "stored states differ at step {step}");
+    }
+    passes.swap_remove(0)
+}
+
 #[test]
 fn every_path_gives_the_scalar_bits_through_elastic_and_plastic_steps() {
     if !has_avx2() {
@@ -131,28 +167,7 @@ fn every_path_gives_the_scalar_bits_through_elastic_and_plastic_steps() {
                 ]
             })
             .collect();
-        let passes: Vec<Pass> = PATHS
-            .iter()
-            .zip(states.iter_mut())
-            .map(|(&path, cp)| run(path, hexes, &refs, &x, cp))
-            .collect();
-        let scalar = &passes[0];
-        assert!(scalar.result.is_ok(), "step {step}: {:?}", scalar.result);
-        for (path, pass) in PATHS.iter().zip(&passes).skip(1) {
-            assert_eq!(pass.result, scalar.result, "{path:?}, step {step}");
-            assert_eq!(pass.outputs.len(), count, "{path:?}, step {step}");
-            for (a, b) in pass.outputs.iter().zip(&scalar.outputs) {
-                assert_eq!(a, b, "{path:?}, step {step}, element {}", b[0]);
-            }
-        }
-        for cp in &states[1..] {
-            let same = cp
-                .iter()
-                .flatten()
-                .zip(states[0].iter().flatten())
-                .all(|(a, b)| a.to_bits() == b.to_bits());
-            assert!(same, "stored states differ at step {step}");
-        }
+        let scalar = &every_path_alike(step, hexes, &refs, &x, &mut states);
         if scalar.plastic > 0 {
             plastic_steps += 1;
             // Batches with both elastic and plastic lanes.
@@ -324,17 +339,7 @@ fn lanes_past_eta_one_or_with_a_clamped_a2_give_the_scalar_bits() {
                 p.map(|c| c * (1.0 + ramp * (s - 1.0)))
             })
             .collect();
-        let passes: Vec<Pass> = PATHS
-            .iter()
-            .zip(states.iter_mut())
-            .map(|(&path, cp)| run(path, hexes, &refs, &x, cp))
-            .collect();
-        let scalar = &passes[0];
-        assert!(scalar.result.is_ok(), "step {step}: {:?}", scalar.result);
-        for (path, pass) in PATHS.iter().zip(&passes).skip(1) {
-            assert_eq!(pass.result, scalar.result, "{path:?}, step {step}");
-            assert_eq!(pass.outputs, scalar.outputs, "{path:?}, step {step}");
-        }
+        let scalar = &every_path_alike(step, hexes, &refs, &x, &mut states);
         von_mises += scalar.outputs.iter().filter(|o| eta(o) >= 1.0).count();
         near_one += scalar
             .outputs
