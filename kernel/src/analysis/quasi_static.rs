@@ -20,8 +20,8 @@
 //! constant punch speed moves, even when it is perfectly quasi-static, with
 //! the affine field of [`ImposedCompression`]; that motion has no
 //! acceleration, so no inertial force, yet its kinetic energy, about
-//! ½ M v²/3 for a bed of mass M under a punch at speed v, was nearly all of
-//! the published bed's K (BENCHMARKS.md). [`imposed_translation_energy`]
+//! ½ M v²/3 for a bed of mass M under a punch at speed v, was 75–95 % of
+//! the published bed's K over the judged half (BENCHMARKS.md, session 28). [`imposed_translation_energy`]
 //! takes it off each granule's translation, so a failing K/W can be read as
 //! the loading speed's (the imposed part) or as the bed's own motion
 //! (rattling, rearrangement bursts). The verdict still reads the total K, as

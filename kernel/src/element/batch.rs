@@ -12,9 +12,10 @@
 //! of η ≥ 1 and the a2 clamp. Per lane, in scalar code: those branches, the
 //! input checks ([`check_input`]) and, for a lane that yields
 //! ([`yields`]), the plastic corrector ([`plastic_return`]). The element's
-//! results go to a [`Sink`] the loop is generic over, compiled into it. A batch in which any lane fails is evaluated again
-//! element by element by [`hex_forces`], so errors, and the states left
-//! behind, are those of the scalar loop.
+//! results go to a [`Sink`] the loop is generic over, compiled into it. A
+//! batch in which any lane fails is evaluated again element by element by
+//! [`hex_forces`], so errors, and the states left behind, are those of the
+//! scalar loop.
 //!
 //! [`ElementPath`] chooses the code: element by element, portable batches
 //! (the build's vector width: 2 lanes with x86-64's SSE2), or batches compiled
