@@ -8,6 +8,17 @@ use std::io;
 use std::process::ExitCode;
 
 fn main() -> ExitCode {
+    // The workspace builds for x86-64-v3 (.cargo/config.toml): on a processor
+    // without AVX2 the first vector instruction would kill the process with
+    // SIGILL, so say why before any runs.
+    #[cfg(all(target_arch = "x86_64", target_feature = "avx2"))]
+    if !granbed_kernel::element::batch::has_avx2() {
+        eprintln!(
+            "error: this build of granbed-cli needs AVX2 (x86-64-v3), which this processor \
+             lacks; rebuild it with RUSTFLAGS=\"-C target-cpu=x86-64\" (README.md)"
+        );
+        return ExitCode::from(2);
+    }
     match run() {
         Ok(()) => ExitCode::SUCCESS,
         Err(err) => ExitCode::from(granbed_cli::error::report(&err, &mut io::stderr().lock())),
