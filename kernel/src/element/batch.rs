@@ -22,6 +22,9 @@
 //! for AVX2 (4 lanes), taken only when the processor has it (detected at run
 //! time with `cpuid`, no `std` needed). All three give the same bits;
 //! [`ElementPath::fastest`] is AVX2 where available, else element by element.
+//! The run-time choice is for a kernel built for baseline x86-64, as another
+//! project may link it; this workspace builds everything for x86-64-v3
+//! (`.cargo/config.toml`), where all three paths are AVX2 code.
 //!
 //! This is, with the SSE2 square root of [`crate::math::sqrt`], the
 //! kernel's only `unsafe` code (the workspace denies it elsewhere), allowed
@@ -73,7 +76,9 @@ impl ElementPath {
 
 /// Whether the processor (and the operating system, which must save the
 /// 256-bit registers) supports AVX2. Detected once with `cpuid`/`xgetbv`
-/// and cached; `false` on other architectures.
+/// and cached; `false` on other architectures. Not folded to `true` at
+/// compile time in a build for AVX2 (as `is_x86_feature_detected!` is), so
+/// such a build can ask whether it may run at all.
 pub fn has_avx2() -> bool {
     use core::sync::atomic::{AtomicU8, Ordering};
     static CACHE: AtomicU8 = AtomicU8::new(0);
