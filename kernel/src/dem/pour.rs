@@ -753,11 +753,7 @@ impl<'a> PourScene<'a> {
             }
             let moved_to: [Real; 3] = core::array::from_fn(|a| x[a] + dt * kicked[a]);
             *x = moved_to;
-            let d = [
-                moved_to[0] - xb[0],
-                moved_to[1] - xb[1],
-                moved_to[2] - xb[2],
-            ];
+            let d: [Real; 3] = core::array::from_fn(|a| moved_to[a] - xb[a]);
             moved = moved.max(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
         }
         if !moved.is_finite() {
