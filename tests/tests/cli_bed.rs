@@ -172,6 +172,10 @@ fn a_stopped_run_resumes_to_the_same_bits() {
         "5",
         "--strain",
         "0.12",
+        // The contact search every third step: a stop between two searches
+        // must carry what the last one found (asserted below).
+        "--contact-search-interval",
+        "3",
     ];
     let (whole, parts) = (out_dir("whole"), out_dir("parts"));
     let run = |extra: &[&str]| {
@@ -208,6 +212,22 @@ fn a_stopped_run_resumes_to_the_same_bits() {
         .compression_wall_time_s;
     assert!(first_wall > 0.0);
     run(&["--resume", parts_s, "--quiet", "--stop-at-strain", "0.06"]);
+    // This stop falls between two searches, so the checkpoint must carry
+    // what the last search found for the steps up to the next (or the
+    // bits below differ).
+    let interval = 3;
+    let state = granbed_cli::bed::checkpoint::Checkpoint::read(&parts)
+        .unwrap()
+        .state;
+    assert!(
+        interval > 1 && !state.steps.is_multiple_of(interval),
+        "the stop at step {} is no step between searches (every {interval})",
+        state.steps
+    );
+    assert!(
+        state.held.iter().flatten().any(|h| !h.is_empty()),
+        "the checkpoint holds no constraints"
+    );
     let two_walls = summary(&parts)["wall_time_s"].as_f64().unwrap();
     assert!(
         two_walls > first_wall,

@@ -31,12 +31,18 @@ pub struct PairWork {
     pub step: PairForce,
     /// The face lists of the pair's two passes.
     lists: PairLists,
-    /// The constraints of the step's first sweep and the pair they belong
-    /// to (the list is rebuilt by index), which later sweeps re-measure
-    /// instead of searching again ([`ContactPhase::detect`]).
+    /// The constraints of the last search's first sweep and the pair they
+    /// belong to (the list is rebuilt by index), which the step's later
+    /// sweeps, and the steps up to the next search, re-measure instead of
+    /// searching again ([`ContactPhase::detect`]).
     held: Vec<Constraint>,
     held_pair: Option<GranulePair>,
 }
+
+/// What a pair holds from the last search for the sweeps that follow
+/// without searching (`None`: nothing; `Some` of no constraints: it was
+/// searched and found none).
+pub type HeldConstraints = Option<Vec<Constraint>>;
 
 /// A pair's face lists (pass A→B, pass B→A) and what they were built for.
 #[derive(Clone, Debug, Default)]
@@ -121,8 +127,9 @@ struct DetectScratch {
 
 impl PairWork {
     /// After a search of pair `p`: with `keep`, holds its constraints for
-    /// the step's later sweeps; else forgets any held ones (a later sweep
-    /// that searched, or no holding).
+    /// the step's later sweeps and the first sweeps of the steps up to the
+    /// next search; else forgets any held ones (a later sweep that
+    /// searched, or no holding).
     fn hold(&mut self, p: GranulePair, keep: bool) {
         self.held.clear();
         self.held_pair = None;
@@ -342,16 +349,37 @@ impl ContactPhase {
         missed
     }
 
-    /// The candidate pairs and the bounding spheres of their build.
-    pub(super) fn broad_state(&self) -> (Vec<GranulePair>, Vec<Bound>) {
-        (self.pairs.clone(), self.built.clone())
+    /// The candidate pairs, the bounding spheres of their build and, per
+    /// pair, the constraints it holds from the last search (`None`: it
+    /// holds nothing).
+    pub(super) fn broad_state(&self) -> (Vec<GranulePair>, Vec<Bound>, Vec<HeldConstraints>) {
+        let held = self
+            .pairs
+            .iter()
+            .zip(&self.work)
+            .map(|(p, w)| (w.held_pair == Some(*p)).then(|| w.held.clone()))
+            .collect();
+        (self.pairs.clone(), self.built.clone(), held)
     }
 
-    /// Continues with `pairs` built from `built` (from [`Self::broad_state`]).
-    pub(super) fn restore_broad(&mut self, pairs: &[GranulePair], built: &[Bound]) {
+    /// Continues with `pairs` built from `built`, each holding its entry of
+    /// `held` (from [`Self::broad_state`]; shorter, e.g. empty: the pairs
+    /// past its end hold nothing, and their next sweep searches).
+    pub(super) fn restore_broad(
+        &mut self,
+        pairs: &[GranulePair],
+        built: &[Bound],
+        held: &[HeldConstraints],
+    ) {
         self.pairs = pairs.to_vec();
         self.built = built.to_vec();
         self.work = vec![PairWork::default(); pairs.len()];
+        for ((w, p), h) in self.work.iter_mut().zip(pairs).zip(held) {
+            if let Some(h) = h {
+                w.held.clone_from(h);
+                w.held_pair = Some(*p);
+            }
+        }
         self.index_pairs();
     }
 
@@ -482,6 +510,13 @@ impl ContactPhase {
     /// current x̃ at their contact points ([`regap`]), keeping those still
     /// penetrating (a pair held with none stays without any for the step).
     /// Only a pair new to the list (a rebuild within the step) is searched.
+    ///
+    /// With `hold` and `between` (a step between two searches,
+    /// [`super::AssemblyParams::contact_search_interval`]) the first sweep
+    /// does the same with what the last search held: a pair that holds
+    /// constraints of the last step's first sweep (searched or held then)
+    /// re-measures them; only a pair that holds nothing (new to the list
+    /// since) is searched, and what it finds is held from then on.
     pub(super) fn detect(
         &mut self,
         granules: &[GranuleStore],
@@ -489,9 +524,22 @@ impl ContactPhase {
         settings: &PairSettings,
         first: bool,
         hold: bool,
+        between: bool,
     ) -> Result<(), ContactError> {
         let drift = self.list_drift;
-        self.refresh_surfaces(granules, mesh, first, !hold || first || self.unheld);
+        // Which pairs re-measure what they hold instead of searching.
+        let reuse_held = hold && (!first || between);
+        // A sweep searches some pair unless every pair re-measures: only
+        // then does it need the boxes and anchors (else it marks them stale).
+        let searching = !reuse_held
+            || self.unheld
+            || (first
+                && !self
+                    .pairs
+                    .iter()
+                    .zip(&self.work)
+                    .all(|(p, w)| w.held_pair == Some(*p)));
+        self.refresh_surfaces(granules, mesh, first, searching);
         let (boxes, bounds, quad_boxes) = (&self.boxes, &self.bounds, &self.quad_boxes);
         let (touched, anchors, epochs) = (&self.touched, &self.anchors, &self.epochs);
         let stale = &self.stale;
@@ -550,7 +598,7 @@ impl ContactPhase {
                     }
                     let body_a = body(&granules[a], mesh, (boxes[a], bounds[a], &quad_boxes[a]));
                     let body_b = body(&granules[b], mesh, (boxes[b], bounds[b], &quad_boxes[b]));
-                    if hold && !first && w.held_pair == Some(*p) {
+                    if reuse_held && w.held_pair == Some(*p) {
                         if w.constraints.len() < w.held.len() {
                             w.constraints.resize(w.held.len(), Constraint::default());
                         }
@@ -917,7 +965,8 @@ mod tests {
         let mut granules = granules_at(&mesh, &start);
         let mut p = phase(&granules, &mesh);
         p.broad(&granules, &mesh, settings.margin, true).unwrap();
-        p.detect(&granules, &mesh, &settings, true, true).unwrap();
+        p.detect(&granules, &mesh, &settings, true, true, false)
+            .unwrap();
         assert!(
             pair_constraints(&p, 0, 2).is_none(),
             "C is no candidate yet"
@@ -938,7 +987,8 @@ mod tests {
         p.touched.clone_from(&p.forced);
         shift(&mut granules[1], [-1e-3 * settings.margin, 0.0, 0.0]);
         p.broad(&granules, &mesh, settings.margin, false).unwrap();
-        p.detect(&granules, &mesh, &settings, false, true).unwrap();
+        p.detect(&granules, &mesh, &settings, false, true, false)
+            .unwrap();
         assert!(p.stale[1], "a held sweep takes no boxes");
         assert!(p.stale_boxes(&granules, &mesh).is_empty());
 
@@ -950,7 +1000,8 @@ mod tests {
         let now = granules[2].x_pred[0][1] - mesh.positions[0][1];
         shift(&mut granules[2], [0.0, to[1] - now, 0.0]);
         p.broad(&granules, &mesh, settings.margin, false).unwrap();
-        p.detect(&granules, &mesh, &settings, false, true).unwrap();
+        p.detect(&granules, &mesh, &settings, false, true, false)
+            .unwrap();
         let found = pair_constraints(&p, 0, 2).expect("(A, C) is a candidate");
 
         let mut fresh = phase(&granules, &mesh);
@@ -958,11 +1009,93 @@ mod tests {
             .broad(&granules, &mesh, settings.margin, true)
             .unwrap();
         fresh
-            .detect(&granules, &mesh, &settings, true, true)
+            .detect(&granules, &mesh, &settings, true, true, false)
             .unwrap();
         let expected = pair_constraints(&fresh, 0, 2).unwrap();
         assert!(!expected.is_empty(), "A and C touch");
         assert_eq!(found, expected, "the new pair was not searched on C's x̃");
+        assert!(p.stale_boxes(&granules, &mesh).is_empty());
+    }
+
+    /// A step between two searches holds the last search's constraints:
+    /// its first sweep re-measures them on the new x̃ (the same nodes,
+    /// faces, weights and normals, the new gaps), searches nothing and
+    /// takes no boxes; a pair new to the list since is searched and finds
+    /// what a search of the same x̃ finds.
+    #[test]
+    fn a_step_between_searches_re_measures_what_the_last_search_held() {
+        let mesh = OwnedReference::sphere(R, MeshLevel::new(4, 1), false).unwrap();
+        let settings = PairSettings::standard(0.1);
+        let overlap = 0.02 * R;
+        let start = [
+            [0.0; 3],
+            [2.0 * R - overlap, 0.0, 0.0],
+            [0.0, 10.0 * R, 0.0],
+        ];
+        let mut granules = granules_at(&mesh, &start);
+        let mut p = phase(&granules, &mesh);
+        p.broad(&granules, &mesh, settings.margin, true).unwrap();
+        p.detect(&granules, &mesh, &settings, true, true, false)
+            .unwrap();
+        let held = pair_constraints(&p, 0, 1).unwrap();
+        assert!(!held.is_empty(), "A and B touch");
+        let searches = p.searches();
+
+        // The next step moves B a little deeper into A (no rebuild).
+        let shift = |g: &mut GranuleStore, d: [Real; 3]| {
+            for x in &mut g.x_pred {
+                for a in 0..3 {
+                    x[a] += d[a];
+                }
+            }
+        };
+        let push = 1e-3 * overlap;
+        shift(&mut granules[1], [-push, 0.0, 0.0]);
+        p.broad(&granules, &mesh, settings.margin, true).unwrap();
+        p.detect(&granules, &mesh, &settings, true, true, true)
+            .unwrap();
+        assert_eq!(p.searches(), searches, "a held step searched");
+        assert!(p.stale.iter().all(|&s| s), "a held step takes no boxes");
+        let again = pair_constraints(&p, 0, 1).unwrap();
+        assert_eq!(again.len(), held.len(), "every held constraint deepened");
+        for (c, h) in again.iter().zip(&held) {
+            assert_eq!(
+                (c.side, c.slave, c.quad, c.weights, c.normal),
+                (h.side, h.slave, h.quad, h.weights, h.normal)
+            );
+            let moved = match c.side {
+                Side::A => push * h.normal[0],
+                Side::B => -push * h.normal[0],
+            };
+            assert!(
+                (c.gap - (h.gap + moved)).abs() <= 1e-12 * R,
+                "gap {} against {} + {moved}",
+                c.gap,
+                h.gap
+            );
+        }
+
+        // The step after moves C onto A: the list is rebuilt and only the
+        // new pair (A, C) is searched, on current boxes.
+        let to = [0.0, -(2.0 * R - overlap), 0.0];
+        let now = granules[2].x_pred[0][1] - mesh.positions[0][1];
+        shift(&mut granules[2], [0.0, to[1] - now, 0.0]);
+        p.broad(&granules, &mesh, settings.margin, true).unwrap();
+        p.detect(&granules, &mesh, &settings, true, true, true)
+            .unwrap();
+        assert_eq!(p.searches(), searches + 1, "only (A, C) is searched");
+        assert_eq!(pair_constraints(&p, 0, 1).unwrap(), again);
+        let found = pair_constraints(&p, 0, 2).expect("(A, C) is a candidate");
+        let mut fresh = phase(&granules, &mesh);
+        fresh
+            .broad(&granules, &mesh, settings.margin, true)
+            .unwrap();
+        fresh
+            .detect(&granules, &mesh, &settings, true, true, false)
+            .unwrap();
+        let expected = pair_constraints(&fresh, 0, 2).unwrap();
+        assert!(!expected.is_empty(), "A and C touch");
+        assert_eq!(found, expected);
         assert!(p.stale_boxes(&granules, &mesh).is_empty());
     }
 
@@ -983,7 +1116,8 @@ mod tests {
         let granules = granules_at(&mesh, &centres);
         let mut p = phase(&granules, &mesh);
         p.broad(&granules, &mesh, settings.margin, true).unwrap();
-        p.detect(&granules, &mesh, &settings, true, true).unwrap();
+        p.detect(&granules, &mesh, &settings, true, true, false)
+            .unwrap();
         p.count_contacts(&granules, &mesh, &[]);
 
         let nodes = mesh.positions.len();

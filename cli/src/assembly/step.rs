@@ -16,7 +16,7 @@ use granbed_kernel::granule::quality::worst_element;
 use granbed_kernel::granule::timestep::{Linearisation, PowerIterationBuffers, TimeStepMethod};
 use rayon::prelude::*;
 
-use super::{Assembly, AssemblyParams, granule_kinetic, set_masses};
+use super::{Assembly, AssemblyParams, MAX_CONTACT_SEARCH_INTERVAL, granule_kinetic, set_masses};
 
 /// Why an assembly cannot be set up or stopped.
 #[derive(Clone, Debug, PartialEq)]
@@ -160,7 +160,7 @@ impl core::error::Error for AssemblyError {}
 
 pub(super) fn validate(p: &AssemblyParams) -> Result<(), AssemblyError> {
     let global = matches!(p.time_step_method, TimeStepMethod::Global { .. });
-    let checks: [(bool, &'static str, Real, &'static str); 15] = [
+    let checks: [(bool, &'static str, Real, &'static str); 17] = [
         (
             (0.0..=1.0).contains(&p.face_list_skin),
             "face_list_skin",
@@ -184,6 +184,18 @@ pub(super) fn validate(p: &AssemblyParams) -> Result<(), AssemblyError> {
             "contact_sweeps",
             Real::from(p.contact_sweeps),
             "1..=50",
+        ),
+        (
+            (1..=MAX_CONTACT_SEARCH_INTERVAL).contains(&p.contact_search_interval),
+            "contact_search_interval",
+            Real::from(p.contact_search_interval),
+            "1..=10",
+        ),
+        (
+            p.contact_search_interval == 1 || p.hold_constraints,
+            "contact_search_interval",
+            Real::from(p.contact_search_interval),
+            "1 unless hold_constraints (the steps between searches hold their constraints)",
         ),
         (
             (0.0..=2.0).contains(&p.damping_ratio),
@@ -560,7 +572,14 @@ impl Assembly<'_> {
             .broad(&self.granules, mesh, p.contact.margin, first)
             .map_err(contact_error)?;
         self.contact
-            .detect(&self.granules, mesh, &p.contact, first, p.hold_constraints)
+            .detect(
+                &self.granules,
+                mesh,
+                &p.contact,
+                first,
+                p.hold_constraints,
+                !self.searches_step(step),
+            )
             .map_err(contact_error)?;
         let surface = mesh.surface_range();
         if p.mass_sharing {

@@ -13,6 +13,7 @@ use std::path::{Path, PathBuf};
 use anyhow::{Context as _, bail};
 use granbed_kernel::Real;
 use granbed_kernel::contact::broad::{Bound, GranulePair};
+use granbed_kernel::contact::pair::{Constraint, Side};
 
 use super::run::{BedSample, Window};
 use crate::assembly::die::DieScene;
@@ -40,9 +41,18 @@ pub const FILE_NAME: &str = "checkpoint.bin";
 /// 5: samples gained the kinetic energy relative to the imposed
 /// compression (after the smallest Gauss-point Jacobian). Older files read
 /// it as NaN (not recorded), which the certificate's diagnostic skips.
-pub const VERSION: u32 = 5;
+///
+/// 6: the pairs are followed, per pair, by the constraints it holds from
+/// the last contact search (a flag u64, 1: held, then the constraints as
+/// [`CONSTRAINT_FLOATS`] floats each), which the steps up to the next
+/// search re-measure (`contact_search_interval` > 1). Older files hold
+/// nothing: their first step searches every pair, as it did when written.
+pub const VERSION: u32 = 6;
 /// The oldest version read.
 const OLDEST_VERSION: u32 = 2;
+/// Floats per held constraint: side (0: A, 1: B), slave node, master quad,
+/// the four weights, the normal, the gap.
+const CONSTRAINT_FLOATS: usize = 11;
 /// Granule flag: still a rigid body.
 const FLAG_RIGID: u64 = 1;
 const MAGIC: &[u8; 16] = b"GRANBED-CKPT\0\0\0\0";
@@ -82,6 +92,52 @@ pub struct Checkpoint {
 fn fnv1a(bytes: &[u8]) -> u64 {
     bytes.iter().fold(0xcbf2_9ce4_8422_2325, |h, &b| {
         (h ^ u64::from(b)).wrapping_mul(0x0000_0100_0000_01b3)
+    })
+}
+
+fn constraint_to(c: &Constraint) -> [f64; CONSTRAINT_FLOATS] {
+    let side = match c.side {
+        Side::A => 0.0,
+        Side::B => 1.0,
+    };
+    let [w0, w1, w2, w3] = c.weights;
+    let [n0, n1, n2] = c.normal;
+    [
+        side,
+        f64::from(c.slave),
+        f64::from(c.quad),
+        w0,
+        w1,
+        w2,
+        w3,
+        n0,
+        n1,
+        n2,
+        c.gap,
+    ]
+}
+
+fn constraint_from(v: [f64; CONSTRAINT_FLOATS]) -> anyhow::Result<Constraint> {
+    let side = match v[0] {
+        0.0 => Side::A,
+        1.0 => Side::B,
+        other => bail!("held constraint on side {other}"),
+    };
+    // Ids were written from u32s: anything else is a damaged file.
+    let id = |x: f64, what: &str| -> anyhow::Result<u32> {
+        if x.fract() == 0.0 && (0.0..=f64::from(u32::MAX)).contains(&x) {
+            Ok(x as u32)
+        } else {
+            bail!("held constraint with {what} id {x}")
+        }
+    };
+    Ok(Constraint {
+        side,
+        slave: id(v[1], "slave")?,
+        quad: id(v[2], "quad")?,
+        weights: [v[3], v[4], v[5], v[6]],
+        normal: [v[7], v[8], v[9]],
+        gap: v[10],
     })
 }
 
@@ -306,6 +362,15 @@ impl Checkpoint {
                 .map(|b| [b.centre[0], b.centre[1], b.centre[2], b.radius])
                 .collect::<Vec<_>>(),
         );
+        for held in (0..s.pairs.len()).map(|k| s.held.get(k)) {
+            match held {
+                Some(Some(list)) => {
+                    e.u64(1);
+                    e.vecs(&list.iter().map(constraint_to).collect::<Vec<_>>());
+                }
+                _ => e.u64(0),
+            }
+        }
         e.0
     }
 
@@ -399,6 +464,21 @@ impl Checkpoint {
                 radius: b[3],
             })
             .collect();
+        let held = match version {
+            2..=5 => Vec::new(),
+            _ => (0..np)
+                .map(|_| match d.u64()? {
+                    0 => Ok(None),
+                    1 => d
+                        .vecs::<CONSTRAINT_FLOATS>()?
+                        .into_iter()
+                        .map(constraint_from)
+                        .collect::<anyhow::Result<Vec<_>>>()
+                        .map(Some),
+                    other => bail!("unknown held-constraints flag {other}"),
+                })
+                .collect::<anyhow::Result<Vec<_>>>()?,
+        };
         if !d.0.is_empty() {
             bail!("checkpoint has {} bytes after its end", d.0.len());
         }
@@ -433,6 +513,7 @@ impl Checkpoint {
                 granules,
                 pairs,
                 built,
+                held,
             },
         })
     }

@@ -315,6 +315,7 @@ pub fn run_bed(
     params.rigid_until_touched = scene.rigid_until_touched;
     params.local_sweeps = scene.local_sweeps;
     params.hold_constraints = scene.hold_constraints;
+    params.contact_search_interval = scene.contact_search_interval;
     params.face_list_skin = scene.face_list_skin;
     params.max_node_speed_m_s = scene.watchdog_speed_ratio * scene.punch_speed_m_s;
     params.kinetic_energy_limit = scene.watchdog_energy_ratio;

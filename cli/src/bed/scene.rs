@@ -7,6 +7,7 @@ use granbed_kernel::granule::forces::ElementKind;
 use granbed_kernel::material::{GranuleType, Material, MaterialParams};
 use serde::{Deserialize, Serialize};
 
+use crate::assembly::MAX_CONTACT_SEARCH_INTERVAL;
 use crate::error::InputError;
 use crate::model::MeshLevel;
 
@@ -98,6 +99,15 @@ local_sweeps = true
 # 125-granule bed and 0.24 % on this scene (BENCHMARKS.md). false (the value of scene files
 # without this field): every later sweep searches.
 hold_constraints = true
+# The contact search runs every this many steps (1..=10); on the steps
+# between, the first sweep too re-measures what the last search found (only
+# pairs new to the candidate list are searched), so a node that comes into
+# contact is found up to that many steps minus one late. 1: every step
+# searches. 3 takes a third of the searches and 6-7 % less time on this
+# scene, but a late contact can overlap by more than 1 % of the element
+# (BENCHMARKS.md, "A contact search every k-th step"). More than 1 needs
+# hold_constraints = true.
+contact_search_interval = 1
 # A further contact sweep runs (up to contact_sweeps) while a granule-granule
 # gap deeper than this fraction of the element size is left (0 < t <= 0.1).
 # The default 0.01 takes a fifth to a quarter fewer sweeps in a dense bed
@@ -235,6 +245,12 @@ pub struct Scene {
     /// published scene's is true).
     #[serde(default)]
     pub hold_constraints: bool,
+    /// The contact search runs every this many steps, 1..=10; the steps
+    /// between re-measure what it found
+    /// (`AssemblyParams::contact_search_interval`; absent: 1, every step,
+    /// as before the field; more than 1 needs `hold_constraints`).
+    #[serde(default = "default_contact_search_interval")]
+    pub contact_search_interval: u32,
     /// A further contact sweep runs while a granule–granule gap deeper than
     /// this fraction of the element size (the mesh's shortest surface edge)
     /// is left, 0 < t ≤ 0.1 (absent: [`super::run::SWEEP_TOLERANCE_REL`],
@@ -258,6 +274,10 @@ pub struct Scene {
     /// Material overrides.
     #[serde(default)]
     pub material: MaterialOverrides,
+}
+
+fn default_contact_search_interval() -> u32 {
+    1
 }
 
 fn default_sweep_tolerance() -> f64 {
@@ -353,7 +373,7 @@ impl Scene {
         self.granule_type()?;
         self.mesh_level()?;
         self.element_kind()?;
-        let checks: [(bool, &str, f64, &str); 20] = [
+        let checks: [(bool, &str, f64, &str); 22] = [
             (
                 self.sweep_tolerance > 0.0 && self.sweep_tolerance <= 0.1,
                 "sweep_tolerance",
@@ -469,6 +489,18 @@ impl Scene {
                 "0 <= xi <= 2",
             ),
             (
+                (1..=MAX_CONTACT_SEARCH_INTERVAL).contains(&self.contact_search_interval),
+                "contact_search_interval",
+                f64::from(self.contact_search_interval),
+                "1..=10",
+            ),
+            (
+                self.contact_search_interval == 1 || self.hold_constraints,
+                "contact_search_interval",
+                f64::from(self.contact_search_interval),
+                "1 unless hold_constraints = true",
+            ),
+            (
                 (1..=50).contains(&self.contact_sweeps),
                 "contact_sweeps",
                 f64::from(self.contact_sweeps),
@@ -581,16 +613,18 @@ mod tests {
         // the bed's default"), the rigid modes physical up to F = 10 and
         // F/10 times heavier beyond ("Selective x30 with heavier rigid
         // modes"), later sweeps on the held constraints ("Later sweeps
-        // re-measure the held constraints").
+        // re-measure the held constraints"), a contact search every step
+        // ("A contact search every k-th step": later ones overlap too far).
         assert_eq!(
             (
                 s.mass_scaling,
                 s.selective_mass_scaling,
                 s.selective_mass_ratio,
                 s.sweep_tolerance,
-                s.hold_constraints
+                s.hold_constraints,
+                s.contact_search_interval
             ),
-            (20.0, true, 10.0, 0.01, true)
+            (20.0, true, 10.0, 0.01, true, 1)
         );
         // The TOML written back parses to the same scene.
         assert_eq!(Scene::from_toml(&s.to_toml()).unwrap(), s);
@@ -608,5 +642,26 @@ mod tests {
         assert!(bad("friction = 0.1", "friction = -1").contains("material.friction"));
         assert!(bad("seed = 1", "seed = 1\ncolour = 3").contains("colour"));
         assert!(bad("final_strain = 0.3", "final_strain = 1.5").contains("`final_strain`"));
+        for k in ["0", "11"] {
+            let line = format!("contact_search_interval = {k}");
+            let e = bad("contact_search_interval = 1", &line);
+            assert!(
+                e.contains("`contact_search_interval`") && e.contains("1..=10"),
+                "{e}"
+            );
+        }
+        // The steps between searches hold constraints: not without holding.
+        let text = DEFAULT_SCENE
+            .replace("contact_search_interval = 1", "contact_search_interval = 3")
+            .replace("hold_constraints = true", "hold_constraints = false");
+        let e = format!("{:#}", Scene::from_toml(&text).unwrap_err());
+        assert!(
+            e.contains("`contact_search_interval`") && e.contains("hold_constraints"),
+            "{e}"
+        );
+        // A scene file without the field searches every step.
+        let text = DEFAULT_SCENE.replace("contact_search_interval = 1", "");
+        assert_ne!(text, DEFAULT_SCENE);
+        assert_eq!(Scene::from_toml(&text).unwrap().contact_search_interval, 1);
     }
 }

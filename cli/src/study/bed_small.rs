@@ -58,6 +58,7 @@ pub fn bed_grid(mesh: MeshLevel, quick: bool) -> (Setting, Vec<Setting>) {
         selective_mass: Scene::published().selective_mass_scaling,
         sweep_tolerance: Scene::published().sweep_tolerance,
         hold_constraints: Scene::published().hold_constraints,
+        contact_search_interval: Scene::published().contact_search_interval,
         time_step_floor: Scene::published().time_step_floor,
         ..Setting::default_on(mesh)
     };
@@ -71,11 +72,16 @@ pub fn bed_grid(mesh: MeshLevel, quick: bool) -> (Setting, Vec<Setting>) {
             s.time_step_floor = 0.0;
         }
     };
-    // The most exact of each: later sweeps search too.
+    // Every sweep of every step searches (needs no held constraints).
+    let search_always = |s: &mut Setting| {
+        s.hold_constraints = false;
+        s.contact_search_interval = 1;
+    };
+    // The most exact of each: every sweep searches.
     let reference = with("reference", &|s| {
         s.element = ElementKind::FBar;
         s.speed_factor = 0.5;
-        s.hold_constraints = false;
+        search_always(s);
         uniform(1.0)(s);
     });
     let mut grid = vec![
@@ -110,8 +116,11 @@ pub fn bed_grid(mesh: MeshLevel, quick: bool) -> (Setting, Vec<Setting>) {
             with("safety 0.7", &|s| s.safety = 0.7),
             with("sweep tol 0.005", &|s| s.sweep_tolerance = 0.005),
             with("sweep tol 0.02", &|s| s.sweep_tolerance = 0.02),
+            // The contact search every third step (the steps between
+            // re-measure what it found).
+            with("search every 3rd step", &|s| s.contact_search_interval = 3),
             // The published scene before session 19: every sweep searches.
-            with("search sweeps", &|s| s.hold_constraints = false),
+            with("search sweeps", &search_always),
             with("kappa 0.02", &|s| s.kappa = 0.02),
             with("kappa 0.1", &|s| s.kappa = 0.1),
             with("fbar", &|s| s.element = ElementKind::FBar),
@@ -142,6 +151,7 @@ fn scene_for(args: &WorkPrecisionArgs, size: &Size, setting: &Setting, seed: u64
         time_step_safety: setting.safety,
         sweep_tolerance: setting.sweep_tolerance,
         hold_constraints: setting.hold_constraints,
+        contact_search_interval: setting.contact_search_interval,
         time_step_floor: setting.time_step_floor,
         material: MaterialOverrides {
             youngs_modulus_pa: m.youngs_modulus_pa,
@@ -292,7 +302,10 @@ mod tests {
                     || s.time_step_floor != base.time_step_floor,
                 s.speed_factor != base.speed_factor,
                 s.sweep_tolerance != base.sweep_tolerance,
-                s.hold_constraints != base.hold_constraints,
+                // What the contact sweeps hold: within a step, and between
+                // searches.
+                s.hold_constraints != base.hold_constraints
+                    || s.contact_search_interval != base.contact_search_interval,
             ];
             assert_eq!(
                 differs.iter().filter(|d| **d).count(),

@@ -43,7 +43,7 @@ pub const CSV_FILE: &str = "work_precision.csv";
 pub const SVG_FILE: &str = "work_precision.svg";
 
 /// Columns of [`CSV_FILE`].
-pub const COLUMNS: [&str; 25] = [
+pub const COLUMNS: [&str; 26] = [
     "setting",
     "seed",
     "mesh_n",
@@ -56,6 +56,7 @@ pub const COLUMNS: [&str; 25] = [
     "speed_factor",
     "sweep_tolerance",
     "hold_constraints",
+    "contact_search_interval",
     "time_step_floor",
     "steps",
     "wall_time_s",
@@ -103,6 +104,9 @@ pub struct Setting {
     /// Later contact sweeps re-measure the held constraints instead of
     /// searching (bed; the scene's `hold_constraints`).
     pub hold_constraints: bool,
+    /// The contact search runs every this many steps (bed; the scene's
+    /// `contact_search_interval`; more than 1 needs `hold_constraints`).
+    pub contact_search_interval: u32,
     /// Variable mass scaling's floor on the granules' steps (bed; the
     /// scene's `time_step_floor`, 0 = off).
     pub time_step_floor: Real,
@@ -122,6 +126,7 @@ impl Setting {
             speed_factor: 1.0,
             sweep_tolerance: crate::bed::run::SWEEP_TOLERANCE_REL,
             hold_constraints: false,
+            contact_search_interval: 1,
             time_step_floor: 0.0,
         }
     }
@@ -488,6 +493,7 @@ pub fn write_csv(path: &Path, rows: &[Row<'_>]) -> anyhow::Result<()> {
             Field::Real(s.speed_factor),
             Field::Real(s.sweep_tolerance),
             Field::from(s.hold_constraints),
+            Field::from(s.contact_search_interval),
             Field::Real(s.time_step_floor),
             Field::Int(r.m.steps),
             Field::Real(r.m.wall_time_s),
