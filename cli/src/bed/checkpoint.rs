@@ -44,7 +44,7 @@ pub const FILE_NAME: &str = "checkpoint.bin";
 ///
 /// 6: the pairs are followed, per pair, by the constraints it holds from
 /// the last contact search (a flag u64, 1: held, then the constraints as
-/// [`CONSTRAINT_FLOATS`] floats each), which the steps up to the next
+/// 11 floats each: `CONSTRAINT_FLOATS`), which the steps up to the next
 /// search re-measure (`contact_search_interval` > 1). Older files hold
 /// nothing: their first step searches every pair, as it did when written.
 pub const VERSION: u32 = 6;
