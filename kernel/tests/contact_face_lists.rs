@@ -188,7 +188,11 @@ fn full_and_listed(
 /// (full pass, listed pass) constraints of scene `s`, lists built with
 /// drift `d`.
 fn both(s: &Scene, d: Real) -> (Vec<Constraint>, Vec<Constraint>) {
-    let settings = PairSettings::standard(0.1);
+    both_with(s, d, PairSettings::standard(0.1))
+}
+
+/// [`both`] with `settings`.
+fn both_with(s: &Scene, d: Real, settings: PairSettings) -> (Vec<Constraint>, Vec<Constraint>) {
     let mesh = (&s.mesh.quads[..], &s.mesh.node_quads[..]);
     let quad_boxes = s.pred.each_ref().map(|x| boxes(x, mesh.0));
     let mass = vec![1e-9; s.mesh.positions.len()];
@@ -233,6 +237,37 @@ fn listed_detection_finds_the_full_passes_constraints_while_nodes_stay_within_th
     assert!(
         constraints > 100,
         "the scenes touch: {constraints} constraints"
+    );
+}
+
+/// With a capture distance the lists still give the full pass's
+/// constraints, near ones (in front of a face, gap ≥ 0) included: a node
+/// within the capture distance in front of a face lies in the face's box
+/// grown by its window, which the lists cover.
+#[test]
+fn listed_detection_finds_the_near_constraints_of_a_capture_distance_too() {
+    let d = 100e-6;
+    let settings = PairSettings {
+        capture: 10e-6,
+        ..PairSettings::standard(0.1)
+    };
+    let (mut near, mut constraints) = (0, 0);
+    for seed in 0..40 {
+        let overlap = 20e-6 + 2e-6 * seed as Real;
+        let s = scene(seed, overlap, d);
+        let (full, listed) = both_with(&s, d, settings);
+        assert_eq!(bits(&full), bits(&listed), "seed {seed}");
+        near += full.iter().filter(|c| c.gap >= 0.0).count();
+        constraints += full.len();
+        // The penetrating ones are those of no capture, to the bit.
+        let (plain, _) = both(&s, d);
+        let mut kept = full.clone();
+        let k = granbed_kernel::contact::pair::penetrating(&mut kept);
+        assert_eq!(bits(&kept[..k]), bits(&plain), "seed {seed}");
+    }
+    assert!(
+        near > 20 && near < constraints,
+        "{near} near of {constraints} constraints"
     );
 }
 

@@ -6,7 +6,8 @@
 use granbed_kernel::Real;
 use granbed_kernel::contact::broad::bounding_sphere;
 use granbed_kernel::contact::pair::{
-    CandidateFace, Constraint, ContactError, NodeForce, PairSettings, detect, forces, regap,
+    CandidateFace, Constraint, ContactError, NodeForce, PairSettings, detect, forces, penetrating,
+    regap,
 };
 use granbed_kernel::contact::surface::{Aabb, SurfaceBody, quad_bounds};
 
@@ -112,6 +113,71 @@ fn folded_master() -> (Vec<Vec3>, Vec<[u32; 4]>) {
         [0.8, 1.0, 0.3],
     ];
     (x, vec![[0, 1, 2, 3], [4, 5, 6, 7]])
+}
+
+/// [`constraints`] with a capture distance.
+fn constraints_capturing(
+    slave: &[Vec3],
+    master: &[Vec3],
+    master_quads: &[[u32; 4]],
+    capture: Real,
+) -> Vec<Constraint> {
+    with_bodies(slave, master, master_quads, |a, b| {
+        let settings = PairSettings {
+            margin: 0.5,
+            symmetric: false,
+            capture,
+            ..PairSettings::standard(0.0)
+        };
+        let mut scratch = vec![CandidateFace::default(); master_quads.len()];
+        let mut out = vec![Constraint::default(); 16];
+        let n = detect(a, b, &settings, &mut scratch, &mut out).unwrap();
+        out.truncate(n);
+        out
+    })
+}
+
+/// A capture distance adds near constraints (gap ≥ 0) for nodes in front
+/// of a face by less than it, and nothing else: nodes farther in front get
+/// none, and the constraints of penetrating nodes keep their bits.
+/// `penetrating` keeps the penetrating ones in their order.
+#[test]
+fn a_capture_distance_holds_the_nodes_just_in_front_of_a_face() {
+    let (master, quads) = folded_master();
+    let front = slave_at(0.4, 0.02);
+    assert!(constraints(&front, &master, &quads).is_empty());
+    assert!(constraints_capturing(&front, &master, &quads, 0.01).is_empty());
+    let near = constraints_capturing(&front, &master, &quads, 0.05);
+    assert_eq!(near.len(), 4, "{near:?}");
+    for (c, x) in near.iter().zip(&front) {
+        assert_eq!(c.quad, 0);
+        assert!((c.gap - 0.02).abs() < 1e-12, "gap {}", c.gap);
+        // The contact point is the node's foot on the face.
+        let foot = [x[0], x[1]];
+        let corners = [[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]];
+        for a in 0..2 {
+            let at: Real = c.weights.iter().zip(&corners).map(|(w, p)| w * p[a]).sum();
+            assert!((at - foot[a]).abs() < 1e-12, "{c:?}");
+        }
+    }
+    let behind = slave_at(0.4, -0.01);
+    let plain = constraints(&behind, &master, &quads);
+    assert_eq!(plain.len(), 4);
+    assert_eq!(constraints_capturing(&behind, &master, &quads, 0.05), plain);
+    // A slave quad tilted through the face: two nodes behind, two in front.
+    let mut tilted = slave_at(0.4, -0.01);
+    tilted[1][2] = 0.02;
+    tilted[2][2] = 0.02;
+    let mut mixed = constraints_capturing(&tilted, &master, &quads, 0.05);
+    assert_eq!(mixed.len(), 4, "{mixed:?}");
+    let k = penetrating(&mut mixed);
+    assert_eq!(k, 2);
+    assert_eq!(
+        mixed[..k].iter().map(|c| c.slave).collect::<Vec<_>>(),
+        [0, 3]
+    );
+    assert!(mixed[..k].iter().all(|c| c.gap < 0.0));
+    assert_eq!(&mixed[..k], &constraints(&tilted, &master, &quads)[..]);
 }
 
 #[test]

@@ -8,7 +8,7 @@ use granbed_kernel::contact::broad::{
 use granbed_kernel::contact::face_lists::{self, AnchorSurface, FaceLists, FaceListsMut, ReachBox};
 use granbed_kernel::contact::pair::{
     CandidateFace, Constraint, ContactError, Involvement, NodeForce, PairForce, PairSettings, Side,
-    detect, detect_listed, forces, mark_side, regap,
+    detect, detect_listed, forces, mark_side, penetrating, regap,
 };
 use granbed_kernel::contact::surface::{Aabb, SurfaceBody, quad_bounds};
 use granbed_kernel::contact::wall::{Wall, count_wall_contacts};
@@ -611,6 +611,11 @@ impl ContactPhase {
                     // Every search, and only a search, renews what is held
                     // (the first sweep searches every pair).
                     w.hold(*p, hold && first);
+                    // Near constraints (a capture distance) are held only:
+                    // the forces and counts take the penetrating ones.
+                    if settings.capture > 0.0 {
+                        w.count = penetrating(&mut w.constraints[..w.count]);
+                    }
                     Ok((scratch, builds, searches))
                 },
             )

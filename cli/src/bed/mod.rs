@@ -171,17 +171,25 @@ pub struct BedArgs {
 
     /// Override: the contact search runs every N steps (1..=10); the steps
     /// between re-measure the constraints it found and search only pairs
-    /// new to the candidate list, so a new contact is found up to N − 1
-    /// steps late. The published scene's is 1 (every step); 3 takes 6–7 %
-    /// less time on it but can leave overlaps above 1 % of the element.
-    /// More than 1 needs --hold-constraints true. Allowed with --resume.
+    /// new to the candidate list (with --contact-capture, nodes just in
+    /// front of a face are held too). The published scene's is 5; 1
+    /// searches every step. More than 1 needs --hold-constraints true.
+    /// Allowed with --resume.
     #[arg(long, value_name = "N")]
     pub contact_search_interval: Option<u32>,
+
+    /// Override: the contact search's capture distance as a fraction C of
+    /// the element size (0 ≤ C ≤ 0.1; published 0.1): nodes this close in
+    /// front of a face are held with the contacts, so that the steps
+    /// between two searches (--contact-search-interval) see them close.
+    /// Allowed with --resume.
+    #[arg(long, value_name = "C")]
+    pub contact_capture: Option<f64>,
 
     /// Continue the run whose checkpoint is in DIR (its `checkpoint.bin`);
     /// the outputs go to DIR. Only --strain, --stop-at-strain,
     /// --time-step-safety, --mass-scaling, --sweep-tolerance,
-    /// --hold-constraints, --contact-search-interval, --face-list-skin,
+    /// --hold-constraints, --contact-search-interval, --contact-capture, --face-list-skin,
     /// --time-step-floor, --max-mass-factor, -j and --quiet may be given
     /// with it.
     #[arg(long, value_name = "DIR", conflicts_with_all = ["scene", "out", "granule_type", "granules", "mesh", "seed", "die_diameter_mm", "element", "hourglass_kappa", "rigid_until_touched", "local_sweeps", "selective_mass_scaling", "selective_mass_ratio"])]
@@ -312,6 +320,9 @@ impl BedArgs {
         }
         if let Some(k) = self.contact_search_interval {
             scene.contact_search_interval = k;
+        }
+        if let Some(c) = self.contact_capture {
+            scene.contact_capture = c;
         }
         if let Some(c) = self.time_step_safety {
             scene.time_step_safety = c;

@@ -316,6 +316,7 @@ pub fn run_bed(
     params.local_sweeps = scene.local_sweeps;
     params.hold_constraints = scene.hold_constraints;
     params.contact_search_interval = scene.contact_search_interval;
+    params.contact.capture = scene.contact_capture * mesh.shortest_surface_edge();
     params.face_list_skin = scene.face_list_skin;
     params.max_node_speed_m_s = scene.watchdog_speed_ratio * scene.punch_speed_m_s;
     params.kinetic_energy_limit = scene.watchdog_energy_ratio;

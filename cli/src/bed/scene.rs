@@ -101,13 +101,18 @@ local_sweeps = true
 hold_constraints = true
 # The contact search runs every this many steps (1..=10); on the steps
 # between, the first sweep too re-measures what the last search found (only
-# pairs new to the candidate list are searched), so a node that comes into
-# contact is found up to that many steps minus one late. 1: every step
-# searches. 3 takes a third of the searches and 6-7 % less time on this
-# scene, but a late contact can overlap by more than 1 % of the element
-# (BENCHMARKS.md, "A contact search every k-th step"). More than 1 needs
-# hold_constraints = true.
-contact_search_interval = 1
+# pairs new to the candidate list are searched). 5 takes a fifth of the
+# searches; P(C) moved by 0.2 % on this scene (BENCHMARKS.md). 1 (the value
+# of scene files without this field): every step searches. More than 1
+# needs the held constraints above.
+contact_search_interval = 5
+# Capture distance of the search, as a fraction of the element size
+# (0 <= c <= 0.1): nodes this close in front of a face are held with the
+# contacts, so that the steps between two searches see them close (without
+# it a contact closing between two searches is found late and overlaps
+# more). 0 (the value of scene files without this field): only overlapping
+# nodes are held.
+contact_capture = 0.1
 # A further contact sweep runs (up to contact_sweeps) while a granule-granule
 # gap deeper than this fraction of the element size is left (0 < t <= 0.1).
 # The default 0.01 takes a fifth to a quarter fewer sweeps in a dense bed
@@ -251,6 +256,10 @@ pub struct Scene {
     /// as before the field; more than 1 needs `hold_constraints`).
     #[serde(default = "default_contact_search_interval")]
     pub contact_search_interval: u32,
+    /// Capture distance of the contact search as a fraction of the element
+    /// size, 0 ≤ c ≤ 0.1 (`PairSettings::capture`; absent: 0).
+    #[serde(default)]
+    pub contact_capture: f64,
     /// A further contact sweep runs while a granule–granule gap deeper than
     /// this fraction of the element size (the mesh's shortest surface edge)
     /// is left, 0 < t ≤ 0.1 (absent: [`super::run::SWEEP_TOLERANCE_REL`],
@@ -373,7 +382,7 @@ impl Scene {
         self.granule_type()?;
         self.mesh_level()?;
         self.element_kind()?;
-        let checks: [(bool, &str, f64, &str); 22] = [
+        let checks: [(bool, &str, f64, &str); 23] = [
             (
                 self.sweep_tolerance > 0.0 && self.sweep_tolerance <= 0.1,
                 "sweep_tolerance",
@@ -495,6 +504,12 @@ impl Scene {
                 "1..=10",
             ),
             (
+                (0.0..=0.1).contains(&self.contact_capture),
+                "contact_capture",
+                self.contact_capture,
+                "0 <= c <= 0.1",
+            ),
+            (
                 self.contact_search_interval == 1 || self.hold_constraints,
                 "contact_search_interval",
                 f64::from(self.contact_search_interval),
@@ -613,8 +628,9 @@ mod tests {
         // the bed's default"), the rigid modes physical up to F = 10 and
         // F/10 times heavier beyond ("Selective x30 with heavier rigid
         // modes"), later sweeps on the held constraints ("Later sweeps
-        // re-measure the held constraints"), a contact search every step
-        // ("A contact search every k-th step": later ones overlap too far).
+        // re-measure the held constraints"), a contact search every fifth
+        // step with a capture distance of 0.1 element ("A contact search
+        // every k-th step").
         assert_eq!(
             (
                 s.mass_scaling,
@@ -624,8 +640,9 @@ mod tests {
                 s.hold_constraints,
                 s.contact_search_interval
             ),
-            (20.0, true, 10.0, 0.01, true, 1)
+            (20.0, true, 10.0, 0.01, true, 5)
         );
+        assert_eq!(s.contact_capture, 0.1);
         // The TOML written back parses to the same scene.
         assert_eq!(Scene::from_toml(&s.to_toml()).unwrap(), s);
     }
@@ -644,24 +661,31 @@ mod tests {
         assert!(bad("final_strain = 0.3", "final_strain = 1.5").contains("`final_strain`"));
         for k in ["0", "11"] {
             let line = format!("contact_search_interval = {k}");
-            let e = bad("contact_search_interval = 1", &line);
+            let e = bad("contact_search_interval = 5", &line);
             assert!(
                 e.contains("`contact_search_interval`") && e.contains("1..=10"),
                 "{e}"
             );
         }
         // The steps between searches hold constraints: not without holding.
-        let text = DEFAULT_SCENE
-            .replace("contact_search_interval = 1", "contact_search_interval = 3")
-            .replace("hold_constraints = true", "hold_constraints = false");
+        let text = DEFAULT_SCENE.replace("hold_constraints = true", "hold_constraints = false");
         let e = format!("{:#}", Scene::from_toml(&text).unwrap_err());
         assert!(
             e.contains("`contact_search_interval`") && e.contains("hold_constraints"),
             "{e}"
         );
         // A scene file without the field searches every step.
-        let text = DEFAULT_SCENE.replace("contact_search_interval = 1", "");
-        assert_ne!(text, DEFAULT_SCENE);
-        assert_eq!(Scene::from_toml(&text).unwrap().contact_search_interval, 1);
+        let e = bad("contact_capture = 0.1", "contact_capture = 0.2");
+        assert!(
+            e.contains("`contact_capture`") && e.contains("0 <= c <= 0.1"),
+            "{e}"
+        );
+        // A scene file without the fields searches every step and holds
+        // only overlapping nodes.
+        let text = DEFAULT_SCENE
+            .replace("contact_search_interval = 5\n", "")
+            .replace("contact_capture = 0.1\n", "");
+        let old = Scene::from_toml(&text).unwrap();
+        assert_eq!((old.contact_search_interval, old.contact_capture), (1, 0.0));
     }
 }

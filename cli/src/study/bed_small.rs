@@ -116,9 +116,9 @@ pub fn bed_grid(mesh: MeshLevel, quick: bool) -> (Setting, Vec<Setting>) {
             with("safety 0.7", &|s| s.safety = 0.7),
             with("sweep tol 0.005", &|s| s.sweep_tolerance = 0.005),
             with("sweep tol 0.02", &|s| s.sweep_tolerance = 0.02),
-            // The contact search every third step (the steps between
-            // re-measure what it found).
-            with("search every 3rd step", &|s| s.contact_search_interval = 3),
+            // The published scene before session 30: the contact search
+            // every step.
+            with("search every step", &|s| s.contact_search_interval = 1),
             // The published scene before session 19: every sweep searches.
             with("search sweeps", &search_always),
             with("kappa 0.02", &|s| s.kappa = 0.02),

@@ -46,6 +46,15 @@ pub struct PairSettings {
     /// passes see the spot, see [`forces`]) or a single pass with A's nodes
     /// as slaves (weight 1).
     pub symmetric: bool,
+    /// Capture distance, m (0 ≤ c ≤ `margin`): a node with no penetration
+    /// that lies in front of a face by less than this (inside it, normals
+    /// opposing) gets a *near* constraint, with gap ≥ 0, so that a driver
+    /// that holds the constraints over steps without searching
+    /// ([`regap`]) sees it close. [`forces`] and [`mark_involvement`]
+    /// take penetrating constraints only: a driver hands them
+    /// [`penetrating`]'s part. 0: no near constraints (the detection as it
+    /// was, bit for bit).
+    pub capture: Real,
     /// Also estimate the contact area ([`PairForce::area`]): each
     /// constraint then evaluates its slave node's tributary area, which no
     /// force needs (false: the area is 0; the forces are the same bits).
@@ -54,14 +63,15 @@ pub struct PairSettings {
 
 impl PairSettings {
     /// physics.md's choices: μ = `friction`, inside tolerance 1e-6, window
-    /// 0.25 × face diagonal, 20 µm margin, symmetric two-pass; no contact
-    /// area.
+    /// 0.25 × face diagonal, 20 µm margin, symmetric two-pass; no capture
+    /// distance, no contact area.
     pub fn standard(friction: Real) -> Self {
         Self {
             friction,
             inside_tolerance: 1e-6,
             window_fraction: 0.25,
             margin: 20e-6,
+            capture: 0.0,
             symmetric: true,
             contact_area: false,
         }
@@ -515,20 +525,41 @@ fn closest_face<'c>(
         dot(&ns, n) < 0.0
     };
     let mut best: Option<Hit> = None;
+    // The nearest face in front within the capture distance (a near
+    // constraint, returned only when the node penetrates nothing).
+    let mut near: Option<Hit> = None;
+    let capture = settings.capture;
     let mut near_outside = false;
     // The sieve passes what projects within this reach of the face.
     let reach = max(EDGE_REACH, settings.inside_tolerance);
     for face in candidates.clone() {
+        let front = if capture > 0.0 {
+            crate::math::min(capture, face.window)
+        } else {
+            0.0
+        };
         if !face.reach.contains(&p)
             || !face
                 .sieve
-                .is_some_and(|s| s.may_touch(&p, face.window, reach))
+                .is_some_and(|s| s.may_touch_within(&p, face.window, front, reach))
         {
             continue;
         }
         let Some(pr) = project(&p, &face.corners) else {
             continue;
         };
+        if front > 0.0
+            && pr.gap >= 0.0
+            && pr.gap < front
+            && pr.inside(settings.inside_tolerance)
+            && near.as_ref().is_none_or(|h| pr.gap < h.projection.gap)
+            && opposing(&pr.normal)
+        {
+            near = Some(Hit {
+                quad: face.quad,
+                projection: pr,
+            });
+        }
         if !(pr.gap < 0.0 && pr.gap > -face.window) {
             continue;
         }
@@ -572,9 +603,26 @@ fn closest_face<'c>(
             return best;
         }
     } else if !near_outside {
-        return None;
+        return near;
     }
-    concave_edge(&p, candidates).filter(|h| opposing(&h.projection.normal))
+    concave_edge(&p, candidates)
+        .filter(|h| opposing(&h.projection.normal))
+        .or(near)
+}
+
+/// Moves the penetrating constraints (gap < 0) of `constraints` to its
+/// front, in their order, and returns how many: what [`forces`] and
+/// [`mark_involvement`] take of a detection with a capture distance
+/// ([`PairSettings::capture`]).
+pub fn penetrating(constraints: &mut [Constraint]) -> usize {
+    let mut k = 0;
+    for i in 0..constraints.len() {
+        if constraints[i].gap < 0.0 {
+            constraints[k] = constraints[i];
+            k += 1;
+        }
+    }
+    k
 }
 
 /// Clamped projections [`concave_edge`] keeps between its two loops, so

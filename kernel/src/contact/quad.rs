@@ -339,6 +339,13 @@ impl QuadSieve {
     /// False only if `p` can be neither behind the face by less than
     /// `window` nor within `reach` (in ξ, η beyond ±1) of it.
     pub fn may_touch(&self, p: &Vec3, window: Real, reach: Real) -> bool {
+        self.may_touch_within(p, window, 0.0, reach)
+    }
+
+    /// [`Self::may_touch`] that also passes what may lie in front of the
+    /// face by less than `front` (0 ≤ `front` ≤ `window`; 0: the same
+    /// test, bit for bit).
+    pub fn may_touch_within(&self, p: &Vec3, window: Real, front: Real, reach: Real) -> bool {
         let r = 1.0 + reach;
         let t = r * self.bend;
         // The face may fold within the reach (N*·n ≤ 0 needs t ≥ 1): no
@@ -349,7 +356,7 @@ impl QuadSieve {
         let d = sub(p, &self.centre);
         let g0 = dot(&d, &self.normal);
         let warp = r * r * self.warp + self.floor;
-        if g0 > warp || g0 < -window - warp {
+        if g0 > warp + front || g0 < -window - warp {
             return false;
         }
         let tilt = t / (1.0 - t);
