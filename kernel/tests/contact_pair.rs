@@ -59,18 +59,7 @@ fn with_bodies<R>(
 /// (single pass, a margin that covers the unit-sized scene: the master's
 /// faces must lie within it of the slave's box to be tried).
 fn constraints(slave: &[Vec3], master: &[Vec3], master_quads: &[[u32; 4]]) -> Vec<Constraint> {
-    with_bodies(slave, master, master_quads, |a, b| {
-        let settings = PairSettings {
-            margin: 0.5,
-            symmetric: false,
-            ..PairSettings::standard(0.0)
-        };
-        let mut scratch = vec![CandidateFace::default(); master_quads.len()];
-        let mut out = vec![Constraint::default(); 16];
-        let n = detect(a, b, &settings, &mut scratch, &mut out).unwrap();
-        out.truncate(n);
-        out
-    })
+    constraints_capturing(slave, master, master_quads, 0.0)
 }
 
 /// [`regap`] of `held` with `slave` (one quad) against `master`.

@@ -952,6 +952,58 @@ mod tests {
         Some(p.work[k].constraints().to_vec())
     }
 
+    /// A at the origin touching B (overlap 0.02 R), C far away, to be
+    /// moved onto A: the granules and their contact phase after a first
+    /// sweep (a search, holding).
+    fn a_touching_b_and_c_far(
+        mesh: &OwnedReference,
+        settings: &PairSettings,
+    ) -> (Vec<GranuleStore>, ContactPhase) {
+        let overlap = 0.02 * R;
+        let start = [
+            [0.0; 3],
+            [2.0 * R - overlap, 0.0, 0.0],
+            [0.0, 10.0 * R, 0.0],
+        ];
+        let granules = granules_at(mesh, &start);
+        let mut p = phase(&granules, mesh);
+        p.broad(&granules, mesh, settings.margin, true).unwrap();
+        p.detect(&granules, mesh, settings, true, true, false)
+            .unwrap();
+        (granules, p)
+    }
+
+    /// Moves granule `g`'s x̃ by `d`.
+    fn shift(g: &mut GranuleStore, d: [Real; 3]) {
+        for x in &mut g.x_pred {
+            for a in 0..3 {
+                x[a] += d[a];
+            }
+        }
+    }
+
+    /// Moves C (granule 2 of [`a_touching_b_and_c_far`]) onto A from below.
+    fn move_c_onto_a(granules: &mut [GranuleStore], mesh: &OwnedReference) {
+        let to = 2.0 * R - 0.02 * R;
+        let now = granules[2].x_pred[0][1] - mesh.positions[0][1];
+        shift(&mut granules[2], [0.0, -to - now, 0.0]);
+    }
+
+    /// What a fresh search (first sweep) of `granules` finds for (a, b).
+    fn searched(
+        granules: &[GranuleStore],
+        mesh: &OwnedReference,
+        settings: &PairSettings,
+        (a, b): (u32, u32),
+    ) -> Vec<Constraint> {
+        let mut fresh = phase(granules, mesh);
+        fresh.broad(granules, mesh, settings.margin, true).unwrap();
+        fresh
+            .detect(granules, mesh, settings, true, true, false)
+            .unwrap();
+        pair_constraints(&fresh, a, b).unwrap()
+    }
+
     /// A held sweep leaves the boxes and anchor of a granule it moved for
     /// the next search to take. When the list is rebuilt within the step,
     /// the new pair is searched, and on the moved granule's current boxes
@@ -960,18 +1012,7 @@ mod tests {
     fn a_pair_new_in_a_later_sweep_is_searched_on_current_boxes() {
         let mesh = OwnedReference::sphere(R, MeshLevel::new(4, 1), false).unwrap();
         let settings = PairSettings::standard(0.1);
-        let overlap = 0.02 * R;
-        // A at the origin touching B; C far away, to be moved onto A.
-        let start = [
-            [0.0; 3],
-            [2.0 * R - overlap, 0.0, 0.0],
-            [0.0, 10.0 * R, 0.0],
-        ];
-        let mut granules = granules_at(&mesh, &start);
-        let mut p = phase(&granules, &mesh);
-        p.broad(&granules, &mesh, settings.margin, true).unwrap();
-        p.detect(&granules, &mesh, &settings, true, true, false)
-            .unwrap();
+        let (mut granules, mut p) = a_touching_b_and_c_far(&mesh, &settings);
         assert!(
             pair_constraints(&p, 0, 2).is_none(),
             "C is no candidate yet"
@@ -981,13 +1022,6 @@ mod tests {
 
         // A later sweep that moves B a little (no rebuild, no search):
         // B's boxes are left stale.
-        let shift = |g: &mut GranuleStore, d: [Real; 3]| {
-            for x in &mut g.x_pred {
-                for a in 0..3 {
-                    x[a] += d[a];
-                }
-            }
-        };
         p.forced = vec![false, true, false];
         p.touched.clone_from(&p.forced);
         shift(&mut granules[1], [-1e-3 * settings.margin, 0.0, 0.0]);
@@ -1001,22 +1035,12 @@ mod tests {
         // pair (A, C) searched, and B's boxes taken as well.
         p.forced = vec![false, false, true];
         p.touched.clone_from(&p.forced);
-        let to = [0.0, -(2.0 * R - overlap), 0.0];
-        let now = granules[2].x_pred[0][1] - mesh.positions[0][1];
-        shift(&mut granules[2], [0.0, to[1] - now, 0.0]);
+        move_c_onto_a(&mut granules, &mesh);
         p.broad(&granules, &mesh, settings.margin, false).unwrap();
         p.detect(&granules, &mesh, &settings, false, true, false)
             .unwrap();
         let found = pair_constraints(&p, 0, 2).expect("(A, C) is a candidate");
-
-        let mut fresh = phase(&granules, &mesh);
-        fresh
-            .broad(&granules, &mesh, settings.margin, true)
-            .unwrap();
-        fresh
-            .detect(&granules, &mesh, &settings, true, true, false)
-            .unwrap();
-        let expected = pair_constraints(&fresh, 0, 2).unwrap();
+        let expected = searched(&granules, &mesh, &settings, (0, 2));
         assert!(!expected.is_empty(), "A and C touch");
         assert_eq!(found, expected, "the new pair was not searched on C's x̃");
         assert!(p.stale_boxes(&granules, &mesh).is_empty());
@@ -1031,30 +1055,13 @@ mod tests {
     fn a_step_between_searches_re_measures_what_the_last_search_held() {
         let mesh = OwnedReference::sphere(R, MeshLevel::new(4, 1), false).unwrap();
         let settings = PairSettings::standard(0.1);
-        let overlap = 0.02 * R;
-        let start = [
-            [0.0; 3],
-            [2.0 * R - overlap, 0.0, 0.0],
-            [0.0, 10.0 * R, 0.0],
-        ];
-        let mut granules = granules_at(&mesh, &start);
-        let mut p = phase(&granules, &mesh);
-        p.broad(&granules, &mesh, settings.margin, true).unwrap();
-        p.detect(&granules, &mesh, &settings, true, true, false)
-            .unwrap();
+        let (mut granules, mut p) = a_touching_b_and_c_far(&mesh, &settings);
         let held = pair_constraints(&p, 0, 1).unwrap();
         assert!(!held.is_empty(), "A and B touch");
         let searches = p.searches();
 
         // The next step moves B a little deeper into A (no rebuild).
-        let shift = |g: &mut GranuleStore, d: [Real; 3]| {
-            for x in &mut g.x_pred {
-                for a in 0..3 {
-                    x[a] += d[a];
-                }
-            }
-        };
-        let push = 1e-3 * overlap;
+        let push = 1e-3 * 0.02 * R;
         shift(&mut granules[1], [-push, 0.0, 0.0]);
         p.broad(&granules, &mesh, settings.margin, true).unwrap();
         p.detect(&granules, &mesh, &settings, true, true, true)
@@ -1082,23 +1089,14 @@ mod tests {
 
         // The step after moves C onto A: the list is rebuilt and only the
         // new pair (A, C) is searched, on current boxes.
-        let to = [0.0, -(2.0 * R - overlap), 0.0];
-        let now = granules[2].x_pred[0][1] - mesh.positions[0][1];
-        shift(&mut granules[2], [0.0, to[1] - now, 0.0]);
+        move_c_onto_a(&mut granules, &mesh);
         p.broad(&granules, &mesh, settings.margin, true).unwrap();
         p.detect(&granules, &mesh, &settings, true, true, true)
             .unwrap();
         assert_eq!(p.searches(), searches + 1, "only (A, C) is searched");
         assert_eq!(pair_constraints(&p, 0, 1).unwrap(), again);
         let found = pair_constraints(&p, 0, 2).expect("(A, C) is a candidate");
-        let mut fresh = phase(&granules, &mesh);
-        fresh
-            .broad(&granules, &mesh, settings.margin, true)
-            .unwrap();
-        fresh
-            .detect(&granules, &mesh, &settings, true, true, false)
-            .unwrap();
-        let expected = pair_constraints(&fresh, 0, 2).unwrap();
+        let expected = searched(&granules, &mesh, &settings, (0, 2));
         assert!(!expected.is_empty(), "A and C touch");
         assert_eq!(found, expected);
         assert!(p.stale_boxes(&granules, &mesh).is_empty());
