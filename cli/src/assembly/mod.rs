@@ -149,10 +149,13 @@ pub struct AssemblyParams {
     /// 1..=[`MAX_CONTACT_SEARCH_INTERVAL`]; 1: every step searches.
     ///
     /// **An addition to physics.md §5** (the explicit codes' "contact
-    /// search every N cycles"): a node that was not in contact at the last
-    /// search is found up to k − 1 steps late, by which time it has
-    /// approached by k − 1 steps of its relative motion (about 0.4 µm per
-    /// step, 0.6 % of the element, in the published bed). What the pairs
+    /// search every N cycles" with a capture band): what the search holds
+    /// includes the nodes in front of a face by less than
+    /// `contact.capture` ([`PairSettings::capture`]), whose re-measured
+    /// gaps close on the step they cross; a node that approaches faster
+    /// than the capture distance over k − 1 steps, or without one, is found
+    /// up to k − 1 steps late (at k = 3 without capture the coarse CI bed
+    /// overlapped by 1.9 % of the element, BENCHMARKS.md). What the pairs
     /// hold is part of [`AssemblyState`], so a run stopped between two
     /// searches resumes with the same bits.
     pub contact_search_interval: u32,
