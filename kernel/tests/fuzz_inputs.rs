@@ -279,6 +279,40 @@ fn norm3(a: V3) -> Real {
     dot3(a, a).sqrt()
 }
 
+/// A bilinear face's centre, its two axes and its twist: x(ξ, η) = c + ξ e1
+/// + η e2 + ξη tw.
+fn bilinear_frame(q: &[V3; 4]) -> (V3, V3, V3, V3) {
+    let w = |s: [Real; 4]| -> V3 {
+        core::array::from_fn(|a| 0.25 * (0..4).map(|k| s[k] * q[k][a]).sum::<Real>())
+    };
+    (
+        w([1.0; 4]),
+        w([-1.0, 1.0, 1.0, -1.0]),
+        w([-1.0, -1.0, 1.0, 1.0]),
+        w([1.0, -1.0, 1.0, -1.0]),
+    )
+}
+
+/// The point `offset` from the face at (ξ, η) along its local unit normal
+/// there (negative: behind the face), a stationary point of the distance;
+/// `None` where the local normal vanishes.
+fn along_local_normal(
+    &(c, e1, e2, tw): &(V3, V3, V3, V3),
+    xi: Real,
+    eta: Real,
+    offset: Real,
+) -> Option<V3> {
+    let t1: V3 = core::array::from_fn(|a| e1[a] + eta * tw[a]);
+    let t2: V3 = core::array::from_fn(|a| e2[a] + xi * tw[a]);
+    let nl = cross3(t1, t2);
+    let nl_len = norm3(nl);
+    (nl_len > 0.0).then(|| {
+        core::array::from_fn(|a| {
+            c[a] + xi * e1[a] + eta * e2[a] + xi * eta * tw[a] + offset * nl[a] / nl_len
+        })
+    })
+}
+
 proptest! {
     #![proptest_config(ProptestConfig::with_cases(cases()))]
 
@@ -290,26 +324,14 @@ proptest! {
         window in 0.01..0.8f64,
     ) {
         prop_assume!(!folded(&q));
-        let w = |s: [Real; 4]| -> V3 {
-            core::array::from_fn(|a| 0.25 * (0..4).map(|k| s[k] * q[k][a]).sum::<Real>())
-        };
-        let (c, e1, e2, tw) = (
-            w([1.0; 4]),
-            w([-1.0, 1.0, 1.0, -1.0]),
-            w([-1.0, -1.0, 1.0, 1.0]),
-            w([1.0, -1.0, 1.0, -1.0]),
-        );
-        let t1: V3 = core::array::from_fn(|a| e1[a] + eta * tw[a]);
-        let t2: V3 = core::array::from_fn(|a| e2[a] + xi * tw[a]);
-        let nl = cross3(t1, t2);
-        let nl_len = norm3(nl);
-        prop_assume!(nl_len > 0.0);
+        let frame = bilinear_frame(&q);
+        let (c, e1, e2, tw) = frame;
         // The point `depth` of the window behind the face at (ξ, η), along
         // the local normal there: a stationary point of the distance.
         let h = depth * window;
-        let p: V3 = core::array::from_fn(|a| {
-            c[a] + xi * e1[a] + eta * e2[a] + xi * eta * tw[a] - h * nl[a] / nl_len
-        });
+        let p = along_local_normal(&frame, xi, eta, -h);
+        prop_assume!(p.is_some());
+        let p = p.unwrap();
         // The undoubled bounds (QuadSieve docs), for R = max(|ξ|, |η|).
         let n0 = cross3(e1, e2);
         let len = norm3(n0);
@@ -348,6 +370,28 @@ proptest! {
                         sieve.may_touch(&p, window, reach),
                         "the sieve rejected a point within reach {reach}: p {p:?}, quad {q:?}, \
                          xi {} eta {} gap {}",
+                        r.xi,
+                        r.eta,
+                        r.gap
+                    );
+                }
+            }
+        }
+        // The capture distance's side (`may_touch_within`): the same point
+        // in front of the face passes with that front wherever the
+        // projection finds it within the reach (else a near constraint
+        // would be lost).
+        if let Some(front) = along_local_normal(&frame, xi, eta, h)
+            && let Some(r) = project(&front, &q)
+            && r.gap >= 0.0
+            && r.gap <= window
+        {
+            for reach in [0.0, 0.25] {
+                if r.inside(reach) {
+                    prop_assert!(
+                        sieve.may_touch_within(&front, window, window, reach),
+                        "the sieve rejected a point in front within reach {reach}: p {front:?}, \
+                         quad {q:?}, xi {} eta {} gap {}",
                         r.xi,
                         r.eta,
                         r.gap
