@@ -42,7 +42,7 @@ use crate::constitutive::update::{Trial, check_input, plastic_return, trial, yie
 use crate::constitutive::yield_surface::{self, YieldCoefficients};
 use crate::constitutive::{UpdateError, UpdateInfo, UpdateOptions, elastic};
 use crate::element::force::{
-    ElementGeometry, HexForces, hex_forces, mean_gradient_rows, nodal_forces,
+    ElementGeometry, HexForces, hex_forces, mean_gradient_rows, nodal_forces_into,
 };
 use crate::element::reference::HexReference;
 use crate::lanes::{Lanes, Num};
@@ -307,6 +307,28 @@ const UNSET: UpdateInfo = UpdateInfo::elastic(
     0.0,
 );
 
+/// The node coordinates and nodal forces of a batch in lanes, kept from
+/// batch to batch: every batch overwrites them all, and arrays made afresh
+/// per batch were zeroed by a call of `memset` each (with the element's
+/// returned forces also copied by `memcpy`: 8 % of the elastic element,
+/// BENCHMARKS.md, session 31).
+struct BatchLanes {
+    /// x_I, `[node][xyz]`, m.
+    x: [[Lanes<BATCH>; 3]; 8],
+    /// f_I, `[node][xyz]`, N.
+    forces: [[Lanes<BATCH>; 3]; 8],
+}
+
+impl BatchLanes {
+    const ZERO: Self = {
+        let zero = Lanes([0.0; BATCH]);
+        Self {
+            x: [[zero; 3]; 8],
+            forces: [[zero; 3]; 8],
+        }
+    };
+}
+
 /// The inputs shared by every element of a loop.
 struct Job<'a> {
     mat: &'a Material,
@@ -360,8 +382,9 @@ impl Job<'_> {
         let full = batch_count(cp_inv.len()) * BATCH;
         let (head, tail) = cp_inv.split_at_mut(full);
         let (states, _) = head.as_chunks_mut::<BATCH>();
+        let mut lanes = BatchLanes::ZERO;
         for (b, c) in states.iter_mut().enumerate() {
-            if !self.batch(b, c, sink) {
+            if !self.batch(b, c, &mut lanes, sink) {
                 self.scalar(b * BATCH, c, sink)?;
             }
         }
@@ -376,7 +399,13 @@ impl Job<'_> {
     /// over whole structs were left out of line and copied through memory.
     #[allow(non_snake_case)]
     #[inline(always)]
-    fn batch<S: Sink + ?Sized>(&self, b: usize, cp_inv: &mut [Voigt; BATCH], sink: &mut S) -> bool {
+    fn batch<S: Sink + ?Sized>(
+        &self,
+        b: usize,
+        cp_inv: &mut [Voigt; BATCH],
+        lanes: &mut BatchLanes,
+        sink: &mut S,
+    ) -> bool {
         const W: usize = BATCH;
         let first = b * W;
         let hexes = &self.hexes[first..first + W];
@@ -394,7 +423,7 @@ impl Job<'_> {
         // Each lane vector is made whole from its W scalars (written lane
         // by lane into memory and read back as one vector, it stalled on
         // store forwarding: BENCHMARKS.md).
-        let mut x = [[zero; 3]; 8];
+        let BatchLanes { x, forces } = lanes;
         for (i, xi) in x.iter_mut().enumerate() {
             let p: [&[Real; 3]; W] = core::array::from_fn(|l| &self.x[hexes[l][i] as usize]);
             for (a, xia) in xi.iter_mut().enumerate() {
@@ -406,7 +435,7 @@ impl Job<'_> {
             *ck = Lanes(core::array::from_fn(|l| cp_inv[l][k]));
         }
 
-        let F = mean_gradient_rows(&g.b0, &x);
+        let F = mean_gradient_rows(&g.b0, x);
         let t = trial(self.mat, &F, &c);
         let mut tau = elastic::kirchhoff(self.mat, &t.b, t.je);
         // The yield test of `check_trial` for all lanes at once: the
@@ -471,20 +500,20 @@ impl Job<'_> {
             hourglass_geometry: g.hourglass_geometry,
         };
         let kappa_modulus = self.kappa * self.mat.p_wave_modulus();
-        let forces = nodal_forces(kappa_modulus, &geometry, &x, &F, j, &tau);
+        let hourglass_energy = nodal_forces_into(kappa_modulus, &geometry, x, &F, j, &tau, forces);
         for l in 0..W {
             if let Some(cp) = new_state[l] {
                 cp_inv[l] = cp;
             }
             let mut out = HexForces {
                 f: [[0.0; 3]; 8],
-                hourglass_energy: forces.hourglass_energy.0[l],
+                hourglass_energy: hourglass_energy.0[l],
                 j: j.0[l],
                 tau: [0.0; 6],
                 info: info[l],
                 plastic_dissipation: dissipation[l],
             };
-            for (o, fl) in out.f.iter_mut().zip(&forces.f) {
+            for (o, fl) in out.f.iter_mut().zip(forces.iter()) {
                 for (oa, fa) in o.iter_mut().zip(fl) {
                     *oa = fa.0[l];
                 }

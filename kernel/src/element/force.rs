@@ -116,7 +116,6 @@ impl<'a> ElementGeometry<'a, Real> {
 /// Nodal forces f_I = V0 τ F̄⁻ᵀ B0_I plus the stiffening hourglass forces, for
 /// nodes at `x` with F̄ = `f` (J = `j`) and Kirchhoff stress `tau`.
 /// `kappa_modulus` = κ(λ + 2μ), Pa.
-#[allow(non_snake_case)]
 #[inline(always)]
 pub fn nodal_forces<T: Num>(
     kappa_modulus: Real,
@@ -126,6 +125,30 @@ pub fn nodal_forces<T: Num>(
     j: T,
     tau: &[T; 6],
 ) -> NodalForces<T> {
+    let mut out = [[T::splat(0.0); 3]; 8];
+    let hourglass_energy = nodal_forces_into(kappa_modulus, g, x, f, j, tau, &mut out);
+    NodalForces {
+        f: out,
+        hourglass_energy,
+    }
+}
+
+/// [`nodal_forces`] written into `out` (every entry is overwritten), with
+/// the hourglass energy returned. A loop that keeps `out` from element to
+/// element spares the zeroing and the copy of a returned array, which the
+/// compiler left in the batch loop as calls of `memset` and `memcpy`
+/// (BENCHMARKS.md, session 31).
+#[allow(non_snake_case)]
+#[inline(always)]
+pub fn nodal_forces_into<T: Num>(
+    kappa_modulus: Real,
+    g: &ElementGeometry<'_, T>,
+    x: &[[T; 3]; 8],
+    f: &Rows<T>,
+    j: T,
+    tau: &[T; 6],
+    out: &mut [[T; 3]; 8],
+) -> T {
     // P = V0 τ F⁻ᵀ: (τ F⁻ᵀ)_ab = Σ_k τ_ak (F⁻¹)_bk, summed k = 0, 1, 2, then
     // scaled by V0; f_I = P B0_I. The products are written out: left to
     // nalgebra's generic `Mul`, whether they were inlined depended on how
@@ -139,7 +162,6 @@ pub fn nodal_forces<T: Num>(
             *Pab = (ta[0] * f_inv_b[0] + ta[1] * f_inv_b[1] + ta[2] * f_inv_b[2]) * g.volume;
         }
     }
-    let mut out = [[T::splat(0.0); 3]; 8];
     for (fi, bi) in out.iter_mut().zip(g.b0.iter()) {
         for (fia, Pa) in fi.iter_mut().zip(&P) {
             *fia = Pa[0] * bi[0] + Pa[1] * bi[1] + Pa[2] * bi[2];
@@ -178,10 +200,7 @@ pub fn nodal_forces<T: Num>(
             }
         }
     }
-    NodalForces {
-        f: out,
-        hourglass_energy: energy,
-    }
+    energy
 }
 
 /// Forces of one element at current node positions `x` (m).
