@@ -9,6 +9,7 @@ use granbed_kernel::dem::pour::{PourBuffers, PourParams};
 use granbed_kernel::element::batch::{ElementBatch, batch_count, regroup};
 use granbed_kernel::element::reference::HexReference;
 use granbed_kernel::granule::dynamics::GranuleBuffers;
+use granbed_kernel::granule::quality::reference_gauss_dets;
 use granbed_kernel::granule::timestep::PowerIterationBuffers;
 use granbed_kernel::mesh::octant::{MeshView, extract_octant, octant_size};
 use granbed_kernel::mesh::reference::{ReferenceMesh, compute_element_data};
@@ -81,6 +82,10 @@ pub struct OwnedReference {
     pub batches: Vec<ElementBatch>,
     /// Lumped nodal volumes, m³.
     pub node_volume: Vec<Real>,
+    /// det J at each element's 2×2×2 Gauss points on the reference mesh,
+    /// `[element][point]`, m³ (`quality::reference_gauss_dets`): what the
+    /// worst-element check of every granule divides by.
+    pub gauss_dets: Vec<[Real; 8]>,
 }
 
 /// `elements` regrouped for the batched one-point element.
@@ -187,7 +192,9 @@ impl OwnedReference {
             batches: regrouped(&elements),
             elements,
             node_volume,
-        })
+            gauss_dets: Vec::new(),
+        }
+        .with_gauss_dets())
     }
 
     /// The shortest edge of the surface quads, m: the element size that
@@ -237,7 +244,17 @@ impl OwnedReference {
             batches: regrouped(&elements),
             elements,
             node_volume,
-        })
+            gauss_dets: Vec::new(),
+        }
+        .with_gauss_dets())
+    }
+
+    /// `self` with its [`Self::gauss_dets`] taken.
+    fn with_gauss_dets(mut self) -> Self {
+        let mut dets = vec![[0.0; 8]; self.hexes.len()];
+        reference_gauss_dets(&self.view(), &mut dets).expect("one per hex");
+        self.gauss_dets = dets;
+        self
     }
 
     /// The kernel's borrowed view.

@@ -36,7 +36,7 @@ use granbed_kernel::granule::damping::{
     RigidFrame, RigidMotion, damping_coefficient, selective_kinetic_excess,
 };
 use granbed_kernel::granule::forces::ElementSettings;
-use granbed_kernel::granule::quality::{WorstElement, worst_element};
+use granbed_kernel::granule::quality::{WorstElement, worst_element_against};
 use granbed_kernel::granule::timestep::{
     TimeStepControl, TimeStepMemory, TimeStepMethod, power_start,
 };
@@ -820,7 +820,7 @@ impl<'m> Assembly<'m> {
         let per: Vec<Option<WorstElement>> = self
             .granules
             .par_iter()
-            .map(|g| worst_element(&view, &g.x))
+            .map(|g| worst_element_against(&view, &self.mesh.gauss_dets, &g.x))
             .collect();
         per.into_iter()
             .enumerate()

@@ -58,7 +58,14 @@ pub fn shape_gradients(xi: [Real; 3]) -> [[Real; 3]; 8] {
 /// Jacobian J_ij = ∂x_i/∂ξ_j of the trilinear map at (ξ, η, ζ).
 #[inline]
 pub fn jacobian(x: &HexCoords, xi: [Real; 3]) -> Mat3 {
-    let g = shape_gradients(xi);
+    jacobian_from_gradients(x, &shape_gradients(xi))
+}
+
+/// [`jacobian`] from the parent-space gradients `g` =
+/// [`shape_gradients`]`(ξ)`, for a caller that evaluates many elements at
+/// the same point (the same bits).
+#[inline]
+pub fn jacobian_from_gradients(x: &HexCoords, g: &[[Real; 3]; 8]) -> Mat3 {
     let mut j = Mat3::zeros();
     for (xn, gn) in x.iter().zip(g.iter()) {
         for r in 0..3 {

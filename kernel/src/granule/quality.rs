@@ -19,18 +19,67 @@ pub struct WorstElement {
     pub element: usize,
 }
 
+/// The parent-space shape gradients at the 2×2×2 Gauss points, in
+/// [`hex8::gauss_points`] order.
+fn gauss_gradients() -> [[[Real; 3]; 8]; 8] {
+    hex8::gauss_points().map(hex8::shape_gradients)
+}
+
+/// det J_g at the Gauss points of the hex `hex` with node positions `x`.
+#[inline]
+fn gauss_dets(grads: &[[[Real; 3]; 8]; 8], x: &[[Real; 3]], hex: &[u32; 8]) -> [Real; 8] {
+    let xe: hex8::HexCoords = core::array::from_fn(|i| x[hex[i] as usize]);
+    core::array::from_fn(|g| det_mat(&hex8::jacobian_from_gradients(&xe, &grads[g])))
+}
+
+/// det J_g(X) of every element of `mesh` at its 2×2×2 Gauss points (in
+/// [`hex8::gauss_points`] order), `[element][point]`, m³: the denominators
+/// of [`worst_element_against`], the same for every granule of the mesh.
+/// `Err` holds the length `out` must have (one per hex).
+pub fn reference_gauss_dets(mesh: &ReferenceMesh<'_>, out: &mut [[Real; 8]]) -> Result<(), usize> {
+    let hexes = mesh.mesh.hexes;
+    if out.len() != hexes.len() {
+        return Err(hexes.len());
+    }
+    let grads = gauss_gradients();
+    for (o, hex) in out.iter_mut().zip(hexes) {
+        *o = gauss_dets(&grads, mesh.mesh.positions, hex);
+    }
+    Ok(())
+}
+
 /// The smallest Gauss-point Jacobian ratio of the granule at positions `x`
 /// (one per mesh node, m) against the reference mesh, with its element;
 /// `None` for a mesh without elements. A NaN ratio wins (it is reported,
-/// not skipped).
+/// not skipped). [`worst_element_against`] with the reference determinants
+/// taken on the way.
 pub fn worst_element(mesh: &ReferenceMesh<'_>, x: &[[Real; 3]]) -> Option<WorstElement> {
-    let reference = mesh.mesh.positions;
+    worst_element_against(mesh, &[], x)
+}
+
+/// [`worst_element`] with the reference determinants `reference` of
+/// [`reference_gauss_dets`] (a driver checking many granules of one mesh
+/// takes them once: they were half the work). If `reference` is not one
+/// per hex (empty, say), they are taken on the way; the same bits either
+/// way.
+pub fn worst_element_against(
+    mesh: &ReferenceMesh<'_>,
+    reference: &[[Real; 8]],
+    x: &[[Real; 3]],
+) -> Option<WorstElement> {
+    let hexes = mesh.mesh.hexes;
+    let cached = reference.len() == hexes.len();
+    let grads = gauss_gradients();
     let mut worst: Option<WorstElement> = None;
-    for (e, hex) in mesh.mesh.hexes.iter().enumerate() {
-        let now: hex8::HexCoords = core::array::from_fn(|i| x[hex[i] as usize]);
-        let then: hex8::HexCoords = core::array::from_fn(|i| reference[hex[i] as usize]);
-        for g in hex8::gauss_points() {
-            let ratio = det_mat(&hex8::jacobian(&now, g)) / det_mat(&hex8::jacobian(&then, g));
+    for (e, hex) in hexes.iter().enumerate() {
+        let now = gauss_dets(&grads, x, hex);
+        let then = if cached {
+            reference[e]
+        } else {
+            gauss_dets(&grads, mesh.mesh.positions, hex)
+        };
+        for (n, t) in now.iter().zip(&then) {
+            let ratio = n / t;
             let worse = match worst {
                 None => true,
                 Some(w) => ratio.is_nan() && !w.ratio.is_nan() || ratio < w.ratio,
