@@ -10,7 +10,9 @@ use common::{Rng, assert_close, material, sphere_mesh};
 use granbed_kernel::Real;
 use granbed_kernel::constitutive::UpdateOptions;
 use granbed_kernel::element::force::{hex_forces, mean_deformation_gradient};
-use granbed_kernel::element::hex8::{HexCoords, NODE_SIGNS};
+use granbed_kernel::element::hex8::{
+    GAUSS_GRADIENTS, HexCoords, NODE_SIGNS, gauss_points, shape_gradients,
+};
 use granbed_kernel::element::reference::hex_reference;
 use granbed_kernel::granule::damping::{damping_forces, rigid_motion};
 use granbed_kernel::material::GranuleType;
@@ -462,4 +464,17 @@ fn the_hex_volume_is_the_reference_volume_to_the_bit() {
     inverted[6] = [-3e-4, -3e-4, -3e-4];
     assert_eq!(hex_volume(&inverted), None);
     assert!(hex_reference(&inverted).is_none());
+}
+
+/// The compile-time table of the shape gradients at the Gauss points (what
+/// the quadrature, the time-step estimate and the worst-element check
+/// read) is `shape_gradients` there, to the bit.
+#[test]
+fn the_gauss_gradient_table_is_the_shape_gradients_to_the_bit() {
+    for (table, g) in GAUSS_GRADIENTS.iter().zip(gauss_points()) {
+        let want = shape_gradients(g);
+        for (t, w) in table.iter().flatten().zip(want.iter().flatten()) {
+            assert_eq!(t.to_bits(), w.to_bits(), "at {g:?}");
+        }
+    }
 }

@@ -55,6 +55,35 @@ pub fn shape_gradients(xi: [Real; 3]) -> [[Real; 3]; 8] {
     })
 }
 
+/// [`shape_gradients`] at the eight [`gauss_points`], `[point][node][ξηζ]`,
+/// evaluated at compile time with the same operations (so the same bits):
+/// for loops over many elements at the Gauss points (quadrature, the
+/// time-step estimate, the worst-element check), which otherwise took the
+/// gradients afresh for every element.
+pub const GAUSS_GRADIENTS: [[[Real; 3]; 8]; 8] = {
+    let mut out = [[[0.0; 3]; 8]; 8];
+    let mut g = 0;
+    while g < 8 {
+        let p = NODE_SIGNS[g];
+        let xi = [p[0] * GAUSS_2, p[1] * GAUSS_2, p[2] * GAUSS_2];
+        let mut i = 0;
+        while i < 8 {
+            let s = NODE_SIGNS[i];
+            let a = 1.0 + s[0] * xi[0];
+            let b = 1.0 + s[1] * xi[1];
+            let c = 1.0 + s[2] * xi[2];
+            out[g][i] = [
+                0.125 * s[0] * b * c,
+                0.125 * s[1] * a * c,
+                0.125 * s[2] * a * b,
+            ];
+            i += 1;
+        }
+        g += 1;
+    }
+    out
+};
+
 /// Jacobian J_ij = ∂x_i/∂ξ_j of the trilinear map at (ξ, η, ζ).
 #[inline]
 pub fn jacobian(x: &HexCoords, xi: [Real; 3]) -> Mat3 {
@@ -64,17 +93,20 @@ pub fn jacobian(x: &HexCoords, xi: [Real; 3]) -> Mat3 {
 /// [`jacobian`] from the parent-space gradients `g` =
 /// [`shape_gradients`]`(ξ)`, for a caller that evaluates many elements at
 /// the same point (the same bits).
-#[inline]
+#[inline(always)]
 pub fn jacobian_from_gradients(x: &HexCoords, g: &[[Real; 3]; 8]) -> Mat3 {
-    let mut j = Mat3::zeros();
+    // Summed in rows of plain arrays (each entry over the nodes in order,
+    // from zero: the bits of summing into the matrix), which the compiler
+    // keeps in registers.
+    let mut j = [[0.0; 3]; 3];
     for (xn, gn) in x.iter().zip(g.iter()) {
-        for r in 0..3 {
-            for c in 0..3 {
-                j[(r, c)] += xn[r] * gn[c];
+        for (jr, &xr) in j.iter_mut().zip(xn) {
+            for (jrc, &gc) in jr.iter_mut().zip(gn) {
+                *jrc += xr * gc;
             }
         }
     }
-    j
+    crate::tensor::from_rows(&j)
 }
 
 /// The eight 2×2×2 Gauss points, in node order (point I near node I).
