@@ -464,6 +464,9 @@ fn the_hex_volume_is_the_reference_volume_to_the_bit() {
     inverted[6] = [-3e-4, -3e-4, -3e-4];
     assert_eq!(hex_volume(&inverted), None);
     assert!(hex_reference(&inverted).is_none());
+    let mut nan: HexCoords = core::array::from_fn(|i| NODE_SIGNS[i].map(|s| 1e-4 * s));
+    nan[3][1] = Real::NAN;
+    assert_eq!(hex_volume(&nan), None);
 }
 
 /// The compile-time table of the shape gradients at the Gauss points (what

@@ -5,7 +5,7 @@
 //! and runs the kinematics, the elastic trial state, the elastic stress, the
 //! nodal forces and the hourglass forces once for all lanes — the same code
 //! as the scalar element ([`mean_gradient_rows`], [`trial`],
-//! [`nodal_forces`] are generic over [`Num`]), so every lane gets exactly the
+//! [`nodal_forces_into`] are generic over [`Num`]), so every lane gets exactly the
 //! scalar result. The yield test of [`check_trial`] runs in lanes too (its
 //! pieces, [`yield_surface::porous_formula`],
 //! [`yield_surface::yield_function_of`], are generic), all but the branches
@@ -308,10 +308,11 @@ const UNSET: UpdateInfo = UpdateInfo::elastic(
 );
 
 /// The node coordinates and nodal forces of a batch in lanes, kept from
-/// batch to batch: every batch overwrites them all, and arrays made afresh
-/// per batch were zeroed by a call of `memset` each (with the element's
-/// returned forces also copied by `memcpy`: 8 % of the elastic element,
-/// BENCHMARKS.md, session 31).
+/// batch to batch: a batch writes all of `x` before it reads it, and all of
+/// `forces` (in [`nodal_forces_into`]) before it reads them, so nothing of
+/// an earlier batch is seen. Arrays made afresh per batch were zeroed by a
+/// call of `memset` each, and the returned forces copied by `memcpy`
+/// (about 7 % of the elastic element: BENCHMARKS.md, session 31).
 struct BatchLanes {
     /// x_I, `[node][xyz]`, m.
     x: [[Lanes<BATCH>; 3]; 8],
@@ -393,7 +394,8 @@ impl Job<'_> {
 
     /// Batch `b` (elements `b·BATCH…`) side by side: updates the states and
     /// hands the outputs to `sink`, in element order. Returns `false`,
-    /// having changed nothing, if any lane fails (the caller redoes the
+    /// having changed no state and called no sink (only the scratch
+    /// `lanes`), if any lane fails (the caller redoes the
     /// batch element by element). Plain loops, but for `core::array::from_fn`
     /// making one lane vector from its scalars: `array::map` and `from_fn`
     /// over whole structs were left out of line and copied through memory.

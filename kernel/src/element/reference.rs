@@ -38,7 +38,7 @@ pub struct HexReference {
 /// The volume Σ_g det J_g of a hex at node positions `x` (m³, [`hex8`]
 /// order) by 2×2×2 Gauss quadrature, exact for the trilinear map — the
 /// [`HexReference::volume`] of [`hex_reference`] to the bit, without the
-/// gradients (the time-step estimate needs only this, every step). `None`
+/// gradients (the time-step estimate needs only this, at every re-estimate). `None`
 /// if a Gauss-point Jacobian is not positive.
 pub fn hex_volume(x: &HexCoords) -> Option<Real> {
     let mut volume = 0.0;

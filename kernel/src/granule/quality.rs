@@ -52,7 +52,7 @@ pub fn worst_element(mesh: &ReferenceMesh<'_>, x: &[[Real; 3]]) -> Option<WorstE
 
 /// [`worst_element`] with the reference determinants `reference` of
 /// [`reference_gauss_dets`] (a driver checking many granules of one mesh
-/// takes them once: they were half the work). If `reference` is not one
+/// takes them once: they were two thirds of the work). If `reference` is not one
 /// per hex (empty, say), they are taken on the way; the same bits either
 /// way.
 pub fn worst_element_against(
