@@ -64,8 +64,8 @@ fn worst_by_definition(mesh: &ReferenceMesh<'_>, x: &[[Real; 3]]) -> Option<Wors
 
 /// With the determinants taken once or on the way, the same worst element
 /// to the bit as the check's definition, on randomly distorted granules; a
-/// wrong-length table is refused by `reference_gauss_dets` and ignored by
-/// the check.
+/// wrong-length table is refused by `reference_gauss_dets`, and it and
+/// another mesh's table are ignored by the check.
 #[test]
 fn cached_reference_determinants_give_the_same_bits() {
     check(|mesh, dets, x0| {
@@ -83,6 +83,9 @@ fn cached_reference_determinants_give_the_same_bits() {
                 bits(worst_element_against(mesh, &dets[1..], &x)),
                 bits(want)
             );
+            // Another mesh's table (here: a stretched one) is not used.
+            let other: Vec<[Real; 8]> = dets.iter().map(|d| d.map(|v| 2.0 * v)).collect();
+            assert_eq!(bits(worst_element_against(mesh, &other, &x)), bits(want));
         }
         let mut short = vec![[0.0; 8]; dets.len() - 1];
         assert_eq!(reference_gauss_dets(mesh, &mut short), Err(dets.len()));
