@@ -42,24 +42,33 @@ fn bits(w: Option<WorstElement>) -> Option<(u64, usize)> {
 
 /// The check written out as its definition: each element's Jacobians at
 /// the Gauss points (shape gradients taken at each point) now and then,
-/// their ratio, the smallest kept (a NaN wins, the first on a tie).
+/// their ratios in (element, point) order; the first NaN if there is one,
+/// else the first of the smallest.
 fn worst_by_definition(mesh: &ReferenceMesh<'_>, x: &[[Real; 3]]) -> Option<WorstElement> {
-    let mut worst: Option<WorstElement> = None;
-    for (e, hex) in mesh.mesh.hexes.iter().enumerate() {
-        let now: [[Real; 3]; 8] = core::array::from_fn(|i| x[hex[i] as usize]);
-        let then: [[Real; 3]; 8] = core::array::from_fn(|i| mesh.mesh.positions[hex[i] as usize]);
-        for g in gauss_points() {
-            let ratio = det_mat(&jacobian(&now, g)) / det_mat(&jacobian(&then, g));
-            let worse = match worst {
-                None => true,
-                Some(w) => ratio.is_nan() && !w.ratio.is_nan() || ratio < w.ratio,
-            };
-            if worse {
-                worst = Some(WorstElement { ratio, element: e });
-            }
-        }
-    }
-    worst
+    let positions = mesh.mesh.positions;
+    let ratios: Vec<WorstElement> = mesh
+        .mesh
+        .hexes
+        .iter()
+        .enumerate()
+        .flat_map(|(element, hex)| {
+            let now: [[Real; 3]; 8] = core::array::from_fn(|i| x[hex[i] as usize]);
+            let then: [[Real; 3]; 8] = core::array::from_fn(|i| positions[hex[i] as usize]);
+            gauss_points().map(|g| WorstElement {
+                ratio: det_mat(&jacobian(&now, g)) / det_mat(&jacobian(&then, g)),
+                element,
+            })
+        })
+        .collect();
+    let smallest = ratios
+        .iter()
+        .map(|w| w.ratio)
+        .fold(Real::INFINITY, Real::min);
+    ratios
+        .iter()
+        .find(|w| w.ratio.is_nan())
+        .or_else(|| ratios.iter().find(|w| w.ratio == smallest))
+        .copied()
 }
 
 /// With the determinants taken once or on the way, the same worst element

@@ -76,17 +76,7 @@ pub fn mean_gradient_rows<T: Num>(b0: &[[T; 3]; 8], x: &[[T; 3]; 8]) -> Rows<T> 
     f
 }
 
-/// What an element contributes once its stress is known (over any [`Num`],
-/// one element or a batch of them side by side).
-#[derive(Clone, Copy, Debug)]
-pub struct NodalForces<T> {
-    /// Internal plus hourglass force of each node, `[node][xyz]`, N.
-    pub f: [[T; 3]; 8],
-    /// Hourglass energy, J.
-    pub hourglass_energy: T,
-}
-
-/// The reference data [`nodal_forces`] reads, as references so that the
+/// The reference data [`nodal_forces_into`] reads, as references so that the
 /// scalar element borrows its [`HexReference`] and a batch its lanes.
 #[derive(Clone, Copy, Debug)]
 pub struct ElementGeometry<'a, T> {
@@ -114,30 +104,13 @@ impl<'a> ElementGeometry<'a, Real> {
 }
 
 /// Nodal forces f_I = V0 τ F̄⁻ᵀ B0_I plus the stiffening hourglass forces, for
-/// nodes at `x` with F̄ = `f` (J = `j`) and Kirchhoff stress `tau`.
-/// `kappa_modulus` = κ(λ + 2μ), Pa.
-#[inline(always)]
-pub fn nodal_forces<T: Num>(
-    kappa_modulus: Real,
-    g: &ElementGeometry<'_, T>,
-    x: &[[T; 3]; 8],
-    f: &Rows<T>,
-    j: T,
-    tau: &[T; 6],
-) -> NodalForces<T> {
-    let mut out = [[T::splat(0.0); 3]; 8];
-    let hourglass_energy = nodal_forces_into(kappa_modulus, g, x, f, j, tau, &mut out);
-    NodalForces {
-        f: out,
-        hourglass_energy,
-    }
-}
-
-/// [`nodal_forces`] written into `out` (every entry is overwritten), with
-/// the hourglass energy returned. A loop that keeps `out` from element to
-/// element spares the zeroing and the copy of a returned array, which the
-/// compiler left in the batch loop as calls of `memset` and `memcpy`
-/// (BENCHMARKS.md, session 31).
+/// nodes at `x` with F̄ = `f` (J = `j`) and Kirchhoff stress `tau`, written
+/// into `out` (`[node][xyz]`, N; every entry is overwritten); returns the
+/// hourglass energy, J. `kappa_modulus` = κ(λ + 2μ), Pa. Over any [`Num`]:
+/// one element, or a batch of them side by side. The caller owns `out`: a
+/// loop that keeps it from element to element spares the zeroing and the
+/// copy of a returned array, which the compiler left in the batch loop as
+/// calls of `memset` and `memcpy` (BENCHMARKS.md, session 31).
 #[allow(non_snake_case)]
 #[inline(always)]
 pub fn nodal_forces_into<T: Num>(
@@ -224,17 +197,19 @@ pub fn hex_forces(
     let F = mean_gradient_rows(&r.b0, x);
     let up = update_point_rows(mat, opts, &F, cp_inv)?;
     let j = det_rows(&F);
-    let out = nodal_forces(
+    let mut f = [[0.0; 3]; 8];
+    let hourglass_energy = nodal_forces_into(
         kappa * mat.p_wave_modulus(),
         &ElementGeometry::of(r),
         x,
         &F,
         j,
         &up.tau,
+        &mut f,
     );
     Ok(HexForces {
-        f: out.f,
-        hourglass_energy: out.hourglass_energy,
+        f,
+        hourglass_energy,
         j,
         tau: up.tau,
         info: up.info,
