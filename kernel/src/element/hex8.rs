@@ -39,46 +39,37 @@ pub fn shape(xi: [Real; 3]) -> [Real; 8] {
     })
 }
 
-/// Parent-space gradients ∂N_I/∂(ξ, η, ζ) at (ξ, η, ζ).
+/// Parent-space gradients ∂N_I/∂(ξ, η, ζ) at (ξ, η, ζ). A `const fn`, so
+/// that [`GAUSS_GRADIENTS`] is this function evaluated at compile time.
 #[inline]
-pub fn shape_gradients(xi: [Real; 3]) -> [[Real; 3]; 8] {
-    core::array::from_fn(|i| {
+pub const fn shape_gradients(xi: [Real; 3]) -> [[Real; 3]; 8] {
+    let mut out = [[0.0; 3]; 8];
+    let mut i = 0;
+    while i < 8 {
         let s = NODE_SIGNS[i];
         let a = 1.0 + s[0] * xi[0];
         let b = 1.0 + s[1] * xi[1];
         let c = 1.0 + s[2] * xi[2];
-        [
+        out[i] = [
             0.125 * s[0] * b * c,
             0.125 * s[1] * a * c,
             0.125 * s[2] * a * b,
-        ]
-    })
+        ];
+        i += 1;
+    }
+    out
 }
 
 /// [`shape_gradients`] at the eight [`gauss_points`], `[point][node][ξηζ]`,
-/// evaluated at compile time with the same operations (so the same bits):
-/// for loops over many elements at the Gauss points (quadrature, the
-/// time-step estimate, the worst-element check), which otherwise took the
-/// gradients afresh for every element.
+/// evaluated at compile time (IEEE arithmetic, so the bits of the run-time
+/// call): for loops over many elements at the Gauss points (quadrature,
+/// the time-step estimate, the worst-element check), which otherwise took
+/// the gradients afresh for every element.
 pub const GAUSS_GRADIENTS: [[[Real; 3]; 8]; 8] = {
     let mut out = [[[0.0; 3]; 8]; 8];
     let mut g = 0;
     while g < 8 {
-        let p = NODE_SIGNS[g];
-        let xi = [p[0] * GAUSS_2, p[1] * GAUSS_2, p[2] * GAUSS_2];
-        let mut i = 0;
-        while i < 8 {
-            let s = NODE_SIGNS[i];
-            let a = 1.0 + s[0] * xi[0];
-            let b = 1.0 + s[1] * xi[1];
-            let c = 1.0 + s[2] * xi[2];
-            out[g][i] = [
-                0.125 * s[0] * b * c,
-                0.125 * s[1] * a * c,
-                0.125 * s[2] * a * b,
-            ];
-            i += 1;
-        }
+        out[g] = shape_gradients(gauss_point(g));
         g += 1;
     }
     out
@@ -111,10 +102,13 @@ pub fn jacobian_from_gradients(x: &HexCoords, g: &[[Real; 3]; 8]) -> Mat3 {
 
 /// The eight 2×2×2 Gauss points, in node order (point I near node I).
 pub fn gauss_points() -> [[Real; 3]; 8] {
-    core::array::from_fn(|i| {
-        let s = NODE_SIGNS[i];
-        [s[0] * GAUSS_2, s[1] * GAUSS_2, s[2] * GAUSS_2]
-    })
+    core::array::from_fn(gauss_point)
+}
+
+/// Gauss point `i` of [`gauss_points`].
+const fn gauss_point(i: usize) -> [Real; 3] {
+    let s = NODE_SIGNS[i];
+    [s[0] * GAUSS_2, s[1] * GAUSS_2, s[2] * GAUSS_2]
 }
 
 /// Scaled Jacobian at corner `i`: the determinant of the three unit edge

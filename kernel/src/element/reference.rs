@@ -41,15 +41,20 @@ pub struct HexReference {
 /// gradients (the time-step estimate needs only this, at every re-estimate). `None`
 /// if a Gauss-point Jacobian is not positive.
 pub fn hex_volume(x: &HexCoords) -> Option<Real> {
-    let mut volume = 0.0;
-    for g in &hex8::GAUSS_GRADIENTS {
-        let det = det_mat(&hex8::jacobian_from_gradients(x, g));
-        if det.is_nan() || det <= 0.0 {
-            return None;
-        }
-        volume += det;
+    let dets = gauss_determinants(x);
+    if dets.iter().any(|d| d.is_nan() || *d <= 0.0) {
+        return None;
     }
-    Some(volume)
+    Some(dets.iter().fold(0.0, |volume, det| volume + det))
+}
+
+/// det J_g of a hex at node positions `x` (m, [`hex8`] order) at its
+/// 2×2×2 Gauss points, in [`hex8::gauss_points`] order, m³ (no sign
+/// check): the determinants of the quadrature, of [`hex_volume`] and of the
+/// worst-element check.
+#[inline]
+pub fn gauss_determinants(x: &HexCoords) -> [Real; 8] {
+    hex8::GAUSS_GRADIENTS.map(|g| det_mat(&hex8::jacobian_from_gradients(x, &g)))
 }
 
 /// The Jacobian and its determinant at each of [`hex8::gauss_points`], in

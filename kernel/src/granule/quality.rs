@@ -4,9 +4,8 @@
 //! element) while its centre Jacobian stays healthy.
 
 use crate::Real;
-use crate::element::hex8;
+use crate::element::reference::gauss_determinants;
 use crate::mesh::reference::ReferenceMesh;
-use crate::tensor::det_mat;
 
 /// The worst element of a granule: the smallest ratio det J_g(x)/det J_g(X)
 /// over the 2×2×2 Gauss points of every element, and that element.
@@ -22,12 +21,11 @@ pub struct WorstElement {
 /// det J_g at the Gauss points of the hex `hex` with node positions `x`.
 #[inline]
 fn gauss_dets(x: &[[Real; 3]], hex: &[u32; 8]) -> [Real; 8] {
-    let xe: hex8::HexCoords = core::array::from_fn(|i| x[hex[i] as usize]);
-    hex8::GAUSS_GRADIENTS.map(|g| det_mat(&hex8::jacobian_from_gradients(&xe, &g)))
+    gauss_determinants(&core::array::from_fn(|i| x[hex[i] as usize]))
 }
 
 /// det J_g(X) of every element of `mesh` at its 2×2×2 Gauss points (in
-/// [`hex8::gauss_points`] order), `[element][point]`, m³: the denominators
+/// [`crate::element::hex8::gauss_points`] order), `[element][point]`, m³: the denominators
 /// of [`worst_element_against`], the same for every granule of the mesh.
 /// `Err` holds the length `out` must have (one per hex).
 pub fn reference_gauss_dets(mesh: &ReferenceMesh<'_>, out: &mut [[Real; 8]]) -> Result<(), usize> {
