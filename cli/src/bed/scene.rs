@@ -674,7 +674,6 @@ mod tests {
             e.contains("`contact_search_interval`") && e.contains("hold_constraints"),
             "{e}"
         );
-        // A scene file without the field searches every step.
         let e = bad("contact_capture = 0.1", "contact_capture = 0.2");
         assert!(
             e.contains("`contact_capture`") && e.contains("0 <= c <= 0.1"),
