@@ -3,19 +3,25 @@
 //! it) — forces, energies, diagnostics and the stored states, through
 //! elastic and plastic steps with lanes of both kinds in one batch, for a
 //! count of elements that leaves a remainder, and on failure (the same
-//! element reported, the same states left behind).
+//! element reported, the same states left behind); and so does a granule's
+//! assembly of them (`internal_forces_on`), whose sink takes a batch's
+//! forces straight from its lanes.
 
 mod common;
 
 use common::{Rng, material, sphere_mesh};
 use granbed_kernel::Real;
 use granbed_kernel::constitutive::UpdateError;
+use granbed_kernel::constitutive::update::{check_input, input_is_valid, trial};
 use granbed_kernel::element::batch::{
     BATCH, ElementBatch, ElementPath, batch_count, has_avx2, one_point_elements, regroup, sink,
 };
 use granbed_kernel::element::force::HexForces;
 use granbed_kernel::element::reference::{HexReference, hex_reference};
+use granbed_kernel::granule::forces::{ElementKind, ElementSettings, internal_forces_on};
 use granbed_kernel::material::GranuleType;
+use granbed_kernel::mesh::octant::MeshView;
+use granbed_kernel::mesh::reference::{ReferenceMesh, compute_element_data};
 use granbed_kernel::mesh::sphere::SphereMeshParams;
 use granbed_kernel::tensor::{VOIGT_IDENTITY, Voigt};
 
@@ -188,6 +194,45 @@ fn every_path_gives_the_scalar_bits_through_elastic_and_plastic_steps() {
     );
 }
 
+/// Runs every path on positions `x` where element `bad` fails (lane 2 of
+/// the second batch), and checks that each reports it with an error that
+/// `expected` accepts and leaves the scalar path's states behind; returns
+/// the scalar pass and its states.
+fn fails_alike(
+    hexes: &[[u32; 8]],
+    refs: &[HexReference],
+    x: &[[Real; 3]],
+    bad: usize,
+    expected: fn(&UpdateError) -> bool,
+) -> (Pass, Vec<Voigt>) {
+    // Lanes 0 and 1 were evaluated side by side with it, and must be
+    // updated by the redo alone.
+    assert_eq!(bad / BATCH, 1);
+    assert_eq!(bad % BATCH, 2);
+    let mut reference: Option<(Pass, Vec<Voigt>)> = None;
+    for path in PATHS {
+        let mut cp = vec![VOIGT_IDENTITY; hexes.len()];
+        let pass = run(path, hexes, refs, x, &mut cp);
+        match &pass.result {
+            Err((element, error)) if expected(error) => {
+                assert_eq!(*element, bad, "{path:?}: element {element}")
+            }
+            other => panic!("{path:?}: expected element {bad} to fail, got {other:?}"),
+        }
+        match &reference {
+            None => reference = Some((pass, cp)),
+            Some((scalar, scalar_cp)) => {
+                assert_eq!(pass.result, scalar.result, "{path:?}");
+                assert_eq!(pass.outputs, scalar.outputs, "{path:?}");
+                let bits =
+                    |c: &[Voigt]| c.iter().flatten().map(|v| v.to_bits()).collect::<Vec<_>>();
+                assert_eq!(bits(&cp), bits(scalar_cp), "{path:?}: states left behind");
+            }
+        }
+    }
+    reference.unwrap()
+}
+
 #[test]
 fn a_failing_element_is_reported_alike_and_leaves_the_same_states() {
     let mesh = sphere_mesh(&SphereMeshParams::standard());
@@ -206,41 +251,29 @@ fn a_failing_element_is_reported_alike_and_leaves_the_same_states() {
     let bad = 6;
     let centre: [Real; 3] =
         core::array::from_fn(|a| hexes[bad].iter().map(|&n| x[n as usize][a]).sum::<Real>() / 8.0);
+    let mut flipped = x.clone();
     for &n in &hexes[bad][..4] {
-        let p = &mut x[n as usize];
+        let p = &mut flipped[n as usize];
         p[2] = 2.0 * centre[2] - p[2];
     }
-    let mut reference: Option<(Pass, Vec<Voigt>)> = None;
-    for path in PATHS {
-        let mut cp = vec![VOIGT_IDENTITY; count];
-        let pass = run(path, hexes, &refs, &x, &mut cp);
-        let Err((element, UpdateError::InvertedDeformation { .. })) = pass.result else {
-            panic!(
-                "{path:?}: expected an inverted element, got {:?}",
-                pass.result
-            );
-        };
-        // Element 6 is lane 2 of batch 1: lanes 0 and 1 were evaluated
-        // side by side with it, and must be updated by the redo alone.
-        assert_eq!(element, bad, "{path:?}: element {element}");
-        assert_eq!(bad % BATCH, 2);
-        match &reference {
-            None => reference = Some((pass, cp)),
-            Some((scalar, scalar_cp)) => {
-                assert_eq!(pass.result, scalar.result, "{path:?}");
-                assert_eq!(pass.outputs, scalar.outputs, "{path:?}");
-                let bits =
-                    |c: &[Voigt]| c.iter().flatten().map(|v| v.to_bits()).collect::<Vec<_>>();
-                assert_eq!(bits(&cp), bits(scalar_cp), "{path:?}: states left behind");
-            }
-        }
-    }
-    let (scalar, cp) = reference.unwrap();
+    let (scalar, cp) = fails_alike(hexes, &refs, &flipped, bad, |e| {
+        matches!(e, UpdateError::InvertedDeformation { .. })
+    });
     assert!(
         scalar.plastic > 0,
         "the elements before the failure yielded"
     );
     assert!(cp.iter().any(|c| c != &VOIGT_IDENTITY));
+    // A NaN coordinate, at a node element 6 has and no element before it
+    // (the batch's test of F for finite entries, in lanes).
+    let node = hexes[bad]
+        .iter()
+        .find(|n| hexes[..bad].iter().all(|h| !h.contains(n)))
+        .expect("element 6 has a node of its own among the first elements");
+    x[*node as usize][1] = Real::NAN;
+    fails_alike(hexes, &refs, &x, bad, |e| {
+        matches!(e, UpdateError::NonFinite)
+    });
 }
 
 /// The kernel's own `cpuid`/`xgetbv` detection agrees with the standard
@@ -357,4 +390,124 @@ fn lanes_past_eta_one_or_with_a_clamped_a2_give_the_scalar_bits() {
         von_mises > 0 && near_one > 0 && clamp > 0 && mixed > 0,
         "lanes past 1: {von_mises}, just below 1: {near_one}, clamped: {clamp}, batches across 1: {mixed}"
     );
+}
+
+/// A granule's assembled forces and summary are the same bits on every
+/// path, through elastic and plastic steps: the batch hands its forces to
+/// the assembly from the lanes (`Sink::batch`), the element by element
+/// loop as arrays, and each must add them node by node in element order.
+#[test]
+fn the_assembled_forces_are_the_same_on_every_path() {
+    let mesh = sphere_mesh(&SphereMeshParams::standard());
+    let view = MeshView {
+        positions: &mesh.positions,
+        hexes: &mesh.hexes,
+        quads: &mesh.quads,
+        surface_nodes: mesh.size.surface_nodes,
+    };
+    let mut elements = vec![hex_reference(&mesh.hex_coords(0)).unwrap(); mesh.hexes.len()];
+    let mut node_volume = vec![0.0; mesh.positions.len()];
+    compute_element_data(&view, &mut elements, &mut node_volume).unwrap();
+    let mut batches = vec![ElementBatch::ZERO; batch_count(elements.len())];
+    regroup(&elements, &mut batches).unwrap();
+    let reference = ReferenceMesh {
+        mesh: view,
+        node_quads: &mesh.node_quads,
+        elements: &elements,
+        batches: &batches,
+        node_volume: &node_volume,
+    };
+    let mat = material(GranuleType::B2);
+    let settings = ElementSettings {
+        kind: ElementKind::OnePoint,
+        update: Default::default(),
+        hourglass_kappa: 0.05,
+    };
+    let paths = [ElementPath::Scalar, ElementPath::Batched, ElementPath::Avx2];
+    let mut states: Vec<Vec<Voigt>> = paths
+        .iter()
+        .map(|_| vec![VOIGT_IDENTITY; mesh.hexes.len()])
+        .collect();
+    let mut rng = Rng::new(11);
+    let size = 1.0e-3 / 8.0;
+    let mut plastic_steps = 0;
+    for step in 1..=20 {
+        let c = 0.01 * step as Real;
+        let x: Vec<[Real; 3]> = mesh
+            .positions
+            .iter()
+            .map(|p| {
+                [
+                    p[0] + 0.2 * c * p[2] + rng.uniform(-0.02, 0.02) * size,
+                    p[1] + rng.uniform(-0.02, 0.02) * size,
+                    p[2] * (1.0 - c) + rng.uniform(-0.02, 0.02) * size,
+                ]
+            })
+            .collect();
+        let mut results = Vec::new();
+        for (&path, cp) in paths.iter().zip(states.iter_mut()) {
+            let mut f = vec![[Real::NAN; 3]; x.len()];
+            let s = internal_forces_on(path, &reference, &mat, &settings, &x, cp, &mut f).unwrap();
+            let mut bits: Vec<u64> = f.iter().flatten().map(|v| v.to_bits()).collect();
+            bits.extend([s.hourglass_energy, s.plastic_dissipation, s.min_j].map(Real::to_bits));
+            bits.extend([
+                s.plastic_elements as u64,
+                u64::from(s.max_iterations),
+                s.a2_clamped as u64,
+            ]);
+            results.push(bits);
+            if path == ElementPath::Scalar && s.plastic_elements > 0 {
+                plastic_steps += 1;
+            }
+        }
+        for (path, r) in paths.iter().zip(&results).skip(1) {
+            assert!(
+                r == &results[0],
+                "{path:?} differs from the scalar path at step {step}"
+            );
+        }
+    }
+    assert!(plastic_steps >= 5, "only {plastic_steps} plastic steps");
+}
+
+/// The batch's branch-free input test says yes exactly when the scalar
+/// element's `check_input` does, for every combination of ordinary and
+/// special values (NaN, ±∞, ±0, subnormal, the largest finite).
+#[test]
+fn the_batch_input_test_agrees_with_check_input() {
+    let mat = material(GranuleType::B2);
+    let specials = [
+        1.0,
+        0.5,
+        -1.0,
+        0.0,
+        -0.0,
+        f64::MIN_POSITIVE / 4.0,
+        f64::MAX,
+        -f64::MAX,
+        f64::INFINITY,
+        f64::NEG_INFINITY,
+        f64::NAN,
+    ];
+    let mut checked = 0;
+    for f_finite in [true, false] {
+        for &j in &specials {
+            for &det_c in &specials {
+                for &eta in &specials {
+                    // A trial state built from a diagonal F and C_p⁻¹, its
+                    // J, det C_p⁻¹ and η then set to the values under test.
+                    let f = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
+                    let mut t = trial(&mat, &f, &VOIGT_IDENTITY);
+                    (t.j, t.det_cp_inv, t.eta) = (j, det_c, eta);
+                    assert_eq!(
+                        input_is_valid(f_finite, j, det_c, eta),
+                        check_input(f_finite, &t).is_ok(),
+                        "F finite {f_finite}, J {j:e}, det C_p⁻¹ {det_c:e}, η {eta:e}"
+                    );
+                    checked += 1;
+                }
+            }
+        }
+    }
+    assert_eq!(checked, 2 * 11 * 11 * 11);
 }

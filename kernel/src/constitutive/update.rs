@@ -283,6 +283,16 @@ pub fn check_input(f_finite: bool, t: &Trial<Real>) -> Result<(), UpdateError> {
     Ok(())
 }
 
+/// [`check_input`]'s verdict without the error: F finite (`f_finite`),
+/// J > 0, 0 < det C_p⁻¹ < ∞ and η finite (a NaN fails every test). For an
+/// element batch, which only needs to know whether all its lanes pass
+/// (a batch that fails is redone element by element, which names the
+/// error); the tests are combined without branches.
+#[inline(always)]
+pub fn input_is_valid(f_finite: bool, j: Real, det_cp_inv: Real, eta: Real) -> bool {
+    f_finite & (j > 0.0) & (det_cp_inv > 0.0) & (det_cp_inv < Real::INFINITY) & eta.is_finite()
+}
+
 /// Whether a trial state with yield function `phi_tr` and scale
 /// (2/3)a2σy² `scale` yields: not `φ ≤ tol·scale`. Not `φ > tol·scale`: a
 /// NaN φ (overflowed trial state) must go to the corrector, which reports

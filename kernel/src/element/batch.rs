@@ -9,13 +9,14 @@
 //! scalar result. The yield test of [`check_trial`] runs in lanes too (its
 //! pieces, [`yield_surface::porous_formula`],
 //! [`yield_surface::yield_function_of`], are generic), all but the branches
-//! of η ≥ 1 and the a2 clamp. Per lane, in scalar code: those branches, the
-//! input checks ([`check_input`]) and, for a lane that yields
-//! ([`yields`]), the plastic corrector ([`plastic_return`]). The element's
-//! results go to a [`Sink`] the loop is generic over, compiled into it. A
-//! batch in which any lane fails is evaluated again element by element by
-//! [`hex_forces`], so errors, and the states left behind, are those of the
-//! scalar loop.
+//! of η ≥ 1 and the a2 clamp; so do the input checks of [`check_input`],
+//! as one verdict for the batch ([`input_is_valid`]). Per lane, in scalar
+//! code: those branches and, for a lane that yields ([`yields`]), the
+//! plastic corrector ([`plastic_return`]). The batch's results go to a
+//! [`Sink`] the loop is generic over, compiled into it, from the lanes
+//! ([`Sink::batch`]). A batch in which any lane fails is evaluated again
+//! element by element by [`hex_forces`], so errors, and the states left
+//! behind, are those of the scalar loop.
 //!
 //! [`ElementPath`] chooses the code: element by element, portable batches
 //! (the build's vector width: 2 lanes with x86-64's SSE2), or batches compiled
@@ -36,9 +37,9 @@
 //! transition penalty on every call.
 
 use crate::Real;
+use crate::constitutive::update::{Trial, input_is_valid, plastic_return, trial, yields};
 #[cfg(doc)]
-use crate::constitutive::update::check_trial;
-use crate::constitutive::update::{Trial, check_input, plastic_return, trial, yields};
+use crate::constitutive::update::{check_input, check_trial};
 use crate::constitutive::yield_surface::{self, YieldCoefficients};
 use crate::constitutive::{UpdateError, UpdateInfo, UpdateOptions, elastic};
 use crate::element::force::{
@@ -47,7 +48,7 @@ use crate::element::force::{
 use crate::element::reference::HexReference;
 use crate::lanes::{Lanes, Num};
 use crate::material::Material;
-use crate::tensor::{Voigt, det_rows};
+use crate::tensor::{Rows, Voigt};
 
 /// Elements per batch.
 pub const BATCH: usize = 4;
@@ -124,7 +125,7 @@ fn detect_avx2() -> bool {
 pub type ElementOutput = HexForces;
 
 /// What the element loop hands each element's result to, in element
-/// order. The loop is generic over it so that a sink whose `element` is
+/// order. The loop is generic over it so that a sink whose methods are
 /// `#[inline(always)]` is compiled into the batch loop (an indirect call
 /// per element, with the output copied through memory, was 10 % of the
 /// elastic element: BENCHMARKS.md, session 28). Any closure
@@ -134,12 +135,67 @@ pub type ElementOutput = HexForces;
 pub trait Sink {
     /// Takes the result `out` of element `element` with node ids `hex`.
     fn element(&mut self, element: usize, hex: &[u32; 8], out: &ElementOutput);
+
+    /// Takes the results of the batch of elements `first..first +`
+    /// [`BATCH`] (node ids `hexes`), lane l of `out` being element
+    /// `first + l`. The default hands each lane to [`Sink::element`] in
+    /// order ([`BatchOutput::lane`]); a sink that reads the lanes where
+    /// they are spares copying every element's forces out of them and
+    /// back in (the assembly's scatter: BENCHMARKS.md, session 32).
+    #[inline(always)]
+    fn batch(&mut self, first: usize, hexes: &[[u32; 8]; BATCH], out: &BatchOutput<'_>) {
+        for (l, hex) in hexes.iter().enumerate() {
+            self.element(first + l, hex, &out.lane(l));
+        }
+    }
 }
 
 impl<S: FnMut(usize, &[u32; 8], &ElementOutput) + ?Sized> Sink for S {
     #[inline(always)]
     fn element(&mut self, element: usize, hex: &[u32; 8], out: &ElementOutput) {
         self(element, hex, out)
+    }
+}
+
+/// The results of one batch where the loop keeps them, lane l = element l
+/// of the batch: each lane is the [`ElementOutput`] of the scalar element.
+#[derive(Clone, Copy, Debug)]
+pub struct BatchOutput<'a> {
+    /// Internal plus hourglass force of each node, `[node][xyz]`, N.
+    pub forces: &'a [[Lanes<BATCH>; 3]; 8],
+    /// Hourglass energy, J.
+    pub hourglass_energy: Lanes<BATCH>,
+    /// J = det F̄.
+    pub j: Lanes<BATCH>,
+    /// Kirchhoff stress, Pa (Voigt).
+    pub tau: &'a [Lanes<BATCH>; 6],
+    /// Constitutive diagnostics.
+    pub info: &'a [UpdateInfo; BATCH],
+    /// Plastic dissipation of the step, J.
+    pub plastic_dissipation: &'a [Real; BATCH],
+}
+
+impl BatchOutput<'_> {
+    /// Lane `l` as one element's output.
+    #[inline(always)]
+    pub fn lane(&self, l: usize) -> ElementOutput {
+        let mut out = HexForces {
+            f: [[0.0; 3]; 8],
+            hourglass_energy: self.hourglass_energy.0[l],
+            j: self.j.0[l],
+            tau: [0.0; 6],
+            info: self.info[l],
+            plastic_dissipation: self.plastic_dissipation[l],
+        };
+        for (o, fl) in out.f.iter_mut().zip(self.forces) {
+            for (oa, fa) in o.iter_mut().zip(fl) {
+                *oa = fa.0[l];
+            }
+        }
+        for (o, tk) in out.tau.iter_mut().zip(self.tau) {
+            *o = tk.0[l];
+        }
+        out
     }
 }
 
@@ -307,6 +363,26 @@ const UNSET: UpdateInfo = UpdateInfo::elastic(
     0.0,
 );
 
+/// Whether every lane passes [`check_input`] ([`input_is_valid`]). A lane
+/// of F with an entry that is not finite makes its lane of Σ F_ab·0 NaN;
+/// finite entries leave it ±0.
+#[allow(non_snake_case)]
+#[inline(always)]
+fn inputs_valid<const W: usize>(F: &Rows<Lanes<W>>, t: &Trial<Lanes<W>>) -> bool {
+    let zero = Lanes::splat(0.0);
+    let probe = F.iter().flatten().fold(zero, |p, &v| p + v * zero);
+    let mut valid = true;
+    for l in 0..W {
+        valid &= input_is_valid(
+            !probe.0[l].is_nan(),
+            t.j.0[l],
+            t.det_cp_inv.0[l],
+            t.eta.0[l],
+        );
+    }
+    valid
+}
+
 /// The node coordinates and nodal forces of a batch in lanes, kept from
 /// batch to batch: a batch writes all of `x` before it reads it, and all of
 /// `forces` (in [`nodal_forces_into`]) before it reads them, so nothing of
@@ -453,27 +529,27 @@ impl Job<'_> {
         let scale = yield_surface::yield_scale_of(a2, params.yield_stress_pa);
         let phi = yield_surface::yield_function_of(a1, scale, t.beta, t.alpha);
         let residual = phi / scale;
-        // Per lane: the checks and, if it yields, the corrector.
+        // The input checks for all lanes; then per lane the diagnostics and,
+        // if it yields, the corrector.
         let mut info = [UNSET; W];
         let mut new_state: [Option<Voigt>; W] = [None; W];
         let mut dissipation = [0.0; W];
+        if !inputs_valid(&F, &t) {
+            return false;
+        }
         for l in 0..W {
-            let finite = F.iter().flatten().all(|v| v.0[l].is_finite());
-            let lane_t: Trial<Real> = t.lane(l);
-            if check_input(finite, &lane_t).is_err() {
-                return false;
-            }
             // `check_trial`'s elastic diagnostics, written field by field
             // into the placeholder (building the struct and copying it in
             // stalled on store forwarding: BENCHMARKS.md).
             let i = &mut info[l];
-            (i.eta, i.je) = (lane_t.eta, lane_t.je);
+            (i.eta, i.je) = (t.eta.0[l], t.je.0[l]);
             i.coefficients = coefficients[l];
             i.residual = residual.0[l];
             // V0 × 0 as the scalar element computes it (−0 or NaN for a
             // malformed volume, like the scalar path).
             dissipation[l] = g.volume.0[l] * 0.0;
             if yields(self.opts, phi.0[l], scale.0[l]) {
+                let lane_t: Trial<Real> = t.lane(l);
                 let scale = scale.0[l];
                 let mut lane_f = [[0.0; 3]; 3];
                 for (row, f_row) in lane_f.iter_mut().zip(&F) {
@@ -494,7 +570,8 @@ impl Job<'_> {
                 dissipation[l] = g.volume.0[l] * up.dissipation_density();
             }
         }
-        let j = det_rows(&F);
+        // det F̄, as the trial state took it.
+        let j = t.j;
         let geometry = ElementGeometry {
             volume: g.volume,
             b0: &g.b0,
@@ -503,28 +580,24 @@ impl Job<'_> {
         };
         let kappa_modulus = self.kappa * self.mat.p_wave_modulus();
         let hourglass_energy = nodal_forces_into(kappa_modulus, &geometry, x, &F, j, &tau, forces);
-        for l in 0..W {
-            if let Some(cp) = new_state[l] {
-                cp_inv[l] = cp;
+        for (c, new) in cp_inv.iter_mut().zip(new_state) {
+            if let Some(cp) = new {
+                *c = cp;
             }
-            let mut out = HexForces {
-                f: [[0.0; 3]; 8],
-                hourglass_energy: hourglass_energy.0[l],
-                j: j.0[l],
-                tau: [0.0; 6],
-                info: info[l],
-                plastic_dissipation: dissipation[l],
-            };
-            for (o, fl) in out.f.iter_mut().zip(forces.iter()) {
-                for (oa, fa) in o.iter_mut().zip(fl) {
-                    *oa = fa.0[l];
-                }
-            }
-            for (o, tk) in out.tau.iter_mut().zip(&tau) {
-                *o = tk.0[l];
-            }
-            sink.element(first + l, &self.hexes[first + l], &out);
         }
+        let (hexes, _) = hexes.as_chunks::<W>();
+        sink.batch(
+            first,
+            &hexes[0],
+            &BatchOutput {
+                forces,
+                hourglass_energy,
+                j,
+                tau: &tau,
+                info: &info,
+                plastic_dissipation: &dissipation,
+            },
+        );
         true
     }
 }

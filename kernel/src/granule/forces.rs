@@ -5,8 +5,8 @@
 use core::fmt;
 
 use crate::Real;
-use crate::constitutive::{UpdateError, UpdateOptions};
-use crate::element::batch::{ElementPath, Sink, one_point_elements};
+use crate::constitutive::{UpdateError, UpdateInfo, UpdateOptions};
+use crate::element::batch::{BATCH, BatchOutput, ElementPath, Sink, one_point_elements};
 use crate::element::fbar::{fbar_elastic_energy, fbar_forces};
 use crate::element::force::HexForces;
 use crate::material::Material;
@@ -137,7 +137,7 @@ pub fn internal_forces_on(
                 let xe = core::array::from_fn(|i| x[hex[i] as usize]);
                 let out = fbar_forces(mat, &settings.update, &xr, &xe, c)
                     .map_err(|error| ElementFailure { element, error })?;
-                scatter(f, hex, &out.f);
+                scatter(f, hex, |i, a| out.f[i][a]);
                 s.plastic_dissipation += out.plastic_dissipation;
                 s.min_j = crate::math::min(s.min_j, out.min_j);
                 if out.plastic_points > 0 {
@@ -151,15 +151,17 @@ pub fn internal_forces_on(
     Ok(s)
 }
 
-/// Adds an element's nodal forces `fe` to the granule's `f` at its nodes
-/// `hex`.
+/// Adds an element's nodal forces to the granule's `f` at its nodes `hex`:
+/// `fe(i, a)` is component a of node i's force. Node by node in element
+/// order, so the sums keep their order however the element hands them
+/// over.
 #[inline(always)]
-fn scatter(f: &mut [[Real; 3]], hex: &[u32; 8], fe: &[[Real; 3]; 8]) {
-    for (id, fe) in hex.iter().zip(fe.iter()) {
+fn scatter(f: &mut [[Real; 3]], hex: &[u32; 8], fe: impl Fn(usize, usize) -> Real) {
+    for (i, id) in hex.iter().enumerate() {
         let fi = &mut f[*id as usize];
-        fi[0] += fe[0];
-        fi[1] += fe[1];
-        fi[2] += fe[2];
+        fi[0] += fe(i, 0);
+        fi[1] += fe(i, 1);
+        fi[2] += fe(i, 2);
     }
 }
 
@@ -171,19 +173,54 @@ struct Assemble<'a> {
     summary: &'a mut ForceSummary,
 }
 
+impl Assemble<'_> {
+    /// Adds one element's energies and diagnostics to the summary.
+    #[inline(always)]
+    fn tally(
+        &mut self,
+        hourglass_energy: Real,
+        plastic_dissipation: Real,
+        j: Real,
+        info: &UpdateInfo,
+    ) {
+        let s = &mut *self.summary;
+        s.hourglass_energy += hourglass_energy;
+        s.plastic_dissipation += plastic_dissipation;
+        s.min_j = crate::math::min(s.min_j, j);
+        if info.plastic {
+            s.plastic_elements += 1;
+            s.max_iterations = s.max_iterations.max(info.iterations);
+        }
+        s.a2_clamped += usize::from(info.coefficients.a2_clamped);
+    }
+}
+
 impl Sink for Assemble<'_> {
     #[inline(always)]
     fn element(&mut self, _: usize, hex: &[u32; 8], out: &HexForces) {
-        let s = &mut *self.summary;
-        scatter(self.f, hex, &out.f);
-        s.hourglass_energy += out.hourglass_energy;
-        s.plastic_dissipation += out.plastic_dissipation;
-        s.min_j = crate::math::min(s.min_j, out.j);
-        if out.info.plastic {
-            s.plastic_elements += 1;
-            s.max_iterations = s.max_iterations.max(out.info.iterations);
+        scatter(self.f, hex, |i, a| out.f[i][a]);
+        self.tally(
+            out.hourglass_energy,
+            out.plastic_dissipation,
+            out.j,
+            &out.info,
+        );
+    }
+
+    /// Straight from the lanes: copying each element's forces out of them
+    /// into an [`HexForces`] first cost more than the scatter itself
+    /// (BENCHMARKS.md, session 32).
+    #[inline(always)]
+    fn batch(&mut self, _: usize, hexes: &[[u32; 8]; BATCH], out: &BatchOutput<'_>) {
+        for (l, hex) in hexes.iter().enumerate() {
+            scatter(self.f, hex, |i, a| out.forces[i][a].0[l]);
+            self.tally(
+                out.hourglass_energy.0[l],
+                out.plastic_dissipation[l],
+                out.j.0[l],
+                &out.info[l],
+            );
         }
-        s.a2_clamped += usize::from(out.info.coefficients.a2_clamped);
     }
 }
 
