@@ -14,7 +14,8 @@
 //! node), the mean dilatation passes it exactly.
 //!
 //! Reference gradients are recomputed from the reference coordinates each
-//! call: this element is for verification, not speed.
+//! call (the parent-space gradients at the Gauss points come from
+//! [`hex8::GAUSS_GRADIENTS`]): this element is for verification, not speed.
 
 use crate::Real;
 use crate::constitutive::{UpdateError, UpdateOptions, update_point};
@@ -39,15 +40,15 @@ pub struct FbarForces {
     pub plastic_dissipation: Real,
 }
 
-/// Reference gradients ∇_X N_I and det J at parent point `xi`.
-fn reference_gradients(x_ref: &HexCoords, xi: [Real; 3]) -> Option<([[Real; 3]; 8], Real)> {
-    let j = hex8::jacobian(x_ref, xi);
+/// Reference gradients ∇_X N_I and det J at the Gauss point whose
+/// parent-space gradients are `dn` (a row of [`hex8::GAUSS_GRADIENTS`]).
+fn reference_gradients(x_ref: &HexCoords, dn: &[[Real; 3]; 8]) -> Option<([[Real; 3]; 8], Real)> {
+    let j = hex8::jacobian_from_gradients(x_ref, dn);
     let det = det_mat(&j);
     if det.is_nan() || det <= 0.0 {
         return None;
     }
     let inv_t = inverse_with_det(&j, det).transpose();
-    let dn = hex8::shape_gradients(xi);
     let grads = core::array::from_fn(|i| {
         core::array::from_fn(|a| {
             inv_t[(a, 0)] * dn[i][0] + inv_t[(a, 1)] * dn[i][1] + inv_t[(a, 2)] * dn[i][2]
@@ -104,9 +105,9 @@ fn kinematics(x_ref: &HexCoords, x: &HexCoords) -> Result<Kinematics, UpdateErro
         b_bar: [[0.0; 3]; 8],
     };
     let (mut v, mut v0) = (0.0, 0.0);
-    for (g, gp) in hex8::gauss_points().into_iter().enumerate() {
+    for (g, dn) in hex8::GAUSS_GRADIENTS.iter().enumerate() {
         let (grads, det_ref) =
-            reference_gradients(x_ref, gp).ok_or(UpdateError::InvertedDeformation { j: 0.0 })?;
+            reference_gradients(x_ref, dn).ok_or(UpdateError::InvertedDeformation { j: 0.0 })?;
         let f = deformation_gradient(x, &grads);
         let j = det_mat(&f);
         if j.is_nan() || j <= 0.0 {

@@ -79,11 +79,15 @@ pub fn hex_reference(x: &HexCoords) -> Option<HexReference> {
     let mut volume = 0.0;
     let mut grad_sum = [[0.0; 3]; 8];
     let mut node_volume = [0.0; 8];
-    for (g, (j, det)) in hex8::gauss_points().into_iter().zip(gauss_jacobians(x)?) {
+    let jacobians = gauss_jacobians(x)?;
+    for ((g, dn), (j, det)) in hex8::gauss_points()
+        .into_iter()
+        .zip(&hex8::GAUSS_GRADIENTS)
+        .zip(jacobians)
+    {
         volume += det;
         // ∇_X N = J⁻ᵀ ∇_ξ N, weighted by det J: det J · J⁻ᵀ = cof(J).
         let inv_t = inverse_with_det(&j, det).transpose();
-        let dn = hex8::shape_gradients(g);
         let n = hex8::shape(g);
         for i in 0..8 {
             for a in 0..3 {
