@@ -62,11 +62,11 @@ impl Num for Real {
 /// `W` values operated on lane by lane.
 ///
 /// Aligned to 32 bytes, the width of an AVX2 register: four lanes then
-/// never straddle a cache line, so the element batch's loads and stores of
-/// its lanes (reference data, coordinates, forces, spills) are one access
-/// each; the batch ran 4 % faster elastic than with the 8-byte alignment
-/// of `[Real; W]` (BENCHMARKS.md, session 32). Fewer than four lanes are
-/// padded to 32 bytes.
+/// never straddle a cache line, so with AVX2 the element batch's loads and
+/// stores of its lanes (reference data, coordinates, forces, spills) are
+/// one access each; the batch's elastic case ran 80 → 76 µs per granule
+/// against the 8-byte alignment of `[Real; W]` (BENCHMARKS.md, session
+/// 32). Fewer than four lanes are padded to 32 bytes.
 #[derive(Clone, Copy, Debug, PartialEq)]
 #[repr(C, align(32))]
 pub struct Lanes<const W: usize>(pub [Real; W]);

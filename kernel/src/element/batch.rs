@@ -9,10 +9,11 @@
 //! scalar result. The yield test of [`check_trial`] runs in lanes too (its
 //! pieces, [`yield_surface::porous_formula`],
 //! [`yield_surface::yield_function_of`], are generic), all but the branches
-//! of η ≥ 1 and the a2 clamp; so do the input checks of [`check_input`],
-//! as one verdict for the batch ([`input_is_valid`]). Per lane, in scalar
-//! code: those branches and, for a lane that yields ([`yields`]), the
-//! plastic corrector ([`plastic_return`]). The batch's results go to a
+//! of η ≥ 1 and the a2 clamp. The input checks of [`check_input`] give one
+//! verdict for the batch, without branches ([`input_is_valid`] of each
+//! lane, F's finiteness probed in lanes). Per lane, in scalar code: those
+//! branches and, for a lane that yields ([`yields`]), the plastic
+//! corrector ([`plastic_return`]). The batch's results go to a
 //! [`Sink`] the loop is generic over, compiled into it, from the lanes
 //! ([`Sink::batch`]). A batch in which any lane fails is evaluated again
 //! element by element by [`hex_forces`], so errors, and the states left
@@ -279,8 +280,9 @@ pub fn regroup(elements: &[HexReference], out: &mut [ElementBatch]) -> Result<()
 
 /// Evaluates the one-point elements `hexes` (with their reference data
 /// `refs` and states `cp_inv`, one per element) at node positions `x`, and
-/// hands each element's result to `sink` ([`Sink::element`]) in element
-/// order. Stops at the first element whose update fails and returns its
+/// hands the results to `sink` in element order: a full batch's at once
+/// ([`Sink::batch`]), an element evaluated alone (the remainder, a batch
+/// redone after a failing lane) by [`Sink::element`]. Stops at the first element whose update fails and returns its
 /// index with the error; the states of the elements before it are updated,
 /// the failing one's and those after it are not (as an element-by-element
 /// loop would leave them).
@@ -599,5 +601,49 @@ impl Job<'_> {
             },
         );
         true
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::material::GranuleType;
+    use crate::tensor::VOIGT_IDENTITY;
+
+    /// F's finiteness is what rejects a lane whose F has an infinite entry
+    /// but whose J, det C_p⁻¹ and η pass: F = diag(∞, 1, 1) gives J = +∞
+    /// and η = η0/∞ = 0. A NaN entry is rejected too, and so is a lane of
+    /// an otherwise valid batch.
+    #[test]
+    #[allow(non_snake_case)]
+    fn an_infinite_entry_of_f_fails_the_batch_although_j_and_eta_pass() {
+        let mat = GranuleType::B2.params().validate().unwrap();
+        let identity: Rows<Real> = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
+        let lanes_of = |bad: Option<Real>| -> Rows<Lanes<BATCH>> {
+            core::array::from_fn(|a| {
+                core::array::from_fn(|b| {
+                    Lanes(core::array::from_fn(|l| match bad {
+                        Some(v) if l == 2 && a == 0 && b == 0 => v,
+                        _ => identity[a][b],
+                    }))
+                })
+            })
+        };
+        let c: [Lanes<BATCH>; 6] = VOIGT_IDENTITY.map(Lanes::splat);
+        let valid = lanes_of(None);
+        assert!(inputs_valid(&valid, &trial(&mat, &valid, &c)));
+        let infinite = lanes_of(Some(Real::INFINITY));
+        let t = trial(&mat, &infinite, &c);
+        assert_eq!(t.j.0[2], Real::INFINITY);
+        assert!(t.eta.0[2].is_finite() && t.det_cp_inv.0[2] > 0.0);
+        assert!(input_is_valid(
+            true,
+            t.j.0[2],
+            t.det_cp_inv.0[2],
+            t.eta.0[2]
+        ));
+        assert!(!inputs_valid(&infinite, &t));
+        let nan = lanes_of(Some(Real::NAN));
+        assert!(!inputs_valid(&nan, &trial(&mat, &nan, &c)));
     }
 }

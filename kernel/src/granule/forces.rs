@@ -207,9 +207,9 @@ impl Sink for Assemble<'_> {
         );
     }
 
-    /// Straight from the lanes: copying each element's forces out of them
-    /// into an [`HexForces`] first cost more than the scatter itself
-    /// (BENCHMARKS.md, session 32).
+    /// Straight from the lanes, sparing the default's copy of each
+    /// element's forces out of them into an [`HexForces`] (30
+    /// instructions per element fewer: BENCHMARKS.md, session 32).
     #[inline(always)]
     fn batch(&mut self, _: usize, hexes: &[[u32; 8]; BATCH], out: &BatchOutput<'_>) {
         for (l, hex) in hexes.iter().enumerate() {
