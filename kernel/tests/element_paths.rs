@@ -465,11 +465,15 @@ fn the_assembled_forces_are_the_same_on_every_path() {
     assert!(plastic_steps >= 5, "only {plastic_steps} plastic steps");
 }
 
-/// The batch's branch-free input test says yes exactly when the scalar
-/// element's `check_input` does, for every combination of ordinary and
-/// special values (NaN, ±∞, ±0, subnormal, the largest finite).
+/// The input checks, which the scalar element (`check_input`) and the
+/// batch (`input_is_valid`, one verdict for its lanes) share, against the
+/// rule written out here: accepted exactly when F is finite, J > 0,
+/// 0 < det C_p⁻¹ < ∞ and η is finite, for every combination of ordinary and
+/// special values (NaN, ±∞, ±0, subnormal, the largest finite); otherwise
+/// the error of the first failed test, in the documented order.
 #[test]
-fn the_batch_input_test_agrees_with_check_input() {
+fn the_input_checks_accept_exactly_the_valid_inputs_and_name_the_first_failure() {
+    use core::cmp::Ordering::Greater;
     let mat = material(GranuleType::B2);
     let specials = [
         1.0,
@@ -484,25 +488,56 @@ fn the_batch_input_test_agrees_with_check_input() {
         f64::NEG_INFINITY,
         f64::NAN,
     ];
-    let mut checked = 0;
+    let positive = |v: Real| v.partial_cmp(&0.0) == Some(Greater);
+    let mut counts = [0; 4];
     for f_finite in [true, false] {
         for &j in &specials {
             for &det_c in &specials {
                 for &eta in &specials {
-                    // A trial state built from a diagonal F and C_p⁻¹, its
-                    // J, det C_p⁻¹ and η then set to the values under test.
+                    // A trial state built from the identity, its J,
+                    // det C_p⁻¹ and η then set to the values under test.
                     let f = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
                     let mut t = trial(&mat, &f, &VOIGT_IDENTITY);
                     (t.j, t.det_cp_inv, t.eta) = (j, det_c, eta);
+                    let expected = if !f_finite {
+                        Some(UpdateError::NonFinite)
+                    } else if !positive(j) {
+                        Some(UpdateError::InvertedDeformation { j })
+                    } else if !positive(det_c) || det_c.is_infinite() {
+                        Some(UpdateError::InvalidState { det: det_c })
+                    } else if eta.is_nan() || eta.is_infinite() {
+                        Some(UpdateError::InvertedDeformation { j })
+                    } else {
+                        None
+                    };
+                    let what =
+                        format!("F finite {f_finite}, J {j:e}, det C_p⁻¹ {det_c:e}, η {eta:e}");
+                    let got = check_input(f_finite, &t);
+                    match expected {
+                        None => assert_eq!(got, Ok(()), "{what}"),
+                        // Compared as text: the errors carry a NaN J or det.
+                        Some(e) => assert_eq!(
+                            format!("{got:?}"),
+                            format!("{:?}", Err::<(), _>(e)),
+                            "{what}"
+                        ),
+                    }
                     assert_eq!(
                         input_is_valid(f_finite, j, det_c, eta),
-                        check_input(f_finite, &t).is_ok(),
-                        "F finite {f_finite}, J {j:e}, det C_p⁻¹ {det_c:e}, η {eta:e}"
+                        expected.is_none(),
+                        "{what}"
                     );
-                    checked += 1;
+                    counts[match expected {
+                        None => 0,
+                        Some(UpdateError::NonFinite) => 1,
+                        Some(UpdateError::InvalidState { .. }) => 2,
+                        Some(_) => 3,
+                    }] += 1;
                 }
             }
         }
     }
-    assert_eq!(checked, 2 * 11 * 11 * 11);
+    // Every outcome occurs: 2 × 11³ cases.
+    assert!(counts.iter().all(|&c| c > 0), "{counts:?}");
+    assert_eq!(counts.iter().sum::<usize>(), 2 * 11 * 11 * 11);
 }

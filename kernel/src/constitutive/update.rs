@@ -261,33 +261,34 @@ pub fn check_trial(
     })
 }
 
-/// The input checks of [`check_trial`]: F finite (`f_finite`), J > 0, a
-/// valid stored state and a finite η (a NaN J or det C_p⁻¹ fails).
+/// The input checks of [`check_trial`]: [`input_is_valid`], and if not,
+/// the first test that failed, in this order: F not finite
+/// ([`UpdateError::NonFinite`]), J not > 0 (inverted), det C_p⁻¹ not in
+/// (0, ∞) (invalid state), η not finite (inverted: J > 0 but so small —
+/// subnormal — that η = η0/J overflows, crushed flat; found by fuzzing).
 #[inline(always)]
 pub fn check_input(f_finite: bool, t: &Trial<Real>) -> Result<(), UpdateError> {
-    if !f_finite {
-        return Err(UpdateError::NonFinite);
-    }
-    if t.j.is_nan() || t.j <= 0.0 {
-        return Err(UpdateError::InvertedDeformation { j: t.j });
-    }
     let det_c = t.det_cp_inv;
-    if det_c.is_nan() || det_c <= 0.0 || det_c.is_infinite() {
-        return Err(UpdateError::InvalidState { det: det_c });
+    if input_is_valid(f_finite, t.j, det_c, t.eta) {
+        return Ok(());
     }
-    if !t.eta.is_finite() {
-        // J > 0 but so small (subnormal) that η = η0/J overflows: crushed
-        // flat, for the update as good as inverted (found by fuzzing).
-        return Err(UpdateError::InvertedDeformation { j: t.j });
-    }
-    Ok(())
+    Err(if !f_finite {
+        UpdateError::NonFinite
+    } else if t.j.is_nan() || t.j <= 0.0 {
+        UpdateError::InvertedDeformation { j: t.j }
+    } else if det_c.is_nan() || det_c <= 0.0 || det_c.is_infinite() {
+        UpdateError::InvalidState { det: det_c }
+    } else {
+        UpdateError::InvertedDeformation { j: t.j }
+    })
 }
 
-/// [`check_input`]'s verdict without the error: F finite (`f_finite`),
-/// J > 0, 0 < det C_p⁻¹ < ∞ and η finite (a NaN fails every test). For an
-/// element batch, which only needs to know whether all its lanes pass
-/// (a batch that fails is redone element by element, which names the
-/// error); the tests are combined without branches.
+/// Whether an update's input is admissible: F finite (`f_finite`), J > 0,
+/// 0 < det C_p⁻¹ < ∞ and η finite (a NaN fails every test) — the rule of
+/// [`check_input`], without naming what failed. The tests are combined
+/// without branches, so an element batch takes one verdict for all its
+/// lanes (a batch that fails is redone element by element, which names
+/// the error).
 #[inline(always)]
 pub fn input_is_valid(f_finite: bool, j: Real, det_cp_inv: Real, eta: Real) -> bool {
     f_finite & (j > 0.0) & (det_cp_inv > 0.0) & (det_cp_inv < Real::INFINITY) & eta.is_finite()
