@@ -6,7 +6,8 @@
 //! run), for the one-point element and the F-bar verification element.
 //! Also one granule's whole predictor and corrector (elements, damping,
 //! the velocity and position updates under selective mass scaling), and the
-//! memory bandwidth (STREAM triad) for the element's roofline.
+//! memory bandwidth (STREAM triad) and the core clock (a chain of dependent
+//! additions) for the element's roofline.
 
 use core::hint::black_box;
 
@@ -322,5 +323,35 @@ fn bench_bandwidth(c: &mut Criterion) {
     g.finish();
 }
 
-criterion_group!(benches, bench_elements, bench_granule_step, bench_bandwidth);
+/// The roofline's clock (the VM has no hardware counters, and
+/// `/proc/cpuinfo` gives the nominal clock, not the boosted one): a chain
+/// of 1 024 dependent f64 additions per iteration, which the compiler can
+/// neither reorder nor vectorise (IEEE addition is not associative).
+/// Criterion reports additions per second; an addition takes 3 cycles on
+/// AMD Zen 3 and 4 (and on Intel since Skylake 4), so the clock is 3 (or
+/// 4) × that rate.
+fn bench_clock(c: &mut Criterion) {
+    const ADDS: usize = 1024;
+    let mut g = c.benchmark_group("clock");
+    g.throughput(Throughput::Elements(ADDS as u64));
+    g.bench_function("dependent_f64_adds", |bench| {
+        let step = black_box(1.0e-300);
+        bench.iter(|| {
+            let mut x = black_box(0.0f64);
+            for _ in 0..ADDS {
+                x += step;
+            }
+            black_box(x)
+        })
+    });
+    g.finish();
+}
+
+criterion_group!(
+    benches,
+    bench_elements,
+    bench_granule_step,
+    bench_bandwidth,
+    bench_clock
+);
 criterion_main!(benches);
