@@ -18,6 +18,7 @@
 
 use crate::Real;
 use crate::constitutive::elastic;
+use crate::lanes::{Lanes, Num};
 use crate::math;
 
 /// Newton iterations before the bisection fallback takes over.
@@ -48,22 +49,27 @@ pub enum ReturnMethod {
 }
 
 /// The trial-state scalars and coefficients that define the corrector.
+///
+/// Over any [`Num`] for the returned state's formulas ([`Self::theta`],
+/// [`Self::je`], [`Self::alpha`], [`Self::beta`]): an element batch
+/// evaluates them for all its lanes at once with the scalar bits
+/// (`update::returned_state`). The solvers are scalar (`T = Real`).
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct ReturnMapSystem {
+pub struct ReturnMapSystem<T = Real> {
     /// θtr = μ tr b^e,tr, Pa (> 0).
-    pub theta_tr: Real,
+    pub theta_tr: T,
     /// Trial elastic volume ratio J^e,tr (> 0).
-    pub je_tr: Real,
+    pub je_tr: T,
     /// βtr = ‖dev τtr‖, Pa (≥ 0).
-    pub beta_tr: Real,
+    pub beta_tr: T,
     /// Yield-surface coefficient a1 ≥ 0.
-    pub a1: Real,
+    pub a1: T,
     /// Yield scale (2/3) a2 σy², Pa² (> 0).
-    pub yield_scale: Real,
+    pub yield_scale: T,
     /// Lamé λ, Pa.
-    pub lambda: Real,
+    pub lambda: T,
     /// Shear modulus μ, Pa.
-    pub mu: Real,
+    pub mu: T,
 }
 
 /// A solution (or best iterate) of the corrector.
@@ -81,31 +87,49 @@ pub struct ReturnSolution {
     pub residual: Real,
 }
 
-impl ReturnMapSystem {
+impl<T: Num> ReturnMapSystem<T> {
     /// θ(ε) = θtr/(1+ε), Pa.
-    #[inline]
-    pub fn theta(&self, eps: Real) -> Real {
-        self.theta_tr / (1.0 + eps)
+    #[inline(always)]
+    pub fn theta(&self, eps: T) -> T {
+        self.theta_tr / (T::splat(1.0) + eps)
     }
 
     /// J^e(ε) = (1 − 1.5ε) J^e,tr (backward-Euler update of J^p).
-    #[inline]
-    pub fn je(&self, eps: Real) -> Real {
-        (1.0 - 1.5 * eps) * self.je_tr
+    #[inline(always)]
+    pub fn je(&self, eps: T) -> T {
+        (T::splat(1.0) - T::splat(1.5) * eps) * self.je_tr
     }
 
     /// α(ε) = θ(ε) + h(J^e(ε)) = tr τ, Pa.
-    #[inline]
-    pub fn alpha(&self, eps: Real) -> Real {
+    #[inline(always)]
+    pub fn alpha(&self, eps: T) -> T {
         self.theta(eps) + elastic::h_lame(self.lambda, self.mu, self.je(eps))
     }
 
     /// β = βtr/(1+ε+δ), Pa.
-    #[inline]
-    pub fn beta(&self, eps: Real, delta: Real) -> Real {
-        self.beta_tr / (1.0 + eps + delta)
+    #[inline(always)]
+    pub fn beta(&self, eps: T, delta: T) -> T {
+        self.beta_tr / (T::splat(1.0) + eps + delta)
     }
+}
 
+impl<const W: usize> ReturnMapSystem<Lanes<W>> {
+    /// The system of lane `l`.
+    #[inline(always)]
+    pub fn lane(&self, l: usize) -> ReturnMapSystem {
+        ReturnMapSystem {
+            theta_tr: self.theta_tr.0[l],
+            je_tr: self.je_tr.0[l],
+            beta_tr: self.beta_tr.0[l],
+            a1: self.a1.0[l],
+            yield_scale: self.yield_scale.0[l],
+            lambda: self.lambda.0[l],
+            mu: self.mu.0[l],
+        }
+    }
+}
+
+impl ReturnMapSystem {
     /// Residuals [R1, R2] (both dimensionless; see the module docs).
     pub fn residual(&self, eps: Real, delta: Real) -> [Real; 2] {
         let alpha = self.alpha(eps);

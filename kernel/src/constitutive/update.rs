@@ -10,9 +10,9 @@
 use core::fmt;
 
 use crate::constitutive::elastic;
-use crate::constitutive::return_map::{ReturnMapSystem, ReturnMethod};
+use crate::constitutive::return_map::{ReturnMapSystem, ReturnMethod, ReturnSolution};
 use crate::constitutive::yield_surface::{self, YieldCoefficients};
-use crate::lanes::{Lanes, Num};
+use crate::lanes::Num;
 use crate::material::Material;
 use crate::tensor::{self, Mat3, Rows, Voigt};
 use crate::{Real, math};
@@ -84,6 +84,20 @@ impl UpdateInfo {
             residual,
         }
     }
+
+    /// Records the corrector's solution `sol` of a returned step, with
+    /// θ(ε) `theta` and J^e(ε) `je` of the returned state.
+    #[inline(always)]
+    pub fn record_return(&mut self, sol: &ReturnSolution, theta: Real, je: Real) {
+        self.plastic = true;
+        self.method = sol.method;
+        self.iterations = sol.iterations;
+        self.eps = sol.eps;
+        self.delta = sol.delta;
+        self.gamma = 3.0 * sol.delta / (4.0 * theta);
+        self.je = je;
+        self.residual = sol.residual;
+    }
 }
 
 /// Why an update could not be done. The state is left unchanged.
@@ -146,11 +160,18 @@ impl PointUpdate {
         if !self.info.plastic {
             return 0.0;
         }
-        let beta = tensor::norm(&tensor::deviator(&self.tau));
-        let alpha = tensor::trace(&self.tau);
-        self.info.gamma
-            * (2.0 * beta * beta + (2.0 / 3.0) * self.info.coefficients.a1 * alpha * alpha)
+        dissipation_density(&self.tau, self.info.gamma, self.info.coefficients.a1)
     }
+}
+
+/// Δγ(2β² + ⅔ a1 α²), J/m³, of a returned stress `tau` (Pa) with plastic
+/// multiplier increment `gamma` (1/Pa) and yield coefficient `a1`, over any
+/// [`Num`] ([`PointUpdate::dissipation_density`] of a plastic step).
+#[inline(always)]
+pub fn dissipation_density<T: Num>(tau: &[T; 6], gamma: T, a1: T) -> T {
+    let beta = tensor::norm(&tensor::deviator(tau));
+    let alpha = tensor::trace(tau);
+    gamma * (T::splat(2.0) * beta * beta + T::splat(2.0 / 3.0) * a1 * alpha * alpha)
 }
 
 /// The elastic trial state of a point (physics.md §1.3), over any [`Num`]
@@ -177,31 +198,6 @@ pub struct Trial<T> {
     pub alpha: T,
     /// Relative density η = η0/J.
     pub eta: T,
-}
-
-impl<const W: usize> Trial<Lanes<W>> {
-    /// The trial state of lane `l`.
-    #[inline(always)]
-    pub fn lane(&self, l: usize) -> Trial<Real> {
-        let pick = |v: &[Lanes<W>; 6]| {
-            let mut out = [0.0; 6];
-            for (o, v) in out.iter_mut().zip(v) {
-                *o = v.0[l];
-            }
-            out
-        };
-        Trial {
-            j: self.j.0[l],
-            det_cp_inv: self.det_cp_inv.0[l],
-            b: pick(&self.b),
-            je: self.je.0[l],
-            theta: self.theta.0[l],
-            s: pick(&self.s),
-            beta: self.beta.0[l],
-            alpha: self.alpha.0[l],
-            eta: self.eta.0[l],
-        }
-    }
 }
 
 /// The trial state at deformation gradient `f` (rows) from the stored
@@ -357,60 +353,102 @@ pub fn plastic_return(
     mut info: UpdateInfo,
     scale: Real,
 ) -> Result<(PointUpdate, Voigt), UpdateError> {
-    let mu = mat.mu;
-    let system = ReturnMapSystem {
-        theta_tr: t.theta,
-        je_tr: t.je,
-        beta_tr: t.beta,
-        a1: info.coefficients.a1,
-        yield_scale: scale,
-        lambda: mat.lambda,
-        mu,
-    };
+    let system = corrector(mat, t, info.coefficients.a1, scale);
     let sol = system.solve().map_err(|best| UpdateError::NoConvergence {
         residual: math::abs(best.residual),
         iterations: best.iterations,
     })?;
+    let r = returned_state(mat, opts, F, t, &system, sol.eps, sol.delta, |_| true);
+    if !r.cp_inv.iter().all(|x| x.is_finite()) {
+        return Err(UpdateError::NonFinite);
+    }
+    info.record_return(&sol, r.theta, r.je);
+    Ok((PointUpdate { tau: r.tau, info }, r.cp_inv))
+}
+
+/// The corrector's system for a trial state `t` with yield coefficient
+/// `a1` and scale (2/3)a2σy² `scale`, over any [`Num`].
+#[inline(always)]
+pub fn corrector<T: Num>(mat: &Material, t: &Trial<T>, a1: T, scale: T) -> ReturnMapSystem<T> {
+    ReturnMapSystem {
+        theta_tr: t.theta,
+        je_tr: t.je,
+        beta_tr: t.beta,
+        a1,
+        yield_scale: scale,
+        lambda: T::splat(mat.lambda),
+        mu: T::splat(mat.mu),
+    }
+}
+
+/// The state on the yield surface at the corrector's solution (ε, δ):
+/// what [`returned_state`] gives.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Returned<T> {
+    /// Kirchhoff stress τ = β n + (α/3) 1, Pa (Voigt).
+    pub tau: [T; 6],
+    /// The new C_p⁻¹ = F⁻¹ b^e F⁻ᵀ (Voigt); the caller checks it is finite.
+    pub cp_inv: [T; 6],
+    /// θ(ε), Pa.
+    pub theta: T,
+    /// J^e(ε).
+    pub je: T,
+}
+
+/// The returned stress and state at the corrector's solution (`eps`,
+/// `delta`) of `system` (physics.md §1.4, §1.6), over any [`Num`]: one
+/// point, or the lanes of an element batch at once with the scalar bits.
+/// `returns(l)` says whether lane l is returned at all: only those solve
+/// the volume fix's cubic (a lane that is not is computed at ε = δ = 0
+/// by the batch and discarded).
+#[allow(non_snake_case, clippy::too_many_arguments)]
+#[inline(always)]
+pub fn returned_state<T: Num>(
+    mat: &Material,
+    opts: &UpdateOptions,
+    F: &Rows<T>,
+    t: &Trial<T>,
+    system: &ReturnMapSystem<T>,
+    eps: T,
+    delta: T,
+    returns: impl Fn(usize) -> bool,
+) -> Returned<T> {
     // 1/μ does not wait for the corrector, so the divisions by μ below
     // become multiplications off the chain of dependent divisions that
     // bounds this function (the Newton's, then the cubic's).
-    let inv_mu = 1.0 / mu;
-    let theta = system.theta(sol.eps);
-    let je = system.je(sol.eps);
-    let alpha = system.alpha(sol.eps);
-    let beta = system.beta(sol.eps, sol.delta);
+    let inv_mu = 1.0 / mat.mu;
+    let theta = system.theta(eps);
+    let je = system.je(eps);
+    let alpha = system.alpha(eps);
+    let beta = system.beta(eps, delta);
     // Unit deviatoric direction, frozen at its trial value (n = 0 if βtr = 0).
-    let n = if t.beta > 0.0 {
-        tensor::scale_add_identity(&t.s, 1.0 / t.beta, 0.0)
-    } else {
-        [0.0; 6]
-    };
-    let tau = tensor::scale_add_identity(&n, beta, alpha / 3.0);
+    let n = tensor::scale_add_identity(&t.s, T::splat(1.0) / t.beta, T::splat(0.0))
+        .map(|c| T::from_fn(|l| if t.beta.lane(l) > 0.0 { c.lane(l) } else { 0.0 }));
+    let tau = tensor::scale_add_identity(&n, beta, alpha / T::splat(3.0));
 
     // New elastic left Cauchy–Green tensor b^e = k n + s 1 (§1.4, §1.6).
-    let k = beta * inv_mu;
-    let s_literal = theta * (inv_mu / 3.0);
+    let k = beta * T::splat(inv_mu);
+    let s_literal = theta * T::splat(inv_mu / 3.0);
     let s = if opts.volume_fix {
-        spherical_part_for_volume(k, tensor::det(&n), je, s_literal)
+        let det_n = tensor::det(&n);
+        T::from_fn(|l| {
+            if returns(l) {
+                spherical_part_for_volume(k.lane(l), det_n.lane(l), je.lane(l), s_literal.lane(l))
+            } else {
+                s_literal.lane(l)
+            }
+        })
     } else {
         s_literal
     };
     let be = tensor::scale_add_identity(&n, k, s);
     let f_inv = tensor::inverse_rows_with_det(F, t.j);
-    let cp_new = tensor::push_forward_rows(&f_inv, &be);
-    if !cp_new.iter().all(|x| x.is_finite()) {
-        return Err(UpdateError::NonFinite);
+    Returned {
+        tau,
+        cp_inv: tensor::push_forward_rows(&f_inv, &be),
+        theta,
+        je,
     }
-
-    info.plastic = true;
-    info.method = sol.method;
-    info.iterations = sol.iterations;
-    info.eps = sol.eps;
-    info.delta = sol.delta;
-    info.gamma = 3.0 * sol.delta / (4.0 * theta);
-    info.je = je;
-    info.residual = sol.residual;
-    Ok((PointUpdate { tau, info }, cp_new))
 }
 
 /// The spherical coefficient `s` of b^e = k n + s 1 with det b^e = (J^e)²,
@@ -449,3 +487,107 @@ pub fn spherical_part_for_volume(k: Real, det_n: Real, je: Real, s0: Real) -> Re
 
 /// Newton steps of [`spherical_part_for_volume`] at most.
 const VOLUME_NEWTON_ITERATIONS: u32 = 20;
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::lanes::Lanes;
+    use crate::material::GranuleType;
+    use crate::tensor::VOIGT_IDENTITY;
+
+    /// [`returned_state`] over lanes gives every returned lane the bits of
+    /// the scalar [`plastic_return`] (as the element batch uses it), with
+    /// and without the volume fix: a lane under shear and compression, a
+    /// hydrostatic lane whose βtr is exactly 0 (n = 0 by the lane select,
+    /// where 1/βtr = ∞), an elastic lane computed at ε = δ = 0 and dropped,
+    /// and a lane with a stored plastic state.
+    #[test]
+    fn returned_lanes_have_the_scalar_bits() {
+        let mat = GranuleType::B2.params().validate().unwrap();
+        let points: [(Rows<Real>, Voigt); 4] = [
+            (
+                [[0.97, 0.04, 0.0], [0.01, 0.93, 0.02], [0.0, -0.03, 0.9]],
+                VOIGT_IDENTITY,
+            ),
+            (
+                [[0.95, 0.0, 0.0], [0.0, 0.95, 0.0], [0.0, 0.0, 0.95]],
+                VOIGT_IDENTITY,
+            ),
+            (
+                [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]],
+                VOIGT_IDENTITY,
+            ),
+            (
+                [[0.92, 0.0, 0.05], [0.0, 1.01, 0.0], [-0.02, 0.0, 0.94]],
+                [1.02, 0.99, 1.01, 0.003, -0.002, 0.001],
+            ),
+        ];
+        for volume_fix in [true, false] {
+            let opts = UpdateOptions {
+                volume_fix,
+                ..UpdateOptions::default()
+            };
+            let f: Rows<Lanes<4>> = core::array::from_fn(|a| {
+                core::array::from_fn(|b| Lanes(points.map(|p| p.0[a][b])))
+            });
+            let cp: [Lanes<4>; 6] = core::array::from_fn(|k| Lanes(points.map(|p| p.1[k])));
+            let t = trial(&mat, &f, &cp);
+            let mut a1 = [0.0; 4];
+            let mut scale = [0.0; 4];
+            let mut expected = [None; 4];
+            for (l, (fl, cpl)) in points.iter().enumerate() {
+                let tl = trial(&mat, fl, cpl);
+                let check = check_trial(&mat, &opts, fl, &tl).unwrap();
+                a1[l] = check.info.coefficients.a1;
+                scale[l] = yield_surface::yield_scale(
+                    &check.info.coefficients,
+                    mat.params.yield_stress_pa,
+                );
+                if let Some(s) = check.plastic_scale {
+                    let sol = corrector(&mat, &tl, a1[l], s).solve().unwrap();
+                    let (up, cp_new) = plastic_return(&mat, &opts, fl, &tl, check.info, s).unwrap();
+                    expected[l] = Some((sol, up, cp_new, tl.beta));
+                }
+            }
+            let returned = expected.map(|e| e.is_some());
+            assert_eq!(returned, [true, true, false, true]);
+            assert_eq!(
+                expected[1].unwrap().3,
+                0.0,
+                "the hydrostatic lane has βtr = 0"
+            );
+            let pick = |k: fn(&ReturnSolution) -> Real| {
+                Lanes(expected.map(|e| e.map_or(0.0, |e| k(&e.0))))
+            };
+            let system = corrector(&mat, &t, Lanes(a1), Lanes(scale));
+            let r = returned_state(
+                &mat,
+                &opts,
+                &f,
+                &t,
+                &system,
+                pick(|s| s.eps),
+                pick(|s| s.delta),
+                |l| returned[l],
+            );
+            for (l, e) in expected.iter().enumerate() {
+                let Some((sol, up, cp_new, _)) = e else {
+                    continue;
+                };
+                let lane = |v: &[Lanes<4>; 6]| v.map(|c| c.0[l].to_bits());
+                assert_eq!(lane(&r.tau), up.tau.map(Real::to_bits), "τ of lane {l}");
+                assert_eq!(
+                    lane(&r.cp_inv),
+                    cp_new.map(Real::to_bits),
+                    "C_p⁻¹ of lane {l}"
+                );
+                let mut info = UpdateInfo::elastic(0.0, 0.0, up.info.coefficients, 0.0);
+                info.eta = up.info.eta;
+                info.record_return(sol, r.theta.0[l], r.je.0[l]);
+                assert_eq!(info, up.info, "diagnostics of lane {l}");
+                let density = dissipation_density(&r.tau, Lanes([info.gamma; 4]), system.a1);
+                assert_eq!(density.0[l].to_bits(), up.dissipation_density().to_bits());
+            }
+        }
+    }
+}

@@ -12,8 +12,13 @@
 //! of η ≥ 1 and the a2 clamp. The input checks of [`check_input`] give one
 //! verdict for the batch, without branches ([`input_is_valid`] of each
 //! lane, F's finiteness probed in lanes). Per lane, in scalar code: those
-//! branches and, for a lane that yields ([`yields`]), the plastic
-//! corrector ([`plastic_return`]). The batch's results go to a
+//! branches and, for a lane that yields ([`yields`]), the corrector's
+//! solve ([`ReturnMapSystem::solve`]). The returned state of the yielding
+//! lanes — τ, the new C_p⁻¹, the dissipation — then runs once for all
+//! lanes ([`returned_state`], generic), in a function of its own that is
+//! never inlined: inlined, it cost the elastic batches their registers
+//! (BENCHMARKS.md, session 33; in a kernel built for baseline x86-64 it is
+//! SSE2 code called from the AVX2 loop, the same bits). The batch's results go to a
 //! [`Sink`] the loop is generic over, compiled into it, from the lanes
 //! ([`Sink::batch`]). A batch in which any lane fails is evaluated again
 //! element by element by [`hex_forces`], so errors, and the states left
@@ -38,7 +43,10 @@
 //! transition penalty on every call.
 
 use crate::Real;
-use crate::constitutive::update::{Trial, input_is_valid, plastic_return, trial, yields};
+use crate::constitutive::return_map::{ReturnMapSystem, ReturnSolution};
+use crate::constitutive::update::{
+    Trial, corrector, dissipation_density, input_is_valid, returned_state, trial, yields,
+};
 #[cfg(doc)]
 use crate::constitutive::update::{check_input, check_trial};
 use crate::constitutive::yield_surface::{self, YieldCoefficients};
@@ -532,13 +540,15 @@ impl Job<'_> {
         let phi = yield_surface::yield_function_of(a1, scale, t.beta, t.alpha);
         let residual = phi / scale;
         // The input checks for all lanes; then per lane the diagnostics and,
-        // if it yields, the corrector.
+        // if it yields, the corrector's solution; then the returned state of
+        // the yielding lanes, in lanes.
         let mut info = [UNSET; W];
-        let mut new_state: [Option<Voigt>; W] = [None; W];
+        let mut solutions: [Option<ReturnSolution>; W] = [None; W];
         let mut dissipation = [0.0; W];
         if !inputs_valid(&F, &t) {
             return false;
         }
+        let system = corrector(self.mat, &t, a1, scale);
         for l in 0..W {
             // `check_trial`'s elastic diagnostics, written field by field
             // into the placeholder (building the struct and copying it in
@@ -551,26 +561,28 @@ impl Job<'_> {
             // malformed volume, like the scalar path).
             dissipation[l] = g.volume.0[l] * 0.0;
             if yields(self.opts, phi.0[l], scale.0[l]) {
-                let lane_t: Trial<Real> = t.lane(l);
-                let scale = scale.0[l];
-                let mut lane_f = [[0.0; 3]; 3];
-                for (row, f_row) in lane_f.iter_mut().zip(&F) {
-                    for (v, fv) in row.iter_mut().zip(f_row) {
-                        *v = fv.0[l];
-                    }
-                }
-                let Ok((up, cp)) =
-                    plastic_return(self.mat, self.opts, &lane_f, &lane_t, info[l], scale)
-                else {
+                let Ok(sol) = system.lane(l).solve() else {
                     return false;
                 };
-                for (tk, uk) in tau.iter_mut().zip(up.tau) {
-                    tk.0[l] = uk;
-                }
-                info[l] = up.info;
-                new_state[l] = Some(cp);
-                dissipation[l] = g.volume.0[l] * up.dissipation_density();
+                solutions[l] = Some(sol);
             }
+        }
+        if solutions.iter().any(Option::is_some)
+            && !return_lanes(
+                self.mat,
+                self.opts,
+                &F,
+                &t,
+                &system,
+                g.volume,
+                &solutions,
+                &mut tau,
+                &mut info,
+                &mut dissipation,
+                cp_inv,
+            )
+        {
+            return false;
         }
         // det F̄, as the trial state took it.
         let j = t.j;
@@ -582,11 +594,6 @@ impl Job<'_> {
         };
         let kappa_modulus = self.kappa * self.mat.p_wave_modulus();
         let hourglass_energy = nodal_forces_into(kappa_modulus, &geometry, x, &F, j, &tau, forces);
-        for (c, new) in cp_inv.iter_mut().zip(new_state) {
-            if let Some(cp) = new {
-                *c = cp;
-            }
-        }
         let (hexes, _) = hexes.as_chunks::<W>();
         sink.batch(
             first,
@@ -602,6 +609,59 @@ impl Job<'_> {
         );
         true
     }
+}
+
+/// The returned state of a batch's yielding lanes (`solutions[l]` is
+/// `Some`), in lanes: their τ, diagnostics, dissipation and new C_p⁻¹.
+/// `false` if a new C_p⁻¹ is not finite (nothing of `cp_inv` written).
+#[allow(non_snake_case, clippy::too_many_arguments)]
+#[inline(never)]
+fn return_lanes<const W: usize>(
+    mat: &Material,
+    opts: &UpdateOptions,
+    F: &Rows<Lanes<W>>,
+    t: &Trial<Lanes<W>>,
+    system: &ReturnMapSystem<Lanes<W>>,
+    volume: Lanes<W>,
+    solutions: &[Option<ReturnSolution>; W],
+    tau: &mut [Lanes<W>; 6],
+    info: &mut [UpdateInfo; W],
+    dissipation: &mut [Real; W],
+    cp_inv: &mut [Voigt],
+) -> bool {
+    let a1 = system.a1;
+    // `plastic_return` for every lane at once: ε = δ = 0 in the
+    // lanes that do not yield, whose results are dropped.
+    let of = |pick: fn(&ReturnSolution) -> Real| {
+        Lanes(core::array::from_fn(|l| {
+            solutions[l].as_ref().map_or(0.0, pick)
+        }))
+    };
+    let (eps, delta) = (of(|s| s.eps), of(|s| s.delta));
+    let r = returned_state(mat, opts, F, t, system, eps, delta, |l| {
+        solutions[l].is_some()
+    });
+    for (l, sol) in solutions.iter().enumerate() {
+        let Some(sol) = sol else { continue };
+        if !r.cp_inv.iter().all(|c| c.0[l].is_finite()) {
+            return false;
+        }
+        for (tk, rk) in tau.iter_mut().zip(&r.tau) {
+            tk.0[l] = rk.0[l];
+        }
+        info[l].record_return(sol, r.theta.0[l], r.je.0[l]);
+    }
+    let gamma = Lanes(core::array::from_fn(|l| info[l].gamma));
+    let density = dissipation_density(&r.tau, gamma, a1);
+    for (l, sol) in solutions.iter().enumerate() {
+        if sol.is_some() {
+            dissipation[l] = volume.0[l] * density.0[l];
+            for (c, rk) in cp_inv[l].iter_mut().zip(&r.cp_inv) {
+                *c = rk.0[l];
+            }
+        }
+    }
+    true
 }
 
 #[cfg(test)]
