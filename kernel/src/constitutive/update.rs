@@ -430,14 +430,7 @@ pub fn returned_state<T: Num>(
     let k = beta * T::splat(inv_mu);
     let s_literal = theta * T::splat(inv_mu / 3.0);
     let s = if opts.volume_fix {
-        let det_n = tensor::det(&n);
-        T::from_fn(|l| {
-            if returns(l) {
-                spherical_part_for_volume(k.lane(l), det_n.lane(l), je.lane(l), s_literal.lane(l))
-            } else {
-                s_literal.lane(l)
-            }
-        })
+        spherical_part_for_volume_in(k, tensor::det(&n), je, s_literal, returns)
     } else {
         s_literal
     };
@@ -463,26 +456,66 @@ pub fn returned_state<T: Num>(
 /// step of exactly zero: every call ran one step of round-off more, and
 /// 0.7 % ran all 20 (BENCHMARKS.md, session 24).
 pub fn spherical_part_for_volume(k: Real, det_n: Real, je: Real, s0: Real) -> Real {
+    spherical_part_for_volume_in(k, det_n, je, s0, |_| true)
+}
+
+/// [`spherical_part_for_volume`] over any [`Num`], for the lanes `l` with
+/// `solve(l)` (the others keep `s0`): every lane takes the scalar
+/// function's Newton steps and stops where it stops, so it gets its bits.
+/// The steps run for all lanes at once while any lane is still iterating;
+/// a lane that has stopped keeps its value (at most 64 lanes).
+#[inline(always)]
+pub fn spherical_part_for_volume_in<T: Num>(
+    k: T,
+    det_n: T,
+    je: T,
+    s0: T,
+    solve: impl Fn(usize) -> bool,
+) -> T {
     let target = je * je;
-    if k == 0.0 {
-        return math::cbrt(target);
-    }
-    let c1 = 0.5 * k * k;
+    let c1 = T::splat(0.5) * k * k;
     let c0 = k * k * k * det_n - target;
     let mut s = s0;
-    for _ in 0..VOLUME_NEWTON_ITERATIONS {
-        let f = s * s * s - c1 * s + c0;
-        let df = 3.0 * s * s - c1;
-        let ds = f / df;
-        if !ds.is_finite() {
-            break;
-        }
-        s -= ds;
-        if 3.0 * ds * ds <= 1.0e-16 * math::abs(df) {
-            break;
-        }
+    // Lane l iterates while bit l is set; k = 0 is closed-form.
+    // One bit per lane: checked when the function is instantiated.
+    const { assert!(T::LANES <= 64, "at most 64 lanes") };
+    let mut iterating: u64 = 0;
+    for l in 0..T::LANES {
+        iterating |= u64::from(solve(l) && k.lane(l) != 0.0) << l;
     }
-    s
+    let set = |bits: u64, l: usize| bits >> l & 1 == 1;
+    for _ in 0..VOLUME_NEWTON_ITERATIONS {
+        if iterating == 0 {
+            break;
+        }
+        let f = s * s * s - c1 * s + c0;
+        let df = T::splat(3.0) * s * s - c1;
+        let ds = f / df;
+        let stepped = s - ds;
+        let mut next = iterating;
+        s = T::from_fn(|l| {
+            let (ds, df) = (ds.lane(l), df.lane(l));
+            if !set(iterating, l) {
+                return s.lane(l);
+            }
+            if !ds.is_finite() {
+                next &= !(1 << l);
+                return s.lane(l);
+            }
+            if 3.0 * ds * ds <= 1.0e-16 * math::abs(df) {
+                next &= !(1 << l);
+            }
+            stepped.lane(l)
+        });
+        iterating = next;
+    }
+    T::from_fn(|l| {
+        if solve(l) && k.lane(l) == 0.0 {
+            math::cbrt(target.lane(l))
+        } else {
+            s.lane(l)
+        }
+    })
 }
 
 /// Newton steps of [`spherical_part_for_volume`] at most.
@@ -589,5 +622,56 @@ mod tests {
                 assert_eq!(density.0[l].to_bits(), up.dissipation_density().to_bits());
             }
         }
+    }
+
+    /// The masked lane Newton gives every lane the scalar function's bits,
+    /// whichever iteration it stops at: lanes far from and near to the
+    /// root (different step counts), k = 0 (closed form), a lane not asked
+    /// for (keeps s0) and a lane whose first step is not finite (f' = 0).
+    #[test]
+    fn volume_newton_in_lanes_has_the_scalar_bits() {
+        // (k, det n, J^e, s0): s0 = sqrt(k^2/6) makes f'(s0) = 0.
+        let cases: [(Real, Real, Real, Real); 8] = [
+            (0.3, 0.05, 0.9, 1.2),
+            (0.3, 0.05, 0.9, 0.93),
+            (0.02, -0.1, 1.1, 1.0667),
+            (0.0, 0.0, 0.8, 1.0),
+            (0.5, 0.2, 1.0, 0.8),
+            (0.6, 0.0, 1.0, libm::sqrt(0.06)),
+            (0.1, 0.3, 0.95, 0.5),
+            (0.2, -0.2, 1.05, 1.5),
+        ];
+        let solve = |l: usize| l != 4;
+        let lane = |k: fn(&(Real, Real, Real, Real)) -> Real| Lanes(cases.map(|c| k(&c)));
+        let s = spherical_part_for_volume_in(
+            lane(|c| c.0),
+            lane(|c| c.1),
+            lane(|c| c.2),
+            lane(|c| c.3),
+            solve,
+        );
+        for (l, &(k, det_n, je, s0)) in cases.iter().enumerate() {
+            let expected = if solve(l) {
+                spherical_part_for_volume(k, det_n, je, s0)
+            } else {
+                s0
+            };
+            assert_eq!(s.0[l].to_bits(), expected.to_bits(), "lane {l}");
+        }
+        // The cases do take different numbers of steps (else the mask is
+        // not exercised): the near start stops earlier than the far one.
+        let (k, det_n, je) = (0.3, 0.05, 0.9);
+        let (c1, c0) = (0.5 * k * k, k * k * k * det_n - je * je);
+        let steps = |s0: Real| {
+            let root = spherical_part_for_volume(k, det_n, je, s0);
+            let mut s = s0;
+            (1..=VOLUME_NEWTON_ITERATIONS)
+                .find(|_| {
+                    s -= (s * s * s - c1 * s + c0) / (3.0 * s * s - c1);
+                    s.to_bits() == root.to_bits()
+                })
+                .unwrap_or(u32::MAX)
+        };
+        assert!(steps(0.93) < steps(1.2), "{} {}", steps(0.93), steps(1.2));
     }
 }
