@@ -18,9 +18,9 @@
 //! lanes ([`returned_state`], generic), in a function of its own that is
 //! never inlined: inlined, it cost the elastic batches their registers
 //! (BENCHMARKS.md, session 33; in a kernel built for baseline x86-64 it is
-//! SSE2 code called from the AVX2 loop, the same bits). The batch's results go to a
-//! [`Sink`] the loop is generic over, compiled into it, from the lanes
-//! ([`Sink::batch`]). A batch in which any lane fails is evaluated again
+//! SSE2 code called from the AVX2 loop, the same bits). The batch's results
+//! go to a [`Sink`] the loop is generic over, compiled into it, from the
+//! lanes ([`Sink::batch`]). A batch in which any lane fails is evaluated again
 //! element by element by [`hex_forces`], so errors, and the states left
 //! behind, are those of the scalar loop.
 //!
@@ -290,8 +290,8 @@ pub fn regroup(elements: &[HexReference], out: &mut [ElementBatch]) -> Result<()
 /// `refs` and states `cp_inv`, one per element) at node positions `x`, and
 /// hands the results to `sink` in element order: a full batch's at once
 /// ([`Sink::batch`]), an element evaluated alone (the remainder, a batch
-/// redone after a failing lane) by [`Sink::element`]. Stops at the first element whose update fails and returns its
-/// index with the error; the states of the elements before it are updated,
+/// redone after a failing lane) by [`Sink::element`]. Stops at the first
+/// element whose update fails and returns its index with the error; the states of the elements before it are updated,
 /// the failing one's and those after it are not (as an element-by-element
 /// loop would leave them).
 ///
