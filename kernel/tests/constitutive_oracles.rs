@@ -9,9 +9,10 @@ mod common;
 use common::{Rng, a1_a2, assert_close, material, material_with, normalised_phi};
 use granbed_kernel::Real;
 use granbed_kernel::constitutive::elastic;
-use granbed_kernel::constitutive::return_map::ReturnMapSystem;
+use granbed_kernel::constitutive::return_map::{ReturnMapSystem, ReturnMethod, ReturnSolution};
 use granbed_kernel::constitutive::update::spherical_part_for_volume;
 use granbed_kernel::constitutive::{UpdateOptions, update_point};
+use granbed_kernel::lanes::Lanes;
 use granbed_kernel::material::{GranuleType, MaterialParams};
 use granbed_kernel::material_point::{LoadPath, MaterialPoint};
 use granbed_kernel::tensor::{
@@ -423,6 +424,165 @@ fn c7_jacobian_matches_finite_differences() {
         checked += 1;
     }
     assert_eq!(checked, 500);
+}
+
+/// The corrector solved four lanes side by side (`solve_lanes`, the element
+/// batch's path) gives every lane the bits, iteration count and method of
+/// its scalar `solve`, and leaves the lanes it is not asked for alone.
+/// Random trial states from just past the yield surface to far outside it
+/// (one-step strains of tens of per cent, whose Newton is damped), with
+/// von Mises lanes (a1 = 0, the radial return) mixed in, so that lanes of
+/// one batch stop after different numbers of iterations, and lanes of
+/// strong dilation (J^e,tr up to 3.3) whose return is out of reach: their
+/// Newton is damped and fails, and a batch with such a lane must fail
+/// exactly when a scalar solve fails. Every Newton solution is also checked
+/// against the system itself: |R1|, |R2| ≤ 1e-9, δ ≥ 0 — round-off of the
+/// converged iterate, independent of the shared code. A lane whose system
+/// is not finite fails the batch, as its scalar solve fails.
+#[test]
+fn corrector_lanes_have_the_scalar_bits() {
+    let mut rng = Rng::new(11);
+    let mat = material(GranuleType::B1);
+    let sentinel = ReturnSolution {
+        eps: -7.0,
+        delta: -7.0,
+        iterations: 999,
+        method: ReturnMethod::Bisection,
+        residual: -7.0,
+    };
+    let (mut mixed_counts, mut long, mut radial, mut skipped, mut failed) = (0, 0, 0, 0, 0);
+    for round in 0..3000 {
+        let systems: [ReturnMapSystem; 4] = core::array::from_fn(|_| {
+            let yield_scale = rng.uniform(1e8, 1e10);
+            if rng.uniform(0.0, 1.0) < 0.1 {
+                return ReturnMapSystem {
+                    theta_tr: mat.mu * rng.uniform(4.5, 7.0),
+                    je_tr: rng.uniform(1.5, 3.3),
+                    beta_tr: mat.mu * rng.uniform(0.0, 1.5),
+                    a1: rng.uniform(0.05, 0.5),
+                    yield_scale,
+                    lambda: mat.lambda,
+                    mu: mat.mu,
+                };
+            }
+            // βtr from 1.01 to 100 times the radius of the surface: from a
+            // small increment to a one-step strain of tens of per cent.
+            let over = 10f64.powf(rng.uniform(0.005, 2.0));
+            ReturnMapSystem {
+                theta_tr: mat.mu * rng.uniform(2.8, 3.2),
+                je_tr: rng.uniform(0.9, 1.1),
+                beta_tr: over * yield_scale.sqrt(),
+                a1: if rng.uniform(0.0, 1.0) < 0.15 {
+                    0.0
+                } else {
+                    rng.uniform(1e-6, 0.3)
+                },
+                yield_scale,
+                lambda: mat.lambda,
+                mu: mat.mu,
+            }
+        });
+        let lanes = ReturnMapSystem {
+            theta_tr: Lanes(systems.map(|s| s.theta_tr)),
+            je_tr: Lanes(systems.map(|s| s.je_tr)),
+            beta_tr: Lanes(systems.map(|s| s.beta_tr)),
+            a1: Lanes(systems.map(|s| s.a1)),
+            yield_scale: Lanes(systems.map(|s| s.yield_scale)),
+            lambda: Lanes([mat.lambda; 4]),
+            mu: Lanes([mat.mu; 4]),
+        };
+        // Every subset of the lanes in turn, all four most often.
+        let mask = if round % 2 == 0 {
+            0b1111
+        } else {
+            (round / 2 % 15 + 1) as u64
+        };
+        let mut solutions = [Some(sentinel); 4];
+        let solved = lanes.solve_lanes(mask, &mut solutions);
+        let fails = (0..4).any(|l| mask >> l & 1 == 1 && systems[l].solve().is_err());
+        assert_eq!(solved, !fails, "round {round}");
+        if fails {
+            failed += 1;
+            continue;
+        }
+        let mut counts = Vec::new();
+        for (l, system) in systems.iter().enumerate() {
+            if mask >> l & 1 == 0 {
+                assert_eq!(
+                    solutions[l],
+                    Some(sentinel),
+                    "round {round} lane {l} not asked for"
+                );
+                skipped += 1;
+                continue;
+            }
+            let scalar = system.solve().unwrap();
+            let lane = solutions[l].unwrap();
+            assert_eq!(lane, scalar, "round {round} lane {l}");
+            assert_eq!(lane.eps.to_bits(), scalar.eps.to_bits());
+            assert_eq!(lane.delta.to_bits(), scalar.delta.to_bits());
+            match lane.method {
+                ReturnMethod::RadialReturn => radial += 1,
+                ReturnMethod::Newton => {
+                    counts.push(lane.iterations);
+                    long += usize::from(lane.iterations > 6);
+                    let r = system.residual(lane.eps, lane.delta);
+                    assert!(
+                        r[0].abs() <= 1e-9 && r[1].abs() <= 1e-9,
+                        "round {round} lane {l}: {r:?}"
+                    );
+                    assert!(lane.delta >= 0.0);
+                }
+                other => panic!("round {round} lane {l}: {other:?}"),
+            }
+        }
+        counts.sort_unstable();
+        counts.dedup();
+        mixed_counts += usize::from(counts.len() > 1);
+    }
+    // The cases the test is for did occur.
+    assert!(
+        mixed_counts > 500,
+        "batches with lanes stopping apart: {mixed_counts}"
+    );
+    assert!(
+        long > 100,
+        "Newton solves of more than 6 iterations: {long}"
+    );
+    assert!(
+        radial > 100 && skipped > 1000,
+        "radial {radial}, skipped {skipped}"
+    );
+    assert!(failed > 10, "batches with a lane out of reach: {failed}");
+
+    // A lane that is not finite: its scalar solve fails, so does the batch.
+    let good = ReturnMapSystem {
+        theta_tr: 3.0 * mat.mu,
+        je_tr: 1.0,
+        beta_tr: 2.0e5,
+        a1: 0.1,
+        yield_scale: 1.0e10,
+        lambda: mat.lambda,
+        mu: mat.mu,
+    };
+    let bad = ReturnMapSystem {
+        theta_tr: Real::NAN,
+        ..good
+    };
+    assert!(bad.solve().is_err() && good.solve().is_ok());
+    let pair = |a: ReturnMapSystem, b: ReturnMapSystem| ReturnMapSystem {
+        theta_tr: Lanes([a.theta_tr, b.theta_tr, a.theta_tr, a.theta_tr]),
+        je_tr: Lanes([a.je_tr; 4]),
+        beta_tr: Lanes([a.beta_tr; 4]),
+        a1: Lanes([a.a1; 4]),
+        yield_scale: Lanes([a.yield_scale; 4]),
+        lambda: Lanes([a.lambda; 4]),
+        mu: Lanes([a.mu; 4]),
+    };
+    let mut solutions = [None; 4];
+    assert!(!pair(good, bad).solve_lanes(0b0011, &mut solutions));
+    assert!(pair(good, bad).solve_lanes(0b1101, &mut solutions));
+    assert_eq!(solutions[0], Some(good.solve().unwrap()));
 }
 
 /// The volume fix's cubic (physics.md §1.6): s with det(k n + s 1) = (J^e)²

@@ -111,6 +111,173 @@ impl<T: Num> ReturnMapSystem<T> {
     pub fn beta(&self, eps: T, delta: T) -> T {
         self.beta_tr / (T::splat(1.0) + eps + delta)
     }
+
+    /// The consistency residual R2 = [β² + (a1/3)α² − (2/3)a2σy²] /
+    /// ((2/3)a2σy²) (dimensionless).
+    #[inline(always)]
+    pub fn consistency(&self, eps: T, delta: T) -> T {
+        let alpha = self.alpha(eps);
+        let beta = self.beta(eps, delta);
+        (beta * beta + (self.a1 / T::splat(3.0)) * alpha * alpha - self.yield_scale)
+            / self.yield_scale
+    }
+
+    /// The residual and Jacobian that Newton iterates on: R1 multiplied by
+    /// θtr (Pa) and R2 by (2/3)a2σy² (Pa²), i.e. without the normalising
+    /// divisions. A Newton step is the same for any scaling of the rows, and
+    /// the step is Newton's convergence test, so only round-off changes; the
+    /// normalised [`ReturnMapSystem::residual`] stays what is reported.
+    ///
+    /// Three divisions per call, two of them in sequence (1/(1+ε), then
+    /// 1/det J in [`Self::newton_in`]): the corrector is bound by their
+    /// latency (BENCHMARKS.md, session 23), where the normalised pair took
+    /// about ten.
+    #[inline(always)]
+    fn linearise(&self, eps: T, delta: T) -> ([T; 2], [[T; 2]; 2]) {
+        let one = T::splat(1.0);
+        let inv_e = one / (one + eps);
+        let inv_ed = one / (one + eps + delta);
+        let theta = self.theta_tr * inv_e;
+        let je = self.je(eps);
+        let alpha = theta + elastic::h_lame(self.lambda, self.mu, je);
+        // dθ/dε = −θ/(1+ε); d(εθ)/dε = θ/(1+ε); dα/dε = dθ/dε + h'(J^e) dJ^e/dε
+        // with dJ^e/dε = −1.5 J^e,tr.
+        let theta_e = theta * inv_e;
+        let dalpha =
+            -theta_e - T::splat(4.5) * self.lambda * (T::splat(2.0) * je - one) * self.je_tr;
+        let beta = self.beta_tr * inv_ed;
+        let beta2 = beta * beta;
+        let d_beta2 = -T::splat(2.0) * beta2 * inv_ed;
+        let a1_alpha = self.a1 * alpha;
+        (
+            [
+                a1_alpha * delta - eps * theta,
+                beta2 + (self.a1 / T::splat(3.0)) * alpha * alpha - self.yield_scale,
+            ],
+            [
+                [self.a1 * dalpha * delta - theta_e, a1_alpha],
+                [d_beta2 + T::splat(2.0 / 3.0) * a1_alpha * dalpha, d_beta2],
+            ],
+        )
+    }
+
+    /// Radial-return estimate of δ used as the Newton start.
+    #[inline(always)]
+    fn delta_start(&self) -> T {
+        let alpha = self.alpha(T::splat(0.0));
+        let free = self.yield_scale - (self.a1 / T::splat(3.0)) * alpha * alpha;
+        let floor = T::splat(0.01) * self.yield_scale;
+        let room = T::from_fn(|l| math::max(free.lane(l), floor.lane(l)));
+        let start = self.beta_tr / room.sqrt() - T::splat(1.0);
+        T::from_fn(|l| math::max(0.0, start.lane(l)))
+    }
+
+    /// Damped Newton from (0, δ0) in every lane whose bit is set in
+    /// `lanes`, side by side: each lane steps, damps and stops exactly as
+    /// the one-lane (scalar) instance would for its system, so it gets the
+    /// scalar bits. Returns the last iterates (ε, δ) and the bits of the
+    /// lanes that converged; `iterations[l]` is lane l's count (where it
+    /// stopped: converged, a step not finite, or [`MAX_NEWTON_ITERATIONS`]).
+    /// A lane not in `lanes` is computed along and left at (0, δ0).
+    #[inline(always)]
+    fn newton_in(&self, lanes: u64, iterations: &mut [u32]) -> (T, T, u64) {
+        // One bit per lane: checked when the function is instantiated.
+        const { assert!(T::LANES <= 64, "at most 64 lanes") };
+        let set = |bits: u64, l: usize| bits >> l & 1 == 1;
+        let (mut eps, mut delta) = (T::splat(0.0), self.delta_start());
+        let (mut iterating, mut converged) = (lanes, 0);
+        for it in 1..=MAX_NEWTON_ITERATIONS {
+            if iterating == 0 {
+                return (eps, delta, converged);
+            }
+            let (r, j) = self.linearise(eps, delta);
+            let inv_det = T::splat(1.0) / (j[0][0] * j[1][1] - j[0][1] * j[1][0]);
+            let de = -(j[1][1] * r[0] - j[0][1] * r[1]) * inv_det;
+            let dd = -(j[0][0] * r[1] - j[1][0] * r[0]) * inv_det;
+            // The full step where every iterating lane can take it (finite
+            // and feasible: t = 1, as `damping` finds first); else per lane
+            // a step that is not finite stops the lane (keeping its
+            // iterate), and `damping` finds t.
+            let mut full = 0;
+            for l in 0..T::LANES {
+                let (de, dd) = (de.lane(l), dd.lane(l));
+                let ok = de.is_finite()
+                    && dd.is_finite()
+                    && feasible(eps.lane(l) + de, delta.lane(l) + dd);
+                full |= u64::from(ok) << l;
+            }
+            let mut stepping = iterating;
+            let t = if iterating & !full == 0 {
+                T::splat(1.0)
+            } else {
+                T::from_fn(|l| {
+                    if !set(iterating, l) {
+                        return 0.0;
+                    }
+                    let (de, dd) = (de.lane(l), dd.lane(l));
+                    if !(de.is_finite() && dd.is_finite()) {
+                        stepping &= !(1 << l);
+                        iterations[l] = it;
+                        return 0.0;
+                    }
+                    damping(eps.lane(l), delta.lane(l), de, dd)
+                })
+            };
+            let (stepped_eps, stepped_delta) = (eps + t * de, delta + t * dd);
+            eps = T::from_fn(|l| {
+                if set(stepping, l) {
+                    stepped_eps.lane(l)
+                } else {
+                    eps.lane(l)
+                }
+            });
+            delta = T::from_fn(|l| {
+                if set(stepping, l) {
+                    math::max(stepped_delta.lane(l), 0.0)
+                } else {
+                    delta.lane(l)
+                }
+            });
+            iterating = stepping;
+            for (l, count) in iterations.iter_mut().enumerate().take(T::LANES) {
+                if set(stepping, l)
+                    && t.lane(l) == 1.0
+                    && math::abs(de.lane(l)) < NEWTON_STEP_TOL * (1.0 + math::abs(eps.lane(l)))
+                    && math::abs(dd.lane(l)) < NEWTON_STEP_TOL * (1.0 + delta.lane(l))
+                {
+                    iterating &= !(1 << l);
+                    converged |= 1 << l;
+                    *count = it;
+                }
+            }
+        }
+        for (l, count) in iterations.iter_mut().enumerate().take(T::LANES) {
+            if set(iterating, l) {
+                *count = MAX_NEWTON_ITERATIONS;
+            }
+        }
+        (eps, delta, converged)
+    }
+}
+
+/// Whether (ε, δ) lies in the set Newton's steps are kept in: 1 + ε ≥
+/// 0.05, 1 − 1.5ε ≥ 0.05 and δ ≥ 0.
+#[inline(always)]
+fn feasible(eps: Real, delta: Real) -> bool {
+    1.0 + eps >= STEP_FLOOR && 1.0 - 1.5 * eps >= STEP_FLOOR && delta >= 0.0
+}
+
+/// The damping factor of a Newton step (Δε, Δδ) from (ε, δ): 1, halved
+/// until the step lands in the [`feasible`] set or [`MAX_HALVINGS`] times.
+#[inline(always)]
+fn damping(eps: Real, delta: Real, de: Real, dd: Real) -> Real {
+    let mut t = 1.0;
+    let mut halvings = 0;
+    while !feasible(eps + t * de, delta + t * dd) && halvings < MAX_HALVINGS {
+        t *= 0.5;
+        halvings += 1;
+    }
+    t
 }
 
 impl<const W: usize> ReturnMapSystem<Lanes<W>> {
@@ -127,16 +294,74 @@ impl<const W: usize> ReturnMapSystem<Lanes<W>> {
             mu: self.mu.0[l],
         }
     }
+
+    /// [`ReturnMapSystem::solve`] of every lane whose bit is set in `lanes`,
+    /// into `solutions[l]` (the others are left as they are), with the
+    /// scalar bits: the Newton iterations of the lanes with a1 ≠ 0 run side
+    /// by side (`newton_in`), so the batch waits on one chain of
+    /// divisions instead of one per lane; the radial return and the
+    /// bisection fallback stay per lane. `false` as soon as a lane's solve
+    /// fails (`solve` gives `Err`). Not inlined, like the batch's
+    /// `return_lanes`, so that the elastic path keeps its registers.
+    #[inline(never)]
+    pub fn solve_lanes(&self, lanes: u64, solutions: &mut [Option<ReturnSolution>; W]) -> bool {
+        let set = |bits: u64, l: usize| bits >> l & 1 == 1;
+        if lanes.is_power_of_two() {
+            // One lane: its scalar solve, without the other lanes in tow.
+            let l = lanes.trailing_zeros() as usize;
+            let Some(solution) = solutions.get_mut(l) else {
+                return true;
+            };
+            return match self.lane(l).solve() {
+                Ok(sol) => {
+                    *solution = Some(sol);
+                    true
+                }
+                Err(_) => false,
+            };
+        }
+        let mut newton = 0;
+        for l in 0..W {
+            newton |= u64::from(set(lanes, l) && self.a1.0[l] != 0.0) << l;
+        }
+        let mut iterations = [0; W];
+        let (eps, delta, converged) = self.newton_in(newton, &mut iterations);
+        let residual = self.consistency(eps, delta);
+        for (l, solution) in solutions.iter_mut().enumerate() {
+            if !set(lanes, l) {
+                continue;
+            }
+            let solved = if !set(newton, l) {
+                Ok(self.lane(l).radial_return())
+            } else {
+                let sol = ReturnSolution {
+                    eps: eps.0[l],
+                    delta: delta.0[l],
+                    iterations: iterations[l],
+                    method: ReturnMethod::Newton,
+                    residual: residual.0[l],
+                };
+                if set(converged, l) {
+                    Ok(sol)
+                } else {
+                    self.lane(l).after_newton(Err(sol))
+                }
+            };
+            match solved {
+                Ok(sol) => *solution = Some(sol),
+                Err(_) => return false,
+            }
+        }
+        true
+    }
 }
 
 impl ReturnMapSystem {
     /// Residuals [R1, R2] (both dimensionless; see the module docs).
     pub fn residual(&self, eps: Real, delta: Real) -> [Real; 2] {
-        let alpha = self.alpha(eps);
-        let beta = self.beta(eps, delta);
         [
-            (self.a1 * alpha * delta - eps * self.theta(eps)) / self.theta_tr,
-            (beta * beta + (self.a1 / 3.0) * alpha * alpha - self.yield_scale) / self.yield_scale,
+            (self.a1 * self.alpha(eps) * delta - eps * self.theta(eps)) / self.theta_tr,
+            self.consistency(eps, delta),
         ]
     }
 
@@ -149,42 +374,6 @@ impl ReturnMapSystem {
         core::array::from_fn(|i| [j[i][0] * row[i], j[i][1] * row[i]])
     }
 
-    /// The residual and Jacobian that Newton iterates on: R1 multiplied by
-    /// θtr (Pa) and R2 by (2/3)a2σy² (Pa²), i.e. without the normalising
-    /// divisions. A Newton step is the same for any scaling of the rows, and
-    /// the step is Newton's convergence test, so only round-off changes; the
-    /// normalised [`Self::residual`] stays what is reported.
-    ///
-    /// Three divisions per call, two of them in sequence (1/(1+ε), then
-    /// 1/det J in [`Self::newton`]): the corrector is bound by their latency
-    /// (BENCHMARKS.md, session 23), where the normalised pair took about ten.
-    #[inline(always)]
-    fn linearise(&self, eps: Real, delta: Real) -> ([Real; 2], [[Real; 2]; 2]) {
-        let inv_e = 1.0 / (1.0 + eps);
-        let inv_ed = 1.0 / (1.0 + eps + delta);
-        let theta = self.theta_tr * inv_e;
-        let je = self.je(eps);
-        let alpha = theta + elastic::h_lame(self.lambda, self.mu, je);
-        // dθ/dε = −θ/(1+ε); d(εθ)/dε = θ/(1+ε); dα/dε = dθ/dε + h'(J^e) dJ^e/dε
-        // with dJ^e/dε = −1.5 J^e,tr.
-        let theta_e = theta * inv_e;
-        let dalpha = -theta_e - 4.5 * self.lambda * (2.0 * je - 1.0) * self.je_tr;
-        let beta = self.beta_tr * inv_ed;
-        let beta2 = beta * beta;
-        let d_beta2 = -2.0 * beta2 * inv_ed;
-        let a1_alpha = self.a1 * alpha;
-        (
-            [
-                a1_alpha * delta - eps * theta,
-                beta2 + (self.a1 / 3.0) * alpha * alpha - self.yield_scale,
-            ],
-            [
-                [self.a1 * dalpha * delta - theta_e, a1_alpha],
-                [d_beta2 + (2.0 / 3.0) * a1_alpha * dalpha, d_beta2],
-            ],
-        )
-    }
-
     /// Solves the corrector: radial return for a1 = 0, otherwise damped
     /// Newton with the bisection fallback. `Err` carries the best iterate
     /// when neither reaches |R2| ≤ [`FALLBACK_RESIDUAL_MAX`].
@@ -192,7 +381,16 @@ impl ReturnMapSystem {
         if self.a1 == 0.0 {
             return Ok(self.radial_return());
         }
-        let newton = self.newton();
+        self.after_newton(self.newton())
+    }
+
+    /// The result of `solve` given Newton's: Newton's solution, or after
+    /// its failure the bisection's (or Newton's last iterate) if its |R2| is
+    /// at most [`FALLBACK_RESIDUAL_MAX`].
+    fn after_newton(
+        &self,
+        newton: Result<ReturnSolution, ReturnSolution>,
+    ) -> Result<ReturnSolution, ReturnSolution> {
         match newton {
             Ok(sol) => Ok(sol),
             Err(best) => {
@@ -220,54 +418,19 @@ impl ReturnMapSystem {
         }
     }
 
-    /// Radial-return estimate of δ used as the Newton start.
-    fn delta_start(&self) -> Real {
-        let alpha = self.alpha(0.0);
-        let room = math::max(
-            self.yield_scale - (self.a1 / 3.0) * alpha * alpha,
-            0.01 * self.yield_scale,
-        );
-        math::max(0.0, self.beta_tr / math::sqrt(room) - 1.0)
-    }
-
-    fn feasible(eps: Real, delta: Real) -> bool {
-        1.0 + eps >= STEP_FLOOR && 1.0 - 1.5 * eps >= STEP_FLOOR && delta >= 0.0
-    }
-
-    /// Damped Newton from (0, δ0); `Err` holds the last iterate.
+    /// Damped Newton from (0, δ0): the one-lane [`Self::newton_in`]. `Err`
+    /// holds the last iterate.
     fn newton(&self) -> Result<ReturnSolution, ReturnSolution> {
-        let (mut eps, mut delta) = (0.0, self.delta_start());
-        let sol = |eps, delta, iterations, method| ReturnSolution {
+        let mut iterations = [0];
+        let (eps, delta, converged) = self.newton_in(1, &mut iterations);
+        let sol = ReturnSolution {
             eps,
             delta,
-            iterations,
-            method,
+            iterations: iterations[0],
+            method: ReturnMethod::Newton,
             residual: self.residual(eps, delta)[1],
         };
-        for it in 1..=MAX_NEWTON_ITERATIONS {
-            let (r, j) = self.linearise(eps, delta);
-            let inv_det = 1.0 / (j[0][0] * j[1][1] - j[0][1] * j[1][0]);
-            let de = -(j[1][1] * r[0] - j[0][1] * r[1]) * inv_det;
-            let dd = -(j[0][0] * r[1] - j[1][0] * r[0]) * inv_det;
-            if !(de.is_finite() && dd.is_finite()) {
-                return Err(sol(eps, delta, it, ReturnMethod::Newton));
-            }
-            let mut t = 1.0;
-            let mut halvings = 0;
-            while !Self::feasible(eps + t * de, delta + t * dd) && halvings < MAX_HALVINGS {
-                t *= 0.5;
-                halvings += 1;
-            }
-            eps += t * de;
-            delta = math::max(delta + t * dd, 0.0);
-            let converged = t == 1.0
-                && math::abs(de) < NEWTON_STEP_TOL * (1.0 + math::abs(eps))
-                && math::abs(dd) < NEWTON_STEP_TOL * (1.0 + delta);
-            if converged {
-                return Ok(sol(eps, delta, it, ReturnMethod::Newton));
-            }
-        }
-        Err(sol(eps, delta, MAX_NEWTON_ITERATIONS, ReturnMethod::Newton))
+        if converged == 1 { Ok(sol) } else { Err(sol) }
     }
 
     /// δ(ε) = εθ/(a1 α): the δ that satisfies R1 = 0 exactly.

@@ -12,13 +12,17 @@
 //! of η ≥ 1 and the a2 clamp. The input checks of [`check_input`] give one
 //! verdict for the batch, without branches ([`input_is_valid`] of each
 //! lane, F's finiteness probed in lanes). Per lane, in scalar code: those
-//! branches and, for a lane that yields ([`yields`]), the corrector's
-//! solve ([`ReturnMapSystem::solve`]). The returned state of the yielding
-//! lanes — τ, the new C_p⁻¹, the dissipation — then runs once for all
-//! lanes ([`returned_state`], generic), in a function of its own that is
-//! never inlined: inlined, it cost the elastic batches their registers
-//! (BENCHMARKS.md, session 33; in a kernel built for baseline x86-64 it is
-//! SSE2 code called from the AVX2 loop, the same bits). The batch's results
+//! branches and the test whether the lane yields ([`yields`]). The
+//! corrector of the yielding lanes is solved side by side
+//! ([`ReturnMapSystem::solve_lanes`]: the Newton iterations of all of them
+//! at once, each lane stopping where its scalar solve stops; a batch with
+//! one yielding lane takes the scalar solve), and their returned state — τ,
+//! the new C_p⁻¹, the dissipation — runs once for all lanes
+//! ([`returned_state`], generic). Both are functions of their own that are
+//! never inlined: inlined, they cost the elastic batches their registers
+//! (BENCHMARKS.md, sessions 33 and 34; in a kernel built for baseline
+//! x86-64 they are SSE2 code called from the AVX2 loop, the same bits).
+//! The batch's results
 //! go to a [`Sink`] the loop is generic over, compiled into it, from the
 //! lanes ([`Sink::batch`]). A batch in which any lane fails is evaluated again
 //! element by element by [`hex_forces`], so errors, and the states left
@@ -549,6 +553,7 @@ impl Job<'_> {
             return false;
         }
         let system = corrector(self.mat, &t, a1, scale);
+        let mut yielding = 0;
         for l in 0..W {
             // `check_trial`'s elastic diagnostics, written field by field
             // into the placeholder (building the struct and copying it in
@@ -560,12 +565,10 @@ impl Job<'_> {
             // V0 × 0 as the scalar element computes it (−0 or NaN for a
             // malformed volume, like the scalar path).
             dissipation[l] = g.volume.0[l] * 0.0;
-            if yields(self.opts, phi.0[l], scale.0[l]) {
-                let Ok(sol) = system.lane(l).solve() else {
-                    return false;
-                };
-                solutions[l] = Some(sol);
-            }
+            yielding |= u64::from(yields(self.opts, phi.0[l], scale.0[l])) << l;
+        }
+        if yielding != 0 && !system.solve_lanes(yielding, &mut solutions) {
+            return false;
         }
         if solutions.iter().any(Option::is_some)
             && !return_lanes(
