@@ -194,20 +194,23 @@ impl<T: Num> ReturnMapSystem<T> {
             let inv_det = T::splat(1.0) / (j[0][0] * j[1][1] - j[0][1] * j[1][0]);
             let de = -(j[1][1] * r[0] - j[0][1] * r[1]) * inv_det;
             let dd = -(j[0][0] * r[1] - j[1][0] * r[0]) * inv_det;
-            // The full step where every iterating lane can take it (finite
-            // and feasible: t = 1, as `damping` finds first); else per lane
-            // a step that is not finite stops the lane (keeping its
-            // iterate), and `damping` finds t.
+            // With several lanes, the full step where every iterating lane
+            // can take it (finite and feasible: t = 1, as `damping` finds
+            // first); else (and for one lane) per lane a step that is not
+            // finite stops the lane (keeping its iterate), and `damping`
+            // finds t.
             let mut full = 0;
-            for l in 0..T::LANES {
-                let (de, dd) = (de.lane(l), dd.lane(l));
-                let ok = de.is_finite()
-                    && dd.is_finite()
-                    && feasible(eps.lane(l) + de, delta.lane(l) + dd);
-                full |= u64::from(ok) << l;
+            if T::LANES > 1 {
+                for l in 0..T::LANES {
+                    let (de, dd) = (de.lane(l), dd.lane(l));
+                    let ok = de.is_finite()
+                        && dd.is_finite()
+                        && feasible(eps.lane(l) + de, delta.lane(l) + dd);
+                    full |= u64::from(ok) << l;
+                }
             }
             let mut stepping = iterating;
-            let t = if iterating & !full == 0 {
+            let t = if T::LANES > 1 && iterating & !full == 0 {
                 T::splat(1.0)
             } else {
                 T::from_fn(|l| {
@@ -344,7 +347,7 @@ impl<const W: usize> ReturnMapSystem<Lanes<W>> {
                 if set(converged, l) {
                     Ok(sol)
                 } else {
-                    self.lane(l).after_newton(Err(sol))
+                    self.lane(l).fallback(sol)
                 }
             };
             match solved {
@@ -381,27 +384,21 @@ impl ReturnMapSystem {
         if self.a1 == 0.0 {
             return Ok(self.radial_return());
         }
-        self.after_newton(self.newton())
+        self.newton().or_else(|best| self.fallback(best))
     }
 
-    /// The result of `solve` given Newton's: Newton's solution, or after
-    /// its failure the bisection's (or Newton's last iterate) if its |R2| is
-    /// at most [`FALLBACK_RESIDUAL_MAX`].
-    fn after_newton(
-        &self,
-        newton: Result<ReturnSolution, ReturnSolution>,
-    ) -> Result<ReturnSolution, ReturnSolution> {
-        match newton {
-            Ok(sol) => Ok(sol),
-            Err(best) => {
-                let mut sol = self.bisection().unwrap_or(best);
-                sol.iterations += best.iterations;
-                if math::abs(sol.residual) <= FALLBACK_RESIDUAL_MAX {
-                    Ok(sol)
-                } else {
-                    Err(sol)
-                }
-            }
+    /// The result of `solve` after Newton failed with `best`: the
+    /// bisection's solution (or `best`) if its |R2| is at most
+    /// [`FALLBACK_RESIDUAL_MAX`]. Out of line: Newton nearly always
+    /// converges.
+    #[cold]
+    fn fallback(&self, best: ReturnSolution) -> Result<ReturnSolution, ReturnSolution> {
+        let mut sol = self.bisection().unwrap_or(best);
+        sol.iterations += best.iterations;
+        if math::abs(sol.residual) <= FALLBACK_RESIDUAL_MAX {
+            Ok(sol)
+        } else {
+            Err(sol)
         }
     }
 
