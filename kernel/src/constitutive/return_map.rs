@@ -53,7 +53,10 @@ pub enum ReturnMethod {
 /// Over any [`Num`] for the returned state's formulas ([`Self::theta`],
 /// [`Self::je`], [`Self::alpha`], [`Self::beta`]): an element batch
 /// evaluates them for all its lanes at once with the scalar bits
-/// (`update::returned_state`). The solvers are scalar (`T = Real`).
+/// (`update::returned_state`), and the Newton solve likewise: the scalar
+/// [`ReturnMapSystem::solve`] is its one-lane case, and
+/// [`ReturnMapSystem::solve_lanes`] runs it for a batch's lanes at once.
+/// The radial return and the bisection fallback are scalar (`T = Real`).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct ReturnMapSystem<T = Real> {
     /// θtr = μ tr b^e,tr, Pa (> 0).
@@ -304,7 +307,8 @@ impl<const W: usize> ReturnMapSystem<Lanes<W>> {
     /// by side (`newton_in`), so the batch waits on one chain of
     /// divisions instead of one per lane; the radial return and the
     /// bisection fallback stay per lane. `false` as soon as a lane's solve
-    /// fails (`solve` gives `Err`). Not inlined, like the batch's
+    /// fails (`solve` gives `Err`). Bits of `lanes` at or above `W` are
+    /// ignored. Not inlined, like the batch's
     /// `return_lanes`, so that the elastic path keeps its registers.
     #[inline(never)]
     pub fn solve_lanes(&self, lanes: u64, solutions: &mut [Option<ReturnSolution>; W]) -> bool {

@@ -22,11 +22,10 @@
 //! never inlined: inlined, they cost the elastic batches their registers
 //! (BENCHMARKS.md, sessions 33 and 34; in a kernel built for baseline
 //! x86-64 they are SSE2 code called from the AVX2 loop, the same bits).
-//! The batch's results
-//! go to a [`Sink`] the loop is generic over, compiled into it, from the
-//! lanes ([`Sink::batch`]). A batch in which any lane fails is evaluated again
-//! element by element by [`hex_forces`], so errors, and the states left
-//! behind, are those of the scalar loop.
+//! The batch's results go to a [`Sink`] the loop is generic over, compiled
+//! into it, from the lanes ([`Sink::batch`]). A batch in which any lane
+//! fails is evaluated again element by element by [`hex_forces`], so
+//! errors, and the states left behind, are those of the scalar loop.
 //!
 //! [`ElementPath`] chooses the code: element by element, portable batches
 //! (the build's vector width: 2 lanes with x86-64's SSE2), or batches compiled
@@ -543,9 +542,9 @@ impl Job<'_> {
         let scale = yield_surface::yield_scale_of(a2, params.yield_stress_pa);
         let phi = yield_surface::yield_function_of(a1, scale, t.beta, t.alpha);
         let residual = phi / scale;
-        // The input checks for all lanes; then per lane the diagnostics and,
-        // if it yields, the corrector's solution; then the returned state of
-        // the yielding lanes, in lanes.
+        // The input checks for all lanes; then per lane the diagnostics and
+        // whether it yields; then the corrector's solution and the returned
+        // state of the yielding lanes, in lanes.
         let mut info = [UNSET; W];
         let mut solutions: [Option<ReturnSolution>; W] = [None; W];
         let mut dissipation = [0.0; W];
