@@ -294,9 +294,9 @@ pub fn regroup(elements: &[HexReference], out: &mut [ElementBatch]) -> Result<()
 /// hands the results to `sink` in element order: a full batch's at once
 /// ([`Sink::batch`]), an element evaluated alone (the remainder, a batch
 /// redone after a failing lane) by [`Sink::element`]. Stops at the first
-/// element whose update fails and returns its index with the error; the states of the elements before it are updated,
-/// the failing one's and those after it are not (as an element-by-element
-/// loop would leave them).
+/// element whose update fails and returns its index with the error; the
+/// states of the elements before it are updated, the failing one's and
+/// those after it are not (as an element-by-element loop would leave them).
 ///
 /// `batches` is `refs` regrouped by [`regroup`]; if it is empty, not
 /// [`batch_count`] long, or its first or last batch holds other volumes
@@ -566,23 +566,22 @@ impl Job<'_> {
             dissipation[l] = g.volume.0[l] * 0.0;
             yielding |= u64::from(yields(self.opts, phi.0[l], scale.0[l])) << l;
         }
-        if yielding != 0 && !system.solve_lanes(yielding, &mut solutions) {
-            return false;
-        }
-        if solutions.iter().any(Option::is_some)
-            && !return_lanes(
-                self.mat,
-                self.opts,
-                &F,
-                &t,
-                &system,
-                g.volume,
-                &solutions,
-                &mut tau,
-                &mut info,
-                &mut dissipation,
-                cp_inv,
-            )
+        // A solved batch has a solution in every yielding lane.
+        if yielding != 0
+            && (!system.solve_lanes(yielding, &mut solutions)
+                || !return_lanes(
+                    self.mat,
+                    self.opts,
+                    &F,
+                    &t,
+                    &system,
+                    g.volume,
+                    &solutions,
+                    &mut tau,
+                    &mut info,
+                    &mut dissipation,
+                    cp_inv,
+                ))
         {
             return false;
         }
