@@ -422,8 +422,12 @@ pub fn returned_state<T: Num>(
     let alpha = system.alpha(eps);
     let beta = system.beta(eps, delta);
     // Unit deviatoric direction, frozen at its trial value (n = 0 if βtr = 0).
-    let n = tensor::scale_add_identity(&t.s, T::splat(1.0) / t.beta, T::splat(0.0))
-        .map(|c| T::from_fn(|l| if t.beta.lane(l) > 0.0 { c.lane(l) } else { 0.0 }));
+    // A loop, not the array's `map`, which rustc called out of line
+    // (`core::array::try_map`, with the lanes passed through memory).
+    let mut n = tensor::scale_add_identity(&t.s, T::splat(1.0) / t.beta, T::splat(0.0));
+    for c in &mut n {
+        *c = T::from_fn(|l| if t.beta.lane(l) > 0.0 { c.lane(l) } else { 0.0 });
+    }
     let tau = tensor::scale_add_identity(&n, beta, alpha / T::splat(3.0));
 
     // New elastic left Cauchy–Green tensor b^e = k n + s 1 (§1.4, §1.6).

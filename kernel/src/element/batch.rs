@@ -48,7 +48,7 @@
 use crate::Real;
 use crate::constitutive::return_map::{ReturnMapSystem, ReturnSolution};
 use crate::constitutive::update::{
-    Trial, corrector, dissipation_density, input_is_valid, returned_state, trial, yields,
+    Returned, Trial, corrector, dissipation_density, input_is_valid, returned_state, trial, yields,
 };
 #[cfg(doc)]
 use crate::constitutive::update::{check_input, check_trial};
@@ -382,8 +382,7 @@ const UNSET: UpdateInfo = UpdateInfo::elastic(
 #[allow(non_snake_case)]
 #[inline(always)]
 fn inputs_valid<const W: usize>(F: &Rows<Lanes<W>>, t: &Trial<Lanes<W>>) -> bool {
-    let zero = Lanes::splat(0.0);
-    let probe = F.iter().flatten().fold(zero, |p, &v| p + v * zero);
+    let probe = non_finite_probe(F.iter().flatten());
     let mut valid = true;
     for l in 0..W {
         valid &= input_is_valid(
@@ -396,10 +395,21 @@ fn inputs_valid<const W: usize>(F: &Rows<Lanes<W>>, t: &Trial<Lanes<W>>) -> bool
     valid
 }
 
-/// The node coordinates and nodal forces of a batch in lanes, kept from
-/// batch to batch: a batch writes all of `x` before it reads it, and all of
-/// `forces` (in [`nodal_forces_into`]) before it reads them, so nothing of
-/// an earlier batch is seen. Arrays made afresh per batch were zeroed by a
+/// Σ v·0 over `values`, lane by lane: NaN in exactly the lanes where some
+/// value is not finite (∞·0 and NaN·0 are NaN), 0 elsewhere — one vector
+/// expression whose lanes give a batch's verdict (F in [`inputs_valid`],
+/// the new C_p⁻¹ in [`return_lanes`]).
+#[inline(always)]
+fn non_finite_probe<'a, const W: usize>(values: impl Iterator<Item = &'a Lanes<W>>) -> Lanes<W> {
+    let zero = Lanes::splat(0.0);
+    values.fold(zero, |p, &v| p + v * zero)
+}
+
+/// The node coordinates, nodal forces and returned state of a batch in
+/// lanes, kept from batch to batch: a batch writes all of `x` before it
+/// reads it, all of `forces` (in [`nodal_forces_into`]) and of `returned`
+/// (in [`return_lanes`]) before it reads them, so nothing of an earlier
+/// batch is seen. Arrays made afresh per batch were zeroed by a
 /// call of `memset` each, and the returned forces copied by `memcpy`
 /// (about 7 % of the elastic element: BENCHMARKS.md, session 31).
 struct BatchLanes {
@@ -407,6 +417,8 @@ struct BatchLanes {
     x: [[Lanes<BATCH>; 3]; 8],
     /// f_I, `[node][xyz]`, N.
     forces: [[Lanes<BATCH>; 3]; 8],
+    /// The returned state of the yielding lanes ([`return_lanes`]).
+    returned: Returned<Lanes<BATCH>>,
 }
 
 impl BatchLanes {
@@ -415,6 +427,12 @@ impl BatchLanes {
         Self {
             x: [[zero; 3]; 8],
             forces: [[zero; 3]; 8],
+            returned: Returned {
+                tau: [zero; 6],
+                cp_inv: [zero; 6],
+                theta: zero,
+                je: zero,
+            },
         }
     };
 }
@@ -514,7 +532,11 @@ impl Job<'_> {
         // Each lane vector is made whole from its W scalars (written lane
         // by lane into memory and read back as one vector, it stalled on
         // store forwarding: BENCHMARKS.md).
-        let BatchLanes { x, forces } = lanes;
+        let BatchLanes {
+            x,
+            forces,
+            returned,
+        } = lanes;
         for (i, xi) in x.iter_mut().enumerate() {
             let p: [&[Real; 3]; W] = core::array::from_fn(|l| &self.x[hexes[l][i] as usize]);
             for (a, xia) in xi.iter_mut().enumerate() {
@@ -581,6 +603,7 @@ impl Job<'_> {
                     &mut info,
                     &mut dissipation,
                     cp_inv,
+                    returned,
                 ))
         {
             return false;
@@ -615,6 +638,7 @@ impl Job<'_> {
 /// The returned state of a batch's yielding lanes (`solutions[l]` is
 /// `Some`), in lanes: their τ, diagnostics, dissipation and new C_p⁻¹.
 /// `false` if a new C_p⁻¹ is not finite (nothing of `cp_inv` written).
+/// `returned` is scratch: the whole returned state of all lanes.
 #[allow(non_snake_case, clippy::too_many_arguments)]
 #[inline(never)]
 fn return_lanes<const W: usize>(
@@ -629,6 +653,7 @@ fn return_lanes<const W: usize>(
     info: &mut [UpdateInfo; W],
     dissipation: &mut [Real; W],
     cp_inv: &mut [Voigt],
+    returned: &mut Returned<Lanes<W>>,
 ) -> bool {
     let a1 = system.a1;
     // `plastic_return` for every lane at once: ε = δ = 0 in the
@@ -639,24 +664,41 @@ fn return_lanes<const W: usize>(
         }))
     };
     let (eps, delta) = (of(|s| s.eps), of(|s| s.delta));
-    let r = returned_state(mat, opts, F, t, system, eps, delta, |l| {
+    // The state is stored whole, as lane vectors, into the scratch and the
+    // lanes are read back from there (`black_box` keeps the compiler from
+    // forwarding the stored values to the reads). Only single lanes are
+    // read below, and with the state in registers the compiler computed it
+    // lane by lane in scalar code: 1 736 instructions per call in the bed,
+    // 1 058 now with the two changes below (BENCHMARKS.md, session 35).
+    // Only where the code is generated changes, never a value.
+    *returned = returned_state(mat, opts, F, t, system, eps, delta, |l| {
         solutions[l].is_some()
     });
+    let r = core::hint::black_box(&*returned);
+    // One verdict for the batch, without branches: a test that stops at
+    // the first failing lane had the probe computed lane by lane.
+    let probe = non_finite_probe(r.cp_inv.iter());
+    let mut finite = true;
+    for (l, sol) in solutions.iter().enumerate() {
+        finite &= sol.is_none() | !probe.0[l].is_nan();
+    }
+    if !finite {
+        return false;
+    }
     for (l, sol) in solutions.iter().enumerate() {
         let Some(sol) = sol else { continue };
-        if !r.cp_inv.iter().all(|c| c.0[l].is_finite()) {
-            return false;
-        }
         for (tk, rk) in tau.iter_mut().zip(&r.tau) {
             tk.0[l] = rk.0[l];
         }
         info[l].record_return(sol, r.theta.0[l], r.je.0[l]);
     }
     let gamma = Lanes(core::array::from_fn(|l| info[l].gamma));
-    let density = dissipation_density(&r.tau, gamma, a1);
+    // V0 × the density for all lanes first: computed inside the test of
+    // each lane, it ran lane by lane in scalar code.
+    let lane_dissipation = volume * dissipation_density(&r.tau, gamma, a1);
     for (l, sol) in solutions.iter().enumerate() {
         if sol.is_some() {
-            dissipation[l] = volume.0[l] * density.0[l];
+            dissipation[l] = lane_dissipation.0[l];
             for (c, rk) in cp_inv[l].iter_mut().zip(&r.cp_inv) {
                 *c = rk.0[l];
             }
@@ -706,5 +748,70 @@ mod tests {
         assert!(!inputs_valid(&infinite, &t));
         let nan = lanes_of(Some(Real::NAN));
         assert!(!inputs_valid(&nan, &trial(&mat, &nan, &c)));
+    }
+
+    /// A new C_p⁻¹ that is not finite fails the batch only in a yielding
+    /// lane: then nothing of the states is written; in a lane that does not
+    /// yield (computed along and dropped) it is ignored, and only the
+    /// yielding lanes' states are written. J = 0 in the trial state makes
+    /// F̄⁻¹, and with it the lane's C_p⁻¹, infinite.
+    #[test]
+    #[allow(non_snake_case)]
+    fn a_returned_state_that_is_not_finite_fails_the_batch_only_where_it_yields() {
+        use crate::constitutive::return_map::ReturnMethod;
+        let mat = GranuleType::B2.params().validate().unwrap();
+        let opts = UpdateOptions::default();
+        let squeeze = [[0.97, 0.0, 0.01], [0.0, 0.95, 0.0], [0.0, -0.02, 0.96]];
+        let F: Rows<Lanes<BATCH>> = squeeze.map(|row| row.map(Lanes::splat));
+        let c: [Lanes<BATCH>; 6] = VOIGT_IDENTITY.map(Lanes::splat);
+        let solution = Some(ReturnSolution {
+            eps: 1.0e-4,
+            delta: 2.0e-4,
+            iterations: 3,
+            method: ReturnMethod::Newton,
+            residual: 0.0,
+        });
+        // Lanes 0 and 2 yield.
+        let solutions = [solution, None, solution, None];
+        let run = |zero_j: &[usize]| {
+            let mut t = trial(&mat, &F, &c);
+            for &l in zero_j {
+                t.j.0[l] = 0.0;
+            }
+            let system = corrector(&mat, &t, Lanes::splat(0.5), Lanes::splat(1.0e6));
+            let mut states = [[7.0; 6]; BATCH];
+            let mut returned = BatchLanes::ZERO.returned;
+            let ok = return_lanes(
+                &mat,
+                &opts,
+                &F,
+                &t,
+                &system,
+                Lanes::splat(1.0e-12),
+                &solutions,
+                &mut c.clone(),
+                &mut [UNSET; BATCH],
+                &mut [0.0; BATCH],
+                &mut states,
+                &mut returned,
+            );
+            let finite = returned.cp_inv.map(|k| k.0.map(Real::is_finite));
+            (ok, states, finite)
+        };
+        // A dropped lane with an infinite state: ignored.
+        let (ok, states, finite) = run(&[1]);
+        assert!(!finite.iter().all(|k| k[1]), "lane 1's state is not finite");
+        assert!(ok);
+        for (l, state) in states.iter().enumerate() {
+            let written = solutions[l].is_some();
+            assert_eq!(state != &[7.0; 6], written, "lane {l}");
+            assert!(state.iter().all(|v| v.is_finite()));
+        }
+        // A yielding lane with an infinite state: the batch fails, and no
+        // state is written (lane 0, before it, neither).
+        let (ok, states, finite) = run(&[1, 2]);
+        assert!(!finite.iter().all(|k| k[2]));
+        assert!(!ok);
+        assert_eq!(states, [[7.0; 6]; BATCH]);
     }
 }
