@@ -497,19 +497,21 @@ pub fn spherical_part_for_volume_in<T: Num>(
         let ds = f / df;
         let stepped = s - ds;
         let mut next = iterating;
+        // Per lane without early returns (fewer instructions in the batch:
+        // BENCHMARKS.md, session 35): a step that is not finite stops the
+        // lane untaken; the step predicted below round-off is the last.
         s = T::from_fn(|l| {
             let (ds, df) = (ds.lane(l), df.lane(l));
-            if !set(iterating, l) {
-                return s.lane(l);
-            }
-            if !ds.is_finite() {
-                next &= !(1 << l);
-                return s.lane(l);
-            }
-            if 3.0 * ds * ds <= 1.0e-16 * math::abs(df) {
+            let live = set(iterating, l);
+            let finite = ds.is_finite();
+            if live & (!finite | (3.0 * ds * ds <= 1.0e-16 * math::abs(df))) {
                 next &= !(1 << l);
             }
-            stepped.lane(l)
+            if live & finite {
+                stepped.lane(l)
+            } else {
+                s.lane(l)
+            }
         });
         iterating = next;
     }
