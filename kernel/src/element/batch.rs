@@ -18,8 +18,9 @@
 //! at once, each lane stopping where its scalar solve stops; a batch with
 //! one yielding lane takes the scalar solve), and their returned state — τ,
 //! the new C_p⁻¹, the dissipation — runs once for all lanes
-//! ([`returned_state`], generic). Both are functions of their own that are
-//! never inlined: inlined, they cost the elastic batches their registers
+//! ([`returned_state`], generic; stored whole into the batch's scratch
+//! before the lanes are picked, so that the compiler keeps it in lanes).
+//! Both are functions of their own that are never inlined: inlined, they cost the elastic batches their registers
 //! (BENCHMARKS.md, sessions 33 and 34; in a kernel built for baseline
 //! x86-64 they are SSE2 code called from the AVX2 loop, the same bits).
 //! The batch's results go to a [`Sink`] the loop is generic over, compiled
