@@ -269,9 +269,9 @@ impl<T: Num> ReturnMapSystem<T> {
 /// Whether (ε, δ) lies in the set Newton's steps are kept in: 1 + ε ≥
 /// 0.05, 1 − 1.5ε ≥ 0.05 and δ ≥ 0.
 ///
-/// The tests here and in the lane Newton's per-lane checks are joined with
-/// `&`, not `&&`: without a branch per test they take fewer instructions
-/// in the batch (BENCHMARKS.md, session 35).
+/// The tests here, and the lane Newton's full-step and convergence checks,
+/// are joined with `&`, not `&&`: without a branch per test they take fewer
+/// instructions in the batch (BENCHMARKS.md, session 35).
 #[inline(always)]
 fn feasible(eps: Real, delta: Real) -> bool {
     (1.0 + eps >= STEP_FLOOR) & (1.0 - 1.5 * eps >= STEP_FLOOR) & (delta >= 0.0)

@@ -20,9 +20,10 @@
 //! the new C_p⁻¹, the dissipation — runs once for all lanes
 //! ([`returned_state`], generic; stored whole into the batch's scratch
 //! before the lanes are picked, so that the compiler keeps it in lanes).
-//! Both are functions of their own that are never inlined: inlined, they cost the elastic batches their registers
-//! (BENCHMARKS.md, sessions 33 and 34; in a kernel built for baseline
-//! x86-64 they are SSE2 code called from the AVX2 loop, the same bits).
+//! Both are functions of their own that are never inlined: inlined, they
+//! cost the elastic batches their registers (BENCHMARKS.md, sessions 33
+//! and 34; in a kernel built for baseline x86-64 they are SSE2 code called
+//! from the AVX2 loop, the same bits).
 //! The batch's results go to a [`Sink`] the loop is generic over, compiled
 //! into it, from the lanes ([`Sink::batch`]). A batch in which any lane
 //! fails is evaluated again element by element by [`hex_forces`], so
@@ -379,7 +380,7 @@ const UNSET: UpdateInfo = UpdateInfo::elastic(
 
 /// Whether every lane passes [`check_input`] ([`input_is_valid`]). A lane
 /// of F with an entry that is not finite makes its lane of Σ F_ab·0 NaN;
-/// finite entries leave it ±0.
+/// finite entries leave it +0 ([`non_finite_probe`]).
 #[allow(non_snake_case)]
 #[inline(always)]
 fn inputs_valid<const W: usize>(F: &Rows<Lanes<W>>, t: &Trial<Lanes<W>>) -> bool {
@@ -397,7 +398,7 @@ fn inputs_valid<const W: usize>(F: &Rows<Lanes<W>>, t: &Trial<Lanes<W>>) -> bool
 }
 
 /// Σ v·0 over `values`, lane by lane: NaN in exactly the lanes where some
-/// value is not finite (∞·0 and NaN·0 are NaN), 0 elsewhere — one vector
+/// value is not finite (∞·0 and NaN·0 are NaN), +0 elsewhere — one vector
 /// expression whose lanes give a batch's verdict (F in [`inputs_valid`],
 /// the new C_p⁻¹ in [`return_lanes`]).
 #[inline(always)]
@@ -411,14 +412,15 @@ fn non_finite_probe<'a, const W: usize>(values: impl Iterator<Item = &'a Lanes<W
 /// reads it, all of `forces` (in [`nodal_forces_into`]) and of `returned`
 /// (in [`return_lanes`]) before it reads them, so nothing of an earlier
 /// batch is seen. Arrays made afresh per batch were zeroed by a
-/// call of `memset` each, and the returned forces copied by `memcpy`
-/// (about 7 % of the elastic element: BENCHMARKS.md, session 31).
+/// call of `memset` each, and the nodal forces handed back copied by
+/// `memcpy` (about 7 % of the elastic element: BENCHMARKS.md, session 31).
 struct BatchLanes {
     /// x_I, `[node][xyz]`, m.
     x: [[Lanes<BATCH>; 3]; 8],
     /// f_I, `[node][xyz]`, N.
     forces: [[Lanes<BATCH>; 3]; 8],
-    /// The returned state of the yielding lanes ([`return_lanes`]).
+    /// The returned state of all lanes, of which only the yielding ones
+    /// are read ([`return_lanes`]).
     returned: Returned<Lanes<BATCH>>,
 }
 
@@ -638,8 +640,10 @@ impl Job<'_> {
 
 /// The returned state of a batch's yielding lanes (`solutions[l]` is
 /// `Some`), in lanes: their τ, diagnostics, dissipation and new C_p⁻¹.
-/// `false` if a new C_p⁻¹ is not finite (nothing of `cp_inv` written).
-/// `returned` is scratch: the whole returned state of all lanes.
+/// `false` if a yielding lane's new C_p⁻¹ is not finite: then nothing of
+/// `tau`, `info`, `dissipation` or `cp_inv` is written (only the scratch
+/// `returned`, the whole returned state of all lanes). A lane that does not
+/// yield is computed along at ε = δ = 0 and dropped, its C_p⁻¹ unchecked.
 #[allow(non_snake_case, clippy::too_many_arguments)]
 #[inline(never)]
 fn return_lanes<const W: usize>(
@@ -666,12 +670,14 @@ fn return_lanes<const W: usize>(
     };
     let (eps, delta) = (of(|s| s.eps), of(|s| s.delta));
     // The state is stored whole, as lane vectors, into the scratch and the
-    // lanes are read back from there (`black_box` keeps the compiler from
-    // forwarding the stored values to the reads). Only single lanes are
-    // read below, and with the state in registers the compiler computed it
-    // lane by lane in scalar code: 1 736 instructions per call in the bed,
-    // 1 058 now with the two changes below (BENCHMARKS.md, session 35).
-    // Only where the code is generated changes, never a value.
+    // lanes are read back from there (`black_box`, a best-effort hint, in
+    // practice keeps rustc from forwarding the stored values to the reads).
+    // Only single lanes are read below, and with the state in registers
+    // the compiler computed it lane by lane in scalar code: 1 736
+    // instructions per call in the bed, 1 058 with the two changes below
+    // (BENCHMARKS.md, session 35; a later rustc may do otherwise, and the
+    // callgrind count there is the check). Only the code generated
+    // changes, never a value.
     *returned = returned_state(mat, opts, F, t, system, eps, delta, |l| {
         solutions[l].is_some()
     });
@@ -780,6 +786,7 @@ mod tests {
                 t.j.0[l] = 0.0;
             }
             let system = corrector(&mat, &t, Lanes::splat(0.5), Lanes::splat(1.0e6));
+            let mut tau = c;
             let mut states = [[7.0; 6]; BATCH];
             let mut returned = BatchLanes::ZERO.returned;
             let ok = return_lanes(
@@ -790,7 +797,7 @@ mod tests {
                 &system,
                 Lanes::splat(1.0e-12),
                 &solutions,
-                &mut c.clone(),
+                &mut tau,
                 &mut [UNSET; BATCH],
                 &mut [0.0; BATCH],
                 &mut states,
