@@ -59,6 +59,14 @@ impl Num for Real {
     }
 }
 
+/// Whether bit `l` of a lane mask is set: the masks of the lane solvers
+/// (`u64`, bit l for lane l, so at most 64 lanes) that say which lanes are
+/// still iterating.
+#[inline(always)]
+pub fn lane_bit(bits: u64, l: usize) -> bool {
+    bits >> l & 1 == 1
+}
+
 /// `W` values operated on lane by lane.
 ///
 /// Aligned to 32 bytes, the width of an AVX2 register: four lanes then

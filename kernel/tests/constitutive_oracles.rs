@@ -482,15 +482,7 @@ fn corrector_lanes_have_the_scalar_bits() {
                 mu: mat.mu,
             }
         });
-        let lanes = ReturnMapSystem {
-            theta_tr: Lanes(systems.map(|s| s.theta_tr)),
-            je_tr: Lanes(systems.map(|s| s.je_tr)),
-            beta_tr: Lanes(systems.map(|s| s.beta_tr)),
-            a1: Lanes(systems.map(|s| s.a1)),
-            yield_scale: Lanes(systems.map(|s| s.yield_scale)),
-            lambda: Lanes([mat.lambda; 4]),
-            mu: Lanes([mat.mu; 4]),
-        };
+        let lanes = in_lanes(systems);
         // Every subset of the lanes in turn, all four most often.
         let mask = if round % 2 == 0 {
             0b1111
@@ -574,19 +566,26 @@ fn corrector_lanes_have_the_scalar_bits() {
         ..good
     };
     assert!(bad.solve().is_err() && good.solve().is_ok());
-    let pair = |a: ReturnMapSystem, b: ReturnMapSystem| ReturnMapSystem {
-        theta_tr: Lanes([a.theta_tr, b.theta_tr, a.theta_tr, a.theta_tr]),
-        je_tr: Lanes([a.je_tr; 4]),
-        beta_tr: Lanes([a.beta_tr; 4]),
-        a1: Lanes([a.a1; 4]),
-        yield_scale: Lanes([a.yield_scale; 4]),
-        lambda: Lanes([a.lambda; 4]),
-        mu: Lanes([a.mu; 4]),
-    };
+    let pair = in_lanes([good, bad, good, good]);
     let mut solutions = [None; 4];
-    assert!(!pair(good, bad).solve_lanes(0b0011, &mut solutions));
-    assert!(pair(good, bad).solve_lanes(0b1101, &mut solutions));
+    assert!(!pair.solve_lanes(0b0011, &mut solutions));
+    assert!(pair.solve_lanes(0b1101, &mut solutions));
     assert_eq!(solutions[0], Some(good.solve().unwrap()));
+}
+
+/// Four scalar systems as the lanes of one (the inverse of
+/// `ReturnMapSystem::lane`).
+fn in_lanes(systems: [ReturnMapSystem; 4]) -> ReturnMapSystem<Lanes<4>> {
+    let lanes = |pick: fn(&ReturnMapSystem) -> Real| Lanes(systems.map(|s| pick(&s)));
+    ReturnMapSystem {
+        theta_tr: lanes(|s| s.theta_tr),
+        je_tr: lanes(|s| s.je_tr),
+        beta_tr: lanes(|s| s.beta_tr),
+        a1: lanes(|s| s.a1),
+        yield_scale: lanes(|s| s.yield_scale),
+        lambda: lanes(|s| s.lambda),
+        mu: lanes(|s| s.mu),
+    }
 }
 
 /// The volume fix's cubic (physics.md §1.6): s with det(k n + s 1) = (J^e)²

@@ -18,7 +18,7 @@
 
 use crate::Real;
 use crate::constitutive::elastic;
-use crate::lanes::{Lanes, Num};
+use crate::lanes::{Lanes, Num, lane_bit};
 use crate::math;
 
 /// Newton iterations before the bisection fallback takes over.
@@ -186,7 +186,6 @@ impl<T: Num> ReturnMapSystem<T> {
     fn newton_in(&self, lanes: u64, iterations: &mut [u32]) -> (T, T, u64) {
         // One bit per lane: checked when the function is instantiated.
         const { assert!(T::LANES <= 64, "at most 64 lanes") };
-        let set = |bits: u64, l: usize| bits >> l & 1 == 1;
         let (mut eps, mut delta) = (T::splat(0.0), self.delta_start());
         let (mut iterating, mut converged) = (lanes, 0);
         for it in 1..=MAX_NEWTON_ITERATIONS {
@@ -217,7 +216,7 @@ impl<T: Num> ReturnMapSystem<T> {
                 T::splat(1.0)
             } else {
                 T::from_fn(|l| {
-                    if !set(iterating, l) {
+                    if !lane_bit(iterating, l) {
                         return 0.0;
                     }
                     let (de, dd) = (de.lane(l), dd.lane(l));
@@ -231,14 +230,14 @@ impl<T: Num> ReturnMapSystem<T> {
             };
             let (stepped_eps, stepped_delta) = (eps + t * de, delta + t * dd);
             eps = T::from_fn(|l| {
-                if set(stepping, l) {
+                if lane_bit(stepping, l) {
                     stepped_eps.lane(l)
                 } else {
                     eps.lane(l)
                 }
             });
             delta = T::from_fn(|l| {
-                if set(stepping, l) {
+                if lane_bit(stepping, l) {
                     math::max(stepped_delta.lane(l), 0.0)
                 } else {
                     delta.lane(l)
@@ -246,7 +245,7 @@ impl<T: Num> ReturnMapSystem<T> {
             });
             iterating = stepping;
             for (l, count) in iterations.iter_mut().enumerate().take(T::LANES) {
-                if set(stepping, l)
+                if lane_bit(stepping, l)
                     & (t.lane(l) == 1.0)
                     & (math::abs(de.lane(l)) < NEWTON_STEP_TOL * (1.0 + math::abs(eps.lane(l))))
                     & (math::abs(dd.lane(l)) < NEWTON_STEP_TOL * (1.0 + delta.lane(l)))
@@ -258,7 +257,7 @@ impl<T: Num> ReturnMapSystem<T> {
             }
         }
         for (l, count) in iterations.iter_mut().enumerate().take(T::LANES) {
-            if set(iterating, l) {
+            if lane_bit(iterating, l) {
                 *count = MAX_NEWTON_ITERATIONS;
             }
         }
@@ -316,7 +315,6 @@ impl<const W: usize> ReturnMapSystem<Lanes<W>> {
     /// `return_lanes`, so that the elastic path keeps its registers.
     #[inline(never)]
     pub fn solve_lanes(&self, lanes: u64, solutions: &mut [Option<ReturnSolution>; W]) -> bool {
-        let set = |bits: u64, l: usize| bits >> l & 1 == 1;
         if lanes.is_power_of_two() {
             // One lane: its scalar solve, without the other lanes in tow.
             let l = lanes.trailing_zeros() as usize;
@@ -333,16 +331,16 @@ impl<const W: usize> ReturnMapSystem<Lanes<W>> {
         }
         let mut newton = 0;
         for l in 0..W {
-            newton |= u64::from(set(lanes, l) && self.a1.0[l] != 0.0) << l;
+            newton |= u64::from(lane_bit(lanes, l) && self.a1.0[l] != 0.0) << l;
         }
         let mut iterations = [0; W];
         let (eps, delta, converged) = self.newton_in(newton, &mut iterations);
         let residual = self.consistency(eps, delta);
         for (l, solution) in solutions.iter_mut().enumerate() {
-            if !set(lanes, l) {
+            if !lane_bit(lanes, l) {
                 continue;
             }
-            let solved = if !set(newton, l) {
+            let solved = if !lane_bit(newton, l) {
                 Ok(self.lane(l).radial_return())
             } else {
                 let sol = ReturnSolution {
@@ -352,7 +350,7 @@ impl<const W: usize> ReturnMapSystem<Lanes<W>> {
                     method: ReturnMethod::Newton,
                     residual: residual.0[l],
                 };
-                if set(converged, l) {
+                if lane_bit(converged, l) {
                     Ok(sol)
                 } else {
                     self.lane(l).fallback(sol)

@@ -12,7 +12,7 @@ use core::fmt;
 use crate::constitutive::elastic;
 use crate::constitutive::return_map::{ReturnMapSystem, ReturnMethod, ReturnSolution};
 use crate::constitutive::yield_surface::{self, YieldCoefficients};
-use crate::lanes::Num;
+use crate::lanes::{Num, lane_bit};
 use crate::material::Material;
 use crate::tensor::{self, Mat3, Rows, Voigt};
 use crate::{Real, math};
@@ -487,7 +487,6 @@ pub fn spherical_part_for_volume_in<T: Num>(
     for l in 0..T::LANES {
         iterating |= u64::from(solve(l) && k.lane(l) != 0.0) << l;
     }
-    let set = |bits: u64, l: usize| bits >> l & 1 == 1;
     for _ in 0..VOLUME_NEWTON_ITERATIONS {
         if iterating == 0 {
             break;
@@ -502,7 +501,7 @@ pub fn spherical_part_for_volume_in<T: Num>(
         // lane untaken; the step predicted below round-off is the last.
         s = T::from_fn(|l| {
             let (ds, df) = (ds.lane(l), df.lane(l));
-            let live = set(iterating, l);
+            let live = lane_bit(iterating, l);
             let finite = ds.is_finite();
             if live & (!finite | (3.0 * ds * ds <= 1.0e-16 * math::abs(df))) {
                 next &= !(1 << l);
