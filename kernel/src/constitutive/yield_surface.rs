@@ -5,7 +5,7 @@
 //! a2 = 1 (von Mises) for η ≥ 1.
 
 use crate::Real;
-use crate::lanes::Num;
+use crate::lanes::{Lanes, Num};
 use crate::material::MaterialParams;
 
 /// Smallest a2 the update accepts: below it (η ≤ η_c, extreme dilation) the
@@ -52,18 +52,44 @@ pub fn porous_formula<T: Num>(params: &MaterialParams, eta: T) -> (T, T) {
 }
 
 /// [`coefficients`] at `eta` from [`porous_formula`]'s `a1` and `a2`
-/// there: von Mises for η ≥ 1, else a2 clamped up to [`A2_MIN`].
+/// there: von Mises for η ≥ 1, else a2 clamped up to [`A2_MIN`]. One lane
+/// of [`coefficients_in_lanes`].
 #[inline(always)]
 pub fn coefficients_from(eta: Real, a1: Real, a2: Real) -> YieldCoefficients {
-    if eta >= 1.0 {
-        return VON_MISES;
-    }
-    let a2_clamped = a2.is_nan() || a2 < A2_MIN;
+    let (a1, a2, a2_clamped) = coefficients_in_lanes(Lanes([eta]), Lanes([a1]), Lanes([a2]));
     YieldCoefficients {
-        a1,
-        a2: if a2_clamped { A2_MIN } else { a2 },
-        a2_clamped,
+        a1: a1.0[0],
+        a2: a2.0[0],
+        a2_clamped: a2_clamped[0],
     }
+}
+
+/// [`coefficients_from`] for `W` lanes at once: a1, a2 and whether a2 was
+/// clamped, lane by lane. The tests pick without branches (η ≥ 1 and the
+/// clamp are selections of each lane), so a batch of elements gets them as
+/// vector compares and blends; lane by lane with branches they cost the
+/// elastic element 21 instructions of its 723 (BENCHMARKS.md, session 36).
+#[inline(always)]
+pub fn coefficients_in_lanes<const W: usize>(
+    eta: Lanes<W>,
+    a1: Lanes<W>,
+    a2: Lanes<W>,
+) -> (Lanes<W>, Lanes<W>, [bool; W]) {
+    let (mut c1, mut c2, mut clamped) = (a1, a2, [false; W]);
+    for (l, clamped_l) in clamped.iter_mut().enumerate() {
+        let von_mises = eta.0[l] >= 1.0;
+        let low = a2.0[l].is_nan() | (a2.0[l] < A2_MIN);
+        *clamped_l = !von_mises & low;
+        c1.0[l] = if von_mises { VON_MISES.a1 } else { a1.0[l] };
+        c2.0[l] = if von_mises {
+            VON_MISES.a2
+        } else if low {
+            A2_MIN
+        } else {
+            a2.0[l]
+        };
+    }
+    (c1, c2, clamped)
 }
 
 /// Yield function φ from the deviatoric norm `beta` = ‖dev τ‖ and trace
@@ -96,7 +122,6 @@ pub fn yield_function_of<T: Num>(a1: T, scale: T, beta: T, alpha: T) -> T {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::lanes::Lanes;
     use crate::material::GranuleType;
 
     /// The pieces an element batch evaluates in lanes give each lane the
@@ -125,11 +150,12 @@ mod tests {
         for chunk in etas.chunks_exact(4) {
             let eta = Lanes::<4>(core::array::from_fn(|l| chunk[l]));
             let (a1_formula, a2_formula) = porous_formula(&params, eta);
-            let c: [YieldCoefficients; 4] = core::array::from_fn(|l| {
-                coefficients_from(eta.0[l], a1_formula.0[l], a2_formula.0[l])
+            let (a1, a2, clamped) = coefficients_in_lanes(eta, a1_formula, a2_formula);
+            let c: [YieldCoefficients; 4] = core::array::from_fn(|l| YieldCoefficients {
+                a1: a1.0[l],
+                a2: a2.0[l],
+                a2_clamped: clamped[l],
             });
-            let a1 = Lanes::<4>(core::array::from_fn(|l| c[l].a1));
-            let a2 = Lanes::<4>(core::array::from_fn(|l| c[l].a2));
             let scale = yield_scale_of(a2, params.yield_stress_pa);
             let phi =
                 yield_function_of(a1, scale, Lanes::<4>::splat(beta), Lanes::<4>::splat(alpha));

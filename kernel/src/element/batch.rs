@@ -8,11 +8,12 @@
 //! [`nodal_forces_into`] are generic over [`Num`]), so every lane gets exactly the
 //! scalar result. The yield test of [`check_trial`] runs in lanes too (its
 //! pieces, [`yield_surface::porous_formula`],
-//! [`yield_surface::yield_function_of`], are generic), all but the branches
-//! of η ≥ 1 and the a2 clamp. The input checks of [`check_input`] give one
+//! [`yield_surface::yield_function_of`], are generic, and η ≥ 1 and the a2
+//! clamp are picked lane by lane without branches,
+//! [`yield_surface::coefficients_in_lanes`]). The input checks of [`check_input`] give one
 //! verdict for the batch, without branches ([`input_is_valid`] of each
-//! lane, F's finiteness probed in lanes). Per lane, in scalar code: those
-//! branches and the test whether the lane yields ([`yields`]). The
+//! lane, F's finiteness probed in lanes). Per lane, in scalar code: the
+//! test whether the lane yields ([`yields`]). The
 //! corrector of the yielding lanes is solved side by side
 //! ([`ReturnMapSystem::solve_lanes`]: the Newton iterations of all of them
 //! at once, each lane stopping where its scalar solve stops; a batch with
@@ -384,7 +385,7 @@ const UNSET: UpdateInfo = UpdateInfo::elastic(
 #[allow(non_snake_case)]
 #[inline(always)]
 fn inputs_valid<const W: usize>(F: &Rows<Lanes<W>>, t: &Trial<Lanes<W>>) -> bool {
-    let probe = non_finite_probe(F.iter().flatten());
+    let probe = non_finite_probe(F.as_flattened());
     let mut valid = true;
     for l in 0..W {
         valid &= input_is_valid(
@@ -402,9 +403,13 @@ fn inputs_valid<const W: usize>(F: &Rows<Lanes<W>>, t: &Trial<Lanes<W>>) -> bool
 /// expression whose lanes give a batch's verdict (F in [`inputs_valid`],
 /// the new C_p⁻¹ in [`return_lanes`]).
 #[inline(always)]
-fn non_finite_probe<'a, const W: usize>(values: impl Iterator<Item = &'a Lanes<W>>) -> Lanes<W> {
+fn non_finite_probe<const W: usize>(values: &[Lanes<W>]) -> Lanes<W> {
     let zero = Lanes::splat(0.0);
-    values.fold(zero, |p, &v| p + v * zero)
+    let mut probe = zero;
+    for &v in values {
+        probe = probe + v * zero;
+    }
+    probe
 }
 
 /// The node coordinates, nodal forces and returned state of a batch in
@@ -555,15 +560,12 @@ impl Job<'_> {
         let t = trial(self.mat, &F, &c);
         let mut tau = elastic::kirchhoff(self.mat, &t.b, t.je);
         // The yield test of `check_trial` for all lanes at once: the
-        // porous coefficients' formula, then per lane η ≥ 1 and the clamp,
-        // then the scale, φ and φ/scale (the scalar bits).
+        // porous coefficients' formula, then η ≥ 1 and the clamp (selected
+        // per lane), then the scale, φ and φ/scale (the scalar bits).
         let params = &self.mat.params;
         let (a1_formula, a2_formula) = yield_surface::porous_formula(params, t.eta);
-        let coefficients: [YieldCoefficients; W] = core::array::from_fn(|l| {
-            yield_surface::coefficients_from(t.eta.0[l], a1_formula.0[l], a2_formula.0[l])
-        });
-        let a1 = Lanes(core::array::from_fn(|l| coefficients[l].a1));
-        let a2 = Lanes(core::array::from_fn(|l| coefficients[l].a2));
+        let (a1, a2, a2_clamped) =
+            yield_surface::coefficients_in_lanes(t.eta, a1_formula, a2_formula);
         let scale = yield_surface::yield_scale_of(a2, params.yield_stress_pa);
         let phi = yield_surface::yield_function_of(a1, scale, t.beta, t.alpha);
         let residual = phi / scale;
@@ -584,7 +586,11 @@ impl Job<'_> {
             // stalled on store forwarding: BENCHMARKS.md).
             let i = &mut info[l];
             (i.eta, i.je) = (t.eta.0[l], t.je.0[l]);
-            i.coefficients = coefficients[l];
+            i.coefficients = YieldCoefficients {
+                a1: a1.0[l],
+                a2: a2.0[l],
+                a2_clamped: a2_clamped[l],
+            };
             i.residual = residual.0[l];
             // V0 × 0 as the scalar element computes it (−0 or NaN for a
             // malformed volume, like the scalar path).
@@ -684,7 +690,7 @@ fn return_lanes<const W: usize>(
     let r = core::hint::black_box(&*returned);
     // One verdict for the batch, without branches: a test that stops at
     // the first failing lane had the probe computed lane by lane.
-    let probe = non_finite_probe(r.cp_inv.iter());
+    let probe = non_finite_probe(&r.cp_inv);
     let mut finite = true;
     for (l, sol) in solutions.iter().enumerate() {
         finite &= sol.is_none() | !probe.0[l].is_nan();
