@@ -178,4 +178,39 @@ mod tests {
             "von Mises, clamped and porous lanes"
         );
     }
+
+    /// The rule of physics.md §1.1 lane by lane, against values worked out
+    /// here rather than by the code under test (the scalar
+    /// [`coefficients_from`] is [`coefficients_in_lanes`] with one lane):
+    /// a1 = c_p(1 − η²) and a2 = (η² − η_c²)/(1 − η_c²) below η = 1,
+    /// a2 raised to [`A2_MIN`] and flagged where it falls below it or is
+    /// NaN, von Mises (0, 1, not flagged) from η = 1 on.
+    #[test]
+    fn each_lane_follows_the_porous_rule_the_clamp_and_von_mises() {
+        let params = GranuleType::B1.params();
+        let (cp, ec2) = (params.cp, params.eta_c * params.eta_c);
+        assert!(ec2 > 0.0 && ec2 < 1.0);
+        let porous = |eta: Real| (cp * (1.0 - eta * eta), (eta * eta - ec2) / (1.0 - ec2));
+        // Porous, at η_c (a2 = 0 < A2_MIN), von Mises (where the porous
+        // formula would give a1 < 0, a2 > 1), NaN.
+        let eta = Lanes([0.7, params.eta_c, 1.3, Real::NAN]);
+        let (a1_formula, a2_formula) = porous_formula(&params, eta);
+        let (a1, a2, clamped) = coefficients_in_lanes(eta, a1_formula, a2_formula);
+        let (a1_want, a2_want) = porous(0.7);
+        assert!(a2_want > A2_MIN);
+        assert_eq!((a1.0[0], a2.0[0], clamped[0]), (a1_want, a2_want, false));
+        assert_eq!(
+            (a1.0[1], a2.0[1], clamped[1]),
+            (porous(params.eta_c).0, A2_MIN, true)
+        );
+        assert_eq!((a1.0[2], a2.0[2], clamped[2]), (0.0, 1.0, false));
+        assert!(a1.0[3].is_nan());
+        assert_eq!((a2.0[3], clamped[3]), (A2_MIN, true));
+        // A lane's result does not depend on its neighbours.
+        for (l, &clamped_l) in clamped.iter().enumerate() {
+            let one = coefficients_from(eta.0[l], a1_formula.0[l], a2_formula.0[l]);
+            assert_eq!(one.a2.to_bits(), a2.0[l].to_bits(), "lane {l}");
+            assert_eq!(one.a2_clamped, clamped_l, "lane {l}");
+        }
+    }
 }
