@@ -67,8 +67,8 @@ pub fn coefficients_from(eta: Real, a1: Real, a2: Real) -> YieldCoefficients {
 /// [`coefficients_from`] for `W` lanes at once: a1, a2 and whether a2 was
 /// clamped, lane by lane. The tests pick without branches (η ≥ 1 and the
 /// clamp are selections of each lane), so a batch of elements gets them as
-/// vector compares and blends; lane by lane with branches they cost the
-/// elastic element 21 instructions of its 723 (BENCHMARKS.md, session 36).
+/// vector compares and blends; lane by lane with branches the element took
+/// 8 instructions more per element-step (BENCHMARKS.md, session 36).
 #[inline(always)]
 pub fn coefficients_in_lanes<const W: usize>(
     eta: Lanes<W>,
