@@ -56,32 +56,55 @@ pub fn porous_formula<T: Num>(params: &MaterialParams, eta: T) -> (T, T) {
 /// of [`coefficients_in_lanes`].
 #[inline(always)]
 pub fn coefficients_from(eta: Real, a1: Real, a2: Real) -> YieldCoefficients {
-    let (a1, a2, a2_clamped) = coefficients_in_lanes(Lanes([eta]), Lanes([a1]), Lanes([a2]));
-    YieldCoefficients {
-        a1: a1.0[0],
-        a2: a2.0[0],
-        a2_clamped: a2_clamped[0],
+    coefficients_in_lanes(Lanes([eta]), Lanes([a1]), Lanes([a2])).lane(0)
+}
+
+/// [`YieldCoefficients`] of `W` lanes side by side (lane l = lane l of
+/// each field).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct CoefficientLanes<const W: usize> {
+    /// a1 of each lane.
+    pub a1: Lanes<W>,
+    /// a2 of each lane.
+    pub a2: Lanes<W>,
+    /// Whether each lane's a2 was clamped.
+    pub a2_clamped: [bool; W],
+}
+
+impl<const W: usize> CoefficientLanes<W> {
+    /// Lane `l`'s coefficients.
+    #[inline(always)]
+    pub fn lane(&self, l: usize) -> YieldCoefficients {
+        YieldCoefficients {
+            a1: self.a1.0[l],
+            a2: self.a2.0[l],
+            a2_clamped: self.a2_clamped[l],
+        }
     }
 }
 
-/// [`coefficients_from`] for `W` lanes at once: a1, a2 and whether a2 was
-/// clamped, lane by lane. The tests pick without branches (η ≥ 1 and the
-/// clamp are selections of each lane), so a batch of elements gets them as
-/// vector compares and blends; lane by lane with branches the element took
-/// 8 instructions more per element-step (BENCHMARKS.md, session 36).
+/// [`coefficients_from`] for `W` lanes at once. The tests pick without
+/// branches (η ≥ 1 and the clamp are selections of each lane), so a batch
+/// of elements gets them as vector compares and blends; lane by lane with
+/// branches the element took 8 instructions more per element-step
+/// (BENCHMARKS.md, session 36).
 #[inline(always)]
 pub fn coefficients_in_lanes<const W: usize>(
     eta: Lanes<W>,
     a1: Lanes<W>,
     a2: Lanes<W>,
-) -> (Lanes<W>, Lanes<W>, [bool; W]) {
-    let (mut c1, mut c2, mut clamped) = (a1, a2, [false; W]);
-    for (l, clamped_l) in clamped.iter_mut().enumerate() {
+) -> CoefficientLanes<W> {
+    let mut c = CoefficientLanes {
+        a1,
+        a2,
+        a2_clamped: [false; W],
+    };
+    for (l, clamped) in c.a2_clamped.iter_mut().enumerate() {
         let von_mises = eta.0[l] >= 1.0;
         let low = a2.0[l].is_nan() | (a2.0[l] < A2_MIN);
-        *clamped_l = !von_mises & low;
-        c1.0[l] = if von_mises { VON_MISES.a1 } else { a1.0[l] };
-        c2.0[l] = if von_mises {
+        *clamped = !von_mises & low;
+        c.a1.0[l] = if von_mises { VON_MISES.a1 } else { a1.0[l] };
+        c.a2.0[l] = if von_mises {
             VON_MISES.a2
         } else if low {
             A2_MIN
@@ -89,7 +112,7 @@ pub fn coefficients_in_lanes<const W: usize>(
             a2.0[l]
         };
     }
-    (c1, c2, clamped)
+    c
 }
 
 /// Yield function φ from the deviatoric norm `beta` = ‖dev τ‖ and trace
@@ -150,15 +173,15 @@ mod tests {
         for chunk in etas.chunks_exact(4) {
             let eta = Lanes::<4>(core::array::from_fn(|l| chunk[l]));
             let (a1_formula, a2_formula) = porous_formula(&params, eta);
-            let (a1, a2, clamped) = coefficients_in_lanes(eta, a1_formula, a2_formula);
-            let c: [YieldCoefficients; 4] = core::array::from_fn(|l| YieldCoefficients {
-                a1: a1.0[l],
-                a2: a2.0[l],
-                a2_clamped: clamped[l],
-            });
-            let scale = yield_scale_of(a2, params.yield_stress_pa);
-            let phi =
-                yield_function_of(a1, scale, Lanes::<4>::splat(beta), Lanes::<4>::splat(alpha));
+            let lanes = coefficients_in_lanes(eta, a1_formula, a2_formula);
+            let c: [YieldCoefficients; 4] = core::array::from_fn(|l| lanes.lane(l));
+            let scale = yield_scale_of(lanes.a2, params.yield_stress_pa);
+            let phi = yield_function_of(
+                lanes.a1,
+                scale,
+                Lanes::<4>::splat(beta),
+                Lanes::<4>::splat(alpha),
+            );
             for l in 0..4 {
                 let want = coefficients(&params, eta.0[l]);
                 let bits = |c: &YieldCoefficients| (c.a1.to_bits(), c.a2.to_bits(), c.a2_clamped);
@@ -195,22 +218,21 @@ mod tests {
         // formula would give a1 < 0, a2 > 1), NaN.
         let eta = Lanes([0.7, params.eta_c, 1.3, Real::NAN]);
         let (a1_formula, a2_formula) = porous_formula(&params, eta);
-        let (a1, a2, clamped) = coefficients_in_lanes(eta, a1_formula, a2_formula);
+        let c = coefficients_in_lanes(eta, a1_formula, a2_formula);
+        let triple = |y: YieldCoefficients| (y.a1, y.a2, y.a2_clamped);
         let (a1_want, a2_want) = porous(0.7);
         assert!(a2_want > A2_MIN);
-        assert_eq!((a1.0[0], a2.0[0], clamped[0]), (a1_want, a2_want, false));
-        assert_eq!(
-            (a1.0[1], a2.0[1], clamped[1]),
-            (porous(params.eta_c).0, A2_MIN, true)
-        );
-        assert_eq!((a1.0[2], a2.0[2], clamped[2]), (0.0, 1.0, false));
-        assert!(a1.0[3].is_nan());
-        assert_eq!((a2.0[3], clamped[3]), (A2_MIN, true));
+        assert_eq!(triple(c.lane(0)), (a1_want, a2_want, false));
+        assert_eq!(triple(c.lane(1)), (porous(params.eta_c).0, A2_MIN, true));
+        assert_eq!(triple(c.lane(2)), (0.0, 1.0, false));
+        assert!(c.lane(3).a1.is_nan());
+        assert_eq!((c.lane(3).a2, c.lane(3).a2_clamped), (A2_MIN, true));
         // A lane's result does not depend on its neighbours.
-        for (l, &clamped_l) in clamped.iter().enumerate() {
+        for l in 0..4 {
             let one = coefficients_from(eta.0[l], a1_formula.0[l], a2_formula.0[l]);
-            assert_eq!(one.a2.to_bits(), a2.0[l].to_bits(), "lane {l}");
-            assert_eq!(one.a2_clamped, clamped_l, "lane {l}");
+            let lane = c.lane(l);
+            assert_eq!(one.a2.to_bits(), lane.a2.to_bits(), "lane {l}");
+            assert_eq!(one.a2_clamped, lane.a2_clamped, "lane {l}");
         }
     }
 }

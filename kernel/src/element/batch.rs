@@ -564,8 +564,8 @@ impl Job<'_> {
         // per lane), then the scale, φ and φ/scale (the scalar bits).
         let params = &self.mat.params;
         let (a1_formula, a2_formula) = yield_surface::porous_formula(params, t.eta);
-        let (a1, a2, a2_clamped) =
-            yield_surface::coefficients_in_lanes(t.eta, a1_formula, a2_formula);
+        let coefficients = yield_surface::coefficients_in_lanes(t.eta, a1_formula, a2_formula);
+        let (a1, a2) = (coefficients.a1, coefficients.a2);
         let scale = yield_surface::yield_scale_of(a2, params.yield_stress_pa);
         let phi = yield_surface::yield_function_of(a1, scale, t.beta, t.alpha);
         let residual = phi / scale;
@@ -586,11 +586,7 @@ impl Job<'_> {
             // stalled on store forwarding: BENCHMARKS.md).
             let i = &mut info[l];
             (i.eta, i.je) = (t.eta.0[l], t.je.0[l]);
-            i.coefficients = YieldCoefficients {
-                a1: a1.0[l],
-                a2: a2.0[l],
-                a2_clamped: a2_clamped[l],
-            };
+            i.coefficients = coefficients.lane(l);
             i.residual = residual.0[l];
             // V0 × 0 as the scalar element computes it (−0 or NaN for a
             // malformed volume, like the scalar path).
