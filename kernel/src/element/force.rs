@@ -139,15 +139,22 @@ pub fn nodal_forces_into<T: Num>(
     let k = T::splat(kappa_modulus) * g.hourglass_geometry;
     let amplitude = T::splat(HOURGLASS_STIFFENING_AMPLITUDE) * g.hourglass_geometry;
     let inv_s2 = T::splat(1.0) / (T::splat(32.0) * amplitude * amplitude);
-    // The four modes side by side: one pass over the nodes for all q_α,
-    // one for all forces. Every sum runs in the order of the mode-by-mode
-    // form (q_α over nodes 0…7; f_I over modes 0…3), so the same bits.
+    // The four modes side by side, one coordinate at a time: a pass over
+    // the nodes per coordinate, four sums in registers (all twelve at once
+    // left one of them in memory, a chain of loads and stores through the
+    // loop: BENCHMARKS.md, session 37). Every sum runs in the order of the
+    // mode-by-mode form (q_α over nodes 0…7; f_I over modes 0…3), so the
+    // same bits.
     let mut q = [[T::splat(0.0); 3]; 4];
-    for (i, xi) in x.iter().enumerate() {
-        for (qa, gm) in q.iter_mut().zip(g.gamma0) {
-            for (qab, &xb) in qa.iter_mut().zip(xi) {
-                *qab = *qab + xb * gm[i];
+    for b in 0..3 {
+        let mut qb = [T::splat(0.0); 4];
+        for (i, xi) in x.iter().enumerate() {
+            for (qab, gm) in qb.iter_mut().zip(g.gamma0) {
+                *qab = *qab + xi[b] * gm[i];
             }
+        }
+        for (qa, qab) in q.iter_mut().zip(qb) {
+            qa[b] = qab;
         }
     }
     let mut energy = T::splat(0.0);
