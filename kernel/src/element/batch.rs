@@ -555,6 +555,13 @@ impl Job<'_> {
         for (k, ck) in c.iter_mut().enumerate() {
             *ck = Lanes(core::array::from_fn(|l| cp_inv[l][k]));
         }
+        // C_p⁻¹'s lanes are read back whole from memory (`black_box`, a
+        // best-effort hint): seen as 24 loose scalars, they led the
+        // compiler to compute the push-forward F C_p⁻¹ Fᵀ partly in
+        // two-lane and scalar code, with spills — 43 instructions per
+        // element-step more (BENCHMARKS.md, session 37). Only the code
+        // generated changes, never a value.
+        let c = *core::hint::black_box(&c);
 
         let F = mean_gradient_rows(&g.b0, x);
         let t = trial(self.mat, &F, &c);
