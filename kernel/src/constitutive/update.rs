@@ -86,15 +86,16 @@ impl UpdateInfo {
     }
 
     /// Records the corrector's solution `sol` of a returned step, with
-    /// θ(ε) `theta` and J^e(ε) `je` of the returned state.
+    /// the plastic multiplier increment `gamma` ([`Returned::gamma`]) and
+    /// J^e(ε) `je` of the returned state.
     #[inline(always)]
-    pub fn record_return(&mut self, sol: &ReturnSolution, theta: Real, je: Real) {
+    pub fn record_return(&mut self, sol: &ReturnSolution, gamma: Real, je: Real) {
         self.plastic = true;
         self.method = sol.method;
         self.iterations = sol.iterations;
         self.eps = sol.eps;
         self.delta = sol.delta;
-        self.gamma = 3.0 * sol.delta / (4.0 * theta);
+        self.gamma = gamma;
         self.je = je;
         self.residual = sol.residual;
     }
@@ -362,7 +363,7 @@ pub fn plastic_return(
     if !r.cp_inv.iter().all(|x| x.is_finite()) {
         return Err(UpdateError::NonFinite);
     }
-    info.record_return(&sol, r.theta, r.je);
+    info.record_return(&sol, r.gamma, r.je);
     Ok((PointUpdate { tau: r.tau, info }, r.cp_inv))
 }
 
@@ -393,6 +394,8 @@ pub struct Returned<T> {
     pub theta: T,
     /// J^e(ε).
     pub je: T,
+    /// The plastic multiplier increment Δγ = 3δ/(4θ(ε)), 1/Pa.
+    pub gamma: T,
 }
 
 /// The returned stress and state at the corrector's solution (`eps`,
@@ -445,6 +448,7 @@ pub fn returned_state<T: Num>(
         cp_inv: tensor::push_forward_rows(&f_inv, &be),
         theta,
         je,
+        gamma: T::splat(3.0) * delta / (T::splat(4.0) * theta),
     }
 }
 
@@ -621,7 +625,7 @@ mod tests {
                 );
                 let mut info = UpdateInfo::elastic(0.0, 0.0, up.info.coefficients, 0.0);
                 info.eta = up.info.eta;
-                info.record_return(sol, r.theta.0[l], r.je.0[l]);
+                info.record_return(sol, r.gamma.0[l], r.je.0[l]);
                 assert_eq!(info, up.info, "diagnostics of lane {l}");
                 let density = dissipation_density(&r.tau, Lanes([info.gamma; 4]), system.a1);
                 assert_eq!(density.0[l].to_bits(), up.dissipation_density().to_bits());

@@ -440,6 +440,7 @@ impl BatchLanes {
                 cp_inv: [zero; 6],
                 theta: zero,
                 je: zero,
+                gamma: zero,
             },
         }
     };
@@ -701,20 +702,31 @@ fn return_lanes<const W: usize>(
     if !finite {
         return false;
     }
+    // τ of the yielding lanes, selected per lane (vector blends, not a
+    // copy lane by lane behind a branch).
+    for (tk, rk) in tau.iter_mut().zip(&r.tau) {
+        for (l, sol) in solutions.iter().enumerate() {
+            tk.0[l] = if sol.is_some() { rk.0[l] } else { tk.0[l] };
+        }
+    }
     for (l, sol) in solutions.iter().enumerate() {
         let Some(sol) = sol else { continue };
-        for (tk, rk) in tau.iter_mut().zip(&r.tau) {
-            tk.0[l] = rk.0[l];
-        }
-        info[l].record_return(sol, r.theta.0[l], r.je.0[l]);
+        info[l].record_return(sol, r.gamma.0[l], r.je.0[l]);
     }
-    let gamma = Lanes(core::array::from_fn(|l| info[l].gamma));
-    // V0 × the density for all lanes first: computed inside the test of
-    // each lane, it ran lane by lane in scalar code.
-    let lane_dissipation = volume * dissipation_density(&r.tau, gamma, a1);
+    // V0 × the density for all lanes, each lane's kept or not by a
+    // select: behind a branch per lane, the compiler moved the density
+    // into the branches and computed it lane by lane in scalar code
+    // (BENCHMARKS.md, session 37).
+    let lane_dissipation = volume * dissipation_density(&r.tau, r.gamma, a1);
+    for (l, sol) in solutions.iter().enumerate() {
+        dissipation[l] = if sol.is_some() {
+            lane_dissipation.0[l]
+        } else {
+            dissipation[l]
+        };
+    }
     for (l, sol) in solutions.iter().enumerate() {
         if sol.is_some() {
-            dissipation[l] = lane_dissipation.0[l];
             for (c, rk) in cp_inv[l].iter_mut().zip(&r.cp_inv) {
                 *c = rk.0[l];
             }
