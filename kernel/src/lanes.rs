@@ -141,9 +141,56 @@ impl<const W: usize> Num for Lanes<W> {
     }
 }
 
+impl Lanes<4> {
+    /// Four scalars as one lane vector, lane l = `v[l]`, the same values as
+    /// `Lanes(v)`.
+    ///
+    /// Where the build targets AVX (every x86-64 Linux build of this
+    /// workspace: `.cargo/config.toml`), made with the `_mm256_setr_pd`
+    /// intrinsic. Made from the array, the element batch's gather of its
+    /// nodes' coordinates stored every scalar on its own into the batch's
+    /// scratch (96 8-byte stores per batch, read back as 24 vectors); made
+    /// here, it stores them in pairs, and the element in the default bed
+    /// took 3 % less time early in the compression (BENCHMARKS.md, session
+    /// 37). Elsewhere (wasm32, a baseline x86-64 build) it is `Lanes(v)`.
+    #[inline(always)]
+    pub fn from_scalars(v: [Real; 4]) -> Self {
+        #[cfg(all(target_arch = "x86_64", target_feature = "avx"))]
+        {
+            use core::arch::x86_64::{__m256d, _mm256_setr_pd};
+            // SAFETY: AVX is enabled for the whole build (the `cfg` above),
+            // so the intrinsic's instructions exist; it touches registers
+            // only. `__m256d` holds four f64 in lane order (`setr`: lane 0
+            // first), the layout of `[f64; 4]`, and every bit pattern is
+            // valid in both.
+            #[allow(unsafe_code)]
+            unsafe {
+                Self(core::mem::transmute::<__m256d, [Real; 4]>(_mm256_setr_pd(
+                    v[0], v[1], v[2], v[3],
+                )))
+            }
+        }
+        #[cfg(not(all(target_arch = "x86_64", target_feature = "avx")))]
+        {
+            Self(v)
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// `from_scalars` puts `v[l]` in lane l, bit for bit (signed zero, NaN
+    /// payload, subnormal), on the intrinsic path and the plain one alike.
+    #[test]
+    fn from_scalars_keeps_lane_order_and_bits() {
+        let v = core::hint::black_box([-0.0, f64::from_bits(0x7ff8_0000_dead_beef), 5e-324, 1.5]);
+        let lanes = Lanes::from_scalars(v);
+        for (l, x) in v.iter().enumerate() {
+            assert_eq!(lanes.0[l].to_bits(), x.to_bits(), "lane {l}");
+        }
+    }
 
     /// Lane l of every operation equals the scalar operation on lane l.
     #[test]

@@ -540,7 +540,9 @@ impl Job<'_> {
         let zero = Lanes::<W>::splat(0.0);
         // Each lane vector is made whole from its W scalars (written lane
         // by lane into memory and read back as one vector, it stalled on
-        // store forwarding: BENCHMARKS.md).
+        // store forwarding: BENCHMARKS.md); the coordinates through
+        // `Lanes::from_scalars`, else the compiler still stored them one
+        // scalar at a time into the scratch (session 37).
         let BatchLanes {
             x,
             forces,
@@ -549,7 +551,7 @@ impl Job<'_> {
         for (i, xi) in x.iter_mut().enumerate() {
             let p: [&[Real; 3]; W] = core::array::from_fn(|l| &self.x[hexes[l][i] as usize]);
             for (a, xia) in xi.iter_mut().enumerate() {
-                *xia = Lanes(core::array::from_fn(|l| p[l][a]));
+                *xia = Lanes::from_scalars(core::array::from_fn(|l| p[l][a]));
             }
         }
         let mut c = [zero; 6];
