@@ -540,9 +540,9 @@ impl Job<'_> {
         let zero = Lanes::<W>::splat(0.0);
         // Each lane vector is made whole from its W scalars (written lane
         // by lane into memory and read back as one vector, it stalled on
-        // store forwarding: BENCHMARKS.md); the coordinates through
-        // `Lanes::from_scalars`, else the compiler still stored them one
-        // scalar at a time into the scratch (session 37).
+        // store forwarding: BENCHMARKS.md). The coordinates go through
+        // `Lanes::from_scalars`: made from the array, they were still
+        // stored one scalar at a time into the scratch (session 37).
         let BatchLanes {
             x,
             forces,
@@ -704,15 +704,11 @@ fn return_lanes<const W: usize>(
     if !finite {
         return false;
     }
-    // τ of the yielding lanes, selected per lane (vector blends, not a
-    // copy lane by lane behind a branch).
-    for (tk, rk) in tau.iter_mut().zip(&r.tau) {
-        for (l, sol) in solutions.iter().enumerate() {
-            tk.0[l] = if sol.is_some() { rk.0[l] } else { tk.0[l] };
-        }
-    }
     for (l, sol) in solutions.iter().enumerate() {
         let Some(sol) = sol else { continue };
+        for (tk, rk) in tau.iter_mut().zip(&r.tau) {
+            tk.0[l] = rk.0[l];
+        }
         info[l].record_return(sol, r.gamma.0[l], r.je.0[l]);
     }
     // V0 × the density for all lanes, each lane's kept or not by a
