@@ -402,3 +402,69 @@ fn study_compare_measures_two_finished_runs() {
     assert_eq!(run.code, 2);
     assert!(run.stderr.contains("--window"), "{}", run.stderr);
 }
+
+/// `granbed-cli study element-time` on a checkpoint of a small bed stopped
+/// where its granules yield: one row, the element-steps of a pass are the
+/// deformable granules' elements, every pass does the same work (the
+/// element-by-element path and the batches see the same yielding share,
+/// which is neither zero nor one), the times are positive and the median
+/// is no faster than the fastest pass; a bad `--passes` is named with its
+/// range, a directory without a checkpoint is an error.
+#[test]
+fn element_time_measures_the_element_loop_on_a_checkpoint() {
+    let dir = common::fresh_dir("cli_study", "element_time");
+    let dir_s = dir.to_str().unwrap();
+    let mut argv = vec!["bed", "--quiet", "--out", dir_s, "--stop-at-strain", "0.2"];
+    argv.extend_from_slice(&common::small_bed("30", "0.3"));
+    let bed = cli(&argv);
+    assert_eq!(bed.code, 0, "{}", bed.stderr);
+    let deformable = granbed_cli::bed::checkpoint::Checkpoint::read(&dir)
+        .unwrap()
+        .state
+        .granules
+        .iter()
+        .filter(|g| !g.rigid)
+        .count();
+    assert!(deformable > 0);
+    let measure = |path: &str| {
+        let run = cli(&[
+            "study",
+            "element-time",
+            dir_s,
+            "--passes",
+            "3",
+            "--path",
+            path,
+        ]);
+        assert_eq!(run.code, 0, "{}", run.stderr);
+        let t = Table::parse(&run.stdout);
+        assert_eq!(t.cells.len(), 1, "{}", run.stdout);
+        let get = |name: &str| t.num(name)[0];
+        // 160 hexes per coarse 4x1 granule.
+        assert_eq!(get("element_steps_per_pass"), (deformable * 160) as f64);
+        assert_eq!(get("passes"), 3.0);
+        assert!((get("strain") - 0.2).abs() < 0.01, "{}", run.stdout);
+        let (median, min) = (
+            get("median_ns_per_element_step"),
+            get("min_ns_per_element_step"),
+        );
+        assert!(min > 0.0 && median >= min, "{}", run.stdout);
+        get("plastic_fraction")
+    };
+    let batched = measure("fastest");
+    let scalar = measure("scalar");
+    assert_eq!(batched, scalar);
+    assert!(batched > 0.0 && batched < 1.0, "plastic fraction {batched}");
+
+    let bad = cli(&["study", "element-time", dir_s, "--passes", "0"]);
+    assert_ne!(bad.code, 0);
+    assert!(
+        bad.stderr.contains("--passes") && bad.stderr.contains("1 to 1000"),
+        "{}",
+        bad.stderr
+    );
+    let empty = common::fresh_dir("cli_study", "element_time_empty");
+    let missing = cli(&["study", "element-time", empty.to_str().unwrap()]);
+    assert_ne!(missing.code, 0);
+    assert!(missing.stderr.contains("checkpoint"), "{}", missing.stderr);
+}

@@ -5,7 +5,9 @@
 //! * `stability` ([`stability`]): every type in beds to 60 % and as single
 //!   granules to 70 %, with the numerics of each run judged;
 //! * `compare` ([`compare`]): the work-precision measures between two
-//!   finished bed runs.
+//!   finished bed runs;
+//! * `element-time` ([`element_time`]): the element loop's time per
+//!   element-step on a bed checkpoint's state.
 
 use std::path::PathBuf;
 
@@ -18,6 +20,7 @@ use crate::output::Streams;
 
 pub mod bed_small;
 pub mod compare;
+pub mod element_time;
 pub mod stability;
 pub mod work_precision;
 
@@ -53,6 +56,13 @@ pub enum Study {
     /// searches per step, from their `compression.csv` and
     /// `summary.json`.
     Compare(compare::CompareArgs),
+    /// The one-point element loop's time per element-step on one core, on
+    /// the state of a bed checkpoint: every deformable granule's internal
+    /// forces at the checkpoint's positions, from its C_p⁻¹, in timed passes
+    /// (each from the checkpoint's state); prints the median and the
+    /// fastest pass's ns per element-step and the share of elements that
+    /// yielded.
+    ElementTime(element_time::ElementTimeArgs),
 }
 
 /// The scene of a work-precision study.
@@ -207,6 +217,7 @@ impl StudyArgs {
             Study::WorkPrecision(args) => args.run(streams),
             Study::Stability(args) => args.run(streams),
             Study::Compare(args) => args.run(streams),
+            Study::ElementTime(args) => args.run(streams),
         }
     }
 }
