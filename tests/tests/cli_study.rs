@@ -408,8 +408,9 @@ fn study_compare_measures_two_finished_runs() {
 /// deformable granules' elements, every pass does the same work (the
 /// element-by-element path and the batches see the same yielding share,
 /// which is neither zero nor one), the times are positive and the median
-/// is no faster than the fastest pass; a bad `--passes` is named with its
-/// range, a directory without a checkpoint is an error.
+/// is no faster than the fastest pass; an F-bar bed's checkpoint is timed
+/// as F-bar; a bad `--passes` is named with its range, a directory without
+/// a checkpoint is an error.
 #[test]
 fn element_time_measures_the_element_loop_on_a_checkpoint() {
     let dir = common::fresh_dir("cli_study", "element_time");
@@ -455,6 +456,23 @@ fn element_time_measures_the_element_loop_on_a_checkpoint() {
     let scalar = measure("scalar");
     assert_eq!(batched, scalar);
     assert!(batched > 0.0 && batched < 1.0, "plastic fraction {batched}");
+    let run = cli(&["study", "element-time", dir_s, "--passes", "1"]);
+    assert!(run.stdout.contains(",one-point,"), "{}", run.stdout);
+
+    // The F-bar element of the same bed: its own row, element by element.
+    let fbar = common::fresh_dir("cli_study", "element_time_fbar");
+    let fbar_s = fbar.to_str().unwrap();
+    let mut argv = vec!["bed", "--quiet", "--out", fbar_s, "--element", "fbar"];
+    argv.extend_from_slice(&["--stop-at-strain", "0.02"]);
+    argv.extend_from_slice(&common::small_bed("30", "0.3"));
+    let bed = cli(&argv);
+    assert_eq!(bed.code, 0, "{}", bed.stderr);
+    let run = cli(&["study", "element-time", fbar_s, "--passes", "1"]);
+    assert_eq!(run.code, 0, "{}", run.stderr);
+    let t = Table::parse(&run.stdout);
+    assert_eq!(t.text("element"), ["fbar"]);
+    assert_eq!(t.text("path"), ["Scalar"]);
+    assert!(t.num("median_ns_per_element_step")[0] > 0.0);
 
     let bad = cli(&["study", "element-time", dir_s, "--passes", "0"]);
     assert_ne!(bad.code, 0);

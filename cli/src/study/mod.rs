@@ -56,7 +56,7 @@ pub enum Study {
     /// searches per step, from their `compression.csv` and
     /// `summary.json`.
     Compare(compare::CompareArgs),
-    /// The one-point element loop's time per element-step on one core, on
+    /// The element loop's time per element-step on one core, on
     /// the state of a bed checkpoint: every deformable granule's internal
     /// forces at the checkpoint's positions, from its C_p⁻¹, in timed passes
     /// (each from the checkpoint's state); prints the median and the
