@@ -419,14 +419,21 @@ fn element_time_measures_the_element_loop_on_a_checkpoint() {
     argv.extend_from_slice(&common::small_bed("30", "0.3"));
     let bed = cli(&argv);
     assert_eq!(bed.code, 0, "{}", bed.stderr);
-    let deformable = granbed_cli::bed::checkpoint::Checkpoint::read(&dir)
-        .unwrap()
+    let checkpoint = granbed_cli::bed::checkpoint::Checkpoint::read(&dir).unwrap();
+    let deformable = checkpoint
         .state
         .granules
         .iter()
         .filter(|g| !g.rigid)
         .count();
     assert!(deformable > 0);
+    // Through the library: no passes is an error, not a division by zero.
+    let none = granbed_cli::study::element_time::measure(
+        &checkpoint,
+        0,
+        granbed_kernel::element::batch::ElementPath::Scalar,
+    );
+    assert!(none.is_err());
     let measure = |path: &str| {
         let run = cli(&[
             "study",

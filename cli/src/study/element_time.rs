@@ -162,6 +162,15 @@ pub fn measure(
         .iter()
         .filter(|g| !g.rigid)
         .collect();
+    if passes == 0 {
+        anyhow::bail!("no passes to time (at least 1)");
+    }
+    if granules.is_empty() {
+        anyhow::bail!(
+            "every granule of the checkpoint is still rigid (untouched), so no element is \
+             evaluated: take a later checkpoint"
+        );
+    }
     let nodes = view.mesh.positions.len();
     let points = view.mesh.hexes.len() * settings.points_per_element();
     for (i, g) in granules.iter().enumerate() {
