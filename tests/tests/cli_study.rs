@@ -405,9 +405,10 @@ fn study_compare_measures_two_finished_runs() {
 
 /// `granbed-cli study element-time` on a checkpoint of a small bed stopped
 /// where its granules yield: one row, the element-steps of a pass are the
-/// deformable granules' elements, every pass does the same work (the
-/// element-by-element path and the batches see the same yielding share,
-/// which is neither zero nor one), the times are positive and the median
+/// deformable granules' elements, every pass does the same work (the same
+/// elements yield in each, and the element-by-element path and the batches
+/// see the same yielding share, neither zero nor one), the times are
+/// positive and the median
 /// is no faster than the fastest pass; an F-bar bed's checkpoint is timed
 /// as F-bar; a bad `--passes` is named with its range, a directory without
 /// a checkpoint is an error.
@@ -434,6 +435,17 @@ fn element_time_measures_the_element_loop_on_a_checkpoint() {
         granbed_kernel::element::batch::ElementPath::Scalar,
     );
     assert!(none.is_err());
+    // Every pass from the checkpoint's state: the same elements yield in
+    // each (a pass from the last one's returned state would find them on
+    // the yield surface).
+    let three = granbed_cli::study::element_time::measure(
+        &checkpoint,
+        3,
+        granbed_kernel::element::batch::ElementPath::Scalar,
+    )
+    .unwrap();
+    assert!(three.plastic_elements[0] > 0);
+    assert_eq!(three.plastic_elements, [three.plastic_elements[0]; 3]);
     let measure = |path: &str| {
         let run = cli(&[
             "study",

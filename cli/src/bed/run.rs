@@ -13,7 +13,6 @@ use granbed_kernel::analysis::bed::{
     surface_geometry,
 };
 use granbed_kernel::dem::pour::PourParams;
-use granbed_kernel::granule::forces::ElementSettings;
 
 use super::checkpoint::{self, Checkpoint};
 use super::scene::Scene;
@@ -271,7 +270,7 @@ pub struct RunControl {
 
 /// The pour's parameters for `scene`.
 fn pour_params(scene: &Scene, material: &granbed_kernel::material::Material) -> PourParams {
-    let radius = 0.5e-3 * scene.diameter_mm;
+    let radius = scene.radius_m();
     let mut pour = PourParams::standard(material.density0, scene.seed);
     let scale = radius / pour.radius;
     pour.granules = scene.granules;
@@ -295,13 +294,9 @@ pub fn run_bed(
     observer: &mut dyn BedObserver,
 ) -> anyhow::Result<BedRun> {
     let material = scene.material()?;
-    let radius = 0.5e-3 * scene.diameter_mm;
-    let mesh = OwnedReference::sphere(radius, scene.mesh_level()?, false)?;
-    let elements = ElementSettings {
-        kind: scene.element_kind()?,
-        update: Default::default(),
-        hourglass_kappa: scene.hourglass_kappa,
-    };
+    let radius = scene.radius_m();
+    let mesh = scene.granule_mesh()?;
+    let elements = scene.element_settings()?;
     let mut params = AssemblyParams::standard(material, elements);
     params.damping_ratio = scene.damping_ratio;
     params.contact_sweeps = scene.contact_sweeps;

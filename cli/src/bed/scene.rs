@@ -3,13 +3,13 @@
 //! embedded default (the published scene) and its validation.
 
 use anyhow::{Context as _, bail};
-use granbed_kernel::granule::forces::ElementKind;
+use granbed_kernel::granule::forces::{ElementKind, ElementSettings};
 use granbed_kernel::material::{GranuleType, Material, MaterialParams};
 use serde::{Deserialize, Serialize};
 
 use crate::assembly::MAX_CONTACT_SEARCH_INTERVAL;
 use crate::error::InputError;
-use crate::model::MeshLevel;
+use crate::model::{MeshLevel, OwnedReference};
 
 /// The format version this build reads and writes.
 pub const SCENE_VERSION: u32 = 1;
@@ -557,6 +557,26 @@ impl Scene {
         self.mesh
             .parse()
             .map_err(|m: String| invalid("mesh", &self.mesh, &m))
+    }
+
+    /// The granules' radius, m.
+    pub fn radius_m(&self) -> f64 {
+        0.5e-3 * self.diameter_mm
+    }
+
+    /// The reference mesh of every granule (the whole sphere).
+    pub fn granule_mesh(&self) -> anyhow::Result<OwnedReference> {
+        OwnedReference::sphere(self.radius_m(), self.mesh_level()?, false)
+    }
+
+    /// The element loop's settings: the element, the default constitutive
+    /// switches and the hourglass coefficient.
+    pub fn element_settings(&self) -> anyhow::Result<ElementSettings> {
+        Ok(ElementSettings {
+            kind: self.element_kind()?,
+            update: Default::default(),
+            hourglass_kappa: self.hourglass_kappa,
+        })
     }
 
     /// The type's preset with the overrides (not validated).

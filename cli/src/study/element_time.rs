@@ -21,12 +21,11 @@ use std::time::Instant;
 use anyhow::Context as _;
 use clap::{Args, ValueEnum};
 use granbed_kernel::element::batch::ElementPath;
-use granbed_kernel::granule::forces::{ElementKind, ElementSettings, internal_forces_on};
+use granbed_kernel::granule::forces::{ElementKind, internal_forces_on};
 
 use crate::bed::checkpoint::Checkpoint;
 use crate::bed::scene::Scene;
 use crate::error::InputError;
-use crate::model::OwnedReference;
 use crate::output::Streams;
 
 /// The element loop's code path ([`ElementPath`]).
@@ -78,8 +77,9 @@ pub struct ElementTime {
     pub kind: ElementKind,
     /// Element-steps per pass (elements of the deformable granules).
     pub element_steps: usize,
-    /// Elements that yielded in a pass.
-    pub plastic_elements: usize,
+    /// Elements that yielded, in each pass (every pass starts from the
+    /// checkpoint's state, so these agree).
+    pub plastic_elements: Vec<usize>,
     /// Wall time of each pass's timed calls, s, in pass order.
     pub pass_seconds: Vec<f64>,
 }
@@ -130,7 +130,7 @@ impl ElementTimeArgs {
             streams.stdout,
             "{strain:.4},{element},{path:?},{},{:.4},{},{:.2},{:.2}",
             t.element_steps,
-            t.plastic_elements as f64 / t.element_steps as f64,
+            t.plastic_elements[0] as f64 / t.element_steps as f64,
             t.pass_seconds.len(),
             t.median_ns(),
             t.min_ns()
@@ -149,13 +149,9 @@ pub fn measure(
     let scene =
         Scene::from_toml(&checkpoint.progress.scene_toml).context("the checkpoint's scene")?;
     let material = scene.material()?;
-    let mesh = OwnedReference::sphere(0.5e-3 * scene.diameter_mm, scene.mesh_level()?, false)?;
+    let mesh = scene.granule_mesh()?;
     let view = mesh.view();
-    let settings = ElementSettings {
-        kind: scene.element_kind()?,
-        update: Default::default(),
-        hourglass_kappa: scene.hourglass_kappa,
-    };
+    let settings = scene.element_settings()?;
     let granules: Vec<_> = checkpoint
         .state
         .granules
@@ -180,11 +176,10 @@ pub fn measure(
     }
     let mut cp_inv = vec![[0.0; 6]; points];
     let mut f = vec![[0.0; 3]; nodes];
-    let mut plastic_elements = 0;
+    let mut plastic_elements = Vec::with_capacity(passes as usize);
     let mut pass_seconds = Vec::with_capacity(passes as usize);
     for _ in 0..passes {
-        let mut seconds = 0.0;
-        plastic_elements = 0;
+        let (mut seconds, mut plastic) = (0.0, 0);
         for (i, g) in granules.iter().enumerate() {
             cp_inv.copy_from_slice(&g.cp_inv);
             let start = Instant::now();
@@ -192,9 +187,10 @@ pub fn measure(
                 internal_forces_on(path, &view, &material, &settings, &g.x, &mut cp_inv, &mut f);
             seconds += start.elapsed().as_secs_f64();
             let summary = summary.with_context(|| format!("deformable granule {i}"))?;
-            plastic_elements += summary.plastic_elements;
+            plastic += summary.plastic_elements;
         }
         pass_seconds.push(seconds);
+        plastic_elements.push(plastic);
     }
     Ok(ElementTime {
         kind: settings.kind,
