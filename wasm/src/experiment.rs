@@ -9,6 +9,7 @@ use alloc::string::String;
 use alloc::vec::Vec;
 use core::fmt::Write as _;
 
+use granbed_host::OwnedReference;
 use granbed_kernel::Real;
 use granbed_kernel::analysis::fit::LineFit;
 use granbed_kernel::analysis::granule::{initial_effective_yield_stress, yield_stress_estimate};
@@ -18,7 +19,7 @@ use granbed_kernel::scene::platens::{
     PlatenParams, PlatenSample, PlatenScene, SAMPLE_COLUMNS, SceneError,
 };
 
-use crate::mesh::{OctantMesh, give_back, octant_mesh, take_buffers};
+use crate::mesh::{give_back, octant_mesh, take_buffers};
 
 /// Strain range of the σ_est fit, x/d (as `granbed-cli granule`).
 pub const FIT_STRAIN_RANGE: [Real; 2] = [0.1, 0.4];
@@ -196,7 +197,7 @@ pub struct Measures {
 /// A running (or finished) experiment.
 pub struct Experiment {
     scene: Option<PlatenScene<'static>>,
-    mesh: &'static OctantMesh,
+    mesh: &'static OwnedReference,
     inputs: Inputs,
     params: PlatenParams,
     diameter: Real,
@@ -223,7 +224,7 @@ impl Experiment {
         })?;
         let params = PlatenParams::standard(material);
         let points = params.elements.points_per_element();
-        let buffers = take_buffers(mesh.positions.len(), mesh.hexes.len() * points);
+        let buffers = take_buffers(mesh, points);
         // On failure the scene has consumed the buffers: they are leaked,
         // which happens only for an unstable initial step.
         let mut scene = PlatenScene::new(params, mesh.view(), buffers)?;
@@ -320,7 +321,7 @@ impl Experiment {
     }
 
     /// The simulated octant mesh.
-    pub fn mesh(&self) -> &'static OctantMesh {
+    pub fn mesh(&self) -> &'static OwnedReference {
         self.mesh
     }
 

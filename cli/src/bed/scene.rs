@@ -566,7 +566,11 @@ impl Scene {
 
     /// The reference mesh of every granule (the whole sphere).
     pub fn granule_mesh(&self) -> anyhow::Result<OwnedReference> {
-        OwnedReference::sphere(self.radius_m(), self.mesh_level()?, false)
+        Ok(OwnedReference::sphere(
+            self.radius_m(),
+            self.mesh_level()?,
+            false,
+        )?)
     }
 
     /// The element loop's settings: the element, the default constitutive
