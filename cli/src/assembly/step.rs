@@ -11,7 +11,7 @@ use granbed_kernel::granule::damping::{RigidFrame, selective_contact_masses};
 use granbed_kernel::granule::dynamics::{
     Loads, StepSizes, StepWork, correct_in, predict_in, predict_rigid,
 };
-use granbed_kernel::granule::forces::{ElementFailure, ForceSummary, elastic_energy};
+use granbed_kernel::granule::forces::{ForceSummary, ForcesError, elastic_energy};
 use granbed_kernel::granule::quality::worst_element;
 use granbed_kernel::granule::timestep::{Linearisation, PowerIterationBuffers, TimeStepMethod};
 use rayon::prelude::*;
@@ -37,7 +37,7 @@ pub enum AssemblyError {
         /// Step.
         step: u64,
         /// The element and what went wrong.
-        failure: ElementFailure,
+        failure: ForcesError,
     },
     /// The contact phase could not proceed.
     Contact {
@@ -547,7 +547,10 @@ impl Assembly<'_> {
         let per: Vec<Real> = self
             .granules
             .par_iter()
-            .map(|g| elastic_energy(&view, &p.material, &p.elements, &g.x, &g.cp_inv))
+            .map(|g| {
+                elastic_energy(&view, &p.material, &p.elements, &g.x, &g.cp_inv)
+                    .expect("every granule's buffers are sized from the mesh")
+            })
             .collect();
         self.energies.elastic = per.iter().sum();
         self.energies.elastic
@@ -680,7 +683,7 @@ impl Assembly<'_> {
             .resize(self.granules.len(), RigidFrame::default());
         self.frame_motions.resize(self.granules.len(), None);
         let surface = self.mesh.surface_range();
-        let predicted: Vec<Result<ForceSummary, ElementFailure>> = self
+        let predicted: Vec<Result<ForceSummary, ForcesError>> = self
             .granules
             .par_iter_mut()
             .zip(self.frames.par_iter_mut())

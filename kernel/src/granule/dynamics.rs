@@ -30,7 +30,7 @@ use crate::Real;
 use crate::granule::damping::{
     MomentSums, RigidFrame, RigidMotion, damping_forces_in, damping_forces_of, selective_excess_of,
 };
-use crate::granule::forces::{ElementFailure, ElementSettings, ForceSummary, internal_forces};
+use crate::granule::forces::{ElementSettings, ForceSummary, ForcesError, internal_forces};
 use crate::material::Material;
 use crate::mesh::reference::ReferenceMesh;
 use crate::tensor::{VOIGT_IDENTITY, Voigt};
@@ -185,7 +185,7 @@ pub fn predict(
     b: &mut GranuleBuffers<'_>,
     sizes: StepSizes,
     loads: &Loads,
-) -> Result<ForceSummary, ElementFailure> {
+) -> Result<ForceSummary, ForcesError> {
     let frame = own_frame(b, loads.rigid_modes);
     predict_in(&frame, None, mesh, mat, settings, b, sizes, loads)
 }
@@ -209,7 +209,7 @@ pub fn predict_in(
     b: &mut GranuleBuffers<'_>,
     sizes: StepSizes,
     loads: &Loads,
-) -> Result<ForceSummary, ElementFailure> {
+) -> Result<ForceSummary, ForcesError> {
     let summary = internal_forces(mesh, mat, settings, b.x, b.cp_inv, b.f_int)?;
     let frame = loads.rigid_modes.then_some(frame);
     match (frame, velocity_motion) {

@@ -60,6 +60,101 @@ impl fmt::Display for ElementFailure {
 
 impl core::error::Error for ElementFailure {}
 
+/// Why an element pass could not run, or stopped.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum ForcesError {
+    /// A buffer's length does not match the mesh: `x` and `f` hold one
+    /// entry per node, `cp_inv` one per integration point, the mesh's
+    /// `elements` one per hex.
+    BufferLength {
+        /// The buffer.
+        buffer: &'static str,
+        /// Entries expected.
+        expected: usize,
+        /// Entries given.
+        got: usize,
+    },
+    /// A hex names a node beyond the node buffers.
+    NodeId {
+        /// The largest node id of the mesh's hexes.
+        id: u32,
+        /// Nodes (ids must be below this).
+        nodes: usize,
+    },
+    /// An element's update failed.
+    Element(ElementFailure),
+}
+
+impl fmt::Display for ForcesError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Self::BufferLength {
+                buffer,
+                expected,
+                got,
+            } => write!(
+                f,
+                "element buffer `{buffer}` has {got} entries, expected {expected}"
+            ),
+            Self::NodeId { id, nodes } => write!(
+                f,
+                "a hex names node {id}, but there are {nodes} nodes (ids 0..{nodes})"
+            ),
+            Self::Element(failure) => failure.fmt(f),
+        }
+    }
+}
+
+impl core::error::Error for ForcesError {}
+
+impl From<ElementFailure> for ForcesError {
+    fn from(failure: ElementFailure) -> Self {
+        Self::Element(failure)
+    }
+}
+
+/// Checks an element pass's buffers against `mesh` (lengths `x`, `cp_inv`,
+/// `f`), as [`internal_forces`] and [`elastic_energy`] do before they run,
+/// so that no length or node id can make the loop index out of bounds: `x` (and
+/// `f`, when given) one entry per node, `cp_inv` `points` per hex, the
+/// mesh's `elements` one per hex, every node id of `hexes` below the node
+/// count (one pass over the ids: a maximum the compiler vectorises, about
+/// 1 % of an element pass).
+pub fn check_element_buffers(
+    mesh: &ReferenceMesh<'_>,
+    points: usize,
+    x: usize,
+    cp_inv: usize,
+    f: Option<usize>,
+) -> Result<(), ForcesError> {
+    let nodes = mesh.mesh.positions.len();
+    let hexes = mesh.mesh.hexes.len();
+    for (buffer, expected, got) in [
+        ("x", nodes, x),
+        ("f", nodes, f.unwrap_or(nodes)),
+        ("cp_inv", hexes * points, cp_inv),
+        ("elements", hexes, mesh.elements.len()),
+    ] {
+        if got != expected {
+            return Err(ForcesError::BufferLength {
+                buffer,
+                expected,
+                got,
+            });
+        }
+    }
+    let id = mesh
+        .mesh
+        .hexes
+        .as_flattened()
+        .iter()
+        .fold(0, |m, &i| m.max(i));
+    if hexes > 0 && id as usize >= nodes {
+        return Err(ForcesError::NodeId { id, nodes });
+    }
+    Ok(())
+}
+
 /// What an element pass measured.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct ForceSummary {
@@ -83,9 +178,11 @@ pub struct ForceSummary {
 /// element, element by element (in/out). The one-point element runs on the
 /// fastest [`ElementPath`] of the processor (all paths give the same bits).
 ///
-/// Lengths: `x`, `f` = nodes; `cp_inv` = hexes × points per element
-/// (checked by the scene's setup; a mismatch panics on indexing — see the
-/// crate's slice policy).
+/// Lengths: `x`, `f` = nodes; `cp_inv` = hexes × points per element; the
+/// mesh's `elements` = hexes; node ids below the node count. Checked
+/// before anything is written ([`ForcesError::BufferLength`],
+/// [`ForcesError::NodeId`]); an element whose update fails stops the pass
+/// with [`ForcesError::Element`].
 pub fn internal_forces(
     mesh: &ReferenceMesh<'_>,
     mat: &Material,
@@ -93,7 +190,7 @@ pub fn internal_forces(
     x: &[[Real; 3]],
     cp_inv: &mut [Voigt],
     f: &mut [[Real; 3]],
-) -> Result<ForceSummary, ElementFailure> {
+) -> Result<ForceSummary, ForcesError> {
     internal_forces_on(ElementPath::fastest(), mesh, mat, settings, x, cp_inv, f)
 }
 
@@ -107,7 +204,14 @@ pub fn internal_forces_on(
     x: &[[Real; 3]],
     cp_inv: &mut [Voigt],
     f: &mut [[Real; 3]],
-) -> Result<ForceSummary, ElementFailure> {
+) -> Result<ForceSummary, ForcesError> {
+    check_element_buffers(
+        mesh,
+        settings.points_per_element(),
+        x.len(),
+        cp_inv.len(),
+        Some(f.len()),
+    )?;
     f.fill([0.0; 3]);
     let mut s = ForceSummary {
         min_j: Real::INFINITY,
@@ -226,14 +330,22 @@ impl Sink for Assemble<'_> {
 
 /// Stored elastic energy Σ ∫ψ(b^e, J^e) dV0 of a granule, J, with
 /// b^e = F C_p⁻¹ Fᵀ and J^e = det F √det C_p⁻¹ at each integration point
-/// (F = F̄ of the element's formulation). `cp_inv` as in [`internal_forces`].
+/// (F = F̄ of the element's formulation). `x` and `cp_inv` as in
+/// [`internal_forces`], checked the same way.
 pub fn elastic_energy(
     mesh: &ReferenceMesh<'_>,
     mat: &Material,
     settings: &ElementSettings,
     x: &[[Real; 3]],
     cp_inv: &[Voigt],
-) -> Real {
+) -> Result<Real, ForcesError> {
+    check_element_buffers(
+        mesh,
+        settings.points_per_element(),
+        x.len(),
+        cp_inv.len(),
+        None,
+    )?;
     let mut energy = 0.0;
     match settings.kind {
         ElementKind::OnePoint => {
@@ -258,5 +370,5 @@ pub fn elastic_energy(
             }
         }
     }
-    energy
+    Ok(energy)
 }

@@ -25,7 +25,9 @@ use crate::contact::rigid::RigidShift;
 use crate::contact::wall::{Plane, PredictedNodes, plane_contact};
 use crate::granule::damping::damping_coefficient;
 use crate::granule::dynamics::{GranuleBuffers, Loads, StepSizes, correct, predict};
-use crate::granule::forces::{ElementFailure, ElementKind, ElementSettings, elastic_energy};
+use crate::granule::forces::{
+    ElementKind, ElementSettings, ForcesError, check_element_buffers, elastic_energy,
+};
 use crate::granule::timestep::{
     Linearisation, PowerIterationBuffers, TimeStepControl, TimeStepMethod, power_start,
 };
@@ -241,8 +243,9 @@ pub enum SceneError {
         step: u64,
         /// Strain reached.
         strain: Real,
-        /// The element and its error.
-        failure: ElementFailure,
+        /// The element and its error (or, at step 0, a mesh whose hexes
+        /// name nodes it does not have).
+        failure: ForcesError,
     },
     /// The motion became non-finite or an element inverted while the time
     /// step was re-estimated.
@@ -534,6 +537,29 @@ impl<'a> PlatenScene<'a> {
             });
         }
         check_len("node_volume", mesh.node_volume.len(), nodes)?;
+        check_element_buffers(
+            &mesh,
+            params.elements.points_per_element(),
+            nodes,
+            states,
+            None,
+        )
+        .map_err(|failure| match failure {
+            ForcesError::BufferLength {
+                buffer,
+                expected,
+                got,
+            } => SceneError::BufferLength {
+                buffer,
+                expected,
+                got,
+            },
+            failure => SceneError::Element {
+                step: 0,
+                strain: 0.0,
+                failure,
+            },
+        })?;
         let mat = Material {
             density0: params.material.density0 * params.mass_scaling,
             ..params.material
@@ -672,7 +698,9 @@ impl<'a> PlatenScene<'a> {
                 &self.params.elements,
                 self.buf.x,
                 self.buf.cp_inv,
-            );
+            )
+            // The buffers and the mesh were checked by `new`.
+            .unwrap_or(Real::NAN);
         let avg = |impulse: Real| {
             if self.window_time > 0.0 {
                 self.force_scale * impulse / self.window_time
