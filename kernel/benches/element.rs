@@ -291,7 +291,8 @@ fn bench_granule_step(c: &mut Criterion) {
                     correct_in(&frame, &mut b, sizes, &loads)
                 } else {
                     correct(&mut b, sizes, &loads)
-                };
+                }
+                .expect("the bench's buffers fit");
                 black_box(w.kinetic)
             })
         });

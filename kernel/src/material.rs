@@ -101,16 +101,34 @@ fn check(
     }
 }
 
+/// Allowed Young's modulus, Pa: from a gel to ten times diamond's; beyond
+/// these the elastic constants, the wave speed and the stable time step
+/// leave the range of `f64` arithmetic this code is tested in.
+pub const YOUNGS_MODULUS_RANGE_PA: [Real; 2] = [1e-3, 1e13];
+
+/// The smallest yield stress, Pa: the yield function scales with σ_y², which
+/// must stay a normal `f64` (a σ_y of 1e-300 made the first step's motion
+/// non-finite).
+pub const MIN_YIELD_STRESS_PA: Real = 1e-3;
+
+/// The largest compaction coefficient c_p (a1 = c_p(1 − η²); the standard
+/// types use 0.3).
+pub const MAX_CP: Real = 1e3;
+
+/// Allowed true density, kg/m³ (osmium is 22 600).
+pub const DENSITY_RANGE_KG_M3: [Real; 2] = [1e-3, 1e5];
+
 impl MaterialParams {
     /// Checks every field against its documented range (NaN is always
     /// rejected) and derives the elastic constants.
     pub fn validate(&self) -> Result<Material, ParamError> {
         let p = self;
         check(
-            p.youngs_modulus_pa.is_finite() && p.youngs_modulus_pa > 0.0,
+            (YOUNGS_MODULUS_RANGE_PA[0]..=YOUNGS_MODULUS_RANGE_PA[1])
+                .contains(&p.youngs_modulus_pa),
             "youngs_modulus_pa",
             p.youngs_modulus_pa,
-            "finite and > 0",
+            "1e-3 <= E <= 1e13 Pa",
         )?;
         check(
             p.poisson_ratio > -1.0 && p.poisson_ratio < 0.5,
@@ -119,10 +137,10 @@ impl MaterialParams {
             "-1 < nu < 0.5",
         )?;
         check(
-            p.yield_stress_pa > 0.0,
+            p.yield_stress_pa >= MIN_YIELD_STRESS_PA,
             "yield_stress_pa",
             p.yield_stress_pa,
-            "> 0 (+inf for a purely elastic material)",
+            ">= 1e-3 Pa (+inf for a purely elastic material)",
         )?;
         check(
             p.eta_c >= 0.0 && p.eta_c < 1.0,
@@ -136,17 +154,12 @@ impl MaterialParams {
             p.eta0,
             "eta_c < eta0 <= 1",
         )?;
+        check((0.0..=MAX_CP).contains(&p.cp), "cp", p.cp, "0 <= cp <= 1e3")?;
         check(
-            p.cp.is_finite() && p.cp >= 0.0,
-            "cp",
-            p.cp,
-            "finite and >= 0",
-        )?;
-        check(
-            p.true_density_kg_m3.is_finite() && p.true_density_kg_m3 > 0.0,
+            (DENSITY_RANGE_KG_M3[0]..=DENSITY_RANGE_KG_M3[1]).contains(&p.true_density_kg_m3),
             "true_density_kg_m3",
             p.true_density_kg_m3,
-            "finite and > 0",
+            "1e-3 <= rho <= 1e5 kg/m3",
         )?;
         check(
             p.friction.is_finite() && p.friction >= 0.0,
@@ -279,7 +292,38 @@ mod tests {
     #[test]
     fn bad_fields_are_named() {
         let base = GranuleType::A1.params();
-        let cases: [(MaterialParams, &str); 6] = [
+        let cases: [(MaterialParams, &str); 11] = [
+            // Extremes that used to pass and then made the first step's
+            // motion non-finite (λ = ∞, σ_y² = 0, zero masses).
+            (
+                MaterialParams {
+                    youngs_modulus_pa: 1e300,
+                    ..base
+                },
+                "youngs_modulus_pa",
+            ),
+            (
+                MaterialParams {
+                    youngs_modulus_pa: 5e-324,
+                    ..base
+                },
+                "youngs_modulus_pa",
+            ),
+            (
+                MaterialParams {
+                    yield_stress_pa: 1e-300,
+                    ..base
+                },
+                "yield_stress_pa",
+            ),
+            (
+                MaterialParams {
+                    true_density_kg_m3: 1e-300,
+                    ..base
+                },
+                "true_density_kg_m3",
+            ),
+            (MaterialParams { cp: 1e300, ..base }, "cp"),
             (MaterialParams { eta0: 0.2, ..base }, "eta0"),
             (
                 MaterialParams {

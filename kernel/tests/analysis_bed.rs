@@ -148,7 +148,7 @@ fn standard_shape(positions: &[[Real; 3]], quads: &[[u32; 4]], v0: Real) -> Gran
 #[test]
 fn standard_mesh_heywood() {
     let m = sphere_mesh(&SphereMeshParams::standard());
-    let (_, v0) = area_and_volume(&m.positions, &m.quads);
+    let (_, v0) = area_and_volume(&m.positions, &m.quads).unwrap();
     let s = standard_shape(&m.positions, &m.quads, v0);
     println!(
         "standard mesh: V = {:.6e} m³, S = {:.6e} m², α(d_V) = {:.6}, α(1 mm) = {:.6}, η = {}",
@@ -183,7 +183,7 @@ fn heywood_tends_to_six_for_a_sphere() {
         .iter()
         .map(|&n| {
             let m = sphere_mesh(&SphereMeshParams::new(r, n, n / 4 + 1));
-            let (_, v0) = area_and_volume(&m.positions, &m.quads);
+            let (_, v0) = area_and_volume(&m.positions, &m.quads).unwrap();
             let e = standard_shape(&m.positions, &m.quads, v0).heywood_dv - 6.0;
             println!("n = {n}: α_SV(d_V) − 6 = {e:.4e}");
             e
@@ -206,7 +206,7 @@ fn heywood_tends_to_six_for_a_sphere() {
 #[test]
 fn heywood_under_scaling_and_stretch() {
     let m = sphere_mesh(&SphereMeshParams::standard());
-    let (_, v0) = area_and_volume(&m.positions, &m.quads);
+    let (_, v0) = area_and_volume(&m.positions, &m.quads).unwrap();
     let s0 = standard_shape(&m.positions, &m.quads, v0);
     let map = |f: &dyn Fn([Real; 3]) -> [Real; 3]| -> Vec<[Real; 3]> {
         m.positions.iter().map(|&x| f(x)).collect()
@@ -271,7 +271,7 @@ fn heywood_under_scaling_and_stretch() {
 #[test]
 fn granule_shape_rejects_bad_input() {
     let m = sphere_mesh(&SphereMeshParams::new(0.5e-3, 4, 1));
-    let (_, v0) = area_and_volume(&m.positions, &m.quads);
+    let (_, v0) = area_and_volume(&m.positions, &m.quads).unwrap();
     let shape = |x: &[[Real; 3]], q: &[[u32; 4]], eta0, v0, d| granule_shape(x, q, eta0, v0, d);
     assert!(matches!(
         shape(&m.positions, &[], 0.6, v0, 1e-3),

@@ -193,3 +193,120 @@ fn elastic_energy_checks_its_buffers_too() {
         })
     );
 }
+
+#[test]
+fn an_hourglass_coefficient_out_of_range_is_an_error() {
+    let fx = fixture();
+    let (h, n) = (fx.mesh.hexes.len(), fx.mesh.positions.len());
+    for kappa in [Real::NAN, -5.0, 1.5] {
+        let mut cp = vec![VOIGT_IDENTITY; h];
+        let mut f = vec![[0.0; 3]; n];
+        let err = internal_forces(
+            &fx.reference(&fx.mesh.hexes),
+            &material(GranuleType::B2),
+            &ElementSettings {
+                hourglass_kappa: kappa,
+                ..settings(ElementKind::OnePoint)
+            },
+            &fx.mesh.positions,
+            &mut cp,
+            &mut f,
+        )
+        .unwrap_err();
+        assert!(
+            matches!(
+                err,
+                ForcesError::InvalidParameter {
+                    field: "hourglass_kappa",
+                    ..
+                }
+            ),
+            "{err}"
+        );
+    }
+}
+
+/// The halves of a step check the granule's buffers and the step sizes
+/// before they write anything: a short buffer or a NaN Δt is an error,
+/// where a slice used to panic and a NaN step to make the motion NaN.
+#[test]
+fn a_step_checks_its_buffers_and_step_sizes() {
+    use granbed_kernel::granule::dynamics::{
+        GranuleBuffers, Loads, StepSizes, correct, predict, predict_rigid,
+    };
+    let fx = fixture();
+    let (h, n) = (fx.mesh.hexes.len(), fx.mesh.positions.len());
+    let mat = material(GranuleType::B2);
+    let reference = fx.reference(&fx.mesh.hexes);
+    let one_point = settings(ElementKind::OnePoint);
+    let loads = Loads {
+        gravity_m_s2: 0.0,
+        damping_c: 0.0,
+        rigid_modes: true,
+        selective_mass_factor: 1.0,
+    };
+    let good = StepSizes {
+        dt_prev: 1e-7,
+        dt: 1e-7,
+    };
+    let z = [0.0; 3];
+    let (mut x, mut v, mut vs, mut xp) = (vec![z; n], vec![z; n], vec![z; n], vec![z; n]);
+    let (mut fi, mut fc, mut fd) = (vec![z; n], vec![z; n], vec![z; n]);
+    let (mut m, mut fixed, mut cp) = (vec![0.0; n], vec![0u8; n], vec![VOIGT_IDENTITY; h]);
+    let mut b = GranuleBuffers {
+        x: &mut x,
+        v: &mut v,
+        v_star: &mut vs,
+        x_pred: &mut xp,
+        f_int: &mut fi,
+        f_c: &mut fc,
+        f_d: &mut fd,
+        mass: &mut m,
+        fixed: &mut fixed,
+        cp_inv: &mut cp,
+    };
+    b.reset(&reference, &mat);
+    predict(&reference, &mat, &one_point, &mut b, good, &loads).unwrap();
+    correct(&mut b, good, &loads).unwrap();
+    for bad in [
+        StepSizes {
+            dt: Real::NAN,
+            ..good
+        },
+        StepSizes { dt: 0.0, ..good },
+        StepSizes {
+            dt_prev: Real::INFINITY,
+            ..good
+        },
+    ] {
+        let before = b.x.to_vec();
+        for err in [
+            predict(&reference, &mat, &one_point, &mut b, bad, &loads).unwrap_err(),
+            predict_rigid(&mut b, bad, &loads).unwrap_err(),
+            correct(&mut b, bad, &loads).unwrap_err(),
+        ] {
+            assert!(matches!(err, ForcesError::InvalidParameter { .. }), "{err}");
+        }
+        assert_eq!(b.x, &before[..], "nothing written");
+    }
+    // A velocity buffer one node short.
+    let mut short_v = vec![z; n - 1];
+    let mut b = GranuleBuffers {
+        v: &mut short_v,
+        ..b
+    };
+    for err in [
+        predict(&reference, &mat, &one_point, &mut b, good, &loads).unwrap_err(),
+        predict_rigid(&mut b, good, &loads).unwrap_err(),
+        correct(&mut b, good, &loads).unwrap_err(),
+    ] {
+        assert_eq!(
+            err,
+            ForcesError::BufferLength {
+                buffer: "v",
+                expected: n,
+                got: n - 1
+            }
+        );
+    }
+}

@@ -64,7 +64,7 @@ fn standard_mesh_geometry() {
     }
     assert_close("V_mesh", volume, 0.514836e-9, 2e-6, 0.0);
     assert_close("V/V_sphere", volume / sphere_volume(), 0.98326, 1e-5, 0.0);
-    let (area, div_volume) = area_and_volume(&m.positions, &m.quads);
+    let (area, div_volume) = area_and_volume(&m.positions, &m.quads).unwrap();
     assert_close("divergence volume", div_volume, volume, 1e-12, 0.0);
     assert_close("S_mesh", area, 3.11550e-6, 2e-6, 0.0);
     assert_close(
@@ -90,7 +90,7 @@ fn volume_converges_at_second_order() {
     let mut deficits = [0.0; 4];
     for (k, n) in [4u32, 8, 16, 32].into_iter().enumerate() {
         let m = sphere_mesh(&SphereMeshParams::new(R, n, (n / 4).max(1)));
-        let (_, v) = area_and_volume(&m.positions, &m.quads);
+        let (_, v) = area_and_volume(&m.positions, &m.quads).unwrap();
         deficits[k] = 1.0 - v / sphere_volume();
         let digits: Real = if k == 0 { 5e-4 } else { 5e-5 };
         assert_close(
@@ -243,4 +243,60 @@ fn bad_resolutions_and_buffers_are_errors() {
         matches!(err, Err(MeshError::InvertedElement { .. })),
         "{err:?}"
     );
+}
+
+/// Connectivity naming nodes the mesh does not have is an error of every
+/// routine that indexes positions by it (it panicked before), and so is a
+/// surface node count beyond the nodes.
+#[test]
+fn ids_out_of_range_are_errors_not_panics() {
+    use granbed_kernel::mesh::octant::{MeshView, octant_size};
+    use granbed_kernel::mesh::reference::compute_element_data;
+    let m = sphere_mesh(&SphereMeshParams::new(R, 4, 1));
+    let n = m.positions.len();
+    let mut hexes = m.hexes.clone();
+    hexes[3][5] = 99_999;
+    let mut quads = m.quads.clone();
+    quads[7][2] = 99_999;
+    let view = |hexes, quads, surface_nodes| MeshView {
+        positions: &m.positions,
+        hexes,
+        quads,
+        surface_nodes,
+    };
+    let good = view(&m.hexes, &m.quads, m.size.surface_nodes);
+    assert_eq!(good.check(), Ok(()));
+    let bad_hex = view(&hexes, &m.quads, m.size.surface_nodes);
+    let expected = Err(MeshError::NodeOutOfRange {
+        buffer: "hexes",
+        index: 3,
+        id: 99_999,
+        nodes: n,
+    });
+    assert_eq!(bad_hex.check(), expected);
+    assert_eq!(octant_size(&bad_hex).map(|_| ()), expected);
+    let mut elements = vec![hex_reference(&m.hex_coords(0)).unwrap(); m.hexes.len()];
+    let mut node_volume = vec![0.0; n];
+    assert_eq!(
+        compute_element_data(&bad_hex, &mut elements, &mut node_volume),
+        expected
+    );
+    let bad_quad = view(&m.hexes, &quads, m.size.surface_nodes);
+    assert!(matches!(
+        bad_quad.check(),
+        Err(MeshError::NodeOutOfRange {
+            buffer: "quads",
+            index: 7,
+            ..
+        })
+    ));
+    assert_eq!(area_and_volume(&m.positions, &quads), None);
+    let too_many = view(&m.hexes, &m.quads, n + 1);
+    assert!(matches!(
+        octant_size(&too_many),
+        Err(MeshError::NodeOutOfRange {
+            buffer: "surface_nodes",
+            ..
+        })
+    ));
 }

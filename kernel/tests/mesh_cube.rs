@@ -110,7 +110,7 @@ fn volume_area_and_element_order() {
             }
         }
         assert_close("sum V0", volume, A * A * A, 1e-12, 0.0);
-        let (area, div_volume) = area_and_volume(&c.positions, &c.quads);
+        let (area, div_volume) = area_and_volume(&c.positions, &c.quads).unwrap();
         assert_close("surface area", area, 6.0 * A * A, 1e-12, 0.0);
         assert_close("divergence volume", div_volume, A * A * A, 1e-12, 0.0);
         for x in &c.positions {

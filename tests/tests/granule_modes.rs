@@ -62,7 +62,7 @@ fn free_run(
     };
     for _ in 0..steps {
         predict(&view, mat, &settings(0.05), &mut b, sizes, &loads).ok()?;
-        let w = correct(&mut b, sizes, &loads);
+        let w = correct(&mut b, sizes, &loads).unwrap();
         if !observe(&b, &w) {
             break;
         }
@@ -288,11 +288,11 @@ fn the_rigid_predictor_is_the_element_predictor_for_an_untouched_granule() {
         };
         for _ in 0..2000 {
             if rigid {
-                predict_rigid(&mut b, sizes, &loads);
+                predict_rigid(&mut b, sizes, &loads).unwrap();
             } else {
                 predict(&view, &mat, &settings(0.05), &mut b, sizes, &loads).unwrap();
             }
-            correct(&mut b, sizes, &loads);
+            correct(&mut b, sizes, &loads).unwrap();
         }
         (b.x.to_vec(), b.v.to_vec(), dt)
     };

@@ -84,12 +84,12 @@ fn run(
     };
     for n in 0..steps {
         if how.rigid_predictor {
-            predict_rigid(&mut b, sizes, &loads);
+            predict_rigid(&mut b, sizes, &loads).unwrap();
         } else {
             predict(&view, &mat, &settings(), &mut b, sizes, &loads).unwrap();
         }
         kick(n, &mut b);
-        let w = correct(&mut b, sizes, &loads);
+        let w = correct(&mut b, sizes, &loads).unwrap();
         observe(&b, dt, &w);
     }
 }

@@ -713,7 +713,7 @@ impl Assembly<'_> {
                     }
                 }
                 if rigid {
-                    return Ok(predict_rigid(&mut g.buffers(), sizes, &loads));
+                    return predict_rigid(&mut g.buffers(), sizes, &loads);
                 }
                 predict_in(
                     frame,
@@ -855,7 +855,7 @@ impl Assembly<'_> {
             constraints += w.step.constraints;
         }
         let contacted_at = clock.elapsed().as_secs_f64();
-        let per: Vec<StepWork> = self
+        let per: Vec<Result<StepWork, ForcesError>> = self
             .granules
             .par_iter_mut()
             .zip(self.frames.par_iter())
@@ -869,6 +869,18 @@ impl Assembly<'_> {
                 )
             })
             .collect();
+        // The buffers and step sizes passed the predictor's checks.
+        let per = per
+            .into_iter()
+            .enumerate()
+            .map(|(granule, r)| {
+                r.map_err(|failure| AssemblyError::Element {
+                    granule,
+                    step,
+                    failure,
+                })
+            })
+            .collect::<Result<Vec<StepWork>, AssemblyError>>()?;
         for ((frame, current), w) in self
             .frames
             .iter_mut()

@@ -156,7 +156,7 @@ impl OwnedReference {
         generate(&params, &mut store.buffers())?;
         if octant {
             let full = store.view();
-            let mut part = MeshStore::new(octant_size(&full));
+            let mut part = MeshStore::new(octant_size(&full)?);
             extract_octant(&full, &mut part.buffers())?;
             store = part;
         }

@@ -244,7 +244,8 @@ pub fn surface_geometry(
             return Err(BedError::NodeOutOfRange { quad, node });
         }
     }
-    let (area_m2, volume_m3) = area_and_volume(positions, quads);
+    // (The ids were checked above; NaN would read as degenerate.)
+    let (area_m2, volume_m3) = area_and_volume(positions, quads).unwrap_or((Real::NAN, Real::NAN));
     if area_m2.is_finite() && area_m2 > 0.0 && volume_m3.is_finite() && volume_m3 > 0.0 {
         Ok((area_m2, volume_m3))
     } else {

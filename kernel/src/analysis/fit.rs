@@ -11,7 +11,8 @@ pub struct LineFit {
     pub slope: Real,
     /// Intercept.
     pub intercept: Real,
-    /// Coefficient of determination R² (1 for a perfect fit; NaN if y is constant).
+    /// Coefficient of determination R² (1 for a perfect fit, including a
+    /// constant y, which the horizontal line fits exactly).
     pub r_squared: Real,
     /// Points used.
     pub points: usize,
@@ -19,7 +20,8 @@ pub struct LineFit {
 
 /// Least-squares line through `points` (x, y), summed in iteration order
 /// after centring on the means (two passes, so the iterator is cloned).
-/// `None` with fewer than two points or when all x are equal.
+/// `None` with fewer than two points, when all x are equal, or when a
+/// coordinate is not finite.
 pub fn linear_fit<I>(points: I) -> Option<LineFit>
 where
     I: Iterator<Item = (Real, Real)> + Clone,
@@ -41,14 +43,18 @@ where
         sxy += dx * dy;
         syy += dy * dy;
     }
-    if sxx == 0.0 {
+    if sxx == 0.0 || !(sxx + syy + mx + my).is_finite() {
         return None;
     }
     let slope = sxy / sxx;
     Some(LineFit {
         slope,
         intercept: my - slope * mx,
-        r_squared: sxy * sxy / (sxx * syy),
+        r_squared: if syy == 0.0 {
+            1.0
+        } else {
+            sxy * sxy / (sxx * syy)
+        },
         points: n,
     })
 }
@@ -56,6 +62,17 @@ where
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn constant_y_fits_exactly_and_non_finite_points_fit_nothing() {
+        let flat = linear_fit([(0.0, 3.0), (1.0, 3.0), (2.0, 3.0)].into_iter()).unwrap();
+        assert_eq!(
+            (flat.slope, flat.intercept, flat.r_squared),
+            (0.0, 3.0, 1.0)
+        );
+        assert!(linear_fit([(0.0, 1.0), (1.0, Real::NAN)].into_iter()).is_none());
+        assert!(linear_fit([(0.0, 1.0), (Real::INFINITY, 2.0)].into_iter()).is_none());
+    }
 
     #[test]
     fn exact_line_is_recovered() {

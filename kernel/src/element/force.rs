@@ -191,7 +191,9 @@ pub fn nodal_forces_into<T: Num>(
 ///
 /// * `cp_inv`: in/out, the element's C_p⁻¹ (start → end of step); untouched
 ///   on error.
-/// * `kappa`: hourglass coefficient κ (dimensionless).
+/// * `kappa`: hourglass coefficient κ (dimensionless, 0 ≤ κ ≤ 1; not
+///   checked here, per element: [`crate::granule::forces::internal_forces`]
+///   and the C ABI check it once per call — a NaN gives NaN forces).
 ///
 /// [`crate::element::batch`] evaluates several elements side by side with
 /// the same bits.

@@ -177,7 +177,42 @@ pub struct StepWork {
     pub next_motion: Option<RigidMotion>,
 }
 
+/// Checks a step's inputs before it writes anything: every node buffer as
+/// long as `x`, and Δt_{n+½} finite and > 0, Δt_{n−½} finite and ≥ 0 (the
+/// node masses are the caller's, set by [`GranuleBuffers::reset`]; they
+/// are not re-checked every step). `cp_inv` is checked against the mesh by
+/// the element pass.
+fn check_step(b: &GranuleBuffers<'_>, sizes: StepSizes) -> Result<(), ForcesError> {
+    if let Some((buffer, expected, got)) = b.wrong_length(b.x.len(), b.cp_inv.len()) {
+        return Err(ForcesError::BufferLength {
+            buffer,
+            expected,
+            got,
+        });
+    }
+    for (field, value, ok, allowed) in [
+        ("dt", sizes.dt, sizes.dt > 0.0, "finite and > 0 s"),
+        (
+            "dt_prev",
+            sizes.dt_prev,
+            sizes.dt_prev >= 0.0,
+            "finite and >= 0 s",
+        ),
+    ] {
+        if !(ok && value.is_finite()) {
+            return Err(ForcesError::InvalidParameter {
+                field,
+                value,
+                allowed,
+            });
+        }
+    }
+    Ok(())
+}
+
 /// First half of a step: forces at x_n, damping, v*, x̃; clears `f_c`.
+/// Errors: a buffer of the wrong length or a bad step size
+/// ([`ForcesError`]), before anything is written; a failed element.
 pub fn predict(
     mesh: &ReferenceMesh<'_>,
     mat: &Material,
@@ -210,6 +245,7 @@ pub fn predict_in(
     sizes: StepSizes,
     loads: &Loads,
 ) -> Result<ForceSummary, ForcesError> {
+    check_step(b, sizes)?;
     let summary = internal_forces(mesh, mat, settings, b.x, b.cp_inv, b.f_int)?;
     let frame = loads.rigid_modes.then_some(frame);
     match (frame, velocity_motion) {
@@ -243,14 +279,20 @@ fn own_frame(b: &GranuleBuffers<'_>, rigid_modes: bool) -> RigidFrame {
 /// translating, never touched since); the step keeps them true, because
 /// with `f_c = 0` every node receives the same gravity acceleration. The
 /// summary reports an undeformed body: J = 1, no plastic or hourglass work.
-pub fn predict_rigid(b: &mut GranuleBuffers<'_>, sizes: StepSizes, loads: &Loads) -> ForceSummary {
+/// Errors as [`predict`]'s checks, before anything is written.
+pub fn predict_rigid(
+    b: &mut GranuleBuffers<'_>,
+    sizes: StepSizes,
+    loads: &Loads,
+) -> Result<ForceSummary, ForcesError> {
+    check_step(b, sizes)?;
     b.f_int.fill([0.0; 3]);
     b.f_d.fill([0.0; 3]);
     advance_predictor(b, sizes, loads, Motion::Translating);
-    ForceSummary {
+    Ok(ForceSummary {
         min_j: 1.0,
         ..ForceSummary::default()
-    }
+    })
 }
 
 /// Whether velocity component `a` of a node with `fixed` bits is held at
@@ -357,7 +399,12 @@ fn contact_increment(dt_ok: bool, dt_n: Real, force: Real, m: Real) -> Real {
 /// Second half of a step: applies the contact forces in `f_c` (with the
 /// selective mass matrix of `loads`, module docs), advances x and v, and
 /// returns the work of every force (gravity `loads.gravity_m_s2`).
-pub fn correct(b: &mut GranuleBuffers<'_>, sizes: StepSizes, loads: &Loads) -> StepWork {
+/// Errors as [`predict`]'s checks, before anything is written.
+pub fn correct(
+    b: &mut GranuleBuffers<'_>,
+    sizes: StepSizes,
+    loads: &Loads,
+) -> Result<StepWork, ForcesError> {
     let frame = own_frame(b, loads.rigid_boost().is_some());
     correct_in(&frame, b, sizes, loads)
 }
@@ -371,14 +418,15 @@ pub fn correct_in(
     b: &mut GranuleBuffers<'_>,
     sizes: StepSizes,
     loads: &Loads,
-) -> StepWork {
+) -> Result<StepWork, ForcesError> {
+    check_step(b, sizes)?;
     let (dt, dt_n) = (sizes.dt, sizes.dt_n());
     let dt_ok = division_skippable(dt_n);
     let gravity_m_s2 = loads.gravity_m_s2;
     let boost = loads.rigid_boost();
     // Every buffer cut to the node count up front, so the loops below
-    // index without bounds checks (the same bits). Callers check the
-    // lengths with `GranuleBuffers::wrong_length`.
+    // index without bounds checks (the same bits); `check_step` made sure
+    // they are that long.
     let n = b.x.len();
     let (mass, fixed, f_c) = (&b.mass[..n], &b.fixed[..n], &b.f_c[..n]);
     let rigid = match boost {
@@ -442,7 +490,7 @@ pub fn correct_in(
     w.max_speed_squared = b.v.iter().fold(0.0, |m: Real, v| {
         m.max(v[0] * v[0] + v[1] * v[1] + v[2] * v[2])
     });
-    w
+    Ok(w)
 }
 
 #[cfg(test)]

@@ -34,6 +34,20 @@ pub struct ElementSettings {
 }
 
 impl ElementSettings {
+    /// [`ForcesError::InvalidParameter`] unless 0 ≤ κ ≤ 1 (a NaN κ made
+    /// every force NaN, a negative one a negative hourglass energy).
+    pub fn check(&self) -> Result<(), ForcesError> {
+        if (0.0..=1.0).contains(&self.hourglass_kappa) {
+            Ok(())
+        } else {
+            Err(ForcesError::InvalidParameter {
+                field: "hourglass_kappa",
+                value: self.hourglass_kappa,
+                allowed: "0 <= kappa <= 1",
+            })
+        }
+    }
+
     /// Integration points, hence C_p⁻¹ states, per element: 1 or 8.
     pub fn points_per_element(&self) -> usize {
         match self.kind {
@@ -81,6 +95,15 @@ pub enum ForcesError {
         /// Nodes (ids must be below this).
         nodes: usize,
     },
+    /// A setting is out of range.
+    InvalidParameter {
+        /// The [`ElementSettings`] field.
+        field: &'static str,
+        /// Value given.
+        value: Real,
+        /// Allowed range.
+        allowed: &'static str,
+    },
     /// An element's update failed.
     Element(ElementFailure),
 }
@@ -100,6 +123,11 @@ impl fmt::Display for ForcesError {
                 f,
                 "a hex names node {id}, but there are {nodes} nodes (ids 0..{nodes})"
             ),
+            Self::InvalidParameter {
+                field,
+                value,
+                allowed,
+            } => write!(f, "invalid `{field}` = {value}: allowed range is {allowed}"),
             Self::Element(failure) => failure.fmt(f),
         }
     }
@@ -205,6 +233,7 @@ pub fn internal_forces_on(
     cp_inv: &mut [Voigt],
     f: &mut [[Real; 3]],
 ) -> Result<ForceSummary, ForcesError> {
+    settings.check()?;
     check_element_buffers(
         mesh,
         settings.points_per_element(),

@@ -11,11 +11,14 @@ use crate::mesh::reference::ReferenceMesh;
 use crate::tensor::Voigt;
 
 /// Smallest characteristic length min_e V_e/A_e,max at positions `x` (m);
-/// `None` if an element is inverted.
+/// `None` if an element is inverted or names a node beyond `x`.
 pub fn min_element_length(mesh: &ReferenceMesh<'_>, x: &[[Real; 3]]) -> Option<Real> {
     let mut min = Real::INFINITY;
     for hex in mesh.mesh.hexes {
-        let xe = core::array::from_fn(|i| x[hex[i] as usize]);
+        let mut xe = [[0.0; 3]; 8];
+        for (xi, &id) in xe.iter_mut().zip(hex) {
+            *xi = *x.get(id as usize)?;
+        }
         let volume = hex_volume(&xe)?;
         min = crate::math::min(min, volume / hex8::max_face_area(&xe));
     }
@@ -28,13 +31,16 @@ pub fn wave_speed(mat: &Material) -> Real {
 }
 
 /// Element estimate of the stable step, s: `safety` × min L_e / c_d;
-/// `None` if an element is inverted.
+/// `None` if `safety` is not finite and > 0, or as [`min_element_length`].
 pub fn element_time_step(
     mesh: &ReferenceMesh<'_>,
     mat: &Material,
     x: &[[Real; 3]],
     safety: Real,
 ) -> Option<Real> {
+    if !(safety > 0.0 && safety.is_finite()) {
+        return None;
+    }
     Some(safety * min_element_length(mesh, x)? / wave_speed(mat))
 }
 

@@ -20,6 +20,41 @@ pub struct MeshView<'a> {
     pub surface_nodes: usize,
 }
 
+impl MeshView<'_> {
+    /// [`MeshError::NodeOutOfRange`] if a hex or quad names a node beyond
+    /// `positions`, or `surface_nodes` exceeds the node count; what every
+    /// routine that indexes positions by these ids checks first.
+    pub fn check(&self) -> Result<(), MeshError> {
+        let nodes = self.positions.len();
+        if self.surface_nodes > nodes {
+            return Err(MeshError::NodeOutOfRange {
+                buffer: "surface_nodes",
+                index: 0,
+                id: self.surface_nodes,
+                nodes,
+            });
+        }
+        let bad = |buffer, ids: &mut dyn Iterator<Item = &[u32]>| {
+            ids.enumerate().find_map(|(index, item)| {
+                item.iter()
+                    .find(|&&id| id as usize >= nodes)
+                    .map(|&id| MeshError::NodeOutOfRange {
+                        buffer,
+                        index,
+                        id: id as usize,
+                        nodes,
+                    })
+            })
+        };
+        match bad("hexes", &mut self.hexes.iter().map(|h| &h[..]))
+            .or_else(|| bad("quads", &mut self.quads.iter().map(|q| &q[..])))
+        {
+            Some(e) => Err(e),
+            None => Ok(()),
+        }
+    }
+}
+
 fn in_octant(x: &[Real; 3]) -> bool {
     x.iter().all(|&c| c >= 0.0)
 }
@@ -29,20 +64,22 @@ fn all_in(view: &MeshView<'_>, ids: &[u32]) -> bool {
 }
 
 /// Buffer sizes of the octant of `full`; `scratch` is `full`'s node count.
-pub fn octant_size(full: &MeshView<'_>) -> MeshSize {
+/// Errors: `full`'s ids out of range ([`MeshView::check`]).
+pub fn octant_size(full: &MeshView<'_>) -> Result<MeshSize, MeshError> {
+    full.check()?;
     let first_surface = full.positions.len() - full.surface_nodes;
     let nodes = full.positions.iter().filter(|x| in_octant(x)).count();
     let surface_nodes = full.positions[first_surface..]
         .iter()
         .filter(|x| in_octant(x))
         .count();
-    MeshSize {
+    Ok(MeshSize {
         nodes,
         hexes: full.hexes.iter().filter(|h| all_in(full, &h[..])).count(),
         quads: full.quads.iter().filter(|q| all_in(full, &q[..])).count(),
         surface_nodes,
         scratch: full.positions.len(),
-    }
+    })
 }
 
 /// Writes the octant of `full` into `out` (sized by [`octant_size`]).
@@ -50,7 +87,7 @@ pub fn extract_octant(
     full: &MeshView<'_>,
     out: &mut MeshBuffers<'_>,
 ) -> Result<MeshSize, MeshError> {
-    let size = octant_size(full);
+    let size = octant_size(full)?;
     for (buffer, got, expected) in [
         ("positions", out.positions.len(), size.nodes),
         ("hexes", out.hexes.len(), size.hexes),

@@ -41,7 +41,8 @@ impl ReferenceMesh<'_> {
 
 /// Computes the element data (`elements`, one per hex) and the assembled
 /// lumped nodal volumes (`node_volume`, one per node) of `mesh`, summing in
-/// element order.
+/// element order. Errors: a buffer length, an id out of range
+/// ([`MeshView::check`]), an inverted element.
 pub fn compute_element_data(
     mesh: &MeshView<'_>,
     elements: &mut [HexReference],
@@ -59,6 +60,7 @@ pub fn compute_element_data(
             });
         }
     }
+    mesh.check()?;
     node_volume.fill(0.0);
     for (e, (hex, out)) in mesh.hexes.iter().zip(elements.iter_mut()).enumerate() {
         let x = core::array::from_fn(|i| mesh.positions[hex[i] as usize]);

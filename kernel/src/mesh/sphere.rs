@@ -125,6 +125,18 @@ pub enum MeshError {
         /// Entries given.
         got: usize,
     },
+    /// A hex or quad names a node beyond the positions, or more surface
+    /// nodes are declared than there are nodes.
+    NodeOutOfRange {
+        /// "hexes", "quads" or "surface_nodes".
+        buffer: &'static str,
+        /// Index of the hex or quad (0 for `surface_nodes`).
+        index: usize,
+        /// The node id (or the surface node count).
+        id: usize,
+        /// Nodes in the mesh.
+        nodes: usize,
+    },
     /// An element has a corner with det J ≤ 0 (bad placement parameters).
     InvertedElement {
         /// Element index.
@@ -148,6 +160,15 @@ impl fmt::Display for MeshError {
             } => write!(
                 f,
                 "mesh buffer `{buffer}` has {got} entries, expected {expected}"
+            ),
+            Self::NodeOutOfRange {
+                buffer,
+                index,
+                id,
+                nodes,
+            } => write!(
+                f,
+                "mesh `{buffer}` entry {index} names node {id}, but there are {nodes} nodes (ids 0..{nodes})"
             ),
             Self::InvertedElement { element, corner } => {
                 write!(f, "mesh element {element} is inverted at corner {corner}")

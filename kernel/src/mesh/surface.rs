@@ -44,16 +44,20 @@ pub fn quad_area(x: &[[Real; 3]; 4]) -> Real {
 }
 
 /// Total area (m²) and enclosed volume (m³) of the closed surface `quads`
-/// (node ids into `positions`, m), summed in quad order.
-pub fn area_and_volume(positions: &[[Real; 3]], quads: &[[u32; 4]]) -> (Real, Real) {
+/// (node ids into `positions`, m), summed in quad order; `None` if a quad
+/// names a node beyond `positions`.
+pub fn area_and_volume(positions: &[[Real; 3]], quads: &[[u32; 4]]) -> Option<(Real, Real)> {
     let (mut area, mut volume) = (0.0, 0.0);
     for q in quads {
-        let x = core::array::from_fn(|i| positions[q[i] as usize]);
+        let mut x = [[0.0; 3]; 4];
+        for (xi, &id) in x.iter_mut().zip(q) {
+            *xi = *positions.get(id as usize)?;
+        }
         let (a, v) = quad_area_and_flux(&x);
         area += a;
         volume += v;
     }
-    (area, volume)
+    Some((area, volume))
 }
 
 #[cfg(test)]

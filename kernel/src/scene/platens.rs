@@ -848,7 +848,12 @@ impl<'a> PlatenScene<'a> {
             Default::default()
         };
 
-        let w = correct(b, sizes, &loads);
+        // The buffers and step sizes passed `predict`'s checks above.
+        let w = correct(b, sizes, &loads).map_err(|failure| SceneError::Element {
+            step: self.step,
+            strain,
+            failure,
+        })?;
         self.window_max_speed_squared =
             math::max(self.window_max_speed_squared, w.max_speed_squared);
         let kinetic = w.kinetic;
