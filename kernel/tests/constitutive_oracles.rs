@@ -282,8 +282,9 @@ fn c4_consistency_on_every_plastic_step() {
     }
 }
 
-/// Simple shear to γ = 1 in `steps` steps; returns (√det b^e, ‖dev τ‖, p) at the end.
-fn shear_to_one(sy: Real, volume_fix: bool, steps: usize) -> (Real, Real, Real) {
+/// Simple shear to γ = 1 in `steps` steps; returns (√det b^e, ‖dev τ‖, p,
+/// det n with n = dev τ/‖dev τ‖) at the end.
+fn shear_to_one(sy: Real, volume_fix: bool, steps: usize) -> (Real, Real, Real, Real) {
     let params = MaterialParams {
         yield_stress_pa: sy,
         ..GranuleType::C3.params()
@@ -297,7 +298,9 @@ fn shear_to_one(sy: Real, volume_fix: bool, steps: usize) -> (Real, Real, Real) 
     for n in 1..=steps {
         let s = point.step_to(n as Real / steps as Real).unwrap();
         let be = push_forward(&s.f, point.cp_inv());
-        last = Some((det(&be).sqrt(), norm(&deviator(&s.tau)), pressure(&s.tau)));
+        let dev = deviator(&s.tau);
+        let n = dev.map(|c| c / norm(&dev));
+        last = Some((det(&be).sqrt(), norm(&dev), pressure(&s.tau), det(&n)));
         if volume_fix && s.info.plastic {
             assert_close("sqrt det be", det(&be).sqrt(), 1.0, 0.0, 1e-12);
         }
@@ -320,11 +323,37 @@ fn c5_isochoric_shear_and_the_volume_fix_switch() {
         (100e3, -2.85e3, 1.1299, -119.9e3),
     ];
     for (sy, p_fix, j_lit, p_lit) in table {
-        let (je, dev, p) = shear_to_one(sy, true, 10_000);
+        let (je, dev, p, det_n) = shear_to_one(sy, true, 10_000);
         assert_close("sqrt det be (fix)", je, 1.0, 0.0, 1e-12);
         assert_close("|dev tau|", dev, (2.0_f64 / 3.0).sqrt() * sy, 1e-12, 0.0);
         assert_close("pressure (fix)", p, p_fix, 0.0, 0.006e3);
-        let (je, _, p) = shear_to_one(sy, false, 10_000);
+        // And against the analysis of §1.6, not only the printed table: with
+        // J^e = 1 and b^e = k n + s 1 (k = β/μ), det b^e = 1 gives
+        // s³ − (k²/2)s + k³ det n − 1 = 0 and τ = μ(b^e − 1), so the pressure
+        // is −μ(s − 1) ≈ −μk²/6. The output τ is the return's (A.26),
+        // whose trace differs from the fixed state's by O(μk²δ) per step:
+        // 1e-3 relative here (the one step's δ ~ γ̇Δt·k).
+        let mu = material_with(MaterialParams {
+            yield_stress_pa: sy,
+            ..GranuleType::C3.params()
+        })
+        .mu;
+        let k = dev / mu;
+        let mut root: Real = 1.0;
+        for _ in 0..50 {
+            root -= (root.powi(3) - 0.5 * k * k * root + k.powi(3) * det_n - 1.0)
+                / (3.0 * root * root - 0.5 * k * k);
+        }
+        let dg = 1.0 / 10_000.0;
+        let trial = root - 1.0 + (2.0 as Real).sqrt() / 3.0 * dg * k + dg * dg * root / 3.0;
+        assert_close(
+            "pressure (fix) vs -mu (s - 1 + trial)",
+            p,
+            -mu * trial,
+            1e-3,
+            0.0,
+        );
+        let (je, _, p, _) = shear_to_one(sy, false, 10_000);
         assert_close(
             "sqrt det be (literal) - 1",
             je - 1.0,

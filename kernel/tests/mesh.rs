@@ -166,7 +166,7 @@ fn reference_vectors_are_orthogonal_to_linear_fields() {
         let r = hex_reference(&x).unwrap();
         let h = r.volume.cbrt();
         for g in &r.gamma0 {
-            assert!(g.iter().sum::<Real>().abs() < 1e-14);
+            assert!(g.iter().sum::<Real>().abs() < 1e-15);
             for a in 0..3 {
                 let gx: Real = (0..8).map(|i| g[i] * x[i][a]).sum();
                 assert!(gx.abs() < 1e-15 * h.max(R), "sum gamma0 X = {gx:e}");

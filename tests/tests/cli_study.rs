@@ -36,9 +36,12 @@ fn the_quick_granule_study_writes_a_consistent_table_and_diagram() {
     assert_eq!(reference[row("reference")], 1.0);
     assert_eq!(error[row("reference")], 0.0);
     for (i, n) in names.iter().enumerate() {
-        // The one-point element against F-bar on 20 hexes: a few per cent.
+        // The one-point element against F-bar (at half speed) on the
+        // 20-hex octant: 5.9 % with κ = 0.05, 9.4 % with κ = 0.1 (measured;
+        // physics.md §2.3's ~5 % is for the standard mesh, checked by the
+        // full study in BENCHMARKS.md). A quarter to spare.
         assert!(
-            error[i].is_finite() && error[i] < 0.15,
+            error[i].is_finite() && error[i] < 0.12,
             "`{n}`: force error {}",
             error[i]
         );

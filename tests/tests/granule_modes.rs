@@ -182,7 +182,7 @@ fn energy_history(
 /// exp(−ct); the fitted rate is within 1 % of c. (ξ = 0.02 here, so that
 /// 1000 steps span ~40 periods while the energy falls by e⁻⁹: the fit then
 /// averages over the kinetic/elastic exchange.) With c = 0 the energy is
-/// conserved (drift < 1e-4 over 4000 steps).
+/// conserved (drift < 1e-4 over 1e4 steps, the oracle's span).
 #[test]
 fn t2_ring_down_decays_at_the_damping_rate() {
     let mesh = OwnedReference::sphere(R, MeshLevel::new(4, 1), false).unwrap();
@@ -194,7 +194,7 @@ fn t2_ring_down_decays_at_the_damping_rate() {
             0.0,
         ]
     };
-    let (e, _) = energy_history(&mesh, &mat, torsion, 4000, 0.0);
+    let (e, _) = energy_history(&mesh, &mat, torsion, 10_000, 0.0);
     let drift = e
         .iter()
         .fold(0.0 as Real, |m, x| m.max((x / e[0] - 1.0).abs()));
@@ -246,6 +246,92 @@ fn rigid_motion_is_not_damped() {
         loss.abs() < 1e-6,
         "rigid motion lost {loss:e} of its energy"
     );
+}
+
+/// Kinetic energy (J), linear momentum (kg m/s) and angular momentum about
+/// the mass centre (kg m²/s) of the nodes of `b`, summed in node order.
+fn rigid_measures(b: &GranuleBuffers<'_>) -> (Real, [Real; 3], [Real; 3]) {
+    let m_total: Real = b.mass.iter().sum();
+    let mut c = [0.0; 3];
+    for (m, x) in b.mass.iter().zip(b.x.iter()) {
+        for a in 0..3 {
+            c[a] += m * x[a] / m_total;
+        }
+    }
+    let (mut k, mut p, mut l) = (0.0, [0.0; 3], [0.0; 3]);
+    for ((m, x), v) in b.mass.iter().zip(b.x.iter()).zip(b.v.iter()) {
+        let r = [x[0] - c[0], x[1] - c[1], x[2] - c[2]];
+        k += 0.5 * m * (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
+        for a in 0..3 {
+            p[a] += m * v[a];
+        }
+        l[0] += m * (r[1] * v[2] - r[2] * v[1]);
+        l[1] += m * (r[2] * v[0] - r[0] * v[2]);
+        l[2] += m * (r[0] * v[1] - r[1] * v[0]);
+    }
+    (k, p, l)
+}
+
+fn norm3(v: [Real; 3]) -> Real {
+    (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt()
+}
+
+/// §4.5 oracle 2, each rigid mode alone and over the oracle's 1e5 damped
+/// steps (ξ = 0.5): a pure spin (ωR = 1 mm/s ≪ c_s) keeps its angular
+/// momentum to 1e-10 (measured 1.5e-11) and loses less than 1e-6 of its
+/// kinetic energy (the damping removes only the centrifugal breathing;
+/// measured 4.9e-10); a pure translation keeps its kinetic energy and
+/// linear momentum to round-off.
+/// (The test above mixes the two, so its spin is 8e-4 of the energy and
+/// its bound far looser for the spin than the oracle's.)
+#[test]
+fn a_rigid_spin_and_a_rigid_translation_are_not_damped_over_1e5_steps() {
+    let mesh = OwnedReference::sphere(R, MeshLevel::new(4, 1), false).unwrap();
+    let mat = elastic_solid();
+    let c = granbed_kernel::granule::damping::damping_coefficient(0.5, mat.mu, mat.density0, R);
+    let steps = 100_000;
+    let spin = |x: &[Real; 3]| [-2.0 * x[1], 2.0 * x[0], 0.0];
+    let translation = |_: &[Real; 3]| [0.01, 0.0, -0.02];
+    for (name, v0) in [
+        ("spin", &spin as &dyn Fn(&[Real; 3]) -> [Real; 3]),
+        ("translation", &translation),
+    ] {
+        let mut first = None;
+        let mut last = None;
+        free_run(&mesh, &mat, v0, steps, c, None, &mut |b, _| {
+            let m = rigid_measures(b);
+            first.get_or_insert(m);
+            last = Some(m);
+            true
+        })
+        .unwrap();
+        let ((k0, p0, l0), (k, p, l)) = (first.unwrap(), last.unwrap());
+        let loss = (k0 - k) / k0;
+        let dp = norm3([p[0] - p0[0], p[1] - p0[1], p[2] - p0[2]]);
+        let dl = norm3([l[0] - l0[0], l[1] - l0[1], l[2] - l0[2]]);
+        println!(
+            "{name}: kinetic energy lost {loss:e}, |dp| {dp:e} of {:e}, |dL| {dl:e} of {:e}",
+            norm3(p0),
+            norm3(l0)
+        );
+        assert!(loss.abs() < 1e-6, "{name} lost {loss:e} of its energy");
+        if name == "spin" {
+            assert!(
+                dl < 1e-10 * norm3(l0),
+                "spin: angular momentum changed by {dl:e} of {:e}",
+                norm3(l0)
+            );
+        } else {
+            // "Exactly" up to the round-off of 1e5 steps (forces of order
+            // ε·E from the moving coordinates, ~1e-15 of the energy per
+            // step; measured 1.5e-10 and 7.6e-11 of the momentum).
+            assert!(loss.abs() < 1e-9, "translation lost {loss:e}");
+            assert!(
+                dp < 1e-9 * norm3(p0),
+                "translation: momentum changed by {dp:e}"
+            );
+        }
+    }
 }
 
 /// `predict_rigid` is `predict` for an undeformed, translating granule: a

@@ -668,8 +668,19 @@ fn the_rigid_presolve_closes_a_punch_without_overshoot() {
             for (forced, gap, _) in pass.nodes {
                 if scheme == Scheme::ContactMasses {
                     // The contact mass allows for the rigid response the
-                    // squeeze cancels: a little short, never open.
-                    assert!(forced && gap <= 0.0, "F {factor} squeezed: {gap}");
+                    // squeeze cancels: a little short, never open — and
+                    // short by no more than measured (2.4 / 7.4 / 21 % of
+                    // the depth at F = 10 / 30 / 100) with a fifth to spare,
+                    // so that a scheme that left the squeeze half open fails.
+                    let short_by = match factor {
+                        10.0 => 0.03,
+                        30.0 => 0.09,
+                        _ => 0.26,
+                    };
+                    assert!(
+                        forced && gap <= 0.0 && gap >= -short_by,
+                        "F {factor} squeezed: {gap}"
+                    );
                 } else {
                     assert!(forced && gap.abs() < 1e-12, "F {factor} squeezed: {gap}");
                 }
