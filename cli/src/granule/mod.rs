@@ -62,7 +62,9 @@ Output, in --out DIR (created if missing; with --types in DIR/<TYPE>/ per type):
     steps                 time steps so far
   summary.json            every input, sigma_est (4/(pi d) dF/dx fitted over
                           strain 0.1 to 0.4; null with fewer than two samples
-                          there), sigma_eff0, fit, energy checks, the
+                          there), sigma_est_strain_range (the strains fitted:
+                          less than 0.1-0.4 when the run ends before 0.4, which
+                          notes and stderr say), sigma_eff0, fit, energy checks, the
                           quasi-static certificate (kinetic/internal work over
                           the second half, with --symmetry full the platen force
                           imbalance, with --rate-check the change at half the
@@ -481,6 +483,14 @@ impl GranuleArgs {
             if o.result.error.is_none() && !o.summary.quasi_static.passed {
                 writeln!(streams.stderr, "{}", o.summary.not_quasi_static())?;
             }
+            // Why sigma_est is null or fitted over less than 0.1-0.4.
+            for note in &o.summary.notes {
+                writeln!(
+                    streams.stderr,
+                    "warning: granule {}: {note}",
+                    o.summary.granule_type
+                )?;
+            }
         }
         kernel_failures(&outcomes)
     }
@@ -522,11 +532,13 @@ fn write_outputs(dir: &Path, result: &RunResult, summary: &Summary) -> anyhow::R
         summary.sigma_est_pa,
     ) {
         (Some(slope), Some(intercept), Some(sigma)) => {
-            let [lo, hi] = summary.sigma_est_strain_range;
+            let [lo, hi] = summary
+                .sigma_est_strain_range
+                .unwrap_or(summary::FIT_STRAIN_RANGE);
             Some(plot::FitLine {
                 slope_n_per_m: slope,
                 intercept_n: intercept,
-                x_range_m: [lo, hi.min(summary.final_strain)].map(|e| e * result.diameter_m),
+                x_range_m: [lo, hi].map(|e| e * result.diameter_m),
                 label: format!("fit: sigma_est = {sigma:.4e} Pa"),
             })
         }

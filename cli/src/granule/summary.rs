@@ -21,7 +21,10 @@ use crate::quasi_static::QuasiStatic;
 pub const FORMAT: &str = "granbed-granule-summary";
 /// Version of the `summary.json` format; bumped when a field changes
 /// meaning or disappears (adding a field does not bump it).
-pub const FORMAT_VERSION: u32 = 1;
+///
+/// 2: `sigma_est_strain_range` is the strain range the fit covered (null
+/// without a fit), no longer always the nominal [0.1, 0.4].
+pub const FORMAT_VERSION: u32 = 2;
 
 /// Strain range of the σ_est fit, x/d (physics.md §7 item 7).
 pub const FIT_STRAIN_RANGE: [Real; 2] = [0.1, 0.4];
@@ -121,8 +124,11 @@ pub struct Summary {
     /// [`Summary::sigma_est_strain_range`], Pa; `null` with fewer than two
     /// samples in range.
     pub sigma_est_pa: Option<Real>,
-    /// Strain range of the fit, x/d.
-    pub sigma_est_strain_range: [Real; 2],
+    /// Strain range the fit actually covered, x/d: the first and the last
+    /// sample within [`FIT_STRAIN_RANGE`] (narrower when the run ends
+    /// before 0.4, which `notes` and stderr then say); `null` without a
+    /// fit.
+    pub sigma_est_strain_range: Option<[Real; 2]>,
     /// σ_y,eff0 = √a2(η0)·σ_y, Pa.
     pub sigma_eff0_pa: Real,
     /// Fitted slope dF/dx, N/m.
@@ -183,15 +189,25 @@ impl Summary {
         let points = samples.iter().map(|s| (s.approach_m, s.mean_force()));
         let fit = yield_stress_estimate(points, result.diameter_m, lo, hi);
         let final_strain = last.map_or(0.0, |s| s.strain);
+        // The samples the fit took (the kernel's filter, on x/d).
+        let fitted: Vec<Real> = samples
+            .iter()
+            .map(|s| s.approach_m / result.diameter_m)
+            .filter(|c| *c >= lo && *c <= hi)
+            .collect();
+        let fitted_range = match (fit, fitted.first(), fitted.last()) {
+            (Some(_), Some(&a), Some(&b)) => Some([a, b]),
+            _ => None,
+        };
         let mut notes = Vec::new();
-        match fit {
+        match fitted_range {
             None => notes.push(format!(
                 "sigma_est needs at least two samples with {lo} <= strain <= {hi}; the run \
                  ended at strain {final_strain}"
             )),
-            Some(_) if final_strain < hi => notes.push(format!(
-                "sigma_est was fitted over strain {lo} to {final_strain} only: the run ended \
-                 before strain {hi}"
+            Some([a, b]) if final_strain < hi => notes.push(format!(
+                "sigma_est was fitted over strain {a} to {b} only, not {lo} to {hi}: the run \
+                 ended at strain {final_strain}"
             )),
             Some(_) => {}
         }
@@ -234,7 +250,7 @@ impl Summary {
             gravity_m_s2: p.gravity_m_s2,
             mass_scaling: p.mass_scaling,
             sigma_est_pa: fit.map(|(sigma, _)| sigma),
-            sigma_est_strain_range: FIT_STRAIN_RANGE,
+            sigma_est_strain_range: fitted_range,
             sigma_eff0_pa: initial_effective_yield_stress(m),
             slope_n_per_m: fit.map(|(_, f)| f.slope),
             intercept_n: fit.map(|(_, f)| f.intercept),
