@@ -16,6 +16,7 @@
 //! * [`model`]: owned buffers for the kernel's meshes;
 //! * [`material_args`]: `--type` and the material-parameter overrides;
 //! * [`output`]: the standard streams and `--out` destinations;
+//! * [`numbers`]: the value parser of whole-number flags (range in its message);
 //! * [`quasi_static`]: the quasi-static certificate of the summaries;
 //! * [`csv`]: a small CSV writer with round-trip exact floats;
 //! * [`vtk`]: a VTK XML unstructured-grid (`.vtu`) writer;
@@ -39,6 +40,7 @@ pub mod export_mesh;
 pub mod granule;
 pub mod material_args;
 pub mod model;
+pub mod numbers;
 pub mod output;
 pub mod pack;
 pub mod plot;

@@ -291,12 +291,34 @@ fn quiet_prints_nothing() {
 
 #[test]
 fn bad_input_exits_2_naming_the_flag() {
-    let cases: [(&[&str], &str); 12] = [
-        (&["--granules", "0"], "`--granules 0`"),
-        (&["--granules", "-3"], "--granules"),
+    let cases: [(&[&str], &str); 15] = [
+        // Whole numbers: the flag and the allowed range, whatever the typo.
+        (
+            &["--granules", "0"],
+            "'--granules <N>': out of range (allowed: whole numbers 1..=100000)",
+        ),
+        (
+            &["--granules", "-3"],
+            "'--granules <N>': out of range (allowed: whole numbers 1..=100000)",
+        ),
+        (
+            &["--granules", "1e3"],
+            "'--granules <N>': not a whole number (allowed: whole numbers 1..=100000)",
+        ),
+        (
+            &["--granules", "1.5"],
+            "'--granules <N>': not a whole number (allowed: whole numbers 1..=100000)",
+        ),
         (&["--die-diameter-mm", "1.5"], "`--die-diameter-mm 1.5`"),
-        (&["--seed", "abc"], "--seed"),
-        (&["--seed", "-1"], "--seed"),
+        (
+            &["--seed", "abc"],
+            "'--seed <SEED>': not a whole number (allowed: whole numbers 0..=",
+        ),
+        (
+            &["--seed", "-1"],
+            "'--seed <SEED>': out of range (allowed: whole numbers 0..=",
+        ),
+        (&["--seed", "1.5"], "'--seed <SEED>': not a whole number"),
         (&["--diameter-mm", "0"], "`--diameter-mm 0`"),
         (&["--youngs-modulus-mpa", "-5"], "`--youngs-modulus-mpa -5`"),
         (&["--max-time-s", "0.2"], "`--max-time-s 0.2`"),

@@ -865,6 +865,24 @@ impl<'m> Assembly<'m> {
             .map_err(|error| AssemblyError::Contact { step, error })
     }
 
+    /// Most negative gap between a granule's surface node and a wall (die,
+    /// punches) on the current positions x_n, at the current time (0 if
+    /// none is behind a wall), m: physics.md §5.6 oracle 1's measure, which
+    /// [`Self::penetration`] (granule against granule) leaves out. A
+    /// minimum, so the same for any thread count.
+    pub fn wall_penetration(&self) -> Real {
+        let walls: Vec<Wall> = self.walls().collect();
+        let surface = self.mesh.surface_range();
+        self.granules
+            .par_iter()
+            .map(|g| {
+                g.x[surface.clone()].iter().fold(0.0, |m: Real, x| {
+                    walls.iter().fold(m, |m, w| m.min(w.gap(x).0))
+                })
+            })
+            .reduce(|| 0.0, Real::min)
+    }
+
     /// Per granule, the factor variable mass scaling has put on its masses
     /// (1: none; [`AssemblyParams::time_step_floor`]).
     pub fn mass_factors(&self) -> &[Real] {

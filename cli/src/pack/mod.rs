@@ -188,21 +188,24 @@ pub struct PackArgs {
     #[arg(long, value_name = "DIR")]
     pub out: PathBuf,
 
-    /// Number of granules poured (1 ≤ N ≤ 100000).
+    /// Number of granules poured (a whole number, 1 ≤ N ≤ 100000).
     #[arg(
         long,
         value_name = "N",
         default_value_t = 1000,
-        allow_negative_numbers = true
+        allow_negative_numbers = true,
+        value_parser = crate::numbers::whole::<usize>(1, 100_000)
     )]
     pub granules: usize,
 
-    /// Random seed of the lattice jitter and the initial velocities.
+    /// Random seed of the lattice jitter and the initial velocities (a
+    /// whole number, 0 ≤ SEED < 2^64).
     #[arg(
         long,
         value_name = "SEED",
         default_value_t = 1,
-        allow_negative_numbers = true
+        allow_negative_numbers = true,
+        value_parser = crate::numbers::whole::<u64>(0, u64::MAX)
     )]
     pub seed: u64,
 
@@ -499,7 +502,20 @@ mod tests {
             assert!(crate::error::is_usage_error(&e), "{e:#}");
             format!("{e:#}")
         };
-        assert!(err(&["--granules", "0"]).starts_with("`--granules 0` rejected"));
+        // Whole-number flags are checked as they are parsed, with the range.
+        for bad in ["0", "-3", "1e3", "1.5", "100001"] {
+            let argv = ["test", "--out", "x", "--granules", bad];
+            let e = Wrapper::try_parse_from(argv).err().unwrap().to_string();
+            assert!(e.contains("--granules") && e.contains("1..=100000"), "{e}");
+        }
+        let e = Wrapper::try_parse_from(["test", "--out", "x", "--seed", "-1"])
+            .err()
+            .unwrap()
+            .to_string();
+        assert!(
+            e.contains("--seed") && e.contains("0..=18446744073709551615"),
+            "{e}"
+        );
         assert!(err(&["--die-diameter-mm", "1.5"]).starts_with("`--die-diameter-mm 1.5`"));
         assert!(err(&["--diameter-mm", "-1"]).starts_with("`--diameter-mm -1`"));
         assert!(err(&["--diameter-mm", "0"]).starts_with("`--diameter-mm 0`"));

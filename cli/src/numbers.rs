@@ -1,0 +1,57 @@
+//! Whole-number flags (`--granules`, `--seed`, `-j`, …): a value parser
+//! whose rejection says what is allowed, where the standard integer
+//! parsers say "invalid digit found in string" for `-3`, `1.5` or `1e3`.
+
+/// A clap value parser of whole numbers `lo..=hi` written in digits; a
+/// rejection (clap prefixes the flag and the value) gives the range.
+pub fn whole<T>(
+    lo: u64,
+    hi: u64,
+) -> impl Fn(&str) -> Result<T, String> + Clone + Send + Sync + 'static
+where
+    T: TryFrom<u64> + Clone + Send + Sync + 'static,
+{
+    move |text: &str| {
+        let allowed = format!("allowed: whole numbers {lo}..={hi}");
+        let Ok(n) = text.trim().parse::<i128>() else {
+            return Err(format!("not a whole number ({allowed})"));
+        };
+        u64::try_from(n)
+            .ok()
+            .filter(|n| (lo..=hi).contains(n))
+            .and_then(|n| T::try_from(n).ok())
+            .ok_or_else(|| format!("out of range ({allowed})"))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn rejections_give_the_range() {
+        let parse = whole::<usize>(1, 100_000);
+        assert_eq!(parse("30"), Ok(30));
+        assert_eq!(parse(" 100000 "), Ok(100_000));
+        for bad in ["-3", "0", "100001", "99999999999999999999999999"] {
+            let e = parse(bad).unwrap_err();
+            assert!(
+                e.contains("out of range") && e.contains("1..=100000"),
+                "{bad}: {e}"
+            );
+        }
+        for bad in ["1.5", "1e3", "abc", ""] {
+            let e = parse(bad).unwrap_err();
+            assert!(
+                e.contains("not a whole number") && e.contains("1..=100000"),
+                "{bad}: {e}"
+            );
+        }
+        let seed = whole::<u64>(0, u64::MAX);
+        assert_eq!(seed(&u64::MAX.to_string()), Ok(u64::MAX));
+        assert!(seed("-1").unwrap_err().contains("0..=18446744073709551615"));
+        let small = whole::<u32>(1, 10);
+        assert_eq!(small("10"), Ok(10));
+        assert!(small("11").is_err());
+    }
+}
