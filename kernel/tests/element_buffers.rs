@@ -7,42 +7,30 @@ mod common;
 
 use common::{material, sphere_mesh};
 use granbed_kernel::Real;
-use granbed_kernel::element::batch::{ElementBatch, batch_count, regroup};
-use granbed_kernel::element::reference::hex_reference;
 use granbed_kernel::granule::forces::{
     ElementKind, ElementSettings, ForcesError, elastic_energy, internal_forces,
 };
 use granbed_kernel::material::GranuleType;
 use granbed_kernel::mesh::octant::MeshView;
-use granbed_kernel::mesh::reference::{ReferenceMesh, compute_element_data};
+use granbed_kernel::mesh::reference::ReferenceMesh;
 use granbed_kernel::mesh::sphere::SphereMeshParams;
 use granbed_kernel::tensor::{VOIGT_IDENTITY, Voigt};
 
 struct Fixture {
     mesh: common::OwnedMesh,
     elements: Vec<granbed_kernel::element::reference::HexReference>,
-    batches: Vec<ElementBatch>,
+    batches: Vec<granbed_kernel::element::batch::ElementBatch>,
     node_volume: Vec<Real>,
 }
 
 fn fixture() -> Fixture {
     let mesh = sphere_mesh(&SphereMeshParams::new(0.5e-3, 4, 1));
-    let view = MeshView {
-        positions: &mesh.positions,
-        hexes: &mesh.hexes,
-        quads: &mesh.quads,
-        surface_nodes: mesh.size.surface_nodes,
-    };
-    let mut elements = vec![hex_reference(&mesh.hex_coords(0)).unwrap(); mesh.hexes.len()];
-    let mut node_volume = vec![0.0; mesh.positions.len()];
-    compute_element_data(&view, &mut elements, &mut node_volume).unwrap();
-    let mut batches = vec![ElementBatch::ZERO; batch_count(elements.len())];
-    regroup(&elements, &mut batches).unwrap();
+    let data = mesh.element_data();
     Fixture {
         mesh,
-        elements,
-        batches,
-        node_volume,
+        elements: data.elements,
+        batches: data.batches,
+        node_volume: data.node_volume,
     }
 }
 

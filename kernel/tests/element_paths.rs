@@ -20,8 +20,7 @@ use granbed_kernel::element::force::HexForces;
 use granbed_kernel::element::reference::{HexReference, hex_reference};
 use granbed_kernel::granule::forces::{ElementKind, ElementSettings, internal_forces_on};
 use granbed_kernel::material::GranuleType;
-use granbed_kernel::mesh::octant::MeshView;
-use granbed_kernel::mesh::reference::{ReferenceMesh, compute_element_data};
+use granbed_kernel::mesh::reference::ReferenceMesh;
 use granbed_kernel::mesh::sphere::SphereMeshParams;
 use granbed_kernel::tensor::{VOIGT_IDENTITY, Voigt};
 
@@ -406,23 +405,13 @@ fn lanes_past_eta_one_or_with_a_clamped_a2_give_the_scalar_bits() {
 #[test]
 fn the_assembled_forces_are_the_same_on_every_path() {
     let mesh = sphere_mesh(&SphereMeshParams::standard());
-    let view = MeshView {
-        positions: &mesh.positions,
-        hexes: &mesh.hexes,
-        quads: &mesh.quads,
-        surface_nodes: mesh.size.surface_nodes,
-    };
-    let mut elements = vec![hex_reference(&mesh.hex_coords(0)).unwrap(); mesh.hexes.len()];
-    let mut node_volume = vec![0.0; mesh.positions.len()];
-    compute_element_data(&view, &mut elements, &mut node_volume).unwrap();
-    let mut batches = vec![ElementBatch::ZERO; batch_count(elements.len())];
-    regroup(&elements, &mut batches).unwrap();
+    let data = mesh.element_data();
     let reference = ReferenceMesh {
-        mesh: view,
+        mesh: mesh.view(),
         node_quads: &mesh.node_quads,
-        elements: &elements,
-        batches: &batches,
-        node_volume: &node_volume,
+        elements: &data.elements,
+        batches: &data.batches,
+        node_volume: &data.node_volume,
     };
     let mat = material(GranuleType::B2);
     let settings = ElementSettings {

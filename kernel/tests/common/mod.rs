@@ -115,8 +115,46 @@ pub fn sphere_mesh(p: &granbed_kernel::mesh::sphere::SphereMeshParams) -> OwnedM
     mesh
 }
 
+/// The element data of an [`OwnedMesh`] (test side), for a
+/// `ReferenceMesh` over it.
+pub struct ElementData {
+    pub elements: Vec<granbed_kernel::element::reference::HexReference>,
+    pub batches: Vec<granbed_kernel::element::batch::ElementBatch>,
+    pub node_volume: Vec<Real>,
+}
+
 impl OwnedMesh {
     pub fn hex_coords(&self, e: usize) -> [[Real; 3]; 8] {
         core::array::from_fn(|i| self.positions[self.hexes[e][i] as usize])
+    }
+
+    pub fn view(&self) -> granbed_kernel::mesh::octant::MeshView<'_> {
+        granbed_kernel::mesh::octant::MeshView {
+            positions: &self.positions,
+            hexes: &self.hexes,
+            quads: &self.quads,
+            surface_nodes: self.size.surface_nodes,
+        }
+    }
+
+    /// Element data, lumped volumes and the batches of the one-point element.
+    pub fn element_data(&self) -> ElementData {
+        use granbed_kernel::element::batch::{ElementBatch, batch_count, regroup};
+        let first = granbed_kernel::element::reference::hex_reference(&self.hex_coords(0)).unwrap();
+        let mut elements = vec![first; self.hexes.len()];
+        let mut node_volume = vec![0.0; self.positions.len()];
+        granbed_kernel::mesh::reference::compute_element_data(
+            &self.view(),
+            &mut elements,
+            &mut node_volume,
+        )
+        .unwrap();
+        let mut batches = vec![ElementBatch::ZERO; batch_count(elements.len())];
+        regroup(&elements, &mut batches).unwrap();
+        ElementData {
+            elements,
+            batches,
+            node_volume,
+        }
     }
 }
