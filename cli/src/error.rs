@@ -5,6 +5,7 @@
 //! | 0 | success, `--help`, `--version`; also a closed stdout (broken pipe, e.g. `| head`), silently |
 //! | 1 | runtime failure: kernel error during a run, I/O error |
 //! | 2 | usage or validation error: unknown flag, unparsable value, value out of range |
+//! | 130 | a `bed` run stopped by SIGINT/SIGTERM after writing its checkpoint and outputs ([`crate::signal`]) |
 //!
 //! An error chain is a usage error if it holds a [`clap::Error`] or an
 //! [`InputError`]; everything else is a runtime failure.
@@ -58,7 +59,9 @@ pub fn exit_code(err: &anyhow::Error) -> u8 {
         // 2 for usage errors; clap's statuses are small and non-negative.
         return u8::try_from(clap_err.exit_code()).unwrap_or(EXIT_USAGE);
     }
-    if is_usage_error(err) {
+    if err.chain().any(|e| e.is::<crate::signal::Interrupted>()) {
+        crate::signal::EXIT_INTERRUPTED
+    } else if is_usage_error(err) {
         EXIT_USAGE
     } else if is_broken_pipe(err) {
         EXIT_SUCCESS
@@ -100,6 +103,8 @@ mod tests {
         assert_eq!(exit_code(&wrapped), EXIT_USAGE);
         let runtime = anyhow::anyhow!("kernel failed");
         assert_eq!(exit_code(&runtime), EXIT_FAILURE);
+        let stopped = anyhow::Error::new(crate::signal::Interrupted("resume".into())).context("x");
+        assert_eq!(exit_code(&stopped), 130);
         let pipe = anyhow::Error::new(io::Error::from(io::ErrorKind::BrokenPipe)).context("row 3");
         assert_eq!(exit_code(&pipe), EXIT_SUCCESS);
         let mut buf = Vec::new();

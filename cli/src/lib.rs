@@ -17,6 +17,7 @@
 //! * [`material_args`]: `--type` and the material-parameter overrides;
 //! * [`output`]: the standard streams and `--out` destinations;
 //! * [`numbers`]: the value parser of whole-number flags (range in its message);
+//! * [`signal`]: SIGINT/SIGTERM during `bed`: a stop flag the run checks;
 //! * [`quasi_static`]: the quasi-static certificate of the summaries;
 //! * [`csv`]: a small CSV writer with round-trip exact floats;
 //! * [`vtk`]: a VTK XML unstructured-grid (`.vtu`) writer;
@@ -24,7 +25,8 @@
 //!
 //! Exit status: 0 success (and `--help`, `--version`), 1 runtime failure
 //! (kernel error, I/O error), 2 usage or validation error (unknown flag, bad
-//! value, parameter out of range).
+//! value, parameter out of range), 130 a `bed` run stopped by SIGINT or
+//! SIGTERM (after writing a checkpoint and its outputs).
 
 use std::ffi::OsString;
 use std::io::Write;
@@ -47,6 +49,7 @@ pub mod plot;
 pub mod point;
 pub mod progress;
 pub mod quasi_static;
+pub mod signal;
 pub mod study;
 pub mod vtk;
 

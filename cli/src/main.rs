@@ -19,6 +19,15 @@ fn main() -> ExitCode {
         );
         return ExitCode::from(2);
     }
+    // `bed` stops cleanly on SIGINT/SIGTERM (granbed_cli::signal): the run
+    // finishes its step and writes a checkpoint and its outputs. The other
+    // commands keep the default handling (they die at once). The subcommand
+    // is always the first argument (the top level has no other options).
+    if std::env::args_os().nth(1).is_some_and(|a| a == "bed")
+        && let Err(e) = granbed_cli::signal::install()
+    {
+        eprintln!("warning: cannot handle SIGINT/SIGTERM ({e}); an interrupt kills the run");
+    }
     match run() {
         Ok(()) => ExitCode::SUCCESS,
         Err(err) => ExitCode::from(granbed_cli::error::report(&err, &mut io::stderr().lock())),

@@ -33,6 +33,10 @@ fn scene_file(dir: &Path, safety: f64, watchdog: [f64; 2]) -> std::path::PathBuf
         .replace("mesh = \"8x2\"", "mesh = \"4x1\"")
         .replace("die_diameter_mm = 11.3", "die_diameter_mm = 4.5")
         .replace("final_strain = 0.3", "final_strain = 0.01")
+        .replace(
+            "snapshot_strains = [0.0, 0.1, 0.2, 0.3]",
+            "snapshot_strains = [0.0]",
+        )
         .replace("mass_scaling = 20.0", "mass_scaling = 1.0")
         .replace(
             "time_step_safety = 0.9",
@@ -94,13 +98,15 @@ fn the_energy_watchdog_stops_a_runaway_bed_and_its_checkpoint_resumes() {
     ] {
         assert!(r.stderr.contains(needle), "no `{needle}` in:\n{}", r.stderr);
     }
+    // (The error's line: a warning before it may speak of overlaps in
+    // element sizes.)
+    let error = r.stderr.lines().find(|l| l.starts_with("error:")).unwrap();
     assert!(
-        !r.stderr.contains("element"),
+        !error.contains("element"),
         "the watchdog must stop the run before an element fails:\n{}",
         r.stderr
     );
-    let failed_at: u64 = r
-        .stderr
+    let failed_at: u64 = error
         .split("step ")
         .nth(1)
         .and_then(|s| s.split(':').next())

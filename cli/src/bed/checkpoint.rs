@@ -17,7 +17,7 @@ use granbed_kernel::contact::pair::{Constraint, Side};
 
 use super::run::{BedSample, Window};
 use crate::assembly::die::DieScene;
-use crate::assembly::{AssemblyState, Energies, GranuleState};
+use crate::assembly::{AssemblyState, Energies, GranuleState, PhaseTimes};
 
 /// File name of the checkpoint in the output directory.
 pub const FILE_NAME: &str = "checkpoint.bin";
@@ -47,7 +47,15 @@ pub const FILE_NAME: &str = "checkpoint.bin";
 /// 11 floats each: `CONSTRAINT_FLOATS`), which the steps up to the next
 /// search re-measure (`contact_search_interval` > 1). Older files hold
 /// nothing: their first step searches every pair, as it did when written.
-pub const VERSION: u32 = 6;
+///
+/// 7: the payload ends with the run's phase times and contact counters so
+/// far (3 floats: predict, contact, correct seconds; then 6 counts:
+/// sweeps, rigid granule-steps, steps, face-list builds, anchor renewals,
+/// pair searches) and the step they count from (u64, 0: the whole run), so
+/// the summary's cost figures of a resumed run cover all of it. Older
+/// files carry none: the resumed run's figures count from the checkpoint's
+/// step, and the summary says so.
+pub const VERSION: u32 = 7;
 /// The oldest version read.
 const OLDEST_VERSION: u32 = 2;
 /// Floats per held constraint: side (0: A, 1: B), slave node, master quad,
@@ -77,6 +85,13 @@ pub struct Progress {
     pub next_output: Real,
     /// Snapshot strains already written (of the sorted list).
     pub snapshots_done: usize,
+    /// Phase times and contact counters of the steps from
+    /// `counters_from_step` to this checkpoint (format 7; older files:
+    /// zero).
+    pub counters: PhaseTimes,
+    /// The step the counters count from: 0 unless the run went through a
+    /// checkpoint older than format 7 (then that checkpoint's step).
+    pub counters_from_step: u64,
 }
 
 /// A checkpoint: progress and assembly state.
@@ -371,6 +386,19 @@ impl Checkpoint {
                 _ => e.u64(0),
             }
         }
+        let c = &p.counters;
+        e.f64s(&[c.predict_s, c.contact_s, c.correct_s]);
+        for n in [
+            c.sweeps,
+            c.rigid_granule_steps,
+            c.steps,
+            c.list_builds,
+            c.anchor_renewals,
+            c.pair_searches,
+            p.counters_from_step,
+        ] {
+            e.u64(n);
+        }
         e.0
     }
 
@@ -479,6 +507,29 @@ impl Checkpoint {
                 })
                 .collect::<anyhow::Result<Vec<_>>>()?,
         };
+        let (counters, counters_from_step) = match version {
+            2..=6 => (PhaseTimes::default(), t[1].to_bits()),
+            _ => {
+                let [predict_s, contact_s, correct_s] = <[f64; 3]>::try_from(d.f64s()?)
+                    .map_err(|_| anyhow::anyhow!("bad phase times"))?;
+                let mut n = [0u64; 7];
+                for x in &mut n {
+                    *x = d.u64()?;
+                }
+                let counters = PhaseTimes {
+                    predict_s,
+                    contact_s,
+                    correct_s,
+                    sweeps: n[0],
+                    rigid_granule_steps: n[1],
+                    steps: n[2],
+                    list_builds: n[3],
+                    anchor_renewals: n[4],
+                    pair_searches: n[5],
+                };
+                (counters, n[6])
+            }
+        };
         if !d.0.is_empty() {
             bail!("checkpoint has {} bytes after its end", d.0.len());
         }
@@ -503,6 +554,8 @@ impl Checkpoint {
                 },
                 next_output,
                 snapshots_done,
+                counters,
+                counters_from_step,
             },
             state: AssemblyState {
                 time: t[0],

@@ -42,21 +42,32 @@ Output, in --out DIR (created if missing):
                    strain (C = (H0 - H)/H0), upper/lower punch force and pressure,
                    die-wall axial friction, coordination number (granule pairs,
                    and with walls), mean granule relative density (arithmetic
-                   mean of eta0 V0/V, and solid/total), mean Heywood coefficient
+                   mean of eta0 V0/V, and solid/total), bed_solid_fraction D
+                   (granule solid volume / (die area x H0 (1 - C)); Heckel:
+                   ln(1/(1 - D)) against the pressure), mean Heywood coefficient
                    (d_V and nominal d), min Jacobian, steps, energies
   summary.json     the scene, Kawakita fit (a, 1/b, R^2, points with C >= 0.25),
                    final strain, max pressure, initial bed height, counts, wall
-                   time, ns per element-step, threads, min Jacobian, max nodal
+                   time, ns per element-step, cost figures (over the whole run,
+                   resumed segments included), threads, min Jacobian, max nodal
                    speed / punch speed, deepest overlap (m and / element size),
-                   hourglass / internal work, energy residual, peak memory, version
-  vtk/bed_<k>.vtu  VTU snapshots at the scene's snapshot_strains: every granule's
+                   hourglass / internal work, energy residual, peak memory,
+                   interrupted, warnings (also on stderr, with --quiet too: a
+                   final strain past the target by more than an output
+                   interval, overlap above 1 % of the element, a Kawakita fit
+                   with a > 1, 1/b <= 0 or R^2 < 0.9, scene fields left out
+                   whose old values are not the published ones), version
+  vtk/bed_<k>.vtu  VTU snapshots at the scene's snapshot_strains (a fresh run
+                   first removes those an earlier run left): every granule's
                    surface quads (all hexes with --vtk-full-mesh), cell data
                    granule id, relative density eta0 V0/V, Heywood d_V S/V and d S/V
   vtk/bed.pvd      ParaView collection of the snapshots (timestep = strain)
   plots/*.svg      pressure, coordination number, relative density and Heywood
                    coefficient against strain; Kawakita plot P/C vs P with the fit
   report.html      one page: the summary table, the plots and the scene
-  checkpoint.bin   the state to continue from with --resume
+  checkpoint.bin   the state to continue from with --resume (every
+                   checkpoint_interval_minutes and checkpoint_strain_interval,
+                   and at the end)
 
 With --types, the files above go to DIR/<TYPE>/ per type (each resumable
 alone with --resume DIR/<TYPE>), and DIR holds the comparison:
@@ -76,8 +87,12 @@ reuse that packing.
 Without --scene the embedded published scene runs (print it with
 --print-scene); the flags below override the scene's fields.
 
+SIGINT (Ctrl-C) or SIGTERM: the run finishes its step, writes a checkpoint and
+the outputs so far (summary.json \"interrupted\": true), prints how to resume and
+exits with status 130; a second signal quits at once.
+
 Exit status: 0 success, 1 runtime failure (the run stopped early: the outputs
-so far are written), 2 usage or validation error.";
+so far are written), 2 usage or validation error, 130 interrupted (resumable).";
 
 /// Options of `granbed-cli bed`.
 #[derive(Args, Debug, Clone, PartialEq)]
@@ -108,23 +123,28 @@ pub struct BedArgs {
     pub types: Option<TypeList>,
 
     /// Override: number of granules (1 ≤ N ≤ 100000).
-    #[arg(long, value_name = "N")]
+    #[arg(long, value_name = "N", allow_negative_numbers = true,
+          value_parser = crate::numbers::whole::<usize>(1, 100_000))]
     pub granules: Option<usize>,
 
     /// Override: mesh level NxM (8x2 = 1280 hexes, 4x1 = 160).
     #[arg(long, value_name = "NxM")]
     pub mesh: Option<MeshLevel>,
 
-    /// Override: final axial strain (0 < C ≤ 0.9).
-    #[arg(long, value_name = "C")]
+    /// Override: final axial strain (0 < C ≤ 0.9, at least the scene's
+    /// output_strain_interval); the scene's snapshot strains beyond it are
+    /// dropped. With --resume, a run already past it takes no step.
+    #[arg(long, value_name = "C", allow_negative_numbers = true)]
     pub strain: Option<f64>,
 
-    /// Override: seed of the pour and the rotations.
-    #[arg(long, value_name = "SEED")]
+    /// Override: seed of the pour and the rotations (a whole number
+    /// 0 ≤ SEED < 2^64).
+    #[arg(long, value_name = "SEED", allow_negative_numbers = true,
+          value_parser = crate::numbers::whole::<u64>(0, u64::MAX))]
     pub seed: Option<u64>,
 
-    /// Override: die diameter, mm.
-    #[arg(long, value_name = "MM")]
+    /// Override: die diameter, mm (more than 4 granule diameters).
+    #[arg(long, value_name = "MM", allow_negative_numbers = true)]
     pub die_diameter_mm: Option<f64>,
 
     /// Override: element formulation (one-point, or fbar for verification:
@@ -134,7 +154,7 @@ pub struct BedArgs {
 
     /// Override: hourglass coefficient κ of the one-point element
     /// (0 ≤ κ ≤ 1).
-    #[arg(long, value_name = "KAPPA")]
+    #[arg(long, value_name = "KAPPA", allow_negative_numbers = true)]
     pub hourglass_kappa: Option<f64>,
 
     /// Override: granules are rigid bodies, without element work, until
@@ -159,14 +179,14 @@ pub struct BedArgs {
     /// deeper than this fraction of the element size is left (0 < t ≤ 0.1;
     /// the published scene's is 0.01, 0.005 leaves half the overlap for a
     /// quarter more sweeps). Allowed with --resume.
-    #[arg(long, value_name = "T")]
+    #[arg(long, value_name = "T", allow_negative_numbers = true)]
     pub sweep_tolerance: Option<f64>,
 
     /// Override: skin of the contact search's per-node face lists as a
     /// fraction of the mean surface-face diagonal (0 ≤ s ≤ 1, 0: none;
     /// default 0.05). Only the speed depends on it, so it may be given with
     /// --resume.
-    #[arg(long, value_name = "S")]
+    #[arg(long, value_name = "S", allow_negative_numbers = true)]
     pub face_list_skin: Option<f64>,
 
     /// Override: the contact search runs every N steps (1..=10); the steps
@@ -175,7 +195,8 @@ pub struct BedArgs {
     /// front of a face are held too). The published scene's is 5; 1
     /// searches every step. More than 1 needs --hold-constraints true.
     /// Allowed with --resume.
-    #[arg(long, value_name = "N")]
+    #[arg(long, value_name = "N", allow_negative_numbers = true,
+          value_parser = crate::numbers::whole::<u32>(1, u64::from(crate::assembly::MAX_CONTACT_SEARCH_INTERVAL)))]
     pub contact_search_interval: Option<u32>,
 
     /// Override: the contact search's capture distance as a fraction C of
@@ -183,7 +204,7 @@ pub struct BedArgs {
     /// front of a face are held with the contacts, so that the steps
     /// between two searches (--contact-search-interval) see them close.
     /// Allowed with --resume.
-    #[arg(long, value_name = "C")]
+    #[arg(long, value_name = "C", allow_negative_numbers = true)]
     pub contact_capture: Option<f64>,
 
     /// Continue the run whose checkpoint is in DIR (its `checkpoint.bin`);
@@ -196,8 +217,8 @@ pub struct BedArgs {
     pub resume: Option<PathBuf>,
 
     /// Write a checkpoint and stop once the strain reaches C (continue
-    /// later with --resume).
-    #[arg(long, value_name = "C")]
+    /// later with --resume; 0 < C ≤ the final strain).
+    #[arg(long, value_name = "C", allow_negative_numbers = true)]
     pub stop_at_strain: Option<f64>,
 
     /// Override: mass scaling F ≥ 1 for quasi-static runs (the stable step
@@ -205,8 +226,8 @@ pub struct BedArgs {
     /// The published scene's is 20, selective (the rigid modes ×2, see
     /// --selective-mass-ratio); 1 gives physical masses; 10 takes 40 % more
     /// steps than 20, 30 a fifth fewer (and fails the certificate narrowly
-    /// on the published scene).
-    #[arg(long, value_name = "F")]
+    /// on the published scene; 1 ≤ F ≤ 1e6).
+    #[arg(long, value_name = "F", allow_negative_numbers = true)]
     pub mass_scaling: Option<f64>,
 
     /// Override: the mass scaling acts on the granules' deformational modes,
@@ -222,27 +243,28 @@ pub struct BedArgs {
     /// inertia (the published scene's R is 10; inf: G = 1 for any F). Above
     /// 10 the contacts of a granule pressed on a punch can inject energy (the
     /// summary's contact loss and certificate show it).
-    #[arg(long, value_name = "R")]
+    #[arg(long, value_name = "R", allow_negative_numbers = true)]
     pub selective_mass_ratio: Option<f64>,
 
     /// Override: safety factor on the stable time step 2/ω_max
     /// (0 < C ≤ 2; default 0.9; above 1 the run is unstable). Allowed with
     /// --resume, e.g. to continue a run that failed with a smaller step.
-    #[arg(long, value_name = "C")]
+    #[arg(long, value_name = "C", allow_negative_numbers = true)]
     pub time_step_safety: Option<f64>,
 
     /// Override: variable mass scaling — a granule whose stable step falls
     /// below this fraction R of the undeformed granule's is given the
     /// least factor on its masses that lifts it back (at most
-    /// --max-mass-factor); 0 < R ≤ 1, 0: off (the published scene's). The
-    /// summary reports the granules scaled and the mass added. Allowed
-    /// with --resume (masses already added stay).
-    #[arg(long, value_name = "R")]
+    /// --max-mass-factor); 0 ≤ R ≤ 1, 0: off. The published scene's is 1
+    /// (a scene file without the field: 0). The summary reports the
+    /// granules scaled and the mass added. Allowed with --resume (masses
+    /// already added stay).
+    #[arg(long, value_name = "R", allow_negative_numbers = true)]
     pub time_step_floor: Option<f64>,
 
-    /// Override: the largest factor K ≥ 1 variable mass scaling puts on a
-    /// granule's masses (default 4).
-    #[arg(long, value_name = "K")]
+    /// Override: the largest factor K variable mass scaling puts on a
+    /// granule's masses (1 ≤ K ≤ 1e6; default 4).
+    #[arg(long, value_name = "K", allow_negative_numbers = true)]
     pub max_mass_factor: Option<f64>,
 
     /// The quasi-static certificate's rate check: after the run, press the
@@ -251,8 +273,10 @@ pub struct BedArgs {
     #[arg(long, conflicts_with_all = ["types", "stop_at_strain"])]
     pub rate_check: bool,
 
-    /// Worker threads (0 = all cores). Results do not depend on it.
-    #[arg(short = 'j', long, value_name = "N", default_value_t = 0)]
+    /// Worker threads (0 = all cores; at most 4096). Results do not depend
+    /// on it.
+    #[arg(short = 'j', long, value_name = "N", default_value_t = 0, allow_negative_numbers = true,
+          value_parser = crate::numbers::whole::<usize>(0, 4096))]
     pub threads: usize,
 
     /// VTU snapshots with every hex of every granule instead of the
@@ -260,7 +284,8 @@ pub struct BedArgs {
     #[arg(long)]
     pub vtk_full_mesh: bool,
 
-    /// No progress line and no summary line on stderr.
+    /// No progress line and no summary line on stderr (warnings are still
+    /// printed).
     #[arg(short, long)]
     pub quiet: bool,
 }
@@ -269,12 +294,22 @@ impl BedArgs {
     /// The scene: the checkpoint's, the file or the published one, with
     /// the overrides, validated.
     pub fn scene(&self, resume: Option<&checkpoint::Checkpoint>) -> anyhow::Result<Scene> {
-        let mut scene = match (&self.scene, resume) {
-            (_, Some(c)) => {
-                Scene::from_toml(&c.progress.scene_toml).context("the checkpoint's scene")?
-            }
-            (Some(path), None) => Scene::read(path)?,
-            (None, None) => Scene::published(),
+        Ok(self.scene_with_notes(resume)?.0)
+    }
+
+    /// [`BedArgs::scene`] and the warnings about it (a scene file's
+    /// omitted fields, [`Scene::read_with_notes`]).
+    pub fn scene_with_notes(
+        &self,
+        resume: Option<&checkpoint::Checkpoint>,
+    ) -> anyhow::Result<(Scene, Vec<String>)> {
+        let (mut scene, notes) = match (&self.scene, resume) {
+            (_, Some(c)) => (
+                Scene::from_toml(&c.progress.scene_toml).context("the checkpoint's scene")?,
+                Vec::new(),
+            ),
+            (Some(path), None) => Scene::read_with_notes(path)?,
+            (None, None) => (Scene::published(), Vec::new()),
         };
         if let Some(t) = self.granule_type {
             scene.granule_type = t.name().to_string();
@@ -287,6 +322,12 @@ impl BedArgs {
         }
         if let Some(c) = self.strain {
             scene.final_strain = c;
+            // Snapshots past the end are never written: a fresh run's scene
+            // (printed, or kept in its checkpoint) leaves them out, so that it
+            // reads back as a scene file. A resumed run keeps its own list.
+            if resume.is_none() {
+                scene.snapshot_strains.retain(|&s| s <= c);
+            }
         }
         if let Some(s) = self.seed {
             scene.seed = s;
@@ -339,8 +380,17 @@ impl BedArgs {
         if let Some(t) = self.sweep_tolerance {
             scene.sweep_tolerance = t;
         }
-        scene.validate()?;
-        Ok(scene)
+        scene.validate().map_err(|e| match self.strain {
+            // The one check --strain can fail besides its own range.
+            Some(c) if format!("{e}").contains("`output_strain_interval`") => {
+                e.context(crate::error::InputError(format!(
+                    "`--strain {c}` is below the scene's output_strain_interval {}",
+                    scene.output_strain_interval
+                )))
+            }
+            _ => e,
+        })?;
+        Ok((scene, notes))
     }
 
     /// Runs the command.
@@ -349,7 +399,10 @@ impl BedArgs {
             Some(dir) => Some(checkpoint::Checkpoint::read(dir)?),
             None => None,
         };
-        let scene = self.scene(resume.as_ref())?;
+        let (scene, notes) = self.scene_with_notes(resume.as_ref())?;
+        for note in &notes {
+            writeln!(streams.stderr, "warning: {note}")?;
+        }
         let out = self.resume.clone().unwrap_or_else(|| self.out.clone());
         if let Some(c) = self.stop_at_strain
             && !(c > 0.0 && c <= scene.final_strain)
@@ -372,15 +425,33 @@ impl BedArgs {
             .num_threads(self.threads)
             .build()?;
         if let Some(types) = &self.types {
-            return self.run_types(&scene, &types.0, &pool, streams);
+            return self.run_types(&scene, &types.0, &notes, &pool, streams);
+        }
+        if let Some(c) = &resume {
+            let reached = c.progress.die.strain_at(c.state.time);
+            // The run loop's own test: no step once the time is reached.
+            if c.state.time >= c.progress.die.time_of_strain(scene.final_strain) {
+                writeln!(
+                    streams.stderr,
+                    "note: the run in `{}` is already at C = {reached:.4}, at or past the final \
+                     strain {}: no step to take; its outputs are written again from the \
+                     checkpoint (a larger --strain continues it)",
+                    out.display(),
+                    scene.final_strain
+                )?;
+            }
         }
         let control = run::RunControl {
             resume,
             packing: None,
             checkpoint_dir: Some(out.clone()),
             stop_at_strain: self.stop_at_strain,
+            interrupt: Some(&crate::signal::INTERRUPT),
         };
-        let mut result = self.compress(&pool, &scene, control, &out, "bed", streams)?;
+        let mut result = self.compress(&pool, &scene, control, &out, "bed", &notes, streams)?;
+        if result.interrupted {
+            return Err(interrupted(&result, &out, ""));
+        }
         if self.rate_check && result.error.is_none() {
             self.rate_check(&pool, &scene, &out, &mut result, streams)?;
         }
@@ -412,8 +483,11 @@ impl BedArgs {
     }
 
     /// One compression of `scene` on `pool` as `control` says, with its
-    /// outputs in `out` (created) and the summary line on stderr; the
+    /// outputs in `out` (created; a fresh run first removes the snapshots
+    /// an earlier run left there), the summary line and the warnings
+    /// (`notes` about the scene, then the summary's own) on stderr; the
     /// progress bar starts with `label`.
+    #[allow(clippy::too_many_arguments)]
     fn compress(
         &self,
         pool: &rayon::ThreadPool,
@@ -421,8 +495,12 @@ impl BedArgs {
         control: run::RunControl,
         out: &std::path::Path,
         label: &str,
+        notes: &[String],
         streams: &mut Streams<'_>,
     ) -> anyhow::Result<run::BedRun> {
+        if control.resume.is_none() {
+            snapshots::remove_old(out)?;
+        }
         let mut observer = Observer {
             progress: outputs::Progress::new(self.quiet, scene.final_strain, label),
             snapshots: snapshots::SnapshotWriter::new(
@@ -440,10 +518,20 @@ impl BedArgs {
             .with_context(|| format!("cannot create output directory `{}`", out.display()))?;
         let result = pool.install(|| run::run_bed(scene, &control, &mut observer));
         observer.progress.finish();
-        let result = result?;
+        let mut result = result?;
+        result.warnings.extend_from_slice(notes);
         outputs::write_all(out, scene, &result)?;
         if !self.quiet {
             writeln!(streams.stderr, "{}", outputs::summary_line(scene, &result))?;
+        }
+        // Scene notes were printed before the run; the rest now, --quiet
+        // or not.
+        for w in outputs::summary(scene, &result)
+            .warnings
+            .iter()
+            .filter(|w| !notes.contains(w))
+        {
+            writeln!(streams.stderr, "warning: {w}")?;
         }
         Ok(result)
     }
@@ -466,11 +554,21 @@ impl BedArgs {
         let dir = out.join(HALF_SPEED_DIR);
         let control = run::RunControl {
             checkpoint_dir: Some(dir.clone()),
+            interrupt: Some(&crate::signal::INTERRUPT),
             ..run::RunControl::default()
         };
         let twin = self
-            .compress(pool, &slow, control, &dir, "half speed", streams)
+            .compress(pool, &slow, control, &dir, "half speed", &[], streams)
             .context("the rate check's run at half the punch speed")?;
+        if twin.interrupted {
+            return Err(anyhow::Error::new(crate::signal::Interrupted(format!(
+                "interrupted during the rate check's run at half the punch speed (its outputs \
+                 so far are in `{}`); the run's own outputs in `{}` are complete, without the \
+                 rate check",
+                dir.display(),
+                out.display()
+            ))));
+        }
         if let Some(e) = twin.error {
             return Err(anyhow::Error::new(e).context(format!(
                 "the rate check's run at half the punch speed failed (its outputs are in `{}`)",
@@ -508,6 +606,7 @@ impl BedArgs {
         &self,
         base: &Scene,
         types: &[GranuleType],
+        notes: &[String],
         pool: &rayon::ThreadPool,
         streams: &mut Streams<'_>,
     ) -> anyhow::Result<()> {
@@ -541,6 +640,11 @@ impl BedArgs {
         let packing = pool
             .install(|| run::pour(&scenes[pour_index]))
             .with_context(|| format!("the pour (sphere density of type {pour_type})"))?;
+        if crate::signal::INTERRUPT.load(core::sync::atomic::Ordering::SeqCst) {
+            return Err(anyhow::Error::new(crate::signal::Interrupted(
+                "interrupted during the pour: nothing was compressed".to_owned(),
+            )));
+        }
         if !self.quiet {
             writeln!(
                 streams.stderr,
@@ -558,11 +662,26 @@ impl BedArgs {
                 packing: Some(packing.clone()),
                 checkpoint_dir: Some(dir.clone()),
                 stop_at_strain: None,
+                interrupt: Some(&crate::signal::INTERRUPT),
             };
             let label = format!("bed {t}");
             let result = self
-                .compress(pool, scene, control, &dir, &label, streams)
+                .compress(pool, scene, control, &dir, &label, notes, streams)
                 .with_context(|| format!("granule type {t}"))?;
+            if result.interrupted {
+                let done = runs.len();
+                let rest: Vec<&str> = types[done + 1..].iter().map(|t| t.name()).collect();
+                let rest = if rest.is_empty() {
+                    String::new()
+                } else {
+                    format!("; not run: {}", rest.join(", "))
+                };
+                return Err(interrupted(
+                    &result,
+                    &dir,
+                    &format!(" (type {t}; no comparison written{rest})"),
+                ));
+            }
             runs.push(result);
         }
         let rows: Vec<compare::ComparisonRow> = types
@@ -593,6 +712,19 @@ impl BedArgs {
         });
         crate::output::all_failures(failed, "stopped early")
     }
+}
+
+/// The error of a run stopped by SIGINT/SIGTERM, its outputs and
+/// checkpoint in `dir`; `what` adds to the message.
+fn interrupted(result: &run::BedRun, dir: &std::path::Path, what: &str) -> anyhow::Error {
+    anyhow::Error::new(crate::signal::Interrupted(format!(
+        "interrupted at C = {:.4}, step {}{what}: the checkpoint and the outputs so far are in \
+         `{}`; continue with: granbed-cli bed --resume {}",
+        result.strain_reached,
+        result.steps,
+        dir.display(),
+        dir.display()
+    )))
 }
 
 /// What the command does with the run as it goes.

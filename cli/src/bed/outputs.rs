@@ -18,7 +18,7 @@ use crate::progress::{StrainBar, draw_target, steps_per_second};
 use crate::quasi_static::QuasiStatic;
 
 /// Columns of `compression.csv`, in order.
-pub const COMPRESSION_COLUMNS: [&str; 28] = [
+pub const COMPRESSION_COLUMNS: [&str; 29] = [
     "time_s",
     "strain",
     "upper_pressure_pa",
@@ -30,6 +30,7 @@ pub const COMPRESSION_COLUMNS: [&str; 28] = [
     "coordination_with_walls",
     "relative_density_mean",
     "relative_density_solid",
+    "bed_solid_fraction",
     "heywood_dv",
     "heywood_d",
     "min_jacobian",
@@ -49,7 +50,16 @@ pub const COMPRESSION_COLUMNS: [&str; 28] = [
     "energy_residual_j",
 ];
 
-fn row(s: &BedSample) -> [Field; 28] {
+/// The bed's solid fraction D at strain C: the granules' solid volume over
+/// the die volume between the punches, `solid_volume_m3` /
+/// (π R_d² H0 (1 − C)) — the relative density of the compact, whose
+/// ln(1/(1 − D)) against the punch pressure is the Heckel plot.
+pub fn bed_solid_fraction(run: &BedRun, strain: Real) -> Real {
+    let die_area = core::f64::consts::PI * run.die_radius_m * run.die_radius_m;
+    run.solid_volume_m3 / (die_area * run.bed_height_m * (1.0 - strain))
+}
+
+fn row(s: &BedSample, run: &BedRun) -> [Field; 29] {
     let e = &s.energies;
     [
         s.time_s.into(),
@@ -63,6 +73,7 @@ fn row(s: &BedSample) -> [Field; 28] {
         s.coordination_with_walls.into(),
         s.relative_density_mean.into(),
         s.relative_density_solid.into(),
+        bed_solid_fraction(run, s.strain).into(),
         s.heywood_dv.into(),
         s.heywood_d.into(),
         s.min_jacobian.into(),
@@ -157,22 +168,25 @@ pub struct Summary<'a> {
     pub pour_wall_time_s: f64,
     /// Compression wall time per element evaluation, ns.
     pub ns_per_element_step: Option<f64>,
-    /// Share of the contact phase in the compression's wall time.
+    /// Share of the contact phase in the compression's wall time (over
+    /// the steps `cost_figures_from_step` on, as the figures below).
     pub contact_share: Option<f64>,
-    /// Contact sweeps per step (of this process's segment of the run).
+    /// Contact sweeps per step.
     pub contact_sweeps_per_step: Option<f64>,
-    /// Face-list builds per step (a pair's two passes count one; of this
-    /// process's segment of the run).
+    /// Face-list builds per step (a pair's two passes count one).
     pub face_list_builds_per_step: Option<f64>,
-    /// Face-list anchor renewals per step, over all granules (of this
-    /// process's segment of the run).
+    /// Face-list anchor renewals per step, over all granules.
     pub anchor_renewals_per_step: Option<f64>,
-    /// Pair searches (detections) per step, over all sweeps (of this
-    /// process's segment of the run).
+    /// Pair searches (detections) per step, over all sweeps.
     pub pair_searches_per_step: Option<f64>,
     /// Share of the granule-steps taken as rigid bodies, without element
-    /// work (of this process's segment of the run).
+    /// work.
     pub rigid_granule_step_share: Option<f64>,
+    /// The first step the cost figures above cover: 0 (the whole run,
+    /// every resumed segment included) unless the run was resumed from a
+    /// checkpoint older than format 7, which did not carry the counters
+    /// (then that checkpoint's step; `warnings` says so).
+    pub cost_figures_from_step: u64,
     /// Threads used.
     pub threads: usize,
     /// Smallest element Jacobian ratio (element centres, every step).
@@ -199,6 +213,15 @@ pub struct Summary<'a> {
     pub quasi_static: QuasiStatic,
     /// What variable mass scaling did (scene `time_step_floor`).
     pub added_mass: super::run::AddedMass,
+    /// True if SIGINT/SIGTERM stopped the run (after a step, with a
+    /// checkpoint): `granbed-cli bed --resume DIR` continues it.
+    pub interrupted: bool,
+    /// What a reader of these figures must know (also printed on stderr):
+    /// a final strain past the target, overlaps above 1 % of the element,
+    /// a Kawakita fit outside the law's regime, cost figures over part of
+    /// the run, scene fields left at pre-publication values, an
+    /// interruption.
+    pub warnings: Vec<String>,
     /// The error that stopped the run early, if any.
     pub error: Option<String>,
 }
@@ -254,6 +277,14 @@ pub fn summary<'a>(scene: &'a Scene, run: &BedRun) -> Summary<'a> {
                 m.max(p)
             }
         });
+    let max_penetration_rel_element = finite_ratio(max_penetration_m, run.element_size_m);
+    let warnings = warnings(
+        scene,
+        run,
+        &k,
+        max_penetration_m,
+        max_penetration_rel_element,
+    );
     Summary {
         version: env!("CARGO_PKG_VERSION"),
         scene,
@@ -285,6 +316,7 @@ pub fn summary<'a>(scene: &'a Scene, run: &BedRun) -> Summary<'a> {
         anchor_renewals_per_step: run.phase_times.per_step(run.phase_times.anchor_renewals),
         pair_searches_per_step: run.phase_times.per_step(run.phase_times.pair_searches),
         rigid_granule_step_share: run.phase_times.rigid_share(run.granules),
+        cost_figures_from_step: run.counters_from_step,
         threads: run.threads,
         min_jacobian,
         min_gauss_jacobian: run.samples.iter().map(|s| s.min_gauss_jacobian).fold(
@@ -305,16 +337,121 @@ pub fn summary<'a>(scene: &'a Scene, run: &BedRun) -> Summary<'a> {
             scene.punch_speed_m_s,
         ),
         max_penetration_m,
-        max_penetration_rel_element: finite_ratio(max_penetration_m, run.element_size_m),
+        max_penetration_rel_element,
         hourglass_to_internal: finite_ratio(e.hourglass, e.internal_work),
         energy_residual_rel: finite_ratio(e.residual().abs(), e.punch_work),
         contact_loss_rel: finite_ratio(e.contact_loss(), e.punch_work),
         peak_memory_bytes: peak_memory_bytes(),
         quasi_static: quasi_static(&run.samples, run.rate_change_rel),
         added_mass: run.added_mass,
+        interrupted: run.interrupted,
+        warnings,
         error: run.error.as_ref().map(|e| e.to_string()),
     }
 }
+
+/// The overlap above which a run is warned about: 1 % of the element size,
+/// the criterion of `granbed-cli study stability` (issue #9's).
+pub const OVERLAP_WARNING_REL: Real = crate::study::stability::MAX_PENETRATION_REL;
+
+/// The summary's warnings: `run.warnings`, then those its figures call
+/// for.
+fn warnings(
+    scene: &Scene,
+    run: &BedRun,
+    kawakita: &KawakitaSummary,
+    max_penetration_m: Real,
+    max_penetration_rel: Option<Real>,
+) -> Vec<String> {
+    let mut w = run.warnings.clone();
+    if run.interrupted {
+        w.push(format!(
+            "interrupted (SIGINT/SIGTERM) at C = {:.4}, step {}: the figures cover the run so \
+             far; `granbed-cli bed --resume DIR` continues it from its checkpoint",
+            run.strain_reached, run.steps
+        ));
+    }
+    if let [.., before, last] = run.samples.as_slice() {
+        let target = scene.final_strain;
+        if last.strain > target + scene.output_strain_interval {
+            let cause = if run.resumed_past_end {
+                "the checkpoint resumed was already past it (a --strain below the strain the \
+                 run had reached)"
+                    .to_owned()
+            } else {
+                let per_step =
+                    (last.strain - before.strain) / last.steps.saturating_sub(before.steps) as Real;
+                format!(
+                    "a step moves the punch by about C = {per_step:.3e}; a lower punch_speed_m_s \
+                     (now {} m/s) or mass_scaling (now {}) takes smaller steps",
+                    scene.punch_speed_m_s, scene.mass_scaling
+                )
+            };
+            w.push(format!(
+                "the run ended at C = {:.4}, past the final strain {target} by more than one \
+                 output interval ({}): {cause}",
+                last.strain, scene.output_strain_interval
+            ));
+        }
+        if last.strain >= 1.0 {
+            w.push(format!(
+                "C = {:.4} >= 1: the upper punch has passed the lower punch's position; the \
+                 figures of this run mean nothing",
+                last.strain
+            ));
+        }
+    }
+    match max_penetration_rel {
+        Some(r) if r > OVERLAP_WARNING_REL => w.push(format!(
+            "granules overlap by up to {:.1} % of the element size ({max_penetration_m:.3e} m), \
+             more than the {} % that `study stability` accepts: the contact settings \
+             hold_constraints = false and contact_search_interval = 1 (`--hold-constraints \
+             false --contact-search-interval 1`) resolve it at a higher cost (on 30-granule 4x1 \
+             beds to 60 %: 26-44 % of the element became 0.5-0.8 %, at 3-5 times the wall \
+             time)",
+            100.0 * r,
+            100.0 * OVERLAP_WARNING_REL
+        )),
+        None if max_penetration_m.is_nan() => {
+            w.push("the granule overlap could not be measured (NaN)".to_owned());
+        }
+        _ => {}
+    }
+    let mut why = Vec::new();
+    if let Some(a) = kawakita.a.filter(|&a| a > 1.0) {
+        why.push(format!(
+            "a = {a:.3} > 1 (a is the limiting strain, at most 1)"
+        ));
+    }
+    if let Some(inv_b) = kawakita.inv_b_pa.filter(|&x| x <= 0.0) {
+        why.push(format!("1/b = {inv_b:.3e} Pa <= 0"));
+    }
+    if let Some(r2) = kawakita.r_squared.filter(|&r| r < KAWAKITA_MIN_R_SQUARED) {
+        why.push(format!("R^2 = {r2:.3} < {KAWAKITA_MIN_R_SQUARED}"));
+    }
+    if !why.is_empty() {
+        w.push(format!(
+            "the Kawakita fit over C >= 0.25 ({} points) does not describe this bed: {}; its a \
+             and 1/b are not material figures (a bed too small or a strain too short for the \
+             law's regime)",
+            kawakita.points,
+            why.join(", ")
+        ));
+    }
+    if run.counters_from_step > 0 {
+        w.push(format!(
+            "the cost figures (contact_share, contact_sweeps_per_step, \
+             face_list_builds_per_step, anchor_renewals_per_step, pair_searches_per_step, \
+             rigid_granule_step_share) cover steps {} to {} only: the run was resumed from a \
+             checkpoint older than format 7, which did not carry them",
+            run.counters_from_step, run.steps
+        ));
+    }
+    w
+}
+
+/// The R² below which the Kawakita fit is warned about.
+pub const KAWAKITA_MIN_R_SQUARED: Real = 0.9;
 
 /// Writes `compression.csv`, `summary.json`, the plots and `report.html`
 /// into `dir` (created).
@@ -325,7 +462,7 @@ pub fn write_all(dir: &Path, scene: &Scene, run: &BedRun) -> anyhow::Result<()> 
     let mut csv = CsvWriter::new(create_file(&path)?, &COMPRESSION_COLUMNS)
         .with_context(|| format!("cannot write to `{}`", path.display()))?;
     for s in &run.samples {
-        csv.write_row(&row(s))
+        csv.write_row(&row(s, run))
             .with_context(|| format!("cannot write to `{}`", path.display()))?;
     }
     finish_file(csv.into_inner(), &path)?;
@@ -355,7 +492,7 @@ pub fn summary_line(scene: &Scene, run: &BedRun) -> String {
     };
     format!(
         "bed {} x {}: C = {:.3} after {} steps in {:.1} s ({} threads, {:.0} ns/element-step); \
-         max pressure {:.1} kPa; Kawakita a = {}, 1/b = {} kPa ({} points){}",
+         max pressure {:.1} kPa; Kawakita a = {}, 1/b = {} kPa, R^2 = {} ({} points){}",
         scene.granules,
         scene.granule_type,
         s.final_strain,
@@ -366,6 +503,7 @@ pub fn summary_line(scene: &Scene, run: &BedRun) -> String {
         s.max_pressure_pa * 1e-3,
         fmt(s.kawakita_a, 1.0),
         fmt(s.kawakita_inv_b_pa, 1e-3),
+        fmt(s.kawakita.r_squared, 1.0),
         s.kawakita.points,
         certificate,
     )

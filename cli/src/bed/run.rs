@@ -3,6 +3,7 @@
 //! time-averaged state every output interval. Nothing here depends on
 //! clap, so the tests drive exactly this code.
 
+use core::sync::atomic::{AtomicBool, Ordering};
 use std::path::PathBuf;
 use std::time::Instant;
 
@@ -17,7 +18,7 @@ use granbed_kernel::dem::pour::PourParams;
 use super::checkpoint::{self, Checkpoint};
 use super::scene::Scene;
 use crate::assembly::die::{DieScene, placements, wall_index};
-use crate::assembly::{Assembly, AssemblyError, AssemblyParams, Energies};
+use crate::assembly::{Assembly, AssemblyError, AssemblyParams, Energies, PhaseTimes};
 use crate::model::OwnedReference;
 use crate::pack::run::run_pour;
 
@@ -111,18 +112,39 @@ pub struct BedRun {
     pub element_size_m: Real,
     /// Steps completed.
     pub steps: u64,
+    /// Strain at the end of the last step (the last sample's, unless the
+    /// run stopped between two output rows).
+    pub strain_reached: Real,
     /// Granule-element evaluations (steps × granules × hexes).
     pub element_steps: u64,
     /// Wall time of the pour, s.
     pub pour_wall_time_s: f64,
     /// Wall time of the compression, s (all segments of a resumed run).
     pub wall_time_s: f64,
-    /// Wall time by phase of the compression.
-    pub phase_times: crate::assembly::PhaseTimes,
+    /// Wall time by phase of the compression and the contact counters,
+    /// over the steps from [`BedRun::counters_from_step`] on (all segments
+    /// of a resumed run: the checkpoint carries them).
+    pub phase_times: PhaseTimes,
+    /// The first step [`BedRun::phase_times`] covers: 0, the whole run,
+    /// unless the run was resumed from a checkpoint older than format 7,
+    /// which did not carry the counters.
+    pub counters_from_step: u64,
+    /// Solid volume of all granules, m³ (N η0 V0 with the reference mesh's
+    /// volume V0; constant): the numerator of the bed's solid fraction.
+    pub solid_volume_m3: Real,
     /// Threads of the pool the run used.
     pub threads: usize,
     /// True if the run stopped at `RunControl::stop_at_strain`.
     pub stopped: bool,
+    /// True if the run stopped because [`RunControl::interrupt`] was set
+    /// (SIGINT/SIGTERM): after the step it was in, with a checkpoint.
+    pub interrupted: bool,
+    /// True if the run was resumed from a checkpoint already at or past
+    /// the final strain (no step taken).
+    pub resumed_past_end: bool,
+    /// Warnings about the run that its samples do not show, for stderr and
+    /// `summary.json` (the summary adds those it derives from the samples).
+    pub warnings: Vec<String>,
     /// The error that stopped the run, if any.
     pub error: Option<AssemblyError>,
     /// With an error: the strain of the newest checkpoint on disk (the
@@ -266,6 +288,26 @@ pub struct RunControl {
     pub checkpoint_dir: Option<PathBuf>,
     /// Stop (after a checkpoint) once the strain reaches this.
     pub stop_at_strain: Option<Real>,
+    /// Stop (after the current step, with a checkpoint) once this is set:
+    /// the CLI passes [`crate::signal::INTERRUPT`], which its SIGINT and
+    /// SIGTERM handler sets. A fresh run that finds it set after the pour
+    /// stops before its first step with [`crate::signal::Interrupted`].
+    pub interrupt: Option<&'static AtomicBool>,
+}
+
+/// `a` and `b` added: the phase times and counters of two segments.
+fn add_times(a: PhaseTimes, b: PhaseTimes) -> PhaseTimes {
+    PhaseTimes {
+        predict_s: a.predict_s + b.predict_s,
+        contact_s: a.contact_s + b.contact_s,
+        correct_s: a.correct_s + b.correct_s,
+        sweeps: a.sweeps + b.sweeps,
+        rigid_granule_steps: a.rigid_granule_steps + b.rigid_granule_steps,
+        steps: a.steps + b.steps,
+        list_builds: a.list_builds + b.list_builds,
+        anchor_renewals: a.anchor_renewals + b.anchor_renewals,
+        pair_searches: a.pair_searches + b.pair_searches,
+    }
 }
 
 /// The pour's parameters for `scene`.
@@ -331,6 +373,13 @@ pub fn run_bed(
                     &poured
                 }
             };
+            if control.interrupt.is_some_and(|f| f.load(Ordering::SeqCst)) {
+                return Err(anyhow::Error::new(crate::signal::Interrupted(
+                    "interrupted before the compression's first step: there is nothing to \
+                     resume (no checkpoint written)"
+                        .to_owned(),
+                )));
+            }
             let die_radius = 0.5e-3 * scene.die_diameter_mm;
             if packing.centres.len() != scene.granules
                 || packing.radius_m != radius
@@ -369,6 +418,14 @@ pub fn run_bed(
     let area = core::f64::consts::PI * die.die_radius_m * die.die_radius_m;
     let granules = scene.granules;
     let eta0 = material.params.eta0;
+    let solid_volume_m3 = granules as Real
+        * eta0
+        * surface_geometry(&mesh.positions, &mesh.quads).map_or(Real::NAN, |(_, v)| v);
+    // The phase times and counters of earlier segments (a checkpoint
+    // before format 7 has none: the figures then start at its step).
+    let (counters_before, counters_from_step) = resumed.map_or((PhaseTimes::default(), 0), |c| {
+        (c.progress.counters, c.progress.counters_from_step)
+    });
     let d = 2.0 * radius;
     // Wall time of earlier segments of a resumed run.
     let wall_before = resumed.map_or(0.0, |c| c.progress.compression_wall_time_s);
@@ -446,6 +503,8 @@ pub fn run_bed(
                     window: *window,
                     next_output: next,
                     snapshots_done: done,
+                    counters: add_times(counters_before, asm.times()),
+                    counters_from_step,
                 },
                 state: asm.state(),
             }
@@ -462,6 +521,9 @@ pub fn run_bed(
     let mut next_checkpoint_strain = die.strain_at(asm.time()) + scene.checkpoint_strain_interval;
     let mut error = None;
     let mut stopped = false;
+    let mut interrupted = false;
+    let resumed_past_end = resumed.is_some() && asm.time() >= end;
+    let first_step = asm.steps();
     while asm.time() < end {
         if let Err(e) = asm.step() {
             error = Some(e);
@@ -503,7 +565,9 @@ pub fn run_bed(
             }
         }
         let stop = control.stop_at_strain.is_some_and(|c| strain + 1e-12 >= c);
+        let interrupt = control.interrupt.is_some_and(|f| f.load(Ordering::SeqCst));
         if stop
+            || interrupt
             || strain >= next_checkpoint_strain
             || last_checkpoint.elapsed().as_secs_f64() >= every_s
         {
@@ -520,6 +584,21 @@ pub fn run_bed(
             stopped = true;
             break;
         }
+        if interrupt {
+            interrupted = true;
+            break;
+        }
+    }
+    // A run that reached its final strain ends with a checkpoint of its
+    // last step, so that `--resume --strain` can take it further.
+    if let Some(dir) = dir
+        && error.is_none()
+        && asm.time() >= end
+        && asm.steps() > first_step
+        && on_disk.is_none_or(|(steps, _)| steps < asm.steps())
+    {
+        make(&asm, &samples, &window, next, snapshots_done).write(dir)?;
+        on_disk = Some((asm.steps(), die.strain_at(asm.time())));
     }
     let mut checkpoint_strain = on_disk.map(|(_, c)| c);
     if let (Some(_), Some(dir), Some(good)) = (&error, dir, &last_good) {
@@ -530,6 +609,7 @@ pub fn run_bed(
         }
     }
     let steps = asm.steps();
+    let strain_reached = die.strain_at(asm.time());
     Ok(BedRun {
         samples,
         bed_height_m: die.bed_height_m,
@@ -538,12 +618,18 @@ pub fn run_bed(
         hexes_per_granule: mesh.hexes.len(),
         element_size_m: mesh.shortest_surface_edge(),
         steps,
+        strain_reached,
         element_steps: steps * (scene.granules * mesh.hexes.len()) as u64,
         pour_wall_time_s,
         wall_time_s: wall(),
-        phase_times: asm.times(),
+        phase_times: add_times(counters_before, asm.times()),
+        counters_from_step,
+        solid_volume_m3,
         threads: rayon::current_num_threads(),
         stopped,
+        interrupted,
+        resumed_past_end,
+        warnings: Vec::new(),
         error,
         checkpoint_strain,
         rate_change_rel: None,

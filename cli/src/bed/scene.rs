@@ -14,10 +14,20 @@ use crate::model::{MeshLevel, OwnedReference};
 /// The format version this build reads and writes.
 pub const SCENE_VERSION: u32 = 1;
 
+/// The fastest punch accepted, m/s: the platen speed limit of
+/// `granbed-cli granule` (10000 mm/s). Far below it a step already moves
+/// the punch by more than an output interval on a small bed (the run says
+/// so); a bed is quasi-static only far below it (the published 0.05).
+pub const MAX_PUNCH_SPEED_M_S: f64 = 10.0;
+
 /// The published scene (physics.md §6 and the paper's bed): 1000 B2
 /// granules of 1280 hexes poured into an 11.3 mm die (seed 1), the upper
 /// punch at 50 mm/s to 30 % axial strain, friction 0.1, ξ = 0.5.
 pub const DEFAULT_SCENE: &str = r#"# granbed bed scene (format version 1). Units are in the field names.
+# A field left out takes its value from before the field existed: for the
+# numerics fields below (mass scaling, time_step_floor, hold_constraints,
+# contact_search_interval, contact_capture, sweep_tolerance) that is not the
+# published value, and granbed-cli bed warns with the values it uses.
 version = 1
 
 # Granules: a standard type A1...C3 (A/B/C: yield stress 10/30/100 kPa;
@@ -186,13 +196,15 @@ pub struct Scene {
     pub seed: u64,
     /// Die diameter, mm.
     pub die_diameter_mm: f64,
-    /// Upper-punch speed, m/s (> 0).
+    /// Upper-punch speed, m/s, 0 < v ≤ [`MAX_PUNCH_SPEED_M_S`].
     pub punch_speed_m_s: f64,
     /// Axial strain at which the run ends, 0 < C ≤ 0.9.
     pub final_strain: f64,
-    /// Strain between output rows, > 0.
+    /// Strain between output rows, 0 < ΔC ≤ the final strain.
     pub output_strain_interval: f64,
-    /// Strains at which VTU snapshots are written (each in [0, 0.9]).
+    /// Strains at which VTU snapshots are written (each in [0, 0.9]; a
+    /// scene file's within its final strain, [`Scene::read`]; beyond a
+    /// final strain lowered by `--strain` they are not written).
     #[serde(default)]
     pub snapshot_strains: Vec<f64>,
     /// Wall time between checkpoints, minutes (> 0).
@@ -474,10 +486,10 @@ impl Scene {
                 "more than 4 granule diameters",
             ),
             (
-                self.punch_speed_m_s > 0.0 && self.punch_speed_m_s.is_finite(),
+                self.punch_speed_m_s > 0.0 && self.punch_speed_m_s <= MAX_PUNCH_SPEED_M_S,
                 "punch_speed_m_s",
                 self.punch_speed_m_s,
-                "> 0",
+                "0 < v <= 10 m/s, the platen speed limit of `granbed-cli granule`",
             ),
             (
                 self.final_strain > 0.0 && self.final_strain <= 0.9,
@@ -486,10 +498,11 @@ impl Scene {
                 "0 < C <= 0.9",
             ),
             (
-                self.output_strain_interval > 0.0 && self.output_strain_interval.is_finite(),
+                self.output_strain_interval > 0.0
+                    && self.output_strain_interval <= self.final_strain,
                 "output_strain_interval",
                 self.output_strain_interval,
-                "> 0",
+                "0 < interval <= final_strain",
             ),
             (
                 (0.0..=2.0).contains(&self.damping_ratio),
@@ -611,12 +624,100 @@ impl Scene {
         })
     }
 
-    /// Reads a scene file.
+    /// Reads a scene file: parsed and validated, and its snapshot strains
+    /// within its final strain (a snapshot beyond it would never be
+    /// written).
     pub fn read(path: &std::path::Path) -> anyhow::Result<Self> {
+        Ok(Self::read_with_notes(path)?.0)
+    }
+
+    /// [`Scene::read`], with the warnings about the file: the fields it
+    /// omits whose value then differs from the published scene's
+    /// ([`Scene::omitted_fields`]).
+    pub fn read_with_notes(path: &std::path::Path) -> anyhow::Result<(Self, Vec<String>)> {
         let text = std::fs::read_to_string(path)
             .with_context(|| format!("cannot read scene `{}`", path.display()))?;
-        Self::from_toml(&text).with_context(|| format!("scene `{}`", path.display()))
+        let scene = Self::from_toml(&text)
+            .and_then(|s| s.check_snapshots().map(|()| s))
+            .with_context(|| format!("scene `{}`", path.display()))?;
+        let omitted = scene.omitted_fields(&text);
+        let notes = if omitted.is_empty() {
+            Vec::new()
+        } else {
+            vec![format!(
+                "scene `{}` omits {}, which then take the values of scene files from before \
+                 those fields existed, not the published scene's: {} (`granbed-cli bed --scene \
+                 FILE --print-scene` prints every value; add the fields to choose)",
+                path.display(),
+                omitted
+                    .iter()
+                    .map(|o| o.field.as_str())
+                    .collect::<Vec<_>>()
+                    .join(", "),
+                omitted
+                    .iter()
+                    .map(|o| format!("{} = {} (published {})", o.field, o.value, o.published))
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            )]
+        };
+        Ok((scene, notes))
     }
+
+    /// Rejects snapshot strains beyond the final strain, naming the field.
+    pub fn check_snapshots(&self) -> anyhow::Result<()> {
+        if let Some(c) = self
+            .snapshot_strains
+            .iter()
+            .find(|&&c| c > self.final_strain)
+        {
+            bail!(invalid(
+                "snapshot_strains",
+                c,
+                &format!("each 0 <= C <= final_strain = {}", self.final_strain)
+            ));
+        }
+        Ok(())
+    }
+
+    /// The fields that the scene file `text` (which parsed to `self`)
+    /// leaves out and whose value then differs from the published scene's:
+    /// the numerics fields added after the format, whose absent values
+    /// keep the older files' runs as they were (`[material]` is not
+    /// listed: absent, the type's preset applies).
+    pub fn omitted_fields(&self, text: &str) -> Vec<OmittedField> {
+        let (Ok(given), Ok(published), Ok(toml::Value::Table(own))) = (
+            toml::from_str::<toml::Table>(text),
+            toml::from_str::<toml::Table>(DEFAULT_SCENE),
+            toml::Value::try_from(self),
+        ) else {
+            return Vec::new();
+        };
+        published
+            .iter()
+            .filter(|(field, _)| field.as_str() != "material" && !given.contains_key(*field))
+            .filter_map(|(field, published)| {
+                let value = own.get(field)?;
+                (value != published).then(|| OmittedField {
+                    field: field.clone(),
+                    value: value.to_string(),
+                    published: published.to_string(),
+                })
+            })
+            .collect()
+    }
+}
+
+/// A field a scene file omits whose value then differs from the published
+/// scene's ([`Scene::omitted_fields`]).
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct OmittedField {
+    /// The field's name.
+    pub field: String,
+    /// The value the scene runs with (TOML).
+    pub value: String,
+    /// The published scene's value (TOML).
+    pub published: String,
 }
 
 #[cfg(test)]

@@ -179,6 +179,33 @@ pub fn snapshot_file(k: usize) -> String {
     format!("bed_{k}.vtu")
 }
 
+/// Removes the snapshots an earlier run left in `out`/[`VTK_DIR`]
+/// (`bed_<k>.vtu` and [`PVD_FILE`]; nothing else), so that a fresh run
+/// into the same directory does not leave stale snapshots beside its own
+/// (e.g. of strains it does not reach). Returns how many files went.
+pub fn remove_old(out: &Path) -> anyhow::Result<usize> {
+    let dir = out.join(VTK_DIR);
+    let Ok(entries) = std::fs::read_dir(&dir) else {
+        return Ok(0);
+    };
+    let mut removed = 0;
+    for entry in entries {
+        let entry = entry.with_context(|| format!("cannot list `{}`", dir.display()))?;
+        let name = entry.file_name();
+        let Some(name) = name.to_str() else { continue };
+        let snapshot = name
+            .strip_prefix("bed_")
+            .and_then(|n| n.strip_suffix(".vtu"))
+            .is_some_and(|k| !k.is_empty() && k.bytes().all(|b| b.is_ascii_digit()));
+        if (snapshot || name == PVD_FILE) && entry.path().is_file() {
+            std::fs::remove_file(entry.path())
+                .with_context(|| format!("cannot remove `{}`", entry.path().display()))?;
+            removed += 1;
+        }
+    }
+    Ok(removed)
+}
+
 /// Writes the snapshots of one run into `<out>/vtk/`.
 #[derive(Debug)]
 pub struct SnapshotWriter {

@@ -1,0 +1,248 @@
+//! `granbed-cli bed` stopped by SIGINT/SIGTERM loses no finished work: the
+//! run finishes its step, writes a checkpoint and the outputs so far
+//! (`summary.json` marked interrupted), says how to resume and exits 130;
+//! the resumed run ends with the uninterrupted run's bits, and its
+//! summary's cost figures cover the whole run (the checkpoint carries the
+//! counters; an older checkpoint's resume says that they cover only the
+//! resumed part).
+//!
+//! Nothing here depends on timing: the signal handler only sets a flag
+//! (`granbed_cli::signal::INTERRUPT`), so the tests set that flag — or a
+//! flag of their own passed to `run_bed` — at a chosen point instead of
+//! sending a signal. One test function: the CLI's flag is process-wide.
+
+mod common;
+
+use core::sync::atomic::{AtomicBool, Ordering};
+use std::path::{Path, PathBuf};
+
+use common::{Table, cli, number, summary};
+use granbed_cli::assembly::Assembly;
+use granbed_cli::bed::Scene;
+use granbed_cli::bed::checkpoint::{Checkpoint, FILE_NAME};
+use granbed_cli::bed::run::{BedObserver, BedSample, RunControl, run_bed};
+use granbed_cli::model::OwnedReference;
+use granbed_cli::signal::INTERRUPT;
+
+fn out_dir(name: &str) -> PathBuf {
+    common::fresh_dir("cli_bed_interrupt", name)
+}
+
+/// 20 coarse granules to 12 %.
+const SMALL: [&str; 8] = common::small_bed("20", "0.12");
+
+fn bed(extra: &[&str]) -> common::Run {
+    let mut argv = vec!["bed", "--quiet", "-j", "1"];
+    argv.extend_from_slice(extra);
+    cli(&argv)
+}
+
+/// Sets `flag` once the run has written `rows` output rows (the first at
+/// t = 0 included).
+struct InterruptAfter {
+    rows: usize,
+    seen: usize,
+    flag: &'static AtomicBool,
+}
+
+impl BedObserver for InterruptAfter {
+    fn sample(&mut self, _: &BedSample, _: f64) {
+        self.seen += 1;
+        if self.seen == self.rows {
+            self.flag.store(true, Ordering::SeqCst);
+        }
+    }
+
+    fn snapshot(&mut self, _: f64, _: &Assembly<'_>, _: &OwnedReference) -> anyhow::Result<()> {
+        Ok(())
+    }
+}
+
+/// The FNV-1a 64 checksum of the checkpoint format.
+fn fnv1a(bytes: &[u8]) -> u64 {
+    bytes.iter().fold(0xcbf2_9ce4_8422_2325, |h, &b| {
+        (h ^ u64::from(b)).wrapping_mul(0x0000_0100_0000_01b3)
+    })
+}
+
+/// Rewrites the format-7 checkpoint in `dir` as format 6: without the
+/// trailing phase times and counters (a length-prefixed list of 3 floats,
+/// then 7 u64s), version 6, the checksum of the shorter payload.
+fn downgrade_to_format_6(dir: &Path) {
+    let path = dir.join(FILE_NAME);
+    let bytes = std::fs::read(&path).unwrap();
+    assert_eq!(u32::from_le_bytes(bytes[16..20].try_into().unwrap()), 7);
+    let payload = &bytes[36..bytes.len() - (8 + 3 * 8 + 7 * 8)];
+    let mut out = bytes[..16].to_vec();
+    out.extend_from_slice(&6u32.to_le_bytes());
+    out.extend_from_slice(&(payload.len() as u64).to_le_bytes());
+    out.extend_from_slice(&fnv1a(payload).to_le_bytes());
+    out.extend_from_slice(payload);
+    std::fs::write(&path, out).unwrap();
+}
+
+/// The cost figures that do not depend on the clock.
+const COUNTED: [&str; 3] = [
+    "contact_sweeps_per_step",
+    "pair_searches_per_step",
+    "rigid_granule_step_share",
+];
+
+#[test]
+fn an_interrupted_run_keeps_its_work_and_resumes_to_the_same_bits() {
+    static FLAG: AtomicBool = AtomicBool::new(false);
+    let (whole, parts, old) = (out_dir("whole"), out_dir("parts"), out_dir("old"));
+    let (whole_s, parts_s, old_s) = (
+        whole.to_str().unwrap(),
+        parts.to_str().unwrap(),
+        old.to_str().unwrap(),
+    );
+
+    // The uninterrupted run, into a folder holding an earlier run's
+    // snapshot of a strain this one does not reach: the fresh run removes
+    // it (and nothing else).
+    std::fs::create_dir_all(whole.join("vtk")).unwrap();
+    std::fs::write(whole.join("vtk/bed_3.vtu"), "stale").unwrap();
+    std::fs::write(whole.join("vtk/notes.txt"), "mine").unwrap();
+    let r = bed(&[&["--out", whole_s][..], &SMALL].concat());
+    assert_eq!(r.code, 0, "{}", r.stderr);
+    assert!(!whole.join("vtk/bed_3.vtu").exists(), "stale snapshot left");
+    assert!(whole.join("vtk/notes.txt").exists());
+    assert!(whole.join("vtk/bed_1.vtu").exists());
+    let whole_summary = summary(&whole);
+    assert_eq!(whole_summary["interrupted"], false);
+    assert_eq!(number(&whole_summary, "cost_figures_from_step"), 0.0);
+
+    // 1. The library: a flag set after the 6th output row stops the run
+    // after that step, with a checkpoint of it.
+    let printed = cli(&[&["bed", "--print-scene"][..], &SMALL].concat());
+    let scene = Scene::from_toml(&printed.stdout).unwrap();
+    std::fs::create_dir_all(&parts).unwrap();
+    let control = RunControl {
+        checkpoint_dir: Some(parts.clone()),
+        interrupt: Some(&FLAG),
+        ..RunControl::default()
+    };
+    let mut observer = InterruptAfter {
+        rows: 6,
+        seen: 0,
+        flag: &FLAG,
+    };
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(1)
+        .build()
+        .unwrap();
+    let run = pool
+        .install(|| run_bed(&scene, &control, &mut observer))
+        .unwrap();
+    assert!(run.interrupted && !run.stopped && run.error.is_none());
+    assert_eq!(run.samples.len(), 6);
+    let first = Checkpoint::read(&parts).unwrap();
+    assert_eq!(first.state.steps, run.steps);
+    assert_eq!(first.progress.counters.steps, run.steps);
+    assert_eq!(first.progress.counters_from_step, 0);
+    // A copy of this checkpoint in the format before the counters.
+    std::fs::create_dir_all(&old).unwrap();
+    std::fs::copy(parts.join(FILE_NAME), old.join(FILE_NAME)).unwrap();
+    downgrade_to_format_6(&old);
+    let older = Checkpoint::read(&old).unwrap();
+    assert_eq!(older.progress.counters_from_step, run.steps);
+    assert_eq!(older.state, first.state);
+
+    // 2. The CLI: the signal handler's flag, set already, stops the resumed
+    // run after its first step — between two output rows — with exit
+    // status 130, the outputs so far, and how to resume.
+    INTERRUPT.store(true, Ordering::SeqCst);
+    let r = bed(&["--resume", parts_s]);
+    INTERRUPT.store(false, Ordering::SeqCst);
+    assert_eq!(r.code, 130, "{}", r.stderr);
+    assert!(
+        r.stderr.contains("interrupted at C =")
+            && r.stderr
+                .contains(&format!("granbed-cli bed --resume {parts_s}")),
+        "{}",
+        r.stderr
+    );
+    let second = Checkpoint::read(&parts).unwrap();
+    assert_eq!(second.state.steps, run.steps + 1);
+    let s = summary(&parts);
+    assert_eq!(s["interrupted"], true);
+    assert!(
+        s["warnings"][0]
+            .as_str()
+            .unwrap()
+            .starts_with("interrupted"),
+        "{s}"
+    );
+    assert_eq!(number(&s, "steps"), (run.steps + 1) as f64);
+    let rows = Table::read(&parts.join("compression.csv"));
+    assert_eq!(rows.cells.len(), 6, "the rows written before the stop");
+
+    // 3. Resumed to the end: the uninterrupted run's bits, and cost
+    // figures over the whole run.
+    let r = bed(&["--resume", parts_s]);
+    assert_eq!(r.code, 0, "{}", r.stderr);
+    assert_eq!(
+        std::fs::read(whole.join("compression.csv")).unwrap(),
+        std::fs::read(parts.join("compression.csv")).unwrap(),
+        "interrupted twice and resumed differs from the uninterrupted run"
+    );
+    let s = summary(&parts);
+    assert_eq!(s["interrupted"], false);
+    assert_eq!(s["steps"], whole_summary["steps"]);
+    assert_eq!(number(&s, "cost_figures_from_step"), 0.0);
+    for key in COUNTED {
+        assert_eq!(s[key], whole_summary[key], "{key}");
+    }
+    assert!(number(&s, "contact_share") > 0.0);
+
+    // 4. A checkpoint from before the counters resumes to the same bits;
+    // its cost figures cover the resumed steps only, and it says so.
+    let r = bed(&["--resume", old_s]);
+    assert_eq!(r.code, 0, "{}", r.stderr);
+    assert_eq!(
+        std::fs::read(whole.join("compression.csv")).unwrap(),
+        std::fs::read(old.join("compression.csv")).unwrap(),
+    );
+    let s = summary(&old);
+    assert_eq!(number(&s, "cost_figures_from_step"), run.steps as f64);
+    let warned = s["warnings"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .any(|w| w.as_str().unwrap().contains("older than format 7"));
+    assert!(warned, "{s}");
+    assert!(r.stderr.contains("older than format 7"), "{}", r.stderr);
+
+    // 5. Resuming a finished run takes no step, says so, and keeps the
+    // cost figures; a --strain below the strain reached says so too.
+    let r = bed(&["--resume", whole_s]);
+    assert_eq!(r.code, 0, "{}", r.stderr);
+    assert!(r.stderr.contains("no step to take"), "{}", r.stderr);
+    let again = summary(&whole);
+    for key in COUNTED {
+        assert_eq!(again[key], whole_summary[key], "{key}");
+    }
+    let r = bed(&["--resume", whole_s, "--strain", "0.05"]);
+    assert_eq!(r.code, 0, "{}", r.stderr);
+    assert!(
+        r.stderr.contains("at or past the final strain 0.05"),
+        "{}",
+        r.stderr
+    );
+    assert!(
+        r.stderr
+            .contains("the checkpoint resumed was already past it"),
+        "{}",
+        r.stderr
+    );
+
+    // 6. A signal during the pour: nothing to keep, exit 130 at once.
+    let fresh = out_dir("fresh");
+    INTERRUPT.store(true, Ordering::SeqCst);
+    let r = bed(&[&["--out", fresh.to_str().unwrap()][..], &SMALL].concat());
+    INTERRUPT.store(false, Ordering::SeqCst);
+    assert_eq!(r.code, 130, "{}", r.stderr);
+    assert!(r.stderr.contains("nothing to resume"), "{}", r.stderr);
+    assert!(!fresh.join(FILE_NAME).exists());
+}
