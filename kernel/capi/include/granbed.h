@@ -9,7 +9,11 @@
 // Tolerance on |ξ|, |η| of the inside-the-face test (physics.md: 1e-6).
 #define GRANBED_INSIDE_TOLERANCE 1e-6
 
-// Doubles per element in the reference array of [`granbed_hex_reference`]:
+// Tolerance of the unit checks of `granbed_node_face_force`: the normal
+// must satisfy | |n| − 1 | ≤ this, the weights |Σ Nᵢ − 1| ≤ this.
+#define GRANBED_UNIT_TOLERANCE 1e-6
+
+// Doubles per element in the reference array of `granbed_hex_reference`:
 // V0 (1), B0 (8 nodes × xyz = 24), γ0 (4 modes × 8 nodes = 32), the
 // hourglass geometry factor V0 Σ|B0_I|²/3 (1), the lumped node volumes (8).
 #define GRANBED_HEX_REFERENCE_LEN 66
@@ -17,10 +21,10 @@
 // Default hourglass coefficient κ of the kernel.
 #define GRANBED_DEFAULT_HOURGLASS_KAPPA 0.05
 
-// Bytes of [`GranbedParamError::field`], NUL included.
+// Bytes of `GranbedParamError::field`, NUL included.
 #define GRANBED_FIELD_LEN 40
 
-// Bytes of [`GranbedParamError::allowed`], NUL included.
+// Bytes of `GranbedParamError::allowed`, NUL included.
 #define GRANBED_ALLOWED_LEN 80
 
 // Success.
@@ -87,14 +91,14 @@ typedef struct GranbedQuadProjection {
   double gap;
   // Bilinear weights of the four corners at (ξ*, η*).
   double weights[4];
-  // 1 if |ξ*|, |η*| ≤ 1 + [`GRANBED_INSIDE_TOLERANCE`], else 0.
+  // 1 if |ξ*|, |η*| ≤ 1 + `GRANBED_INSIDE_TOLERANCE`, else 0.
   int32_t inside;
 } GranbedQuadProjection;
 
 // One node-to-face constraint: the slave node and the master face's four
 // corners at the start of the step and predicted at its end (without
 // contact), their masses, and the projection of the predicted node on the
-// predicted face (from [`granbed_project_node_on_quad`]).
+// predicted face (from `granbed_project_node_on_quad`).
 typedef struct GranbedNodeFace {
   // Slave node mass, kg (> 0; divide by the node's contact count for
   // the mass sharing of physics.md §5.3).
@@ -103,17 +107,20 @@ typedef struct GranbedNodeFace {
   double slave_x_n[3];
   // Slave node predicted position, m.
   double slave_x_pred[3];
-  // Master corner masses, kg (> 0).
+  // Master corner masses, kg (> 0, also where the corner's weight is 0).
   double master_mass[4];
   // Master corners at the start of the step, `[corner][xyz]`, m.
   double master_x_n[4][3];
   // Master corners predicted, `[corner][xyz]`, m.
   double master_x_pred[4][3];
-  // Bilinear weights of the corners at the contact point (Σ = 1).
+  // Bilinear weights of the corners at the contact point (Σ = 1 within
+  // `GRANBED_UNIT_TOLERANCE`).
   double weights[4];
-  // The master face's outward unit normal at the contact point.
+  // The master face's outward unit normal at the contact point
+  // (| |n| − 1 | ≤ `GRANBED_UNIT_TOLERANCE`).
   double normal[3];
-  // Predicted signed gap, m (< 0: penetration, which the force closes).
+  // Predicted signed gap, m (< 0: penetration, which the force closes;
+  // ≥ 0: no contact, zero force).
   double gap;
 } GranbedNodeFace;
 
@@ -135,19 +142,19 @@ typedef struct GranbedNodeFaceForce {
 // `MaterialParams`, field for field; 8 doubles in this order, so a
 // Fortran `props(8)` array maps onto it).
 typedef struct GranbedMaterialParams {
-  // Young's modulus E of the skeleton, Pa. Range: finite, > 0.
+  // Young's modulus E of the skeleton, Pa. Range: 1e-3 ≤ E ≤ 1e13.
   double youngs_modulus_pa;
   // Poisson's ratio ν. Range: −1 < ν < 0.5.
   double poisson_ratio;
-  // Yield stress σ_y, Pa. Range: > 0 (+inf: purely elastic).
+  // Yield stress σ_y, Pa. Range: ≥ 1e-3 (+inf: purely elastic).
   double yield_stress_pa;
   // Initial relative density η0. Range: η_c < η0 ≤ 1.
   double eta0;
-  // Yield-surface constant c_p. Range: finite, ≥ 0.
+  // Yield-surface constant c_p. Range: 0 ≤ c_p ≤ 1e3.
   double cp;
   // Critical relative density η_c. Range: 0 ≤ η_c < 1.
   double eta_c;
-  // True (solid) density, kg/m³. Range: finite, > 0.
+  // True (solid) density, kg/m³. Range: 1e-3 ≤ ρ ≤ 1e5.
   double true_density_kg_m3;
   // Coulomb friction coefficient. Range: finite, ≥ 0.
   double friction;
@@ -169,7 +176,7 @@ typedef struct GranbedPointInfo {
 
 // Which material parameter was rejected, its value and the allowed range.
 typedef struct GranbedParamError {
-  // Field name as in [`GranbedMaterialParams`], NUL-terminated.
+  // Field name as in `GranbedMaterialParams`, NUL-terminated.
   char field[GRANBED_FIELD_LEN];
   // The allowed range, human readable, NUL-terminated.
   char allowed[GRANBED_ALLOWED_LEN];
@@ -193,7 +200,7 @@ const char *granbed_version(void);
 //
 // # Safety
 // `p` points to 3 doubles, `quad` to 12, `out` to a writable
-// [`GranbedQuadProjection`] (or they are NULL: an error).
+// `GranbedQuadProjection` (or they are NULL: an error).
 int32_t granbed_project_node_on_quad(const double *p,
                                      const double *quad,
                                      struct GranbedQuadProjection *out);
@@ -206,15 +213,24 @@ int32_t granbed_project_node_on_quad(const double *p,
 //
 // * `weight`: partition weight w, 0 < w ≤ 1 (½ when both bodies' passes
 //   hold the spot in a symmetric two-pass scheme, else 1).
-// * `friction`: Coulomb coefficient μ ≥ 0 (0: frictionless).
-// * `dt_squared`: Δt_{n+½} Δt_n > 0, s².
+// * `friction`: Coulomb coefficient μ ≥ 0, finite (0: frictionless).
+// * `dt_squared`: Δt_{n+½} Δt_n > 0, finite, s².
 //
-// Returns `GRANBED_OK`, `GRANBED_ERR_INVALID_ARGUMENT` (a mass ≤ 0, w, μ
-// or Δt² outside its range) or `GRANBED_ERR_NON_FINITE`.
+// A constraint with `gap` ≥ 0 is not in contact: the call succeeds and
+// writes a zero force (never a pull).
+//
+// Returns `GRANBED_OK`; `GRANBED_ERR_NON_FINITE` (a position, a weight, a
+// normal component or the gap is NaN or infinite); or
+// `GRANBED_ERR_INVALID_ARGUMENT`: a mass not finite or ≤ 0 (every master
+// corner's, whatever its weight), w, μ or Δt² outside its range, a
+// normal whose length differs from 1 by more than
+// `GRANBED_UNIT_TOLERANCE` (a zero normal included), or weights whose sum
+// differs from 1 by more than `GRANBED_UNIT_TOLERANCE`. On an error `out`
+// is not written.
 //
 // # Safety
-// `c` points to a [`GranbedNodeFace`], `out` to a writable
-// [`GranbedNodeFaceForce`] (or NULL: an error).
+// `c` points to a `GranbedNodeFace`, `out` to a writable
+// `GranbedNodeFaceForce` (or NULL: an error).
 int32_t granbed_node_face_force(const struct GranbedNodeFace *c,
                                 double weight,
                                 double friction,
@@ -226,7 +242,7 @@ int32_t granbed_node_face_force(const struct GranbedNodeFace *c,
 // * `x_ref`: in, n×24, reference node coordinates (m), node-major
 //   `[element][node][xyz]`, nodes in the usual trilinear order (0 at
 //   (−,−,−), 1 (+,−,−), 2 (+,+,−), 3 (−,+,−), then 4–7 the same at +ζ).
-// * `reference`: out, n×[`GRANBED_HEX_REFERENCE_LEN`].
+// * `reference`: out, n×`GRANBED_HEX_REFERENCE_LEN`.
 // * `element_status`: out, n codes (`GRANBED_ERR_DEGENERATE` for a hex
 //   with a non-positive Gauss-point Jacobian, `GRANBED_ERR_NON_FINITE`).
 //
@@ -244,15 +260,19 @@ int32_t granbed_hex_reference(size_t n,
 // subtracts `f` (m a = f_ext − f).
 //
 // * `kappa`: hourglass coefficient κ, 0 ≤ κ ≤ 1
-//   ([`GRANBED_DEFAULT_HOURGLASS_KAPPA`] = 0.05).
-// * `reference`: in, n×66 from [`granbed_hex_reference`].
+//   (`GRANBED_DEFAULT_HOURGLASS_KAPPA` = 0.05).
+// * `reference`: in, n×66 from `granbed_hex_reference`. An element whose
+//   record has a non-finite entry, V0 ≤ 0, a hourglass geometry factor
+//   < 0 or a node volume ≤ 0 fails with `GRANBED_ERR_INVALID_ARGUMENT`
+//   (a corrupt record: what `granbed_hex_reference` writes passes).
 // * `x`: in, n×24, current node coordinates, `[element][node][xyz]`, m.
 // * `cp_inv`: in/out, n×6, the element's C_p⁻¹ (kept on failure).
 // * `f`: out, n×24, nodal forces `[element][node][xyz]`, N (zero on
 //   failure).
 // * `tau`: out, n×6 Kirchhoff stress, Pa, or NULL.
 // * `info`: out, n records, or NULL.
-// * `element_status`: out, n codes.
+// * `element_status`: out, n codes (`GRANBED_ERR_INVALID_ARGUMENT` for a
+//   corrupt reference record, else the constitutive update's code).
 //
 // Returns `GRANBED_OK`, `GRANBED_ERR_POINT_FAILED` or an argument error.
 //
@@ -273,12 +293,12 @@ int32_t granbed_hex_forces(const struct GranbedMaterialParams *params,
 // Writes the parameters of the standard granule type `name` ("A1" … "C3",
 // case-insensitive, NUL-terminated) to `out`.
 //
-// Returns [`GRANBED_OK`], `GRANBED_ERR_NULL_POINTER`, or
+// Returns `GRANBED_OK`, `GRANBED_ERR_NULL_POINTER`, or
 // `GRANBED_ERR_INVALID_ARGUMENT` for an unknown name.
 //
 // # Safety
 // `name` is NULL or a NUL-terminated string; `out` is NULL or points to a
-// writable [`GranbedMaterialParams`].
+// writable `GranbedMaterialParams`.
 int32_t granbed_material_preset(const char *name, struct GranbedMaterialParams *out);
 
 // Checks every field of `params` against its range (NaN always fails).
@@ -287,8 +307,8 @@ int32_t granbed_material_preset(const char *name, struct GranbedMaterialParams *
 // range there.
 //
 // # Safety
-// `params` is NULL or points to a [`GranbedMaterialParams`]; `error` is
-// NULL or points to a writable [`GranbedParamError`].
+// `params` is NULL or points to a `GranbedMaterialParams`; `error` is
+// NULL or points to a writable `GranbedParamError`.
 int32_t granbed_material_check(const struct GranbedMaterialParams *params,
                                struct GranbedParamError *error);
 
@@ -311,8 +331,8 @@ const char *granbed_status_message(int32_t code);
 // * `f`: in, n×9, F_{n+1} of each point, row-major (F11 F12 F13 F21 … F33).
 // * `cp_inv`: in/out, n×6, C_p⁻¹ of each point (Voigt xx yy zz yz xz xy;
 //   start with `granbed_state_init`). A failed point keeps its state.
-// * `stress_measure`: [`GRANBED_STRESS_KIRCHHOFF`] or
-//   [`GRANBED_STRESS_CAUCHY`].
+// * `stress_measure`: `GRANBED_STRESS_KIRCHHOFF` or
+//   `GRANBED_STRESS_CAUCHY`.
 // * `stress`: out, n×6, Pa, Voigt order (zero for a failed point).
 // * `info`: out, n records, or NULL.
 // * `point_status`: out, n status codes (`GRANBED_OK` or the point's error).
@@ -335,13 +355,13 @@ int32_t granbed_update_points(const struct GranbedMaterialParams *params,
 
 // Updates a block of `nblock` points (VUMAT-style arrays, column-major):
 //
-// * `props(nprops)`: the material, [`GRANBED_VUMAT_NPROPS`] = 8 values in
+// * `props(nprops)`: the material, `GRANBED_VUMAT_NPROPS` = 8 values in
 //   the field order of `GranbedMaterialParams` (E, ν, σ_y, η0, c_p, η_c,
 //   ρ_true, μ); `nprops` ≥ 8.
 // * `defgrad_new(nblock, 9)`: F at the end of the step in the VUMAT
 //   component order F11 F22 F33 F12 F23 F31 F21 F32 F13.
 // * `state_old(nblock, nstatev)`, `state_new(nblock, nstatev)`: the state
-//   variables, `nstatev` ≥ 6 (see [`GRANBED_VUMAT_NSTATEV`]). An all-zero
+//   variables, `nstatev` ≥ 6 (see `GRANBED_VUMAT_NSTATEV`). An all-zero
 //   C_p⁻¹ (the zero initial state variables FE codes supply) is read as
 //   the virgin state, the identity. Extra variables are copied through.
 // * `stress_new(nblock, 6)`: out, Cauchy stress σ, Pa, order 11 22 33 12

@@ -3,7 +3,7 @@
 
 use crate::status::{GRANBED_ERR_NULL_POINTER, GRANBED_ERR_SIZE};
 
-/// `count × per` elements of `T`, or [`GRANBED_ERR_SIZE`] if that many
+/// `count × per` elements of `T`, or `GRANBED_ERR_SIZE` if that many
 /// bytes do not fit in `isize`.
 pub(crate) fn length<T>(count: usize, per: usize) -> Result<usize, i32> {
     let n = count.checked_mul(per).ok_or(GRANBED_ERR_SIZE)?;
@@ -35,10 +35,10 @@ pub(crate) unsafe fn input<'a, T>(ptr: *const T, count: usize, per: usize) -> Re
     Ok(unsafe { core::slice::from_raw_parts(ptr, n) })
 }
 
-/// The caller's writable array `ptr[0..count·per]` (see [`input`]).
+/// The caller's writable array `ptr[0..count·per]` (see `input`).
 ///
 /// # Safety
-/// As [`input`], and no other reference may alias it during the borrow.
+/// As `input`, and no other reference may alias it during the borrow.
 pub(crate) unsafe fn output<'a, T>(
     ptr: *mut T,
     count: usize,
@@ -58,7 +58,7 @@ pub(crate) unsafe fn output<'a, T>(
 /// An optional writable array: `None` for NULL.
 ///
 /// # Safety
-/// As [`output`] when `ptr` is not NULL.
+/// As `output` when `ptr` is not NULL.
 pub(crate) unsafe fn optional_output<'a, T>(
     ptr: *mut T,
     count: usize,

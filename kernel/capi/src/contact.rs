@@ -28,7 +28,7 @@ pub struct GranbedQuadProjection {
     pub gap: f64,
     /// Bilinear weights of the four corners at (ξ*, η*).
     pub weights: [f64; 4],
-    /// 1 if |ξ*|, |η*| ≤ 1 + [`GRANBED_INSIDE_TOLERANCE`], else 0.
+    /// 1 if |ξ*|, |η*| ≤ 1 + `GRANBED_INSIDE_TOLERANCE`, else 0.
     pub inside: i32,
 }
 
@@ -41,7 +41,7 @@ pub struct GranbedQuadProjection {
 ///
 /// # Safety
 /// `p` points to 3 doubles, `quad` to 12, `out` to a writable
-/// [`GranbedQuadProjection`] (or they are NULL: an error).
+/// `GranbedQuadProjection` (or they are NULL: an error).
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn granbed_project_node_on_quad(
     p: *const f64,
@@ -79,7 +79,7 @@ pub unsafe extern "C" fn granbed_project_node_on_quad(
 /// One node-to-face constraint: the slave node and the master face's four
 /// corners at the start of the step and predicted at its end (without
 /// contact), their masses, and the projection of the predicted node on the
-/// predicted face (from [`granbed_project_node_on_quad`]).
+/// predicted face (from `granbed_project_node_on_quad`).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct GranbedNodeFace {
@@ -90,17 +90,20 @@ pub struct GranbedNodeFace {
     pub slave_x_n: [f64; 3],
     /// Slave node predicted position, m.
     pub slave_x_pred: [f64; 3],
-    /// Master corner masses, kg (> 0).
+    /// Master corner masses, kg (> 0, also where the corner's weight is 0).
     pub master_mass: [f64; 4],
     /// Master corners at the start of the step, `[corner][xyz]`, m.
     pub master_x_n: [[f64; 3]; 4],
     /// Master corners predicted, `[corner][xyz]`, m.
     pub master_x_pred: [[f64; 3]; 4],
-    /// Bilinear weights of the corners at the contact point (Σ = 1).
+    /// Bilinear weights of the corners at the contact point (Σ = 1 within
+    /// `GRANBED_UNIT_TOLERANCE`).
     pub weights: [f64; 4],
-    /// The master face's outward unit normal at the contact point.
+    /// The master face's outward unit normal at the contact point
+    /// (| |n| − 1 | ≤ `GRANBED_UNIT_TOLERANCE`).
     pub normal: [f64; 3],
-    /// Predicted signed gap, m (< 0: penetration, which the force closes).
+    /// Predicted signed gap, m (< 0: penetration, which the force closes;
+    /// ≥ 0: no contact, zero force).
     pub gap: f64,
 }
 
@@ -120,6 +123,11 @@ pub struct GranbedNodeFaceForce {
     pub slipping: i32,
 }
 
+/// Tolerance of the unit checks of `granbed_node_face_force`: the normal
+/// must satisfy | |n| − 1 | ≤ this, the weights |Σ Nᵢ − 1| ≤ this.
+pub const GRANBED_UNIT_TOLERANCE: f64 = 1e-6;
+const _: () = assert!(GRANBED_UNIT_TOLERANCE == granbed_kernel::contact::pair::UNIT_TOLERANCE);
+
 /// The force that closes the predicted gap of constraint `c` in one step,
 /// shared by effective mass, with Coulomb friction from the relative
 /// tangential motion of the step — the force granbed's contact applies to
@@ -128,15 +136,24 @@ pub struct GranbedNodeFaceForce {
 ///
 /// * `weight`: partition weight w, 0 < w ≤ 1 (½ when both bodies' passes
 ///   hold the spot in a symmetric two-pass scheme, else 1).
-/// * `friction`: Coulomb coefficient μ ≥ 0 (0: frictionless).
-/// * `dt_squared`: Δt_{n+½} Δt_n > 0, s².
+/// * `friction`: Coulomb coefficient μ ≥ 0, finite (0: frictionless).
+/// * `dt_squared`: Δt_{n+½} Δt_n > 0, finite, s².
 ///
-/// Returns `GRANBED_OK`, `GRANBED_ERR_INVALID_ARGUMENT` (a mass ≤ 0, w, μ
-/// or Δt² outside its range) or `GRANBED_ERR_NON_FINITE`.
+/// A constraint with `gap` ≥ 0 is not in contact: the call succeeds and
+/// writes a zero force (never a pull).
+///
+/// Returns `GRANBED_OK`; `GRANBED_ERR_NON_FINITE` (a position, a weight, a
+/// normal component or the gap is NaN or infinite); or
+/// `GRANBED_ERR_INVALID_ARGUMENT`: a mass not finite or ≤ 0 (every master
+/// corner's, whatever its weight), w, μ or Δt² outside its range, a
+/// normal whose length differs from 1 by more than
+/// `GRANBED_UNIT_TOLERANCE` (a zero normal included), or weights whose sum
+/// differs from 1 by more than `GRANBED_UNIT_TOLERANCE`. On an error `out`
+/// is not written.
 ///
 /// # Safety
-/// `c` points to a [`GranbedNodeFace`], `out` to a writable
-/// [`GranbedNodeFaceForce`] (or NULL: an error).
+/// `c` points to a `GranbedNodeFace`, `out` to a writable
+/// `GranbedNodeFaceForce` (or NULL: an error).
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn granbed_node_face_force(
     c: *const GranbedNodeFace,
@@ -149,18 +166,6 @@ pub unsafe extern "C" fn granbed_node_face_force(
         // SAFETY (both): the caller's contract.
         let c = unsafe { one(c) }?;
         let out = unsafe { one_mut(out) }?;
-        let masses_ok = core::iter::once(c.slave_mass)
-            .chain(c.master_mass)
-            .all(|m| m.is_finite() && m > 0.0);
-        let scalars_ok = weight > 0.0
-            && weight <= 1.0
-            && friction.is_finite()
-            && friction >= 0.0
-            && dt_squared.is_finite()
-            && dt_squared > 0.0;
-        if !masses_ok || !scalars_ok {
-            return Err(GRANBED_ERR_INVALID_ARGUMENT);
-        }
         let finite = c
             .slave_x_n
             .iter()
@@ -185,7 +190,10 @@ pub unsafe extern "C" fn granbed_node_face_force(
             normal: c.normal,
             gap: c.gap,
         };
-        let r = node_face_force(&node, weight, friction, dt_squared);
+        // The kernel checks the masses, w, μ, Δt², the weights' sum and
+        // the normal's length (the positions are finite here).
+        let r = node_face_force(&node, weight, friction, dt_squared)
+            .map_err(|_| GRANBED_ERR_INVALID_ARGUMENT)?;
         *out = GranbedNodeFaceForce {
             slave: r.force,
             master: c.weights.map(|w| r.force.map(|v| -w * v)),
@@ -195,4 +203,65 @@ pub unsafe extern "C" fn granbed_node_face_force(
         };
         Ok(GRANBED_OK)
     })())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A node 1 µm behind the face z = 0, all weight on corner 0.
+    fn constraint() -> GranbedNodeFace {
+        GranbedNodeFace {
+            slave_mass: 1e-9,
+            slave_x_pred: [0.0, 0.0, -1e-6],
+            master_mass: [1e-9; 4],
+            weights: [1.0, 0.0, 0.0, 0.0],
+            normal: [0.0, 0.0, 1.0],
+            gap: -1e-6,
+            ..Default::default()
+        }
+    }
+
+    fn call(c: &GranbedNodeFace, friction: f64, dt_squared: f64) -> (i32, GranbedNodeFaceForce) {
+        let mut out = GranbedNodeFaceForce::default();
+        // SAFETY: valid references.
+        let code = unsafe { granbed_node_face_force(c, 1.0, friction, dt_squared, &mut out) };
+        (code, out)
+    }
+
+    #[test]
+    fn a_non_negative_gap_gives_a_zero_force() {
+        let (code, f) = call(&constraint(), 0.3, 1e-16);
+        assert_eq!(code, GRANBED_OK);
+        assert!(f.normal > 0.0);
+        for gap in [0.0, 1e-3] {
+            let (code, f) = call(
+                &GranbedNodeFace {
+                    gap,
+                    ..constraint()
+                },
+                0.3,
+                1e-16,
+            );
+            assert_eq!(code, GRANBED_OK);
+            assert_eq!((f.normal, f.slave, f.friction), (0.0, [0.0; 3], [0.0; 3]));
+        }
+    }
+
+    #[test]
+    fn bad_normals_masses_and_steps_are_invalid_arguments() {
+        let c = constraint();
+        for normal in [[0.0; 3], [0.0, 0.0, 1e6], [0.0, 0.0, 1.0 + 2e-6]] {
+            let (code, _) = call(&GranbedNodeFace { normal, ..c }, 0.3, 1e-16);
+            assert_eq!(code, GRANBED_ERR_INVALID_ARGUMENT, "{normal:?}");
+        }
+        let zero = GranbedNodeFace {
+            master_mass: [1e-9, 0.0, 1e-9, 1e-9],
+            ..c
+        };
+        assert_eq!(call(&zero, 0.3, 1e-16).0, GRANBED_ERR_INVALID_ARGUMENT);
+        assert_eq!(call(&c, f64::NAN, 1e-16).0, GRANBED_ERR_INVALID_ARGUMENT);
+        assert_eq!(call(&c, 0.3, 0.0).0, GRANBED_ERR_INVALID_ARGUMENT);
+        assert_eq!(call(&c, 0.3, f64::INFINITY).0, GRANBED_ERR_INVALID_ARGUMENT);
+    }
 }

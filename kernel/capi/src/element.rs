@@ -12,7 +12,7 @@ use crate::status::{
 };
 use crate::update::{GranbedPointInfo, options};
 
-/// Doubles per element in the reference array of [`granbed_hex_reference`]:
+/// Doubles per element in the reference array of `granbed_hex_reference`:
 /// V0 (1), B0 (8 nodes × xyz = 24), γ0 (4 modes × 8 nodes = 32), the
 /// hourglass geometry factor V0 Σ|B0_I|²/3 (1), the lumped node volumes (8).
 pub const GRANBED_HEX_REFERENCE_LEN: usize = 66;
@@ -32,6 +32,17 @@ fn encode(r: &HexReference, out: &mut [f64; GRANBED_HEX_REFERENCE_LEN]) {
     for (o, v) in out.iter_mut().zip(values) {
         *o = v;
     }
+}
+
+/// True if `v` can be a reference record of `granbed_hex_reference`: every
+/// entry finite, V0 > 0, the hourglass geometry factor ≥ 0 and every node
+/// volume > 0 (B0 and γ0 only finite: their ranges depend on the shape).
+fn reference_ok(v: &[f64; GRANBED_HEX_REFERENCE_LEN]) -> bool {
+    let r = decode(v);
+    v.iter().all(|x| x.is_finite())
+        && r.volume > 0.0
+        && r.hourglass_geometry >= 0.0
+        && r.node_volume.iter().all(|&n| n > 0.0)
 }
 
 fn decode(v: &[f64; GRANBED_HEX_REFERENCE_LEN]) -> HexReference {
@@ -61,7 +72,7 @@ fn coords(x: &[f64; 24]) -> [[f64; 3]; 8] {
 /// * `x_ref`: in, n×24, reference node coordinates (m), node-major
 ///   `[element][node][xyz]`, nodes in the usual trilinear order (0 at
 ///   (−,−,−), 1 (+,−,−), 2 (+,+,−), 3 (−,+,−), then 4–7 the same at +ζ).
-/// * `reference`: out, n×[`GRANBED_HEX_REFERENCE_LEN`].
+/// * `reference`: out, n×`GRANBED_HEX_REFERENCE_LEN`.
 /// * `element_status`: out, n codes (`GRANBED_ERR_DEGENERATE` for a hex
 ///   with a non-positive Gauss-point Jacobian, `GRANBED_ERR_NON_FINITE`).
 ///
@@ -111,15 +122,19 @@ pub unsafe extern "C" fn granbed_hex_reference(
 /// subtracts `f` (m a = f_ext − f).
 ///
 /// * `kappa`: hourglass coefficient κ, 0 ≤ κ ≤ 1
-///   ([`GRANBED_DEFAULT_HOURGLASS_KAPPA`] = 0.05).
-/// * `reference`: in, n×66 from [`granbed_hex_reference`].
+///   (`GRANBED_DEFAULT_HOURGLASS_KAPPA` = 0.05).
+/// * `reference`: in, n×66 from `granbed_hex_reference`. An element whose
+///   record has a non-finite entry, V0 ≤ 0, a hourglass geometry factor
+///   < 0 or a node volume ≤ 0 fails with `GRANBED_ERR_INVALID_ARGUMENT`
+///   (a corrupt record: what `granbed_hex_reference` writes passes).
 /// * `x`: in, n×24, current node coordinates, `[element][node][xyz]`, m.
 /// * `cp_inv`: in/out, n×6, the element's C_p⁻¹ (kept on failure).
 /// * `f`: out, n×24, nodal forces `[element][node][xyz]`, N (zero on
 ///   failure).
 /// * `tau`: out, n×6 Kirchhoff stress, Pa, or NULL.
 /// * `info`: out, n records, or NULL.
-/// * `element_status`: out, n codes.
+/// * `element_status`: out, n codes (`GRANBED_ERR_INVALID_ARGUMENT` for a
+///   corrupt reference record, else the constitutive update's code).
 ///
 /// Returns `GRANBED_OK`, `GRANBED_ERR_POINT_FAILED` or an argument error.
 ///
@@ -169,7 +184,13 @@ pub unsafe extern "C" fn granbed_hex_forces(
         {
             let t = tau.as_deref_mut().and_then(|t| t.get_mut(6 * k..6 * k + 6));
             let record = info.as_deref_mut().and_then(|i| i.get_mut(k));
-            match hex_forces(&mat, &opts, kappa, &decode(r), &coords(x), c) {
+            let result = if reference_ok(r) {
+                hex_forces(&mat, &opts, kappa, &decode(r), &coords(x), c)
+                    .map_err(|e| update_status(&e))
+            } else {
+                Err(GRANBED_ERR_INVALID_ARGUMENT)
+            };
+            match result {
                 Ok(out) => {
                     for (dst, v) in fe.iter_mut().zip(out.f.iter().flatten()) {
                         *dst = *v;
@@ -196,7 +217,7 @@ pub unsafe extern "C" fn granbed_hex_forces(
                     if let Some(rec) = record {
                         *rec = GranbedPointInfo::default();
                     }
-                    *code = update_status(&e);
+                    *code = e;
                     failed = true;
                 }
             }
@@ -207,4 +228,68 @@ pub unsafe extern "C" fn granbed_hex_forces(
             GRANBED_OK
         })
     })())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const CUBE: [f64; 24] = [
+        0., 0., 0., 1., 0., 0., 1., 1., 0., 0., 1., 0., 0., 0., 1., 1., 0., 1., 1., 1., 1., 0., 1.,
+        1.,
+    ];
+
+    #[test]
+    fn a_corrupt_reference_record_fails_its_element() {
+        let mut good = [0.0; GRANBED_HEX_REFERENCE_LEN];
+        let mut st = [0i32; 1];
+        // SAFETY (both calls): arrays of the documented lengths.
+        let code =
+            unsafe { granbed_hex_reference(1, CUBE.as_ptr(), good.as_mut_ptr(), st.as_mut_ptr()) };
+        assert_eq!(code, GRANBED_OK);
+        assert!(reference_ok(&good));
+        let mut p = GranbedMaterialParams::default();
+        // SAFETY: valid name and output.
+        assert_eq!(
+            unsafe { crate::granbed_material_preset(c"B2".as_ptr(), &mut p) },
+            GRANBED_OK
+        );
+        let mut x = CUBE;
+        x[18] += 0.01;
+        // V0, the hourglass factor (57), a γ0 entry (30), a node volume (60).
+        for (at, v) in [
+            (0, f64::NAN),
+            (0, -1.0),
+            (57, f64::NAN),
+            (57, -1.0),
+            (30, f64::INFINITY),
+            (60, 0.0),
+        ] {
+            let mut r = good;
+            r[at] = v;
+            let mut cp = [1.0, 1.0, 1.0, 0.0, 0.0, 0.0];
+            let mut f = [1.0; 24];
+            let code = unsafe {
+                granbed_hex_forces(
+                    &p,
+                    1,
+                    0.05,
+                    1,
+                    r.as_ptr(),
+                    x.as_ptr(),
+                    cp.as_mut_ptr(),
+                    f.as_mut_ptr(),
+                    core::ptr::null_mut(),
+                    core::ptr::null_mut(),
+                    st.as_mut_ptr(),
+                )
+            };
+            assert_eq!(
+                (code, st[0]),
+                (GRANBED_ERR_POINT_FAILED, GRANBED_ERR_INVALID_ARGUMENT),
+                "[{at}] = {v}"
+            );
+            assert_eq!(f, [0.0; 24]);
+        }
+    }
 }

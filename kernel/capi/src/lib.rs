@@ -53,12 +53,26 @@ pub extern "C" fn granbed_version() -> *const core::ffi::c_char {
     VERSION.as_ptr()
 }
 
+// The C library's abort(3). The library is only ever linked into a C,
+// C++ or Fortran program, so libc is always there; it is resolved at the
+// final link (static library) or at load time (shared library).
+#[cfg(not(test))]
+unsafe extern "C" {
+    safe fn abort() -> !;
+}
+
 // Unreachable: .ci/capi-check fails if this handler is linked into the
-// shared library, i.e. if any exported function can reach a panic.
+// shared library, i.e. if any exported function can reach a panic. Should
+// one ever run anyway it must not hang the host (as `loop {}` did): it
+// aborts the process with SIGABRT, as a failed C assert() does. abort(3)
+// rather than a trap instruction (`asm!("ud2")`): it works on every target
+// with a C library, needs no per-architecture code, and tells the host's
+// debugger and core dump what happened. (`core::intrinsics::abort` is not
+// stable.)
 #[cfg(not(test))]
 #[panic_handler]
 fn panic(_: &core::panic::PanicInfo) -> ! {
-    loop {}
+    abort()
 }
 
 /// Only with the `panic-probe` feature: an exported function that can
@@ -70,4 +84,16 @@ pub unsafe extern "C" fn granbed_panic_probe(p: *const f64, n: usize, i: usize) 
     // SAFETY: test-only; the caller passes n readable doubles.
     let s = unsafe { core::slice::from_raw_parts(p, n) };
     s[i]
+}
+
+#[cfg(test)]
+mod tests {
+    /// The header's comments are plain text: no rustdoc link brackets.
+    #[test]
+    fn the_header_has_no_rustdoc_links() {
+        let header = include_str!("../include/granbed.h");
+        for (i, line) in header.lines().enumerate() {
+            assert!(!line.contains("[`"), "include/granbed.h:{}: {line}", i + 1);
+        }
+    }
 }

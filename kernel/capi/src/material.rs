@@ -15,19 +15,19 @@ use crate::status::{GRANBED_ERR_INVALID_ARGUMENT, GRANBED_ERR_INVALID_PARAMETER,
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct GranbedMaterialParams {
-    /// Young's modulus E of the skeleton, Pa. Range: finite, > 0.
+    /// Young's modulus E of the skeleton, Pa. Range: 1e-3 ≤ E ≤ 1e13.
     pub youngs_modulus_pa: f64,
     /// Poisson's ratio ν. Range: −1 < ν < 0.5.
     pub poisson_ratio: f64,
-    /// Yield stress σ_y, Pa. Range: > 0 (+inf: purely elastic).
+    /// Yield stress σ_y, Pa. Range: ≥ 1e-3 (+inf: purely elastic).
     pub yield_stress_pa: f64,
     /// Initial relative density η0. Range: η_c < η0 ≤ 1.
     pub eta0: f64,
-    /// Yield-surface constant c_p. Range: finite, ≥ 0.
+    /// Yield-surface constant c_p. Range: 0 ≤ c_p ≤ 1e3.
     pub cp: f64,
     /// Critical relative density η_c. Range: 0 ≤ η_c < 1.
     pub eta_c: f64,
-    /// True (solid) density, kg/m³. Range: finite, > 0.
+    /// True (solid) density, kg/m³. Range: 1e-3 ≤ ρ ≤ 1e5.
     pub true_density_kg_m3: f64,
     /// Coulomb friction coefficient. Range: finite, ≥ 0.
     pub friction: f64,
@@ -63,16 +63,16 @@ impl From<MaterialParams> for GranbedMaterialParams {
     }
 }
 
-/// Bytes of [`GranbedParamError::field`], NUL included.
+/// Bytes of `GranbedParamError::field`, NUL included.
 pub const GRANBED_FIELD_LEN: usize = 40;
-/// Bytes of [`GranbedParamError::allowed`], NUL included.
+/// Bytes of `GranbedParamError::allowed`, NUL included.
 pub const GRANBED_ALLOWED_LEN: usize = 80;
 
 /// Which material parameter was rejected, its value and the allowed range.
 #[repr(C)]
 #[derive(Clone, Copy, Debug)]
 pub struct GranbedParamError {
-    /// Field name as in [`GranbedMaterialParams`], NUL-terminated.
+    /// Field name as in `GranbedMaterialParams`, NUL-terminated.
     pub field: [c_char; GRANBED_FIELD_LEN],
     /// The allowed range, human readable, NUL-terminated.
     pub allowed: [c_char; GRANBED_ALLOWED_LEN],
@@ -114,12 +114,12 @@ pub(crate) fn validated(
 /// Writes the parameters of the standard granule type `name` ("A1" … "C3",
 /// case-insensitive, NUL-terminated) to `out`.
 ///
-/// Returns [`GRANBED_OK`], `GRANBED_ERR_NULL_POINTER`, or
+/// Returns `GRANBED_OK`, `GRANBED_ERR_NULL_POINTER`, or
 /// `GRANBED_ERR_INVALID_ARGUMENT` for an unknown name.
 ///
 /// # Safety
 /// `name` is NULL or a NUL-terminated string; `out` is NULL or points to a
-/// writable [`GranbedMaterialParams`].
+/// writable `GranbedMaterialParams`.
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn granbed_material_preset(
     name: *const c_char,
@@ -159,8 +159,8 @@ pub unsafe extern "C" fn granbed_material_preset(
 /// range there.
 ///
 /// # Safety
-/// `params` is NULL or points to a [`GranbedMaterialParams`]; `error` is
-/// NULL or points to a writable [`GranbedParamError`].
+/// `params` is NULL or points to a `GranbedMaterialParams`; `error` is
+/// NULL or points to a writable `GranbedParamError`.
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn granbed_material_check(
     params: *const GranbedMaterialParams,

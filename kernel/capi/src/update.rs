@@ -88,8 +88,8 @@ pub(crate) fn update_one(
 /// * `f`: in, n×9, F_{n+1} of each point, row-major (F11 F12 F13 F21 … F33).
 /// * `cp_inv`: in/out, n×6, C_p⁻¹ of each point (Voigt xx yy zz yz xz xy;
 ///   start with `granbed_state_init`). A failed point keeps its state.
-/// * `stress_measure`: [`GRANBED_STRESS_KIRCHHOFF`] or
-///   [`GRANBED_STRESS_CAUCHY`].
+/// * `stress_measure`: `GRANBED_STRESS_KIRCHHOFF` or
+///   `GRANBED_STRESS_CAUCHY`.
 /// * `stress`: out, n×6, Pa, Voigt order (zero for a failed point).
 /// * `info`: out, n records, or NULL.
 /// * `point_status`: out, n status codes (`GRANBED_OK` or the point's error).

@@ -44,13 +44,13 @@ fn set(a: &mut [f64], nblock: usize, i: usize, k: usize, v: f64) {
 
 /// Updates a block of `nblock` points (VUMAT-style arrays, column-major):
 ///
-/// * `props(nprops)`: the material, [`GRANBED_VUMAT_NPROPS`] = 8 values in
+/// * `props(nprops)`: the material, `GRANBED_VUMAT_NPROPS` = 8 values in
 ///   the field order of `GranbedMaterialParams` (E, ν, σ_y, η0, c_p, η_c,
 ///   ρ_true, μ); `nprops` ≥ 8.
 /// * `defgrad_new(nblock, 9)`: F at the end of the step in the VUMAT
 ///   component order F11 F22 F33 F12 F23 F31 F21 F32 F13.
 /// * `state_old(nblock, nstatev)`, `state_new(nblock, nstatev)`: the state
-///   variables, `nstatev` ≥ 6 (see [`GRANBED_VUMAT_NSTATEV`]). An all-zero
+///   variables, `nstatev` ≥ 6 (see `GRANBED_VUMAT_NSTATEV`). An all-zero
 ///   C_p⁻¹ (the zero initial state variables FE codes supply) is read as
 ///   the virgin state, the identity. Extra variables are copied through.
 /// * `stress_new(nblock, 6)`: out, Cauchy stress σ, Pa, order 11 22 33 12

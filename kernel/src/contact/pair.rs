@@ -51,9 +51,9 @@ pub struct PairSettings {
     /// opposing) gets a *near* constraint, with gap ≥ 0, so that a driver
     /// that holds the constraints over steps without searching
     /// ([`regap`]) sees it close. [`forces`] and [`mark_involvement`]
-    /// take penetrating constraints only: a driver hands them
-    /// [`penetrating`]'s part. 0: no near constraints (the detection as it
-    /// was, bit for bit).
+    /// skip near constraints (a driver may hand them [`penetrating`]'s
+    /// part). 0: no near constraints (the detection as it was, bit for
+    /// bit).
     pub capture: Real,
     /// Also estimate the contact area ([`PairForce::area`]): each
     /// constraint then evaluates its slave node's tributary area, which no
@@ -89,19 +89,29 @@ impl PairSettings {
 /// and a 40-granule die kept up to 5 µm of penetration (3.6 % of the
 /// element size; `tests/assembly_die.rs`). Where both passes see the spot
 /// their two halves still add up to one closure.
-fn partition_weight(c: &Constraint, constraints: &[Constraint], quads: &[[u32; 4]]) -> Real {
+///
+/// `split` is where pass B→A starts in `constraints` (computed once per
+/// [`forces`] call), and `c.quad` must be a quad of `quads`.
+#[inline]
+fn partition_weight(
+    c: &Constraint,
+    constraints: &[Constraint],
+    split: usize,
+    quads: &[[u32; 4]],
+) -> Real {
     let other = match c.side {
         Side::A => Side::B,
         Side::B => Side::A,
     };
-    let split = constraints.partition_point(|k| k.side == Side::A);
+    let (pass_a, pass_b) = constraints.split_at(split.min(constraints.len()));
     let opposite = match other {
-        Side::A => &constraints[..split],
-        Side::B => &constraints[split..],
+        Side::A => pass_a,
+        Side::B => pass_b,
     };
-    let shared = quads[c.quad as usize]
-        .iter()
-        .any(|&id| opposite.binary_search_by(|k| k.slave.cmp(&id)).is_ok());
+    let shared = quads.get(c.quad as usize).is_some_and(|q| {
+        q.iter()
+            .any(|&id| opposite.binary_search_by(|k| k.slave.cmp(&id)).is_ok())
+    });
     if shared { 0.5 } else { 1.0 }
 }
 
@@ -188,9 +198,10 @@ pub struct PairForce {
     pub min_gap: Real,
 }
 
-/// A contact buffer problem; the driver must grow the buffer and retry, or
-/// report it: a contact is never dropped silently.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+/// A contact buffer or input problem. A full list ([`Self::Capacity`]):
+/// the driver must grow the buffer and retry, or report it: a contact is
+/// never dropped silently. The other variants are caller errors.
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub enum ContactError {
     /// A fixed-capacity list is full.
     Capacity {
@@ -208,6 +219,28 @@ pub enum ContactError {
         /// Length given.
         got: usize,
     },
+    /// An id read from a caller buffer (a constraint's slave node or
+    /// master quad, a quad's corner node, a node's quad list, a face list)
+    /// is not an index of the buffer it selects from.
+    IdOutOfRange {
+        /// Where the id was read, e.g. `constraints.slave` or `quads`.
+        buffer: &'static str,
+        /// Index of the entry of `buffer` that holds it.
+        index: usize,
+        /// The id.
+        id: u32,
+        /// Length of the buffer the id indexes (ids must be below it).
+        len: usize,
+    },
+    /// A scalar input is outside its range.
+    InvalidParameter {
+        /// Name of the argument or field.
+        field: &'static str,
+        /// The value given.
+        value: Real,
+        /// The allowed range.
+        allowed: &'static str,
+    },
 }
 
 impl fmt::Display for ContactError {
@@ -223,6 +256,24 @@ impl fmt::Display for ContactError {
             } => write!(
                 f,
                 "contact buffer `{buffer}` has length {got}, expected at least {expected}"
+            ),
+            Self::IdOutOfRange {
+                buffer,
+                index,
+                id,
+                len,
+            } => write!(
+                f,
+                "contact id out of range: `{buffer}` entry {index} holds id {id}, \
+                 but the buffer it indexes has {len} entries"
+            ),
+            Self::InvalidParameter {
+                field,
+                value,
+                allowed,
+            } => write!(
+                f,
+                "invalid contact input `{field}` = {value}: allowed range is {allowed}"
             ),
         }
     }
@@ -413,11 +464,13 @@ impl PassFaces for ListedFaces<'_, '_> {
         self.lists
             .faces_of(k)
             .iter()
-            .filter_map(move |&q| candidates.get(slot[q as usize] as usize))
+            .filter_map(move |&q| candidates.get(*slot.get(q as usize)? as usize))
     }
     fn clear(&mut self) {
         for &q in self.lists.used {
-            self.slot[q as usize] = u32::MAX;
+            if let Some(slot) = self.slot.get_mut(q as usize) {
+                *slot = u32::MAX;
+            }
         }
     }
 }
@@ -449,9 +502,20 @@ fn detect_pass(
     let mut faces = 0;
     for i in 0..pass.quad_count(master) {
         let q = pass.quad(i);
-        let bounds = &master.quad_bounds[q];
+        let Some(bounds) = master.quad_bounds.get(q) else {
+            pass.clear();
+            return Err(ContactError::IdOutOfRange {
+                buffer: "face lists (used)",
+                index: i,
+                id: u32::try_from(q).unwrap_or(u32::MAX),
+                len: master.quad_bounds.len(),
+            });
+        };
         if bounds.overlaps(&region) && bounds.distance_to(&slave.sphere.centre) <= slave_reach {
-            let corners = master.quad_pred(q);
+            let Some(corners) = master.corners(q) else {
+                pass.clear();
+                return Err(master.quad_error(q));
+            };
             let window = settings.window_fraction * face_diagonal(&corners);
             scratch[faces] = CandidateFace {
                 quad: q as u32,
@@ -470,15 +534,49 @@ fn detect_pass(
     // Only nodes inside the master's bounding sphere can be behind its
     // surface.
     let (centre, reach) = (master.sphere.centre, master.sphere.radius + m);
-    let mut full = false;
+    let mut failed = None;
     for (s, k) in pass.nodes(slave) {
-        let p = slave.x_pred[s];
+        let Some(&p) = slave.x_pred.get(s) else {
+            failed = Some(ContactError::IdOutOfRange {
+                buffer: "face lists (nodes)",
+                index: k,
+                id: u32::try_from(s).unwrap_or(u32::MAX),
+                len: slave.x_pred.len(),
+            });
+            break;
+        };
         if !region.contains(&p) || norm(&sub(&p, &centre)) > reach {
             continue;
         }
-        if let Some(c) = closest_face(slave, s, pass.faces_of(k, candidates), settings) {
+        let mut bad_normal = false;
+        let hit = closest_face(
+            slave,
+            s,
+            &p,
+            pass.faces_of(k, candidates),
+            settings,
+            &mut bad_normal,
+        );
+        if bad_normal {
+            failed = Some(
+                slave
+                    .node_normal(s)
+                    .err()
+                    .unwrap_or(ContactError::IdOutOfRange {
+                        buffer: "node_quads",
+                        index: s,
+                        id: u32::MAX,
+                        len: slave.quads.len(),
+                    }),
+            );
+            break;
+        }
+        if let Some(c) = hit {
             let Some(slot) = out.get_mut(count) else {
-                full = true;
+                failed = Some(ContactError::Capacity {
+                    buffer: "constraints",
+                    capacity: count,
+                });
                 break;
             };
             *slot = Constraint {
@@ -493,13 +591,10 @@ fn detect_pass(
         }
     }
     pass.clear();
-    if full {
-        return Err(ContactError::Capacity {
-            buffer: "constraints",
-            capacity: count,
-        });
+    match failed {
+        Some(e) => Err(e),
+        None => Ok(count),
     }
-    Ok(count)
 }
 
 #[derive(Clone, Copy)]
@@ -511,17 +606,27 @@ struct Hit {
 /// The face node `s` of `slave` penetrates, by physics.md §5.2's tests:
 /// inside the face, −g_max < g < 0, opposing normals; the smallest |g|
 /// wins. With no face, a concave edge or corner shared by several faces is
-/// tried: the closest point on it with the faces' averaged normal.
+/// tried: the closest point on it with the faces' averaged normal. `p` is
+/// the node's predicted position. If the node's normal is needed and an
+/// id of its quads is outside the buffers, `bad_normal` is set (and no
+/// face opposes the node).
 fn closest_face<'c>(
     slave: &SurfaceBody<'_>,
     s: usize,
+    p: &Vec3,
     candidates: impl Iterator<Item = &'c CandidateFace> + Clone,
     settings: &PairSettings,
+    bad_normal: &mut bool,
 ) -> Option<Hit> {
-    let p = slave.x_pred[s];
+    let p = *p;
     let mut slave_normal: Option<Vec3> = None;
     let mut opposing = |n: &Vec3| {
-        let ns = *slave_normal.get_or_insert_with(|| slave.node_normal(s));
+        let ns = *slave_normal.get_or_insert_with(|| {
+            slave.try_node_normal(s).unwrap_or_else(|| {
+                *bad_normal = true;
+                [0.0; 3]
+            })
+        });
         dot(&ns, n) < 0.0
     };
     let mut best: Option<Hit> = None;
@@ -705,11 +810,16 @@ pub struct Involvement<'a> {
 }
 
 impl Involvement<'_> {
-    /// Counts node `i` once for the contact tagged `tag`.
+    /// Counts node `i` once for the contact tagged `tag`. A node outside
+    /// `tag` or `count` is not counted (no panic): [`forces`] rejects
+    /// both a count slice shorter than the body's nodes and a node id
+    /// outside the body.
     pub fn mark(&mut self, i: usize, tag: u32) {
-        if self.tag[i] != tag {
-            self.tag[i] = tag;
-            self.count[i] = self.count[i].saturating_add(1);
+        if let (Some(t), Some(n)) = (self.tag.get_mut(i), self.count.get_mut(i))
+            && *t != tag
+        {
+            *t = tag;
+            *n = n.saturating_add(1);
         }
     }
 }
@@ -736,6 +846,14 @@ pub fn mark_involvement(
 /// count does not depend on the other body, so a driver may count each
 /// granule over its own pairs, granules in parallel, and get the counts
 /// of a pass over the pairs.
+///
+/// Like [`forces`], it skips constraints that are not penetrating
+/// (g ≥ 0 or NaN). It does not panic on bad ids: a constraint whose quad
+/// id is outside `quads`, or a node outside `inv`, is not counted, and
+/// [`forces`] on the same constraints — the only user of the counts —
+/// reports it ([`ContactError::IdOutOfRange`] or
+/// [`ContactError::BufferLength`]). (It returns nothing so that its
+/// callers need not change; the error surfaces at [`forces`].)
 pub fn mark_side(
     constraints: &[Constraint],
     side: Side,
@@ -744,10 +862,13 @@ pub fn mark_side(
     tag: u32,
 ) {
     for c in constraints {
+        if c.gap.is_nan() || c.gap >= 0.0 {
+            continue;
+        }
         if c.side == side {
             inv.mark(c.slave as usize, tag);
-        } else {
-            for (id, w) in quads[c.quad as usize].iter().zip(c.weights) {
+        } else if let Some(quad) = quads.get(c.quad as usize) {
+            for (id, w) in quad.iter().zip(c.weights) {
                 if w != 0.0 {
                     inv.mark(*id as usize, tag);
                 }
@@ -795,18 +916,113 @@ pub struct NodeFaceForce {
     pub slipping: bool,
 }
 
+/// Tolerance of the unit-length checks of [`node_face_force`]: the normal
+/// must satisfy | |n| − 1 | ≤ this, the weights |Σ Nᵢ − 1| ≤ this.
+pub const UNIT_TOLERANCE: Real = 1e-6;
+
+/// [`ContactError::InvalidParameter`] unless `ok`.
+fn check_param(
+    ok: bool,
+    field: &'static str,
+    value: Real,
+    allowed: &'static str,
+) -> Result<(), ContactError> {
+    if ok {
+        Ok(())
+    } else {
+        Err(ContactError::InvalidParameter {
+            field,
+            value,
+            allowed,
+        })
+    }
+}
+
+/// The per-call scalars of [`node_face_force`] and [`forces`]: μ finite
+/// and ≥ 0, Δt² finite and > 0 (NaN fails both).
+fn check_step(friction: Real, dt_squared: Real) -> Result<(), ContactError> {
+    check_param(
+        friction.is_finite() && friction >= 0.0,
+        "friction",
+        friction,
+        "finite, >= 0",
+    )?;
+    check_param(
+        dt_squared.is_finite() && dt_squared > 0.0,
+        "dt_squared",
+        dt_squared,
+        "finite, > 0",
+    )
+}
+
 /// The force that closes the predicted gap of one node-to-face constraint
 /// in one step, shared by effective mass m_eff = m_s / (1 + m_s Σ Nᵢ²/mᵢ),
 /// with the partition weight `weight` (½ or 1, see [`forces`]), Coulomb
 /// friction `friction` (μ ≥ 0; 0 skips it) from the relative tangential
-/// motion of the step, and `dt_squared` = Δt_{n+½}·Δt_n (s²). A positive
-/// gap gives a pull (the caller only passes penetrating constraints).
+/// motion of the step, and `dt_squared` = Δt_{n+½}·Δt_n (s²).
+///
+/// A constraint with g ≥ 0 is not active (physics.md §5.3: F_n only if
+/// g < 0): its force is zero, normal and friction alike — never a pull.
+///
+/// Errors ([`ContactError::InvalidParameter`], naming the field): `weight`
+/// outside 0 < w ≤ 1; `friction` not finite or < 0; `dt_squared` not
+/// finite or ≤ 0; a mass (`slave_mass`, any of `master_mass`, also one
+/// whose weight is 0) not finite or ≤ 0; a non-finite position or gap; the
+/// `weights` not finite or |Σ Nᵢ − 1| > [`UNIT_TOLERANCE`]; the `normal`
+/// not finite or | |n| − 1 | > [`UNIT_TOLERANCE`].
 pub fn node_face_force(
     c: &NodeFace,
     weight: Real,
     friction: Real,
     dt_squared: Real,
-) -> NodeFaceForce {
+) -> Result<NodeFaceForce, ContactError> {
+    check_param(
+        weight > 0.0 && weight <= 1.0,
+        "weight",
+        weight,
+        "0 < w <= 1",
+    )?;
+    check_step(friction, dt_squared)?;
+    for (field, m) in [("slave_mass", c.slave_mass)]
+        .into_iter()
+        .chain(c.master_mass.map(|m| ("master_mass", m)))
+    {
+        check_param(m.is_finite() && m > 0.0, field, m, "finite, > 0")?;
+    }
+    let positions = [
+        ("slave_x_n", &c.slave_x_n),
+        ("slave_x_pred", &c.slave_x_pred),
+    ]
+    .into_iter()
+    .chain(c.master_x_n.iter().map(|x| ("master_x_n", x)))
+    .chain(c.master_x_pred.iter().map(|x| ("master_x_pred", x)));
+    for (field, x) in positions {
+        if let Some(&v) = x.iter().find(|v| !v.is_finite()) {
+            return Err(ContactError::InvalidParameter {
+                field,
+                value: v,
+                allowed: "finite",
+            });
+        }
+    }
+    check_param(c.gap.is_finite(), "gap", c.gap, "finite")?;
+    let sum: Real = c.weights.iter().sum();
+    check_param(
+        abs(sum - 1.0) <= UNIT_TOLERANCE,
+        "weights",
+        sum,
+        "finite, summing to 1 within 1e-6",
+    )?;
+    let len = norm(&c.normal);
+    check_param(
+        abs(len - 1.0) <= UNIT_TOLERANCE,
+        "normal",
+        len,
+        "unit length: | |n| - 1 | <= 1e-6",
+    )?;
+    if c.gap >= 0.0 {
+        return Ok(NodeFaceForce::default());
+    }
     let increment = || {
         let mut du = sub(&c.slave_x_pred, &c.slave_x_n);
         for i in 0..4 {
@@ -824,7 +1040,9 @@ pub fn node_face_force(
         normal: &c.normal,
         gap: c.gap,
     };
-    kinematic_force(&spot, increment, weight, friction, dt_squared)
+    Ok(kinematic_force(
+        &spot, increment, weight, friction, dt_squared,
+    ))
 }
 
 /// What [`kinematic_force`] needs besides the motion of the step.
@@ -954,12 +1172,128 @@ fn shared_mass(body: &SurfaceBody<'_>, share: &[u16], i: usize) -> Real {
     body.mass[i] / Real::from(n)
 }
 
+/// The error of constraint `index` of [`forces`] (`c`, between `a` and
+/// `b`), if any: a NaN gap, or its slave, quad or a corner id outside the
+/// bodies (or inside `x_pred` but outside a shorter `x_n` or `mass`).
+fn bad_constraint(
+    index: usize,
+    c: &Constraint,
+    a: &SurfaceBody<'_>,
+    b: &SurfaceBody<'_>,
+) -> Option<ContactError> {
+    let (slave, master) = match c.side {
+        Side::A => (a, b),
+        Side::B => (b, a),
+    };
+    // Node `id` (read from entry `at` of `buffer`) of `body`, if bad.
+    let node = |body: &SurfaceBody<'_>, buffer, at, id: u32| {
+        let n = body.x_pred.len();
+        if id as usize >= n {
+            Some(ContactError::IdOutOfRange {
+                buffer,
+                index: at,
+                id,
+                len: n,
+            })
+        } else if id as usize >= body.x_n.len() {
+            Some(ContactError::BufferLength {
+                buffer: "x_n",
+                expected: n,
+                got: body.x_n.len(),
+            })
+        } else if id as usize >= body.mass.len() {
+            Some(ContactError::BufferLength {
+                buffer: "mass",
+                expected: n,
+                got: body.mass.len(),
+            })
+        } else {
+            None
+        }
+    };
+    if c.gap.is_nan() {
+        return Some(ContactError::InvalidParameter {
+            field: "constraints.gap",
+            value: c.gap,
+            allowed: "not NaN (< 0: penetrating, >= 0: inactive)",
+        });
+    }
+    if let Some(e) = node(slave, "constraints.slave", index, c.slave) {
+        return Some(e);
+    }
+    let Some(q) = master.quads.get(c.quad as usize) else {
+        return Some(ContactError::IdOutOfRange {
+            buffer: "constraints.quad",
+            index,
+            id: c.quad,
+            len: master.quads.len(),
+        });
+    };
+    q.iter()
+        .find_map(|&id| node(master, "quads", c.quad as usize, id))
+}
+
+/// The error of the first bad constraint of `constraints` (see
+/// [`bad_constraint`]).
+#[cold]
+#[inline(never)]
+fn first_bad_constraint(
+    constraints: &[Constraint],
+    a: &SurfaceBody<'_>,
+    b: &SurfaceBody<'_>,
+) -> ContactError {
+    constraints
+        .iter()
+        .enumerate()
+        .find_map(|(index, c)| bad_constraint(index, c, a, b))
+        .unwrap_or(ContactError::BufferLength {
+            buffer: "constraints",
+            expected: 0,
+            got: constraints.len(),
+        })
+}
+
+/// The [`ContactError::BufferLength`] of a share slice of [`forces`]
+/// that is neither empty nor one per node.
+#[cold]
+#[inline(never)]
+fn share_error(a: (&SurfaceBody<'_>, &[u16]), b: (&SurfaceBody<'_>, &[u16])) -> ContactError {
+    let (buffer, (body, share)) = if a.1.is_empty() || a.1.len() >= a.0.x_pred.len() {
+        ("share_b", b)
+    } else {
+        ("share_a", a)
+    };
+    ContactError::BufferLength {
+        buffer,
+        expected: body.x_pred.len(),
+        got: share.len(),
+    }
+}
+
 /// The forces of `constraints` (from [`detect`] on the same predicted
 /// configuration), written to `out` in constraint order: the slave node,
 /// then the four master corners. `share_a` / `share_b` are the contact
 /// counts of [`mark_involvement`] (one per node; empty slices mean no mass
 /// sharing). `dt_squared` is Δt_{n+½}·Δt_n. Returns the number of entries
 /// written and the pair's totals.
+///
+/// A constraint with g ≥ 0 (a near constraint of [`PairSettings::capture`])
+/// is not active: it writes nothing and does not count, as in
+/// [`node_face_force`]. The constraints' normals, weights and the bodies'
+/// masses are taken as [`detect`] and the mesh made them (not re-checked:
+/// that would be per-constraint work on the bed's hot path).
+///
+/// Errors, all found before any force is computed (a first pass over the
+/// constraints checks their ids and gaps): `settings.friction` or
+/// `dt_squared` out of range or a NaN gap
+/// ([`ContactError::InvalidParameter`]); `out` shorter than five entries
+/// per constraint, a non-empty share slice shorter than the body's nodes,
+/// a body's `x_n` or `mass` too short for a node a constraint names
+/// ([`ContactError::BufferLength`]); a constraint's slave or quad id or
+/// its quad's corner ids outside the bodies
+/// ([`ContactError::IdOutOfRange`]) — and, only with
+/// [`PairSettings::contact_area`], a bad id in the slave's `node_quads`
+/// (then `out` may hold partial entries).
 pub fn forces(
     a: (&SurfaceBody<'_>, &[u16]),
     b: (&SurfaceBody<'_>, &[u16]),
@@ -975,16 +1309,77 @@ pub fn forces(
             got: out.len(),
         });
     }
+    check_step(settings.friction, dt_squared)?;
+    let share_fits = |(body, share): (&SurfaceBody<'_>, &[u16])| {
+        share.is_empty() | (share.len() >= body.x_pred.len())
+    };
+    if !(share_fits(a) & share_fits(b)) {
+        return Err(share_error(a, b));
+    }
+    // A node id must index x_n, x̃ and the masses.
+    let nodes = |body: &SurfaceBody<'_>| body.x_pred.len().min(body.x_n.len()).min(body.mass.len());
+    let (nodes_a, nodes_b) = (nodes(a.0), nodes(b.0));
+    // The ids and gaps first, in a pass of their own: one branch per
+    // constraint. (Checks inside the force loop, or a branch there around
+    // inactive constraints, cost 10–15 % of a pair's force pass in
+    // instructions; this pass costs 3 %.)
+    let (mut bad, mut inactive) = (false, false);
+    for c in constraints {
+        let (slave_nodes, master, master_nodes) = match c.side {
+            Side::A => (nodes_a, b.0, nodes_b),
+            Side::B => (nodes_b, a.0, nodes_a),
+        };
+        // A quad id out of range reads as corners no body has.
+        let q = master
+            .quads
+            .get(c.quad as usize)
+            .copied()
+            .unwrap_or([u32::MAX; 4]);
+        let top = q[0].max(q[1]).max(q[2].max(q[3])) as usize;
+        bad |= (top >= master_nodes) | (c.slave as usize >= slave_nodes) | c.gap.is_nan();
+        inactive |= c.gap >= 0.0;
+    }
+    if bad {
+        return Err(first_bad_constraint(constraints, a.0, b.0));
+    }
+    // Inactive constraints (g ≥ 0: near constraints of a capture
+    // distance) get no force. The common case, none, runs the loop
+    // without that test.
+    if inactive {
+        force_pass(a, b, constraints, settings, dt_squared, out, |c| {
+            c.gap < 0.0
+        })
+    } else {
+        force_pass(a, b, constraints, settings, dt_squared, out, |_| true)
+    }
+}
+
+/// The loop of [`forces`] over the constraints that pass `active`, their
+/// ids checked.
+#[inline(always)]
+fn force_pass(
+    a: (&SurfaceBody<'_>, &[u16]),
+    b: (&SurfaceBody<'_>, &[u16]),
+    constraints: &[Constraint],
+    settings: &PairSettings,
+    dt_squared: Real,
+    out: &mut [NodeForce],
+    active: impl Fn(&Constraint) -> bool,
+) -> Result<(usize, PairForce), ContactError> {
     let mu = settings.friction;
     let mut total = PairForce::default();
     let mut k = 0;
+    let split = constraints.partition_point(|k| k.side == Side::A);
     for c in constraints {
+        if !active(c) {
+            continue;
+        }
         let (slave, s_share, master, m_share, master_side) = match c.side {
             Side::A => (a.0, a.1, b.0, b.1, Side::B),
             Side::B => (b.0, b.1, a.0, a.1, Side::A),
         };
         let w = if settings.symmetric {
-            partition_weight(c, constraints, master.quads)
+            partition_weight(c, constraints, split, master.quads)
         } else {
             1.0
         };
@@ -1038,7 +1433,7 @@ pub fn forces(
         }
         total.normal += f_n;
         if settings.contact_area {
-            total.area += w * slave.node_area(s);
+            total.area += w * slave.node_area(s)?;
         }
         total.constraints += 1;
         if c.gap < total.min_gap {

@@ -4,6 +4,7 @@
 
 use crate::Real;
 use crate::contact::broad::Bound;
+use crate::contact::pair::ContactError;
 use crate::contact::quad::{Vec3, cross, norm, sub};
 use crate::math::{max, min};
 
@@ -41,45 +42,137 @@ pub struct SurfaceBody<'a> {
 }
 
 /// Fills `out` (one entry per quad) with the box of each quad's corners
-/// in `x`.
+/// in `x`. A quad naming a node outside `x` gets the unbounded box (no
+/// panic): the detection then takes it as a candidate, reads its corners
+/// and reports the id ([`crate::contact::pair::ContactError::IdOutOfRange`]).
 pub fn quad_bounds(x: &[Vec3], quads: &[[u32; 4]], out: &mut [Aabb]) {
     for (b, q) in out.iter_mut().zip(quads) {
-        *b = Aabb::of_points(q.iter().map(|&i| &x[i as usize]));
+        *b = match q.map(|i| x.get(i as usize)) {
+            [Some(p0), Some(p1), Some(p2), Some(p3)] => Aabb::of_points([p0, p1, p2, p3]),
+            _ => Aabb::UNBOUNDED,
+        };
+    }
+}
+
+/// [`ContactError::IdOutOfRange`] for `id`, read from entry `index` of
+/// `buffer`, that indexes a buffer of `len` entries.
+fn out_of_range(buffer: &'static str, index: usize, id: usize, len: usize) -> ContactError {
+    ContactError::IdOutOfRange {
+        buffer,
+        index,
+        id: u32::try_from(id).unwrap_or(u32::MAX),
+        len,
     }
 }
 
 impl SurfaceBody<'_> {
-    /// Corner positions of quad `q` on the predicted configuration.
-    pub fn quad_pred(&self, q: usize) -> [Vec3; 4] {
-        self.quads[q].map(|i| self.x_pred[i as usize])
+    /// Corner positions of quad `q` on the predicted configuration;
+    /// `None` if `q` is not a quad or a corner not a node of `x_pred`
+    /// (the cheap form of [`Self::quad_pred`] for the detection's loops).
+    #[inline]
+    pub(crate) fn corners(&self, q: usize) -> Option<[Vec3; 4]> {
+        let quad = self.quads.get(q)?;
+        let x = |i: usize| self.x_pred.get(quad[i] as usize).copied();
+        Some([x(0)?, x(1)?, x(2)?, x(3)?])
     }
 
-    /// Tributary area of surface node `node` on the predicted
-    /// configuration: a quarter of the areas of its quads, m².
-    pub fn node_area(&self, node: usize) -> Real {
-        self.node_quads[node - self.first_surface]
-            .iter()
-            .filter(|&&q| q != u32::MAX)
-            .map(|&q| 0.25 * crate::mesh::surface::quad_area(&self.quad_pred(q as usize)))
-            .sum()
+    /// Corner positions of quad `q` on the predicted configuration; an
+    /// error ([`ContactError::IdOutOfRange`]) if `q` is not a quad or a
+    /// corner not a node of `x_pred`.
+    pub fn quad_pred(&self, q: usize) -> Result<[Vec3; 4], ContactError> {
+        self.corners(q).ok_or_else(|| self.quad_error(q))
     }
 
-    /// Averaged outward normal (not normalised; zero if degenerate) of
-    /// surface node `node` on the predicted configuration: the sum of the
-    /// area vectors of its quads.
-    pub fn node_normal(&self, node: usize) -> Vec3 {
-        let mut n = [0.0; 3];
-        for &q in &self.node_quads[node - self.first_surface] {
+    /// Why [`Self::corners`] of `q` is `None`.
+    #[cold]
+    #[inline(never)]
+    pub(crate) fn quad_error(&self, q: usize) -> ContactError {
+        let Some(quad) = self.quads.get(q) else {
+            return out_of_range("quad id", q, q, self.quads.len());
+        };
+        let n = self.x_pred.len();
+        let id = quad.iter().find(|&&id| id as usize >= n).copied();
+        out_of_range("quads", q, id.map_or(usize::MAX, |id| id as usize), n)
+    }
+
+    /// The corners of each quad of surface node `node` (`u32::MAX`
+    /// slots skipped) to `f`; `None` if `node` has no `node_quads` entry
+    /// or an id there or in a quad is outside its buffer.
+    #[inline]
+    fn each_quad(&self, node: usize, mut f: impl FnMut(&[Vec3; 4])) -> Option<()> {
+        let quads = self.node_quads.get(node.checked_sub(self.first_surface)?)?;
+        for &q in quads {
+            if q != u32::MAX {
+                f(&self.corners(q as usize)?);
+            }
+        }
+        Some(())
+    }
+
+    /// Why [`Self::each_quad`] of `node` is `None`.
+    #[cold]
+    #[inline(never)]
+    fn node_error(&self, node: usize) -> ContactError {
+        let s = node
+            .checked_sub(self.first_surface)
+            .filter(|&s| s < self.node_quads.len());
+        let Some(s) = s else {
+            return out_of_range(
+                "surface node id (first_surface + index of node_quads)",
+                node,
+                node,
+                self.first_surface + self.node_quads.len(),
+            );
+        };
+        for &q in &self.node_quads[s] {
             if q == u32::MAX {
                 continue;
             }
-            let x = self.quad_pred(q as usize);
+            if q as usize >= self.quads.len() {
+                return out_of_range("node_quads", s, q as usize, self.quads.len());
+            }
+            if self.corners(q as usize).is_none() {
+                return self.quad_error(q as usize);
+            }
+        }
+        out_of_range("node_quads", s, usize::MAX, self.quads.len())
+    }
+
+    /// Tributary area of surface node `node` on the predicted
+    /// configuration: a quarter of the areas of its quads, m². An error
+    /// ([`ContactError::IdOutOfRange`]) for a node, quad or corner id
+    /// outside its buffer.
+    pub fn node_area(&self, node: usize) -> Result<Real, ContactError> {
+        let mut area = 0.0;
+        self.each_quad(node, |x| area += 0.25 * crate::mesh::surface::quad_area(x))
+            .ok_or_else(|| self.node_error(node))?;
+        Ok(area)
+    }
+
+    /// Averaged outward normal (not normalised; zero if degenerate) of
+    /// surface node `node` on the predicted configuration (the sum of the
+    /// area vectors of its quads); `None` for a node, quad or corner id
+    /// outside its buffer (the detection's form of [`Self::node_normal`]).
+    #[inline]
+    pub(crate) fn try_node_normal(&self, node: usize) -> Option<Vec3> {
+        let mut n = [0.0; 3];
+        self.each_quad(node, |x| {
             let a = cross(&sub(&x[2], &x[0]), &sub(&x[3], &x[1]));
             for k in 0..3 {
                 n[k] += a[k];
             }
-        }
-        n
+        })?;
+        Some(n)
+    }
+
+    /// Averaged outward normal (not normalised; zero if degenerate) of
+    /// surface node `node` on the predicted configuration: the sum of the
+    /// area vectors of its quads. An error
+    /// ([`ContactError::IdOutOfRange`]) for a node, quad or corner id
+    /// outside its buffer.
+    pub fn node_normal(&self, node: usize) -> Result<Vec3, ContactError> {
+        self.try_node_normal(node)
+            .ok_or_else(|| self.node_error(node))
     }
 }
 
@@ -97,6 +190,12 @@ impl Aabb {
     pub const EMPTY: Aabb = Aabb {
         lo: [Real::INFINITY; 3],
         hi: [Real::NEG_INFINITY; 3],
+    };
+
+    /// The box of all space.
+    pub const UNBOUNDED: Aabb = Aabb {
+        lo: [Real::NEG_INFINITY; 3],
+        hi: [Real::INFINITY; 3],
     };
 
     /// The box of `points`.

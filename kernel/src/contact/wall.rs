@@ -9,6 +9,14 @@
 //! F_t = μF_n F_t*/|F_t*|. Under selective mass scaling the body's rigid
 //! displacement from the sweep's pre-solve ([`crate::contact::rigid`])
 //! is added to the node's motion first: it closes part of the gap.
+//!
+//! Only a finite negative gap is a contact ([`penetrates`]): a node whose
+//! predicted position is NaN or infinite (gap NaN or −∞) gets no force and
+//! is not counted in [`WallForce::contacts`] — a force from it would be
+//! NaN or infinite (a −∞ gap shows in [`WallForce::min_gap`]). The passes
+//! return no error (their callers take the totals as they are); the
+//! driver's check of the motion (a non-finite kinetic energy) reports the
+//! non-finite state.
 
 use crate::Real;
 use crate::contact::rigid::{RigidContact, RigidShift};
@@ -98,6 +106,13 @@ impl Wall {
     }
 }
 
+/// True if `gap` (m) is a penetration: finite and < 0. NaN (a NaN
+/// position) and −∞ (an infinite one) are not.
+#[inline]
+pub fn penetrates(gap: Real) -> bool {
+    gap < 0.0 && gap > Real::NEG_INFINITY
+}
+
 /// Adds the contact forces of `plane` on the nodes `nodes` (a range of node
 /// indices, usually the surface nodes) into `f_c` (N), without mass
 /// sharing; see [`wall_contact`].
@@ -122,7 +137,9 @@ pub fn plane_contact(
 
 /// Counts (in `count`, one per node) the nodes of `nodes` that penetrate
 /// `wall` on the predicted configuration: each wall is one contact for the
-/// mass sharing of §5.3.
+/// mass sharing of §5.3. A NaN gap does not count; a node at infinity
+/// (gap −∞, no force in [`wall_contact`]) does, which only shares a mass
+/// nothing uses (one comparison per node, as in the force pass).
 pub fn count_wall_contacts(
     wall: &Wall,
     nodes: core::ops::Range<usize>,
@@ -159,12 +176,19 @@ pub fn wall_contact(
     for i in nodes {
         let xp = x_pred[i];
         let (gap, n) = wall.gap(&xp);
-        if gap >= 0.0 {
+        // [`penetrates`] in two steps, so that the common case (no
+        // contact) costs one comparison as before; NaN fails it.
+        let below = gap < 0.0;
+        if !below {
             continue;
         }
         // `min_gap` is the unshifted depth, also of a node that the shift
-        // clears (which gets no force and does not count in `contacts`).
+        // clears (which gets no force and does not count in `contacts`),
+        // and of a node at infinity (−∞, which gets no force either).
         out.min_gap = crate::math::min(out.min_gap, gap);
+        if gap == Real::NEG_INFINITY {
+            continue;
+        }
         let mut du = [xp[0] - x_n[i][0], xp[1] - x_n[i][1], xp[2] - x_n[i][2]];
         let mut gap = gap;
         if shifted {
@@ -172,7 +196,7 @@ pub fn wall_contact(
             // and is part of the node's motion over the step.
             let u = body.rigid_shift.at(&x_n[i]);
             gap += u[0] * n[0] + u[1] * n[1] + u[2] * n[2];
-            if gap >= 0.0 {
+            if !penetrates(gap) {
                 continue;
             }
             for a in 0..3 {
@@ -230,7 +254,7 @@ pub fn add_wall_contacts(
     for i in nodes {
         let (xp, x) = (body.x_pred[i], body.x_n[i]);
         let (gap, n) = wall.gap(&xp);
-        if gap >= 0.0 {
+        if !penetrates(gap) {
             continue;
         }
         let m = shared_wall_mass(body.mass, share, i);

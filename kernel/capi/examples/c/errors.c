@@ -86,6 +86,73 @@ int main(void) {
     GranbedNodeFaceForce out;
     expect("zero masses", granbed_node_face_force(&c, 1.0, 0.1, 1e-12, &out), GRANBED_ERR_INVALID_ARGUMENT);
     expect("NULL constraint", granbed_node_face_force(NULL, 1.0, 0.1, 1e-12, &out), GRANBED_ERR_NULL_POINTER);
+    /* A valid constraint: a node 1 µm behind the face z = 0. */
+    c.slave_mass = 1e-9;
+    for (int i = 0; i < 4; i++) c.master_mass[i] = 1e-9;
+    c.weights[0] = 1;
+    c.normal[2] = 1;
+    c.gap = -1e-6;
+    c.slave_x_pred[2] = -1e-6;
+    expect("penetrating constraint", granbed_node_face_force(&c, 1.0, 0.3, 1e-16, &out), GRANBED_OK);
+    if (!(out.normal > 0)) {
+        fprintf(stderr, "FAIL: a penetrating constraint gives no push (F_n = %g)\n", out.normal);
+        failures++;
+    }
+    /* A non-negative gap is no contact: zero force (it was a pull and NaN). */
+    c.gap = 1e-3;
+    expect("positive gap", granbed_node_face_force(&c, 1.0, 0.3, 1e-16, &out), GRANBED_OK);
+    if (out.normal != 0 || out.slave[0] != 0 || out.slave[1] != 0 || out.slave[2] != 0) {
+        fprintf(stderr, "FAIL: positive gap: F_n = %g, slave force (%g, %g, %g), expected 0\n", out.normal,
+                out.slave[0], out.slave[1], out.slave[2]);
+        failures++;
+    }
+    c.gap = -1e-6;
+    c.normal[2] = 0;
+    expect("zero normal", granbed_node_face_force(&c, 1.0, 0.3, 1e-16, &out), GRANBED_ERR_INVALID_ARGUMENT);
+    c.normal[2] = 1e6;
+    expect("normal of length 1e6", granbed_node_face_force(&c, 1.0, 0.3, 1e-16, &out), GRANBED_ERR_INVALID_ARGUMENT);
+    c.normal[2] = 1 + 0.5 * GRANBED_UNIT_TOLERANCE;
+    expect("normal within tolerance", granbed_node_face_force(&c, 1.0, 0.3, 1e-16, &out), GRANBED_OK);
+    c.normal[2] = 1;
+    c.master_mass[1] = 0; /* its weight is 0 */
+    expect("zero master mass, weight 0", granbed_node_face_force(&c, 1.0, 0.3, 1e-16, &out),
+           GRANBED_ERR_INVALID_ARGUMENT);
+    c.master_mass[1] = 1e-9;
+    expect("NaN friction", granbed_node_face_force(&c, 1.0, NAN, 1e-16, &out), GRANBED_ERR_INVALID_ARGUMENT);
+    expect("dt^2 = 0", granbed_node_face_force(&c, 1.0, 0.3, 0.0, &out), GRANBED_ERR_INVALID_ARGUMENT);
+    expect("dt^2 = inf", granbed_node_face_force(&c, 1.0, 0.3, INFINITY, &out), GRANBED_ERR_INVALID_ARGUMENT);
+    c.weights[1] = 0.5;
+    expect("weights summing to 1.5", granbed_node_face_force(&c, 1.0, 0.3, 1e-16, &out),
+           GRANBED_ERR_INVALID_ARGUMENT);
+    c.weights[1] = 0;
+    c.gap = NAN;
+    expect("NaN gap", granbed_node_face_force(&c, 1.0, 0.3, 1e-16, &out), GRANBED_ERR_NON_FINITE);
+
+    /* A corrupt hex reference record fails its element, not silently. */
+    {
+        static const double cube[24] = {0, 0, 0, 1, 0, 0, 1, 1, 0, 0, 1, 0, 0, 0, 1, 1, 0, 1, 1, 1, 1, 0, 1, 1};
+        double good[GRANBED_HEX_REFERENCE_LEN], r[GRANBED_HEX_REFERENCE_LEN], cp[6], fe[24], x[24];
+        int32_t est[1];
+        expect("unit cube reference", granbed_hex_reference(1, cube, good, est), GRANBED_OK);
+        memcpy(x, cube, sizeof x);
+        x[18] += 0.01;
+        /* V0 NaN and negative, the hourglass factor NaN and negative, a
+         * gamma0 entry infinite, a node volume 0. */
+        const int at[6] = {0, 0, 57, 57, 30, 60};
+        const double value[6] = {NAN, -1.0, NAN, -1.0, INFINITY, 0.0};
+        for (int k = 0; k < 6; k++) {
+            memcpy(r, good, sizeof r);
+            r[at[k]] = value[k];
+            granbed_state_init(1, cp);
+            char what[64];
+            snprintf(what, sizeof what, "corrupt reference [%d] = %g", at[k], value[k]);
+            expect(what, granbed_hex_forces(&p, 1, 0.05, 1, r, x, cp, fe, NULL, NULL, est),
+                   GRANBED_ERR_POINT_FAILED);
+            expect(what, est[0], GRANBED_ERR_INVALID_ARGUMENT);
+        }
+        granbed_state_init(1, cp);
+        expect("good reference", granbed_hex_forces(&p, 1, 0.05, 1, good, x, cp, fe, NULL, NULL, est), GRANBED_OK);
+    }
     expect("vumat nstatev 5", granbed_vumat(1, 5, 8, NULL, NULL, NULL, NULL, NULL, NULL), GRANBED_ERR_INVALID_ARGUMENT);
     if (strcmp(granbed_status_message(12345), "unknown status code") != 0) {
         fprintf(stderr, "FAIL: unknown code message\n");
