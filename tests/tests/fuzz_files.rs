@@ -227,6 +227,18 @@ fn edited_words(ck: &Checkpoint, edit: impl Fn(&mut Checkpoint)) -> (Vec<usize>,
     (words, before)
 }
 
+/// Bytes at the end of a format-7 payload that older formats lack: the
+/// phase times (a length-prefixed list of 3 floats) and 7 counters.
+const COUNTER_BYTES: usize = 8 + 3 * 8 + 7 * 8;
+
+/// The offsets of the 8-byte words of the counters at the end of the
+/// checkpoint file `bytes` (cut from every older format).
+fn counter_words(bytes: &[u8]) -> Vec<usize> {
+    (bytes.len() - COUNTER_BYTES..bytes.len())
+        .step_by(8)
+        .collect()
+}
+
 /// `x` with its sign and lowest mantissa bit flipped: it differs from `x`
 /// in the first and the last byte of its word.
 fn flip(x: f64) -> f64 {
@@ -251,7 +263,8 @@ fn older(bytes: &[u8], cut: &[usize], version: u32) -> Vec<u8> {
     b
 }
 
-/// Checkpoints of older formats still read: version 4 (before the
+/// Checkpoints of older formats still read (without the phase times and
+/// counters of version 7: counted from the checkpoint's step): version 4 (before the
 /// samples' kinetic energy relative to the imposed compression) with that
 /// energy NaN (not recorded), version 3 (before the mass factors and the
 /// undeformed step as well) with every factor 1 and no undeformed step
@@ -298,6 +311,10 @@ fn versions_2_to_4_checkpoints_read_with_the_fields_they_lack_at_their_defaults(
         let mut old = read(&write_checkpoint(name, bytes))
             .unwrap_or_else(|e| panic!("a version {version} checkpoint reads: {e}"));
         assert_eq!(old.progress.samples.len(), ck.progress.samples.len());
+        assert_eq!(old.progress.counters, Default::default());
+        assert_eq!(old.progress.counters_from_step, ck.state.steps);
+        old.progress.counters = ck.progress.counters;
+        old.progress.counters_from_step = ck.progress.counters_from_step;
         for (o, s) in old.progress.samples.iter_mut().zip(&ck.progress.samples) {
             assert!(
                 o.kinetic_relative_j.is_nan(),
@@ -307,13 +324,18 @@ fn versions_2_to_4_checkpoints_read_with_the_fields_they_lack_at_their_defaults(
         }
         old
     };
+    let counters = counter_words(&bytes);
     let cut_of = |parts: &[&Vec<usize>]| {
-        let mut cut: Vec<usize> = parts.iter().flat_map(|p| p.iter().copied()).collect();
+        let mut cut: Vec<usize> = parts
+            .iter()
+            .flat_map(|p| p.iter().copied())
+            .chain(counters.iter().copied())
+            .collect();
         cut.sort_unstable();
         cut
     };
 
-    let v4 = older(&bytes, &relative, 4);
+    let v4 = older(&bytes, &cut_of(&[&relative]), 4);
     assert_eq!(
         read_older("version4", &v4, 4),
         ck,
@@ -351,7 +373,8 @@ fn a_checkpoint_with_a_nudged_float_decodes_and_resumes() {
     let payload = &bytes[36..];
     let resumed = (1..=64).find_map(|k| {
         let mut p = payload.to_vec();
-        let at = p.len().checked_sub(8 * k)?;
+        // Before the counters (a nudged counter only moves a cost figure).
+        let at = p.len().checked_sub(COUNTER_BYTES + 8 * k)?;
         p[at] ^= 1;
         let mut b = bytes[..20].to_vec();
         b.extend_from_slice(&(p.len() as u64).to_le_bytes());
