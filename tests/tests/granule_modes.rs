@@ -466,6 +466,26 @@ fn t1_time_step_estimates_and_the_stability_limit() {
         (dt_element / 1.48e-6 - 1.0).abs() < 0.005,
         "element estimate {dt_element:e}"
     );
+    // The other two densities (§3.4 granule masses ρ0·V_mesh, §4.2 element
+    // steps; both tables at four significant figures): η0 = 0.6 / 0.8 / 1
+    // give 0.4634 / 0.6178 / 0.7723 mg and 1.146 / 1.324 / 1.480 µs.
+    for (t, mass_mg, dt_us) in [
+        (GranuleType::A1, 0.4634, 1.146),
+        (GranuleType::A2, 0.6178, 1.324),
+        (GranuleType::A3, 0.7723, 1.480),
+    ] {
+        let m = t.params().validate().unwrap();
+        let total: Real = mesh.node_volume.iter().map(|v| m.density0 * v).sum();
+        assert!(
+            (total / (mass_mg * 1e-6) - 1.0).abs() < 1e-3,
+            "{t}: granule mass {total:e} kg"
+        );
+        let dt = element_time_step(&view, &m, &mesh.positions, 0.9).unwrap();
+        assert!(
+            (dt / (dt_us * 1e-6) - 1.0).abs() < 1e-3,
+            "{t}: element estimate {dt:e} s"
+        );
+    }
 
     let n = mesh.positions.len();
     let mut rng = 12345u64;
