@@ -194,6 +194,19 @@ fn sphere(shift: Real) -> Body {
 }
 
 /// Calls `f` with the body's surface (its quad boxes computed here).
+/// A constraint of `b`'s first surface node against quad 0, 1 µm deep:
+/// valid in every field.
+fn penetrating_constraint(b: &Body) -> Constraint {
+    Constraint {
+        side: Side::A,
+        slave: b.first as u32,
+        quad: 0,
+        weights: [0.25; 4],
+        normal: [0.0, 0.0, 1.0],
+        gap: -1e-6,
+    }
+}
+
 fn with_surface<R>(b: &Body, f: impl FnOnce(SurfaceBody<'_>) -> R) -> R {
     let mut boxes = vec![Aabb::EMPTY; b.quads.len()];
     quad_bounds(&b.x, &b.quads, &mut boxes);
@@ -248,14 +261,7 @@ fn out_of_range<T: core::fmt::Debug>(r: Result<T, ContactError>) -> (&'static st
 #[test]
 fn pair_forces_reject_bad_ids_buffers_and_scalars() {
     let b = sphere(0.0);
-    let ok = Constraint {
-        side: Side::A,
-        slave: b.first as u32,
-        quad: 0,
-        weights: [0.25; 4],
-        normal: [0.0, 0.0, 1.0],
-        gap: -1e-6,
-    };
+    let ok = penetrating_constraint(&b);
     let settings = PairSettings::standard(0.3);
     with_surface(&b, |a| {
         let (k, total) = forces_on(&a, &[ok], &settings, 1e-16).unwrap();
@@ -357,14 +363,7 @@ fn pair_forces_reject_bad_ids_buffers_and_scalars() {
 fn mark_side_skips_ids_outside_its_buffers() {
     let b = sphere(0.0);
     let n = b.x.len();
-    let ok = Constraint {
-        side: Side::A,
-        slave: b.first as u32,
-        quad: 0,
-        weights: [0.25; 4],
-        normal: [0.0, 0.0, 1.0],
-        gap: -1e-6,
-    };
+    let ok = penetrating_constraint(&b);
     let (mut tag, mut count) = (vec![u32::MAX; n], vec![0u16; n]);
     let constraints = [
         Constraint {
