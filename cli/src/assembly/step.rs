@@ -357,6 +357,26 @@ pub struct PhaseTimes {
     pub pair_searches: u64,
 }
 
+/// The phase times and counters of two segments of a run, summed (a
+/// resumed run adds its checkpoint's to its own).
+impl core::ops::Add for PhaseTimes {
+    type Output = Self;
+
+    fn add(self, b: Self) -> Self {
+        Self {
+            predict_s: self.predict_s + b.predict_s,
+            contact_s: self.contact_s + b.contact_s,
+            correct_s: self.correct_s + b.correct_s,
+            sweeps: self.sweeps + b.sweeps,
+            rigid_granule_steps: self.rigid_granule_steps + b.rigid_granule_steps,
+            steps: self.steps + b.steps,
+            list_builds: self.list_builds + b.list_builds,
+            anchor_renewals: self.anchor_renewals + b.anchor_renewals,
+            pair_searches: self.pair_searches + b.pair_searches,
+        }
+    }
+}
+
 impl PhaseTimes {
     /// Share of the contact phase in the total.
     pub fn contact_share(&self) -> f64 {

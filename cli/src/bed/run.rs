@@ -295,21 +295,6 @@ pub struct RunControl {
     pub interrupt: Option<&'static AtomicBool>,
 }
 
-/// `a` and `b` added: the phase times and counters of two segments.
-fn add_times(a: PhaseTimes, b: PhaseTimes) -> PhaseTimes {
-    PhaseTimes {
-        predict_s: a.predict_s + b.predict_s,
-        contact_s: a.contact_s + b.contact_s,
-        correct_s: a.correct_s + b.correct_s,
-        sweeps: a.sweeps + b.sweeps,
-        rigid_granule_steps: a.rigid_granule_steps + b.rigid_granule_steps,
-        steps: a.steps + b.steps,
-        list_builds: a.list_builds + b.list_builds,
-        anchor_renewals: a.anchor_renewals + b.anchor_renewals,
-        pair_searches: a.pair_searches + b.pair_searches,
-    }
-}
-
 /// The pour's parameters for `scene`.
 fn pour_params(scene: &Scene, material: &granbed_kernel::material::Material) -> PourParams {
     let radius = scene.radius_m();
@@ -503,7 +488,7 @@ pub fn run_bed(
                     window: *window,
                     next_output: next,
                     snapshots_done: done,
-                    counters: add_times(counters_before, asm.times()),
+                    counters: counters_before + asm.times(),
                     counters_from_step,
                 },
                 state: asm.state(),
@@ -622,7 +607,7 @@ pub fn run_bed(
         element_steps: steps * (scene.granules * mesh.hexes.len()) as u64,
         pour_wall_time_s,
         wall_time_s: wall(),
-        phase_times: add_times(counters_before, asm.times()),
+        phase_times: counters_before + asm.times(),
         counters_from_step,
         solid_volume_m3,
         threads: rayon::current_num_threads(),
