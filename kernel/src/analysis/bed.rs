@@ -239,13 +239,19 @@ pub fn surface_geometry(
     if quads.is_empty() {
         return Err(BedError::Empty { buffer: "quads" });
     }
-    for (quad, q) in quads.iter().enumerate() {
-        if let Some(&node) = q.iter().find(|&&n| n as usize >= positions.len()) {
-            return Err(BedError::NodeOutOfRange { quad, node });
-        }
-    }
-    // (The ids were checked above; NaN would read as degenerate.)
-    let (area_m2, volume_m3) = area_and_volume(positions, quads).unwrap_or((Real::NAN, Real::NAN));
+    let Some((area_m2, volume_m3)) = area_and_volume(positions, quads) else {
+        // A quad names a node beyond `positions`: say which.
+        let (quad, node) = quads
+            .iter()
+            .enumerate()
+            .find_map(|(k, q)| {
+                q.iter()
+                    .find(|&&n| n as usize >= positions.len())
+                    .map(|&n| (k, n))
+            })
+            .unwrap_or((0, u32::MAX));
+        return Err(BedError::NodeOutOfRange { quad, node });
+    };
     if area_m2.is_finite() && area_m2 > 0.0 && volume_m3.is_finite() && volume_m3 > 0.0 {
         Ok((area_m2, volume_m3))
     } else {
