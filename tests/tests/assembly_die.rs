@@ -205,6 +205,45 @@ fn held_sweeps_with_face_lists_give_the_bits_of_searching_every_face() {
     });
 }
 
+/// From `exact_contact_from_s` on every contact sweep searches: a run that
+/// holds its constraints and searches every fifth step, switched at t = 0,
+/// gives the bits of a run that never holds (`hold_constraints` false,
+/// `contact_search_interval` 1); switched after the end, those of the held
+/// run, which differ.
+#[test]
+fn searching_every_sweep_from_a_time_gives_the_bits_of_never_holding() {
+    let (_, _, params) = small_die();
+    let held = AssemblyParams {
+        hold_constraints: true,
+        contact_search_interval: 5,
+        ..params
+    };
+    let never_held = AssemblyParams {
+        hold_constraints: false,
+        contact_search_interval: 1,
+        ..params
+    };
+    let exact = die_at_eight_percent(never_held, 2);
+    let from_start = AssemblyParams {
+        exact_contact_from_s: 0.0,
+        ..held
+    };
+    assert!(
+        die_at_eight_percent(from_start, 2) == exact,
+        "switched at t = 0, the run still holds"
+    );
+    let after_end = AssemblyParams {
+        exact_contact_from_s: 1.0,
+        ..held
+    };
+    let held_bits = die_at_eight_percent(held, 2);
+    assert!(die_at_eight_percent(after_end, 2) == held_bits);
+    assert!(
+        held_bits != exact,
+        "holding changes nothing here: the test cannot tell"
+    );
+}
+
 /// Benchmark (BENCHMARKS.md): the same die with the standard 8x2 mesh to
 /// 10 % strain, printing the share of the contact phase.
 #[test]

@@ -115,7 +115,7 @@ fn scene_fields_out_of_range_or_contradicting_are_named() {
 
 #[test]
 fn every_numeric_flag_takes_a_minus_and_names_its_range() {
-    let cases: [(&str, &[&str]); 16] = [
+    let cases: [(&str, &[&str]); 17] = [
         ("--granules", &["'--granules <N>'", "1..=100000"]),
         ("--seed", &["'--seed <SEED>'", "0..=18446744073709551615"]),
         ("--strain", &["`final_strain` = -1", "0 < C <= 0.9"]),
@@ -142,6 +142,10 @@ fn every_numeric_flag_takes_a_minus_and_names_its_range() {
         (
             "--contact-capture",
             &["`contact_capture` = -1", "0 <= c <= 0.1"],
+        ),
+        (
+            "--exact-contact-from-strain",
+            &["`exact_contact_from_strain` = -1", "0 <= C <= 1 (1: never)"],
         ),
         ("--stop-at-strain", &["`--stop-at-strain -1`", "0 < C <="]),
         ("--mass-scaling", &["`mass_scaling` = -1", "1 <= F <= 1e6"]),
@@ -193,16 +197,19 @@ fn a_scene_file_without_the_newer_fields_names_the_values_it_runs_with() {
     let text = small_scene(20, "0.01")
         .replace("time_step_floor = 1.0\n", "")
         .replace("hold_constraints = true\n", "")
-        .replace("contact_search_interval = 5\n", "");
+        .replace("contact_search_interval = 5\n", "")
+        .replace("exact_contact_from_strain = 0.3\n", "");
     let old = scene_file("old", &text);
     let r = bed(&["--print-scene", "--scene", old.to_str().unwrap()]);
     assert_eq!(r.code, 0, "{}", r.stderr);
     for needle in [
         "warning: scene",
-        "omits contact_search_interval, hold_constraints, time_step_floor",
+        "omits contact_search_interval, exact_contact_from_strain, hold_constraints, \
+         time_step_floor",
         "time_step_floor = 0.0 (published 1.0)",
         "hold_constraints = false (published true)",
         "contact_search_interval = 1 (published 5)",
+        "exact_contact_from_strain = 1.0 (published 0.3)",
     ] {
         assert!(r.stderr.contains(needle), "`{needle}` not in {}", r.stderr);
     }
@@ -257,8 +264,8 @@ fn a_punch_too_fast_for_the_bed_says_so() {
         .find(|w| w.contains("granules overlap by up to"))
         .unwrap_or_else(|| panic!("{w:?}"));
     assert!(
-        overlap.contains("hold_constraints = false")
-            && overlap.contains("contact_search_interval = 1"),
+        overlap.contains("--exact-contact-from-strain")
+            && overlap.contains("--hold-constraints false --contact-search-interval 1"),
         "{overlap}"
     );
     // Printed on stderr (with --quiet too).

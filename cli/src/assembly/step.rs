@@ -600,7 +600,7 @@ impl Assembly<'_> {
                 mesh,
                 &p.contact,
                 first,
-                p.hold_constraints,
+                self.holds_constraints(),
                 !self.searches_step(step),
             )
             .map_err(contact_error)?;

@@ -207,10 +207,17 @@ pub struct BedArgs {
     #[arg(long, value_name = "C", allow_negative_numbers = true)]
     pub contact_capture: Option<f64>,
 
+    /// Override: from this axial strain on every contact sweep searches,
+    /// as with --hold-constraints false --contact-search-interval 1
+    /// (0 ≤ C ≤ 1, 1: never; published 0.3). Allowed with --resume.
+    #[arg(long, value_name = "C", allow_negative_numbers = true)]
+    pub exact_contact_from_strain: Option<f64>,
+
     /// Continue the run whose checkpoint is in DIR (its `checkpoint.bin`);
     /// the outputs go to DIR. Only --strain, --stop-at-strain,
     /// --time-step-safety, --mass-scaling, --sweep-tolerance,
-    /// --hold-constraints, --contact-search-interval, --contact-capture, --face-list-skin,
+    /// --hold-constraints, --contact-search-interval, --contact-capture,
+    /// --exact-contact-from-strain, --face-list-skin,
     /// --time-step-floor, --max-mass-factor, -j and --quiet may be given
     /// with it.
     #[arg(long, value_name = "DIR", conflicts_with_all = ["scene", "out", "granule_type", "granules", "mesh", "seed", "die_diameter_mm", "element", "hourglass_kappa", "rigid_until_touched", "local_sweeps", "selective_mass_scaling", "selective_mass_ratio"])]
@@ -364,6 +371,9 @@ impl BedArgs {
         }
         if let Some(c) = self.contact_capture {
             scene.contact_capture = c;
+        }
+        if let Some(c) = self.exact_contact_from_strain {
+            scene.exact_contact_from_strain = c;
         }
         if let Some(c) = self.time_step_safety {
             scene.time_step_safety = c;

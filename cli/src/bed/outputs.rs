@@ -404,11 +404,11 @@ fn warnings(
     match max_penetration_rel {
         Some(r) if r > OVERLAP_WARNING_REL => w.push(format!(
             "granules overlap by up to {:.1} % of the element size ({max_penetration_m:.3e} m), \
-             more than the {} % that `study stability` accepts: the contact settings \
-             hold_constraints = false and contact_search_interval = 1 (`--hold-constraints \
-             false --contact-search-interval 1`) resolve it at a higher cost (on 30-granule 4x1 \
-             beds to 60 %: 26-44 % of the element became 0.5-0.8 %, at 3-5 times the wall \
-             time)",
+             more than the {} % that `study stability` accepts: searching in every contact \
+             sweep (`--exact-contact-from-strain C` from an earlier strain C, or \
+             `--hold-constraints false --contact-search-interval 1` throughout) resolves it at \
+             a higher cost (on 30-granule 4x1 beds to 60 %, held throughout: 26-44 % of the \
+             element; searching from 30 %: 0.7-0.8 %, at 3-4 times the wall time)",
             100.0 * r,
             100.0 * OVERLAP_WARNING_REL
         )),

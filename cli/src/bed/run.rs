@@ -384,6 +384,13 @@ pub fn run_bed(
             (die, placed, None, packing.wall_time_s)
         }
     };
+    // The time at which the punch reaches the strain from which every
+    // contact sweep searches (it starts at t = 0); never at 1 or more.
+    params.exact_contact_from_s = if scene.exact_contact_from_strain < 1.0 {
+        die.time_of_strain(scene.exact_contact_from_strain)
+    } else {
+        Real::INFINITY
+    };
     let mut asm = Assembly::new(params, &mesh, &placed, die.walls())
         .map_err(anyhow::Error::new)
         .context("cannot set up the bed")?;

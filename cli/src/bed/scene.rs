@@ -123,6 +123,14 @@ contact_search_interval = 5
 # more). 0 (the value of scene files without this field): only overlapping
 # nodes are held.
 contact_capture = 0.1
+# From this axial strain on, every contact sweep searches: hold_constraints
+# and contact_search_interval above apply before it only (0 <= C <= 1; 1:
+# never, the value of scene files without this field). They are speed
+# settings measured to keep this scene's answer to 30 %; far beyond, the
+# contacts move within a step by much of an element, and beds compressed to
+# 60 % with them overlapped by up to 44 % of the element (BENCHMARKS.md,
+# "The 30-granule suite at 60 %").
+exact_contact_from_strain = 0.3
 # A further contact sweep runs (up to contact_sweeps) while a granule-granule
 # gap deeper than this fraction of the element size is left (0 < t <= 0.1).
 # The default 0.01 takes a fifth to a quarter fewer sweeps in a dense bed
@@ -272,6 +280,11 @@ pub struct Scene {
     /// size, 0 ≤ c ≤ 0.1 (`PairSettings::capture`; absent: 0).
     #[serde(default)]
     pub contact_capture: f64,
+    /// From this axial strain on every contact sweep searches
+    /// (`AssemblyParams::exact_contact_from_s`), 0 ≤ C ≤ 1 (1 and absent:
+    /// never).
+    #[serde(default = "never_strain")]
+    pub exact_contact_from_strain: f64,
     /// A further contact sweep runs while a granule–granule gap deeper than
     /// this fraction of the element size (the mesh's shortest surface edge)
     /// is left, 0 < t ≤ 0.1 (absent: [`super::run::SWEEP_TOLERANCE_REL`],
@@ -295,6 +308,10 @@ pub struct Scene {
     /// Material overrides.
     #[serde(default)]
     pub material: MaterialOverrides,
+}
+
+fn never_strain() -> f64 {
+    1.0
 }
 
 fn default_contact_search_interval() -> u32 {
@@ -394,7 +411,7 @@ impl Scene {
         self.granule_type()?;
         self.mesh_level()?;
         self.element_kind()?;
-        let checks: [(bool, &str, f64, &str); 23] = [
+        let checks: [(bool, &str, f64, &str); 24] = [
             (
                 self.sweep_tolerance > 0.0 && self.sweep_tolerance <= 0.1,
                 "sweep_tolerance",
@@ -521,6 +538,12 @@ impl Scene {
                 "contact_capture",
                 self.contact_capture,
                 "0 <= c <= 0.1",
+            ),
+            (
+                (0.0..=1.0).contains(&self.exact_contact_from_strain),
+                "exact_contact_from_strain",
+                self.exact_contact_from_strain,
+                "0 <= C <= 1 (1: never)",
             ),
             (
                 self.contact_search_interval == 1 || self.hold_constraints,
@@ -768,6 +791,15 @@ mod tests {
             (20.0, true, 10.0, 0.01, true, 5)
         );
         assert_eq!(s.contact_capture, 0.1);
+        // Beyond 30 % every contact sweep searches (BENCHMARKS.md, "The
+        // 30-granule suite at 60 %"); a scene file without the field never
+        // switches.
+        assert_eq!(s.exact_contact_from_strain, 0.3);
+        let old = DEFAULT_SCENE.replace("exact_contact_from_strain = 0.3\n", "");
+        assert_eq!(
+            Scene::from_toml(&old).unwrap().exact_contact_from_strain,
+            1.0
+        );
         // The TOML written back parses to the same scene.
         assert_eq!(Scene::from_toml(&s.to_toml()).unwrap(), s);
     }
