@@ -20,11 +20,14 @@ use granbed_kernel::contact::pair::{
     CandidateFace, Constraint, ContactError, Involvement, NodeFace, NodeForce, PairSettings, Side,
     detect, detect_listed, forces, mark_side, node_face_force,
 };
+use granbed_kernel::contact::rigid::RigidContact;
 use granbed_kernel::contact::rigid::RigidShift;
 use granbed_kernel::contact::surface::{Aabb, SurfaceBody, quad_bounds};
 use granbed_kernel::contact::wall::{
-    Plane, PredictedNodes, Wall, count_wall_contacts, penetrates, wall_contact,
+    Plane, PredictedNodes, Wall, add_wall_contacts, count_wall_contacts, penetrates, plane_contact,
+    wall_contact,
 };
+use granbed_kernel::granule::damping::RigidFrame;
 use granbed_kernel::mesh::sphere::SphereMeshParams;
 
 type Vec3 = [Real; 3];
@@ -492,6 +495,45 @@ fn detect_listed_reports_list_ids_outside_the_bodies() {
         used: &[0],
     };
     assert_eq!(run(&bad_face), Ok(0));
+    // Offsets that do not lay out the faces (they panicked in
+    // `FaceLists::faces_of`): too few, decreasing, past the faces.
+    let few = FaceLists {
+        nodes: &[first, first + 1],
+        starts: &[0, 1],
+        faces: &[0],
+        used: &[0],
+    };
+    assert!(
+        matches!(
+            run(&few),
+            Err(ContactError::BufferLength {
+                buffer: "face lists (starts)",
+                expected: 3,
+                got: 2
+            })
+        ),
+        "{:?}",
+        run(&few)
+    );
+    let decreasing = FaceLists {
+        nodes: &[first, first + 1],
+        starts: &[0, 1, 0],
+        faces: &[0],
+        used: &[0],
+    };
+    assert_eq!(
+        field(run(&decreasing)),
+        "face lists (starts): index of a decreasing offset"
+    );
+    let past = FaceLists {
+        nodes: &[first],
+        starts: &[0, 7],
+        faces: &[0],
+        used: &[0],
+    };
+    assert_eq!(out_of_range(run(&past)), ("face lists (starts)", 7));
+    assert!(few.faces_of(5).is_empty() && past.faces_of(0).is_empty());
+    assert_eq!(bad_face.faces_of(0), &[888_888]);
     assert!(slot.iter().all(|&s| s == u32::MAX), "slot restored");
 }
 
@@ -524,7 +566,7 @@ fn a_non_finite_position_is_no_wall_contact() {
     });
     for wall in [floor, Wall::Die { radius: 1e-3 }] {
         let mut f_c = vec![[0.0; 3]; 4];
-        let w = wall_contact(&wall, 0.3, 1e-16, 0..4, &body, &[], &mut f_c);
+        let w = wall_contact(&wall, 0.3, 1e-16, 0..4, &body, &[], &mut f_c).unwrap();
         // The node at infinity reports its depth, −∞, but gets no force.
         assert!(
             w.normal.is_finite() && w.min_gap == Real::NEG_INFINITY,
@@ -533,16 +575,151 @@ fn a_non_finite_position_is_no_wall_contact() {
         assert!(f_c[0].iter().all(|v| v.is_finite()) && f_c[0] != [0.0; 3]);
         assert_eq!(f_c[1..], [[0.0; 3]; 3]);
         let mut count = [0u16; 4];
-        count_wall_contacts(&wall, 0..4, &x, &mut count);
+        count_wall_contacts(&wall, 0..4, &x, &mut count).unwrap();
         // NaN does not count (a node at −∞ may: it gets no force).
         assert_eq!(count[..2], [1, 0]);
         assert_eq!(w.contacts, 1);
     }
     let mut f_c = vec![[0.0; 3]; 4];
-    wall_contact(&floor, 0.3, 1e-16, 0..4, &body, &[], &mut f_c);
+    wall_contact(&floor, 0.3, 1e-16, 0..4, &body, &[], &mut f_c).unwrap();
     assert!(
         (f_c[0][2] - 1e-9 * 1e-6 / 1e-16).abs() < 1e-9,
         "{:?}",
         f_c[0]
+    );
+}
+
+/// The buffer, needed and given lengths of a `BufferLength` error (panics
+/// on anything else).
+#[track_caller]
+fn short<T: core::fmt::Debug>(r: Result<T, ContactError>) -> (&'static str, usize, usize) {
+    match r {
+        Err(ContactError::BufferLength {
+            buffer,
+            expected,
+            got,
+        }) => (buffer, expected, got),
+        other => panic!("expected a BufferLength error, got {other:?}"),
+    }
+}
+
+/// The wall passes check what they are given before any node is touched:
+/// a node range longer than a buffer is a `BufferLength` naming it (it
+/// panicked), Δt² = 0 or μ < 0, a plane normal that is not a unit vector
+/// or a die of no radius an `InvalidParameter` (they gave infinite or
+/// scaled forces), and nothing is written to `f_c` or the counts.
+#[test]
+fn wall_passes_reject_short_buffers_and_bad_walls() {
+    // Two nodes, the first 1 µm below the floor z = 0.
+    let x = vec![[0.0, 0.0, -1e-6], [0.0, 0.0, 1e-3]];
+    let mass = [1e-9; 2];
+    let body = PredictedNodes {
+        mass: &mass,
+        x_n: &x,
+        x_pred: &x,
+        rigid_shift: RigidShift::NONE,
+    };
+    let floor = Plane {
+        normal: [0.0, 0.0, 1.0],
+        offset: 0.0,
+    };
+    let wall = Wall::Plane(floor);
+    let mut f_c = vec![[0.0; 3]; 2];
+    assert_eq!(
+        short(wall_contact(&wall, 0.1, 1e-16, 0..3, &body, &[], &mut f_c)),
+        ("mass", 3, 2)
+    );
+    assert_eq!(
+        short(wall_contact(&wall, 0.1, 1e-16, 0..2, &body, &[1], &mut f_c)),
+        ("share", 2, 1)
+    );
+    let mut f_short = vec![[0.0; 3]; 1];
+    assert_eq!(
+        short(wall_contact(
+            &wall,
+            0.1,
+            1e-16,
+            0..2,
+            &body,
+            &[],
+            &mut f_short
+        )),
+        ("f_c", 2, 1)
+    );
+    let mut count = [0u16; 1];
+    assert_eq!(
+        short(count_wall_contacts(&wall, 0..2, &x, &mut count)),
+        ("count", 2, 1)
+    );
+    let mut system = RigidContact::new(RigidFrame::of(&mass, &x));
+    assert_eq!(
+        short(add_wall_contacts(&wall, 0.1, 0..5, &body, &[], &mut system)),
+        ("mass", 5, 2)
+    );
+    assert_eq!(
+        field(wall_contact(&wall, 0.1, 0.0, 0..2, &body, &[], &mut f_c)),
+        "dt_squared"
+    );
+    assert_eq!(
+        field(wall_contact(&wall, -0.1, 1e-16, 0..2, &body, &[], &mut f_c)),
+        "friction"
+    );
+    assert_eq!(
+        field(add_wall_contacts(
+            &wall,
+            Real::NAN,
+            0..2,
+            &body,
+            &[],
+            &mut system
+        )),
+        "friction"
+    );
+    let doubled = Plane {
+        normal: [0.0, 0.0, 2.0],
+        ..floor
+    };
+    assert_eq!(
+        field(plane_contact(&doubled, 0.1, 1e-16, 0..2, &body, &mut f_c)),
+        "plane normal length"
+    );
+    let nowhere = Plane {
+        offset: Real::NAN,
+        ..floor
+    };
+    assert_eq!(
+        field(count_wall_contacts(
+            &Wall::Plane(nowhere),
+            0..2,
+            &x,
+            &mut [0; 2]
+        )),
+        "plane offset"
+    );
+    assert_eq!(
+        field(wall_contact(
+            &Wall::Die { radius: 0.0 },
+            0.1,
+            1e-16,
+            0..2,
+            &body,
+            &[],
+            &mut f_c
+        )),
+        "die radius"
+    );
+    assert_eq!(f_c, vec![[0.0; 3]; 2], "a refused pass wrote forces");
+    // The same call with good input: the floor pushes node 0 back.
+    let w = plane_contact(&floor, 0.1, 1e-16, 0..2, &body, &mut f_c).unwrap();
+    assert_eq!(w.contacts, 1);
+    assert!(
+        (f_c[0][2] - 1e-9 * 1e-6 / 1e-16).abs() < 1e-9,
+        "{:?}",
+        f_c[0]
+    );
+    // An empty range needs no buffer.
+    assert_eq!(
+        wall_contact(&wall, 0.1, 1e-16, 5..5, &body, &[], &mut []).unwrap(),
+        Default::default()
     );
 }

@@ -555,7 +555,7 @@ fn wall_pass(
             rigid_shift: RigidShift::NONE,
         };
         for w in walls {
-            add_wall_contacts(w, friction, surface.clone(), &body, &[], &mut system);
+            add_wall_contacts(w, friction, surface.clone(), &body, &[], &mut system).unwrap();
         }
         system.solve(factor)
     } else {
@@ -574,7 +574,7 @@ fn wall_pass(
     let dt2 = 1e-12;
     let mut f_c = vec![[0.0; 3]; x.len()];
     for w in walls {
-        wall_contact(w, friction, dt2, surface.clone(), &body, &[], &mut f_c);
+        wall_contact(w, friction, dt2, surface.clone(), &body, &[], &mut f_c).unwrap();
     }
     let rigid = rigid_motion_of(&mass, x, |i| f_c[i].map(|c| c / mass[i]));
     let deepest = walls

@@ -697,12 +697,13 @@ impl ContactPhase {
     /// each granule's pairs in list order ([`mark_side`]: a node counts
     /// once per pair it takes part in), then its contacts with `walls`
     /// (one per wall). The counts are those of one pass over the pairs.
+    /// Errors: a wall the count refuses ([`count_wall_contacts`]).
     pub(super) fn count_contacts(
         &mut self,
         granules: &[GranuleStore],
         mesh: &OwnedReference,
         walls: &[Wall],
-    ) {
+    ) -> Result<(), ContactError> {
         // Contacts involve surface nodes only: the other entries stay 0 and
         // u32::MAX from `new`.
         let surface = mesh.surface_range();
@@ -712,7 +713,7 @@ impl ContactPhase {
             .zip(self.tag.par_iter_mut())
             .zip(granules.par_iter())
             .enumerate()
-            .for_each(|(g, ((count, tag), store))| {
+            .try_for_each(|(g, ((count, tag), store))| {
                 count[surface.clone()].fill(0);
                 tag[surface.clone()].fill(u32::MAX);
                 let mut inv = Involvement { tag, count };
@@ -723,10 +724,13 @@ impl ContactPhase {
                     }
                 }
                 let b = bounds[g];
-                for w in walls.iter().filter(|w| w.may_touch(&b.centre, b.radius)) {
-                    count_wall_contacts(w, surface.clone(), &store.x_pred, inv.count);
-                }
-            });
+                walls
+                    .iter()
+                    .filter(|w| w.may_touch(&b.centre, b.radius))
+                    .try_for_each(|w| {
+                        count_wall_contacts(w, surface.clone(), &store.x_pred, inv.count)
+                    })
+            })
     }
 
     /// The forces of every pair (in parallel) into the pairs' own lists.
@@ -1121,7 +1125,7 @@ mod tests {
         p.broad(&granules, &mesh, settings.margin, true).unwrap();
         p.detect(&granules, &mesh, &settings, true, true, false)
             .unwrap();
-        p.count_contacts(&granules, &mesh, &[]);
+        p.count_contacts(&granules, &mesh, &[]).unwrap();
 
         let nodes = mesh.positions.len();
         let mut count = vec![vec![0u16; nodes]; granules.len()];

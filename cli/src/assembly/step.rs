@@ -606,7 +606,9 @@ impl Assembly<'_> {
             .map_err(contact_error)?;
         let surface = mesh.surface_range();
         if p.mass_sharing {
-            self.contact.count_contacts(&self.granules, mesh, walls);
+            self.contact
+                .count_contacts(&self.granules, mesh, walls)
+                .map_err(contact_error)?;
         }
         self.contact
             .forces(&self.granules, mesh, &p.contact, dt2, p.mass_sharing, first)
@@ -644,15 +646,16 @@ impl Assembly<'_> {
                         &body,
                         share,
                         &mut g.f_c,
-                    );
+                    )?;
                     if f.contacts > 0 {
                         on_wall |= 1 << (k % 64);
                     }
                     add_wall(total, &f, false);
                 }
-                (touched || on_wall != 0, on_wall)
+                Ok((touched || on_wall != 0, on_wall))
             })
-            .collect();
+            .collect::<Result<_, ContactError>>()
+            .map_err(contact_error)?;
         self.contact.touched = touched.iter().map(|t| t.0).collect();
         self.contact.forced.clone_from(&self.contact.touched);
         if first {

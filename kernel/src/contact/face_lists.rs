@@ -62,9 +62,46 @@ pub struct FaceLists<'a> {
 }
 
 impl<'a> FaceLists<'a> {
-    /// The faces listed for the `k`-th node of `nodes`.
+    /// The faces listed for the `k`-th node of `nodes` (none for a `k` past
+    /// the lists or offsets that [`Self::check`] refuses).
     pub fn faces_of(&self, k: usize) -> &'a [u32] {
-        &self.faces[self.starts[k] as usize..self.starts[k + 1] as usize]
+        let range =
+            |k: usize| Some(*self.starts.get(k)? as usize..*self.starts.get(k + 1)? as usize);
+        range(k).and_then(|r| self.faces.get(r)).unwrap_or(&[])
+    }
+
+    /// Checks the layout: one offset per node and one more, non-decreasing,
+    /// the last within `faces` — what [`build`] writes. (The ids in the
+    /// lists are checked where they are read, by the detection.)
+    ///
+    /// Errors: `starts` not one longer than `nodes`
+    /// ([`ContactError::BufferLength`]); an offset below the one before
+    /// ([`ContactError::InvalidParameter`], the offset's index as value);
+    /// an offset past the end of `faces` ([`ContactError::IdOutOfRange`]).
+    pub fn check(&self) -> Result<(), ContactError> {
+        if self.starts.len() != self.nodes.len() + 1 {
+            return Err(ContactError::BufferLength {
+                buffer: "face lists (starts)",
+                expected: self.nodes.len() + 1,
+                got: self.starts.len(),
+            });
+        }
+        if let Some(k) = self.starts.windows(2).position(|w| w[1] < w[0]) {
+            return Err(ContactError::InvalidParameter {
+                field: "face lists (starts): index of a decreasing offset",
+                value: (k + 1) as Real,
+                allowed: "non-decreasing offsets",
+            });
+        }
+        match self.starts.last() {
+            Some(&end) if end as usize > self.faces.len() => Err(ContactError::IdOutOfRange {
+                buffer: "face lists (starts)",
+                index: self.nodes.len(),
+                id: end,
+                len: self.faces.len() + 1,
+            }),
+            _ => Ok(()),
+        }
     }
 }
 

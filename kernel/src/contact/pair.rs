@@ -337,7 +337,8 @@ pub fn detect(
 /// `lists[1]`: pass B→A, from [`crate::contact::face_lists::build`] on
 /// anchors that no surface node of A or B has left by more than the
 /// lists' drift). `slot` has one entry per quad of the larger body, all
-/// `u32::MAX` on entry, and is left so.
+/// `u32::MAX` on entry, and is left so. The lists' layout is checked first
+/// ([`FaceLists::check`]).
 pub fn detect_listed(
     a: &SurfaceBody<'_>,
     b: &SurfaceBody<'_>,
@@ -349,6 +350,10 @@ pub fn detect_listed(
 ) -> Result<usize, ContactError> {
     check_buffers(a, b, scratch)?;
     check_len("slot", slot.len(), a.quads.len().max(b.quads.len()))?;
+    lists[0].check()?;
+    if settings.symmetric {
+        lists[1].check()?;
+    }
     let mut faces = ListedFaces {
         lists: lists[0],
         slot,
@@ -921,7 +926,7 @@ pub struct NodeFaceForce {
 pub const UNIT_TOLERANCE: Real = 1e-6;
 
 /// [`ContactError::InvalidParameter`] unless `ok`.
-fn check_param(
+pub(crate) fn check_param(
     ok: bool,
     field: &'static str,
     value: Real,
@@ -940,7 +945,7 @@ fn check_param(
 
 /// The per-call scalars of [`node_face_force`] and [`forces`]: μ finite
 /// and ≥ 0, Δt² finite and > 0 (NaN fails both).
-fn check_step(friction: Real, dt_squared: Real) -> Result<(), ContactError> {
+pub(crate) fn check_step(friction: Real, dt_squared: Real) -> Result<(), ContactError> {
     check_param(
         friction.is_finite() && friction >= 0.0,
         "friction",

@@ -13,12 +13,16 @@
 //! Only a finite negative gap is a contact ([`penetrates`]): a node whose
 //! predicted position is NaN or infinite (gap NaN or −∞) gets no force and
 //! is not counted in [`WallForce::contacts`] — a force from it would be
-//! NaN or infinite (a −∞ gap shows in [`WallForce::min_gap`]). The passes
-//! return no error (their callers take the totals as they are); the
+//! NaN or infinite (a −∞ gap shows in [`WallForce::min_gap`]); the
 //! driver's check of the motion (a non-finite kinetic energy) reports the
-//! non-finite state.
+//! non-finite state. The passes check what they are given before any node
+//! is touched ([`Wall::check`], the node range against every buffer,
+//! μ and Δt²) and return [`ContactError`] rather than panic or write NaN.
+
+use core::ops::Range;
 
 use crate::Real;
+use crate::contact::pair::{ContactError, UNIT_TOLERANCE, check_param, check_step};
 use crate::contact::rigid::{RigidContact, RigidShift};
 
 /// A rigid plane {x : n·x = d} whose inward unit normal n points into the
@@ -87,6 +91,31 @@ impl Wall {
         self.gap(centre).0 - radius < 0.0
     }
 
+    /// Checks the wall: a plane's normal of unit length (to
+    /// [`UNIT_TOLERANCE`]) and a finite offset, the die's radius finite and
+    /// > 0 ([`ContactError::InvalidParameter`]).
+    pub fn check(&self) -> Result<(), ContactError> {
+        match self {
+            Wall::Plane(p) => {
+                let n = p.normal;
+                let len = crate::math::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+                check_param(
+                    (len - 1.0).abs() <= UNIT_TOLERANCE,
+                    "plane normal length",
+                    len,
+                    "1 (a unit normal, to 1e-6)",
+                )?;
+                check_param(p.offset.is_finite(), "plane offset", p.offset, "finite")
+            }
+            Wall::Die { radius } => check_param(
+                radius.is_finite() && *radius > 0.0,
+                "die radius",
+                *radius,
+                "finite, > 0",
+            ),
+        }
+    }
+
     /// Gap (m) and inward unit normal at point `x`.
     pub fn gap(&self, x: &[Real; 3]) -> (Real, [Real; 3]) {
         match self {
@@ -106,6 +135,46 @@ impl Wall {
     }
 }
 
+/// [`ContactError::BufferLength`] for the first of `buffers` (name,
+/// length) shorter than the end of `nodes`; an empty range needs nothing.
+fn check_nodes(
+    nodes: &Range<usize>,
+    buffers: &[(&'static str, usize)],
+) -> Result<(), ContactError> {
+    if nodes.is_empty() {
+        return Ok(());
+    }
+    match buffers.iter().find(|(_, len)| *len < nodes.end) {
+        Some(&(buffer, got)) => Err(ContactError::BufferLength {
+            buffer,
+            expected: nodes.end,
+            got,
+        }),
+        None => Ok(()),
+    }
+}
+
+/// The buffers of `body` and a non-empty `share` against `nodes`.
+fn check_body(
+    nodes: &Range<usize>,
+    body: &PredictedNodes<'_>,
+    share: &[u16],
+) -> Result<(), ContactError> {
+    check_nodes(
+        nodes,
+        &[
+            ("mass", body.mass.len()),
+            ("x_n", body.x_n.len()),
+            ("x_pred", body.x_pred.len()),
+        ],
+    )?;
+    if share.is_empty() {
+        Ok(())
+    } else {
+        check_nodes(nodes, &[("share", share.len())])
+    }
+}
+
 /// True if `gap` (m) is a penetration: finite and < 0. NaN (a NaN
 /// position) and −∞ (an infinite one) are not.
 #[inline]
@@ -115,15 +184,15 @@ pub fn penetrates(gap: Real) -> bool {
 
 /// Adds the contact forces of `plane` on the nodes `nodes` (a range of node
 /// indices, usually the surface nodes) into `f_c` (N), without mass
-/// sharing; see [`wall_contact`].
+/// sharing; see [`wall_contact`] (and its errors).
 pub fn plane_contact(
     plane: &Plane,
     friction: Real,
     dt_squared: Real,
-    nodes: core::ops::Range<usize>,
+    nodes: Range<usize>,
     body: &PredictedNodes<'_>,
     f_c: &mut [[Real; 3]],
-) -> WallForce {
+) -> Result<WallForce, ContactError> {
     wall_contact(
         &Wall::Plane(*plane),
         friction,
@@ -140,17 +209,23 @@ pub fn plane_contact(
 /// mass sharing of §5.3. A NaN gap does not count; a node at infinity
 /// (gap −∞, no force in [`wall_contact`]) does, which only shares a mass
 /// nothing uses (one comparison per node, as in the force pass).
+///
+/// Errors: a bad wall ([`Wall::check`]); `x_pred` or `count` shorter than
+/// the end of `nodes` ([`ContactError::BufferLength`]).
 pub fn count_wall_contacts(
     wall: &Wall,
-    nodes: core::ops::Range<usize>,
+    nodes: Range<usize>,
     x_pred: &[[Real; 3]],
     count: &mut [u16],
-) {
+) -> Result<(), ContactError> {
+    wall.check()?;
+    check_nodes(&nodes, &[("x_pred", x_pred.len()), ("count", count.len())])?;
     for i in nodes {
         if wall.gap(&x_pred[i]).0 < 0.0 {
             count[i] = count[i].saturating_add(1);
         }
     }
+    Ok(())
 }
 
 /// Adds the contact forces of `wall` on the nodes `nodes` (a range of node
@@ -160,15 +235,25 @@ pub fn count_wall_contacts(
 /// (Δx = Δt_{n+½} Δt_n F/m), so the gap closes exactly even when Δt changes.
 /// `share` holds each node's contact count n for the shared mass m/n
 /// (empty: no sharing, the gap closes fully in one step).
+///
+/// Errors, before any force is added: a bad wall ([`Wall::check`]), μ not
+/// finite and ≥ 0 or Δt² not finite and > 0
+/// ([`ContactError::InvalidParameter`]); a buffer of `body`, a non-empty
+/// `share` or `f_c` shorter than the end of `nodes`
+/// ([`ContactError::BufferLength`]).
 pub fn wall_contact(
     wall: &Wall,
     friction: Real,
     dt_squared: Real,
-    nodes: core::ops::Range<usize>,
+    nodes: Range<usize>,
     body: &PredictedNodes<'_>,
     share: &[u16],
     f_c: &mut [[Real; 3]],
-) -> WallForce {
+) -> Result<WallForce, ContactError> {
+    wall.check()?;
+    check_step(friction, dt_squared)?;
+    check_body(&nodes, body, share)?;
+    check_nodes(&nodes, &[("f_c", f_c.len())])?;
     let (mass, x_n, x_pred) = (body.mass, body.x_n, body.x_pred);
     let inv_dt2 = 1.0 / dt_squared;
     let mut out = WallForce::default();
@@ -229,7 +314,7 @@ pub fn wall_contact(
         out.normal += fn_mag;
         out.contacts += 1;
     }
-    out
+    Ok(out)
 }
 
 /// Node `i`'s mass shared among its `share` contacts, m/max(1, n), kg.
@@ -243,14 +328,27 @@ fn shared_wall_mass(mass: &[Real], share: &[u16], i: usize) -> Real {
 /// as in [`wall_contact`]) and the closure its force will have — along the
 /// wall's normal at x̃ (−gap), and with friction (μ = `friction` > 0) as a
 /// sticking point that also cancels the tangential slip of the step.
+///
+/// Errors, before any contact is added: a bad wall ([`Wall::check`]) or μ
+/// not finite and ≥ 0 ([`ContactError::InvalidParameter`]); a buffer of
+/// `body` or a non-empty `share` shorter than the end of `nodes`
+/// ([`ContactError::BufferLength`]).
 pub fn add_wall_contacts(
     wall: &Wall,
     friction: Real,
-    nodes: core::ops::Range<usize>,
+    nodes: Range<usize>,
     body: &PredictedNodes<'_>,
     share: &[u16],
     system: &mut RigidContact,
-) {
+) -> Result<(), ContactError> {
+    wall.check()?;
+    check_param(
+        friction.is_finite() && friction >= 0.0,
+        "friction",
+        friction,
+        "finite, >= 0",
+    )?;
+    check_body(&nodes, body, share)?;
     for i in nodes {
         let (xp, x) = (body.x_pred[i], body.x_n[i]);
         let (gap, n) = wall.gap(&xp);
@@ -267,4 +365,5 @@ pub fn add_wall_contacts(
             system.add(&x, &n, m, -gap);
         }
     }
+    Ok(())
 }

@@ -21,6 +21,7 @@
 use core::fmt;
 
 use crate::Real;
+use crate::contact::pair::ContactError;
 use crate::contact::rigid::RigidShift;
 use crate::contact::wall::{Plane, PredictedNodes, plane_contact};
 use crate::granule::damping::damping_coefficient;
@@ -247,6 +248,17 @@ pub enum SceneError {
         /// name nodes it does not have).
         failure: ForcesError,
     },
+    /// A platen contact pass refused its input (a platen's normal or the
+    /// step's Δt², which the scene's own checks should already have
+    /// caught).
+    Contact {
+        /// Step number.
+        step: u64,
+        /// Strain reached.
+        strain: Real,
+        /// What the pass refused.
+        error: ContactError,
+    },
     /// The motion became non-finite or an element inverted while the time
     /// step was re-estimated.
     Unstable {
@@ -278,6 +290,14 @@ impl fmt::Display for SceneError {
                 strain,
                 failure,
             } => write!(f, "step {step} (strain {strain:.4}): {failure}"),
+            Self::Contact {
+                step,
+                strain,
+                error,
+            } => write!(
+                f,
+                "step {step} (strain {strain:.4}): platen contact: {error}"
+            ),
             Self::Unstable { step, strain } => write!(
                 f,
                 "step {step} (strain {strain:.4}): motion became non-finite or an element inverted"
@@ -823,6 +843,12 @@ impl<'a> PlatenScene<'a> {
             offset: -(self.z_top0 - half),
         };
         let friction = self.params.friction;
+        let step = self.step;
+        let contact_error = |error| SceneError::Contact {
+            step,
+            strain,
+            error,
+        };
         let top = plane_contact(
             &upper,
             friction,
@@ -830,7 +856,8 @@ impl<'a> PlatenScene<'a> {
             surface.clone(),
             &body,
             b.f_c,
-        );
+        )
+        .map_err(contact_error)?;
         let bottom = if self.params.symmetry == Symmetry::Full {
             let lower = Plane {
                 normal: [0.0, 0.0, 1.0],
@@ -844,6 +871,7 @@ impl<'a> PlatenScene<'a> {
                 &body,
                 b.f_c,
             )
+            .map_err(contact_error)?
         } else {
             Default::default()
         };
