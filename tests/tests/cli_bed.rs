@@ -160,6 +160,48 @@ fn bad_input_is_a_usage_error_naming_the_field() {
     assert!(run.stderr.contains("sped"), "{}", run.stderr);
 }
 
+/// A run resumed with other masses (`--mass-scaling` with `--resume`)
+/// takes the step of its new masses at once: resumed with physical masses
+/// after the published ×20 (a step √20 too long before), the segment runs
+/// about √20 times the steps of the same segment resumed unchanged, and
+/// its energy ledger still closes (the kinetic energy the new masses give
+/// the kept velocities is booked as supplied). Before, it stopped on the
+/// energy watchdog within a step.
+#[test]
+fn a_run_resumed_with_lighter_masses_takes_their_step() {
+    let (same, light) = (out_dir("resume-same"), out_dir("resume-light"));
+    let mut first = vec!["bed", "--quiet", "--out", same.to_str().unwrap()];
+    first.extend_from_slice(&common::small_bed("20", "0.1"));
+    first.extend_from_slice(&["--stop-at-strain", "0.04"]);
+    let r = cli(&first);
+    assert_eq!(r.code, 0, "{}", r.stderr);
+    assert_eq!(summary(&same)["scene"]["mass_scaling"], 20.0);
+    std::fs::create_dir_all(&light).unwrap();
+    std::fs::copy(same.join("checkpoint.bin"), light.join("checkpoint.bin")).unwrap();
+    let steps_at_stop = summary(&same)["steps"].as_f64().unwrap();
+    let resume = |dir: &std::path::Path, extra: &[&str]| {
+        let mut argv = vec!["bed", "--quiet", "--resume", dir.to_str().unwrap()];
+        argv.extend_from_slice(&["--stop-at-strain", "0.05"]);
+        argv.extend_from_slice(extra);
+        let r = cli(&argv);
+        assert_eq!(r.code, 0, "resume {extra:?}: {}", r.stderr);
+        summary(dir)["steps"].as_f64().unwrap() - steps_at_stop
+    };
+    let (steps_same, steps_light) = (resume(&same, &[]), resume(&light, &["--mass-scaling", "1"]));
+    let ratio = steps_light / steps_same;
+    assert!(
+        (3.5..5.5).contains(&ratio),
+        "{steps_light} steps with physical masses, {steps_same} with x20: ratio {ratio}"
+    );
+    let s = summary(&light);
+    assert_eq!(s["scene"]["mass_scaling"], 1.0);
+    let residual = s["energy_residual_rel"].as_f64().unwrap();
+    assert!(
+        residual.abs() < 1e-3,
+        "energy residual {residual:e} of the punch work"
+    );
+}
+
 #[test]
 fn a_stopped_run_resumes_to_the_same_bits() {
     let args = [

@@ -691,6 +691,41 @@ impl<'m> Assembly<'m> {
         }
     }
 
+    /// For a resumed run whose mass scaling changed from `old_scaling` to
+    /// this assembly's (`--mass-scaling` with `--resume`): [`Self::restore`]
+    /// set the new masses, and M → kM (k = F_new/F_old) scales every ω² of
+    /// M⁻¹K by 1/k, so the step sizes the state carries — Δt, the last Δt,
+    /// each granule's remembered 2/ω_max and the undeformed granule's step
+    /// — are scaled by √k now rather than at the next estimate (a run
+    /// resumed with ×1 after ×20 kept a step 4.5 times its stability limit
+    /// and stopped on the energy watchdog within its first step). The
+    /// kinetic energy the new masses give the kept velocities is booked as
+    /// supplied, as variable mass scaling books its own. Nothing happens for
+    /// an unchanged, zero or non-finite ratio.
+    pub fn rescale_masses_from(&mut self, old_scaling: Real) {
+        let k = self.params.mass_scaling / old_scaling;
+        if k == 1.0 || !(k > 0.0 && k.is_finite()) {
+            return;
+        }
+        let root = k.sqrt();
+        self.dt *= root;
+        self.dt_prev *= root;
+        self.undeformed_step *= root;
+        for control in &mut self.time_steps {
+            control.scale_masses(k);
+        }
+        let selective = self.params.selective_mass_factor();
+        let kinetic: Real = self
+            .granules
+            .iter()
+            .map(|g| granule_kinetic(g, selective))
+            .sum();
+        self.energies.supplied_kinetic += kinetic - self.energies.kinetic;
+        self.energies.kinetic = kinetic;
+        // A frame the last corrector left holds the old masses.
+        self.frame_motions.iter_mut().for_each(|m| *m = None);
+    }
+
     /// The parameters.
     pub fn params(&self) -> &AssemblyParams {
         &self.params

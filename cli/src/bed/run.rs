@@ -398,14 +398,14 @@ pub fn run_bed(
         asm.restore(&c.state)
             .map_err(anyhow::Error::new)
             .context("the checkpoint does not fit the scene")?;
-        // A changed safety factor (--time-step-safety with --resume) applies
-        // at once, not only from the next re-estimate.
-        let before = Scene::from_toml(&c.progress.scene_toml)
-            .context("the checkpoint's scene")?
-            .time_step_safety;
-        if before != scene.time_step_safety {
-            asm.rescale_time_step(scene.time_step_safety / before);
+        // A changed safety factor or mass scaling (--time-step-safety,
+        // --mass-scaling with --resume) applies at once, not only from the
+        // next re-estimate.
+        let before = Scene::from_toml(&c.progress.scene_toml).context("the checkpoint's scene")?;
+        if before.time_step_safety != scene.time_step_safety {
+            asm.rescale_time_step(scene.time_step_safety / before.time_step_safety);
         }
+        asm.rescale_masses_from(before.mass_scaling);
     }
     let area = core::f64::consts::PI * die.die_radius_m * die.die_radius_m;
     let granules = scene.granules;
