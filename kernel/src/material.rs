@@ -105,18 +105,27 @@ fn check(
 /// these the elastic constants, the wave speed and the stable time step
 /// leave the range of `f64` arithmetic this code is tested in.
 pub const YOUNGS_MODULUS_RANGE_PA: [Real; 2] = [1e-3, 1e13];
+/// [`YOUNGS_MODULUS_RANGE_PA`] as an error names it (a test holds the two
+/// together: a `no_std` constant cannot format a float).
+const YOUNGS_MODULUS_ALLOWED: &str = "1e-3 <= E <= 1e13 Pa";
 
 /// The smallest yield stress, Pa: the yield function scales with σ_y², which
 /// must stay a normal `f64` (a σ_y of 1e-300 made the first step's motion
 /// non-finite).
 pub const MIN_YIELD_STRESS_PA: Real = 1e-3;
+/// [`MIN_YIELD_STRESS_PA`] as an error names it.
+const YIELD_STRESS_ALLOWED: &str = ">= 1e-3 Pa (+inf for a purely elastic material)";
 
 /// The largest compaction coefficient c_p (a1 = c_p(1 − η²); the standard
 /// types use 0.3).
 pub const MAX_CP: Real = 1e3;
+/// [`MAX_CP`] as an error names it.
+const CP_ALLOWED: &str = "0 <= cp <= 1e3";
 
 /// Allowed true density, kg/m³ (osmium is 22 600).
 pub const DENSITY_RANGE_KG_M3: [Real; 2] = [1e-3, 1e5];
+/// [`DENSITY_RANGE_KG_M3`] as an error names it.
+const DENSITY_ALLOWED: &str = "1e-3 <= rho <= 1e5 kg/m3";
 
 impl MaterialParams {
     /// Checks every field against its documented range (NaN is always
@@ -128,7 +137,7 @@ impl MaterialParams {
                 .contains(&p.youngs_modulus_pa),
             "youngs_modulus_pa",
             p.youngs_modulus_pa,
-            "1e-3 <= E <= 1e13 Pa",
+            YOUNGS_MODULUS_ALLOWED,
         )?;
         check(
             p.poisson_ratio > -1.0 && p.poisson_ratio < 0.5,
@@ -140,7 +149,7 @@ impl MaterialParams {
             p.yield_stress_pa >= MIN_YIELD_STRESS_PA,
             "yield_stress_pa",
             p.yield_stress_pa,
-            ">= 1e-3 Pa (+inf for a purely elastic material)",
+            YIELD_STRESS_ALLOWED,
         )?;
         check(
             p.eta_c >= 0.0 && p.eta_c < 1.0,
@@ -154,12 +163,12 @@ impl MaterialParams {
             p.eta0,
             "eta_c < eta0 <= 1",
         )?;
-        check((0.0..=MAX_CP).contains(&p.cp), "cp", p.cp, "0 <= cp <= 1e3")?;
+        check((0.0..=MAX_CP).contains(&p.cp), "cp", p.cp, CP_ALLOWED)?;
         check(
             (DENSITY_RANGE_KG_M3[0]..=DENSITY_RANGE_KG_M3[1]).contains(&p.true_density_kg_m3),
             "true_density_kg_m3",
             p.true_density_kg_m3,
-            "1e-3 <= rho <= 1e5 kg/m3",
+            DENSITY_ALLOWED,
         )?;
         check(
             p.friction.is_finite() && p.friction >= 0.0,
@@ -275,6 +284,27 @@ impl FromStr for GranuleType {
 
 #[cfg(test)]
 mod tests {
+    extern crate std;
+    use std::format;
+
+    /// Each range an error names is the range the check applies: the
+    /// texts hold the constants' values as `{:e}` writes them.
+    #[test]
+    fn the_range_texts_name_the_constants() {
+        let texts: [(&str, &[Real]); 4] = [
+            (YOUNGS_MODULUS_ALLOWED, &YOUNGS_MODULUS_RANGE_PA),
+            (YIELD_STRESS_ALLOWED, &[MIN_YIELD_STRESS_PA]),
+            (CP_ALLOWED, &[MAX_CP]),
+            (DENSITY_ALLOWED, &DENSITY_RANGE_KG_M3),
+        ];
+        for (text, bounds) in texts {
+            for b in bounds {
+                let written = format!("{b:e}");
+                assert!(text.contains(&written), "`{text}` does not name {written}");
+            }
+        }
+    }
+
     use super::*;
 
     #[test]

@@ -943,15 +943,20 @@ pub(crate) fn check_param(
     }
 }
 
-/// The per-call scalars of [`node_face_force`] and [`forces`]: μ finite
-/// and ≥ 0, Δt² finite and > 0 (NaN fails both).
-pub(crate) fn check_step(friction: Real, dt_squared: Real) -> Result<(), ContactError> {
+/// Coulomb μ finite and ≥ 0 (NaN fails).
+pub(crate) fn check_friction(friction: Real) -> Result<(), ContactError> {
     check_param(
         friction.is_finite() && friction >= 0.0,
         "friction",
         friction,
         "finite, >= 0",
-    )?;
+    )
+}
+
+/// The per-call scalars of [`node_face_force`] and [`forces`]: μ finite
+/// and ≥ 0, Δt² finite and > 0 (NaN fails both).
+pub(crate) fn check_step(friction: Real, dt_squared: Real) -> Result<(), ContactError> {
+    check_friction(friction)?;
     check_param(
         dt_squared.is_finite() && dt_squared > 0.0,
         "dt_squared",

@@ -22,7 +22,7 @@
 use core::ops::Range;
 
 use crate::Real;
-use crate::contact::pair::{ContactError, UNIT_TOLERANCE, check_param, check_step};
+use crate::contact::pair::{ContactError, UNIT_TOLERANCE, check_friction, check_param, check_step};
 use crate::contact::rigid::{RigidContact, RigidShift};
 
 /// A rigid plane {x : n·x = d} whose inward unit normal n points into the
@@ -342,12 +342,7 @@ pub fn add_wall_contacts(
     system: &mut RigidContact,
 ) -> Result<(), ContactError> {
     wall.check()?;
-    check_param(
-        friction.is_finite() && friction >= 0.0,
-        "friction",
-        friction,
-        "finite, >= 0",
-    )?;
+    check_friction(friction)?;
     check_body(&nodes, body, share)?;
     for i in nodes {
         let (xp, x) = (body.x_pred[i], body.x_n[i]);
