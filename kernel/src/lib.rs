@@ -18,7 +18,8 @@
 //! * [`element`]: the 8-node hexahedron (one at a time, or four side by side);
 //! * [`lanes`]: arithmetic over one value or several side by side, same bits;
 //! * [`granule`]: element loop, damping and time step of one granule;
-//! * [`contact`]: contact with rigid walls;
+//! * [`contact`]: node-to-surface contact between granules (detection, face
+//!   lists, kinematic forces with friction) and with rigid walls;
 //! * [`dem`]: the discrete-element pour of rigid spheres;
 //! * [`rng`]: the seeded random generator;
 //! * [`analysis`]: post-processing formulas (fits, σ_est);

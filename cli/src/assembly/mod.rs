@@ -393,6 +393,9 @@ pub struct Assembly<'m> {
     /// reduction), s: what `time_step_floor` is a fraction of. 0 until the
     /// first estimate.
     undeformed_step: Real,
+    /// `undeformed_step` came from a checkpoint's state (with the masses
+    /// of that run), not from this assembly's own estimate.
+    undeformed_restored: bool,
     /// Per granule: still a rigid body (untouched since its placement;
     /// [`AssemblyParams::rigid_until_touched`]).
     rigid: Vec<bool>,
@@ -484,6 +487,7 @@ impl<'m> Assembly<'m> {
             mass_factors: vec![1.0; placements.len()],
             base_mass: Vec::new(),
             undeformed_step: 0.0,
+            undeformed_restored: false,
             frames: Vec::new(),
             frame_motions: Vec::new(),
         };
@@ -678,6 +682,7 @@ impl<'m> Assembly<'m> {
         // differs from the interrupted run's in the last bits.
         if state.undeformed_step > 0.0 {
             self.undeformed_step = state.undeformed_step;
+            self.undeformed_restored = true;
         }
         Ok(())
     }
@@ -696,12 +701,18 @@ impl<'m> Assembly<'m> {
     /// set the new masses, and M → kM (k = F_new/F_old) scales every ω² of
     /// M⁻¹K by 1/k, so the step sizes the state carries — Δt, the last Δt,
     /// each granule's remembered 2/ω_max and the undeformed granule's step
-    /// — are scaled by √k now rather than at the next estimate (a run
-    /// resumed with ×1 after ×20 kept a step 4.5 times its stability limit
-    /// and stopped on the energy watchdog within its first step). The
-    /// kinetic energy the new masses give the kept velocities is booked as
-    /// supplied, as variable mass scaling books its own. Nothing happens for
-    /// an unchanged, zero or non-finite ratio.
+    /// (if it came from the checkpoint; an older checkpoint has none, and
+    /// this assembly's own estimate already has the new masses) — are
+    /// scaled by √k now rather than at the next estimate (a run resumed
+    /// with ×1 after ×20 kept a step 4.5 times its stability limit and
+    /// stopped on the energy watchdog within its first step). The last Δt
+    /// is scaled too (a choice): the first step's Δt_n = (Δt_{n−½} +
+    /// Δt_{n+½})/2 would otherwise be 2.7 times the new limit at k = 1/20;
+    /// the step is a restart of the integration with the new masses, its
+    /// impulse and work booked with that Δt_n. The kinetic energy the new
+    /// masses give the kept velocities is booked as supplied, as variable
+    /// mass scaling books its own. Nothing happens for an unchanged, zero
+    /// or non-finite ratio.
     pub fn rescale_masses_from(&mut self, old_scaling: Real) {
         let k = self.params.mass_scaling / old_scaling;
         if k == 1.0 || !(k > 0.0 && k.is_finite()) {
@@ -710,7 +721,9 @@ impl<'m> Assembly<'m> {
         let root = k.sqrt();
         self.dt *= root;
         self.dt_prev *= root;
-        self.undeformed_step *= root;
+        if self.undeformed_restored {
+            self.undeformed_step *= root;
+        }
         for control in &mut self.time_steps {
             control.scale_masses(k);
         }
@@ -1103,6 +1116,112 @@ mod tests {
                 (relative - want).abs() <= 1e-9 * want,
                 "F {f}: {relative:e} against {want:e} (rattle {rattle:e}, spin {spinning:e})"
             );
+        }
+    }
+
+    /// Bad parameters are refused by `Assembly::new`, naming the field:
+    /// the contact switch's time (NaN or negative; ∞ is "never") and, as
+    /// another of the table, the face-list skin.
+    #[test]
+    fn bad_parameters_name_their_field() {
+        use crate::model::MeshLevel;
+        let mesh = OwnedReference::sphere(0.5e-3, MeshLevel::new(4, 1), false).unwrap();
+        let placements = [Placement::at([0.0; 3])];
+        let field_of = |p: AssemblyParams| match Assembly::new(p, &mesh, &placements, Vec::new()) {
+            Err(AssemblyError::InvalidParameter { field, .. }) => field,
+            Err(e) => panic!("{e}"),
+            Ok(_) => "accepted",
+        };
+        let p = b2_one_point();
+        for bad in [Real::NAN, -1.0] {
+            let p = AssemblyParams {
+                exact_contact_from_s: bad,
+                ..p
+            };
+            assert_eq!(field_of(p), "exact_contact_from_s", "{bad}");
+        }
+        for good in [0.0, 1.0, Real::INFINITY] {
+            let p = AssemblyParams {
+                exact_contact_from_s: good,
+                ..p
+            };
+            assert_eq!(field_of(p), "accepted", "{good}");
+        }
+        let p = AssemblyParams {
+            face_list_skin: 2.0,
+            ..p
+        };
+        assert_eq!(field_of(p), "face_list_skin");
+    }
+
+    /// A run resumed with other masses (`rescale_masses_from`, after
+    /// `restore` set the new masses): the step sizes it carries scale by
+    /// √(F_new/F_old), the kinetic energy the lighter masses give the kept
+    /// velocities is booked as supplied — the ledger's residual does not
+    /// move (it would by the whole change, here more than half the kinetic
+    /// energy, without the booking) — and the run steps on.
+    #[test]
+    fn a_resume_with_other_masses_rescales_the_steps_and_books_the_energy() {
+        use crate::model::MeshLevel;
+        let mut p = b2_one_point();
+        p.mass_scaling = 20.0;
+        p.selective_mass_scaling = true;
+        p.selective_mass_ratio = 10.0;
+        let mesh = OwnedReference::sphere(0.5e-3, MeshLevel::new(4, 1), false).unwrap();
+        let placements = [Placement::at([0.0; 3]), Placement::at([3e-3, 0.0, 0.0])];
+        let mut heavy = Assembly::new(p, &mesh, &placements, Vec::new()).unwrap();
+        for (g, centre) in heavy.granules_mut().iter_mut().zip([0.0, 3e-3]) {
+            for (v, x) in g.v.iter_mut().zip(&g.x) {
+                *v = [-40.0 * x[1] + 0.01, 40.0 * (x[0] - centre), 0.02];
+            }
+        }
+        for _ in 0..5 {
+            heavy.step().unwrap();
+        }
+        let light_params = AssemblyParams {
+            mass_scaling: 1.0,
+            ..p
+        };
+        let mut light = Assembly::new(light_params, &mesh, &placements, Vec::new()).unwrap();
+        light.restore(&heavy.state()).unwrap();
+        let (dt, dt_prev, undeformed) = (light.dt, light.dt_prev, light.undeformed_step);
+        let remembered: Vec<Real> = light.time_steps.iter().map(|c| c.memory().1).collect();
+        let residual = light.energies.residual();
+        let kinetic_before = light.energies.kinetic;
+        light.rescale_masses_from(20.0);
+        let root = (1.0 / 20.0 as Real).sqrt();
+        assert_eq!(
+            [light.dt, light.dt_prev, light.undeformed_step],
+            [dt * root, dt_prev * root, undeformed * root]
+        );
+        for (c, r) in light.time_steps.iter().zip(&remembered) {
+            assert!(
+                (c.memory().1 / r - root).abs() < 1e-15,
+                "{} against {r}",
+                c.memory().1
+            );
+        }
+        let kinetic: Real = light
+            .granules
+            .iter()
+            .map(|g| granule_kinetic(g, light_params.selective_mass_factor()))
+            .sum();
+        assert_eq!(light.energies.kinetic, kinetic);
+        assert!(
+            kinetic < 0.5 * kinetic_before,
+            "kinetic energy {kinetic:e} J with physical masses, {kinetic_before:e} J before"
+        );
+        let moved = light.energies.residual() - residual;
+        assert!(
+            moved.abs() < 1e-12 * kinetic_before,
+            "the residual moved by {moved:e} J"
+        );
+        // Unchanged masses change nothing.
+        let same = light.dt;
+        light.rescale_masses_from(1.0);
+        assert_eq!(light.dt, same);
+        for _ in 0..5 {
+            light.step().unwrap();
         }
     }
 

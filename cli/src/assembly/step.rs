@@ -160,7 +160,13 @@ impl core::error::Error for AssemblyError {}
 
 pub(super) fn validate(p: &AssemblyParams) -> Result<(), AssemblyError> {
     let global = matches!(p.time_step_method, TimeStepMethod::Global { .. });
-    let checks: [(bool, &'static str, Real, &'static str); 17] = [
+    let checks: [(bool, &'static str, Real, &'static str); 18] = [
+        (
+            p.exact_contact_from_s >= 0.0,
+            "exact_contact_from_s",
+            p.exact_contact_from_s,
+            ">= 0 s (inf: never)",
+        ),
         (
             (0.0..=1.0).contains(&p.face_list_skin),
             "face_list_skin",

@@ -408,7 +408,7 @@ fn warnings(
              sweep (`--exact-contact-from-strain C` from an earlier strain C, or \
              `--hold-constraints false --contact-search-interval 1` throughout) resolves it at \
              a higher cost (on 30-granule 4x1 beds to 60 %, held throughout: 26-44 % of the \
-             element; searching from 30 %: 0.7-0.8 %, at 3-4 times the wall time)",
+             element; searching from 30 %: 0.7-0.8 %, at 2.7-3.9 times the wall time)",
             100.0 * r,
             100.0 * OVERLAP_WARNING_REL
         )),

@@ -71,13 +71,14 @@ impl<'a> FaceLists<'a> {
     }
 
     /// Checks the layout: one offset per node and one more, non-decreasing,
-    /// the last within `faces` — what [`build`] writes. (The ids in the
-    /// lists are checked where they are read, by the detection.)
+    /// the last within `faces` — what [`build`] writes. (The detection
+    /// checks the node and used-quad ids where it reads them; a listed face
+    /// id outside the master's quads is no candidate.)
     ///
-    /// Errors: `starts` not one longer than `nodes`
-    /// ([`ContactError::BufferLength`]); an offset below the one before
-    /// ([`ContactError::InvalidParameter`], the offset's index as value);
-    /// an offset past the end of `faces` ([`ContactError::IdOutOfRange`]).
+    /// Errors: `starts` not one longer than `nodes`, or `faces` shorter
+    /// than the last offset ([`ContactError::BufferLength`]); an offset
+    /// below the one before ([`ContactError::InvalidParameter`], with the
+    /// offset's index in `starts` as the value).
     pub fn check(&self) -> Result<(), ContactError> {
         if self.starts.len() != self.nodes.len() + 1 {
             return Err(ContactError::BufferLength {
@@ -94,11 +95,10 @@ impl<'a> FaceLists<'a> {
             });
         }
         match self.starts.last() {
-            Some(&end) if end as usize > self.faces.len() => Err(ContactError::IdOutOfRange {
-                buffer: "face lists (starts)",
-                index: self.nodes.len(),
-                id: end,
-                len: self.faces.len() + 1,
+            Some(&end) if end as usize > self.faces.len() => Err(ContactError::BufferLength {
+                buffer: "face lists (faces)",
+                expected: end as usize,
+                got: self.faces.len(),
             }),
             _ => Ok(()),
         }
