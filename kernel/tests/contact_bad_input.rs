@@ -537,6 +537,17 @@ fn detect_listed_reports_list_ids_outside_the_bodies() {
     assert!(slot.iter().all(|&s| s == u32::MAX), "slot restored");
 }
 
+/// Nodes of masses `mass` at `x` that the step has not moved (x̃ = x_n),
+/// without a rigid shift.
+fn resting<'a>(mass: &'a [Real], x: &'a [Vec3]) -> PredictedNodes<'a> {
+    PredictedNodes {
+        mass,
+        x_n: x,
+        x_pred: x,
+        rigid_shift: RigidShift::NONE,
+    }
+}
+
 #[test]
 fn a_non_finite_position_is_no_wall_contact() {
     assert!(penetrates(-1e-9));
@@ -554,12 +565,7 @@ fn a_non_finite_position_is_no_wall_contact() {
         [Real::NEG_INFINITY, 0.0, 0.0],
     ];
     let mass = [1e-9; 4];
-    let body = PredictedNodes {
-        mass: &mass,
-        x_n: &x,
-        x_pred: &x,
-        rigid_shift: RigidShift::NONE,
-    };
+    let body = resting(&mass, &x);
     let floor = Wall::Plane(Plane {
         normal: [0.0, 0.0, 1.0],
         offset: 0.0,
@@ -613,12 +619,7 @@ fn wall_passes_reject_short_buffers_and_bad_walls() {
     // Two nodes, the first 1 µm below the floor z = 0.
     let x = vec![[0.0, 0.0, -1e-6], [0.0, 0.0, 1e-3]];
     let mass = [1e-9; 2];
-    let body = PredictedNodes {
-        mass: &mass,
-        x_n: &x,
-        x_pred: &x,
-        rigid_shift: RigidShift::NONE,
-    };
+    let body = resting(&mass, &x);
     let floor = Plane {
         normal: [0.0, 0.0, 1.0],
         offset: 0.0,

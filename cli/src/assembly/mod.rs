@@ -1018,6 +1018,40 @@ mod tests {
         AssemblyParams::standard(material, elements)
     }
 
+    /// B2, one-point, selective ×20 with the rigid modes' ratio limit 10
+    /// (the published scaling).
+    fn selective_x20() -> AssemblyParams {
+        let mut p = b2_one_point();
+        p.mass_scaling = 20.0;
+        p.selective_mass_scaling = true;
+        p.selective_mass_ratio = 10.0;
+        p
+    }
+
+    /// Centres (on x, m) of the two free granules of [`spinning_pair`].
+    const PAIR_CENTRES: [Real; 2] = [0.0, 3e-3];
+
+    /// The coarse (4x1) granule mesh and two placements 3 mm apart.
+    fn spinning_pair() -> (OwnedReference, [Placement; 2]) {
+        use crate::model::MeshLevel;
+        let mesh = OwnedReference::sphere(0.5e-3, MeshLevel::new(4, 1), false).unwrap();
+        let placements = PAIR_CENTRES.map(|c| Placement::at([c, 0.0, 0.0]));
+        (mesh, placements)
+    }
+
+    /// Gives both granules of [`spinning_pair`] the same spin about z and
+    /// drift, then takes five steps.
+    fn spin_and_step(asm: &mut Assembly<'_>) {
+        for (g, centre) in asm.granules_mut().iter_mut().zip(PAIR_CENTRES) {
+            for (v, x) in g.v.iter_mut().zip(&g.x) {
+                *v = [-40.0 * x[1] + 0.01, 40.0 * (x[0] - centre), 0.02];
+            }
+        }
+        for _ in 0..5 {
+            asm.step().unwrap();
+        }
+    }
+
     /// The kernel's factor is F/G = min(F, R) with selective scaling, 1
     /// without.
     #[test]
@@ -1162,22 +1196,10 @@ mod tests {
     /// energy, without the booking) — and the run steps on.
     #[test]
     fn a_resume_with_other_masses_rescales_the_steps_and_books_the_energy() {
-        use crate::model::MeshLevel;
-        let mut p = b2_one_point();
-        p.mass_scaling = 20.0;
-        p.selective_mass_scaling = true;
-        p.selective_mass_ratio = 10.0;
-        let mesh = OwnedReference::sphere(0.5e-3, MeshLevel::new(4, 1), false).unwrap();
-        let placements = [Placement::at([0.0; 3]), Placement::at([3e-3, 0.0, 0.0])];
+        let p = selective_x20();
+        let (mesh, placements) = spinning_pair();
         let mut heavy = Assembly::new(p, &mesh, &placements, Vec::new()).unwrap();
-        for (g, centre) in heavy.granules_mut().iter_mut().zip([0.0, 3e-3]) {
-            for (v, x) in g.v.iter_mut().zip(&g.x) {
-                *v = [-40.0 * x[1] + 0.01, 40.0 * (x[0] - centre), 0.02];
-            }
-        }
-        for _ in 0..5 {
-            heavy.step().unwrap();
-        }
+        spin_and_step(&mut heavy);
         let light_params = AssemblyParams {
             mass_scaling: 1.0,
             ..p
@@ -1237,25 +1259,12 @@ mod tests {
     /// and the other granule is left as it was.
     #[test]
     fn a_lifted_granule_is_heavier_keeps_its_weight_and_the_ledger_closes() {
-        use crate::model::MeshLevel;
-        let mut p = b2_one_point();
-        p.mass_scaling = 20.0;
-        p.selective_mass_scaling = true;
-        p.selective_mass_ratio = 10.0;
+        let mut p = selective_x20();
         p.time_step_floor = 1.0;
         p.damping_ratio = 0.0;
-        let mesh = OwnedReference::sphere(0.5e-3, MeshLevel::new(4, 1), false).unwrap();
-        let placements = [Placement::at([0.0; 3]), Placement::at([3e-3, 0.0, 0.0])];
+        let (mesh, placements) = spinning_pair();
         let mut asm = Assembly::new(p, &mesh, &placements, Vec::new()).unwrap();
-        // A spin about z and a drift, the same on both granules.
-        for (g, centre) in asm.granules_mut().iter_mut().zip([0.0, 3e-3]) {
-            for (v, x) in g.v.iter_mut().zip(&g.x) {
-                *v = [-40.0 * x[1] + 0.01, 40.0 * (x[0] - centre), 0.02];
-            }
-        }
-        for _ in 0..5 {
-            asm.step().unwrap();
-        }
+        spin_and_step(&mut asm);
         let kinetic = asm.energies.kinetic;
         let residual = asm.energies.residual();
         let mut steps = [0.5 * asm.undeformed_step, asm.undeformed_step];
