@@ -12,83 +12,26 @@
 use core::hint::black_box;
 
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
-use granbed_kernel::element::batch::{ElementBatch, ElementPath, batch_count, has_avx2, regroup};
-use granbed_kernel::element::reference::{HexReference, hex_reference};
+use granbed_host::mesh::{MeshLevel, OwnedReference};
+use granbed_host::store::GranuleStore;
+use granbed_kernel::element::batch::{ElementPath, has_avx2};
 use granbed_kernel::granule::damping::RigidFrame;
 use granbed_kernel::granule::dynamics::{
     GranuleBuffers, Loads, StepSizes, correct, correct_in, predict, predict_in,
 };
 use granbed_kernel::granule::forces::{ElementKind, ElementSettings, internal_forces_on};
 use granbed_kernel::material::GranuleType;
-use granbed_kernel::mesh::octant::MeshView;
-use granbed_kernel::mesh::reference::{ReferenceMesh, compute_element_data};
-use granbed_kernel::mesh::sphere::{MeshBuffers, SphereMeshParams, generate};
 use granbed_kernel::tensor::VOIGT_IDENTITY;
 
-struct Mesh {
-    positions: Vec<[f64; 3]>,
-    hexes: Vec<[u32; 8]>,
-    quads: Vec<[u32; 4]>,
-    node_quads: Vec<[u32; 4]>,
-    elements: Vec<HexReference>,
-    batches: Vec<ElementBatch>,
-    node_volume: Vec<f64>,
-    surface: usize,
-}
-
-fn standard_mesh() -> Mesh {
-    let p = SphereMeshParams::standard();
-    let s = p.size().unwrap();
-    let mut m = Mesh {
-        positions: vec![[0.0; 3]; s.nodes],
-        hexes: vec![[0; 8]; s.hexes],
-        quads: vec![[0; 4]; s.quads],
-        node_quads: vec![[0; 4]; s.surface_nodes],
-        elements: Vec::new(),
-        batches: Vec::new(),
-        node_volume: vec![0.0; s.nodes],
-        surface: s.surface_nodes,
-    };
-    let mut scratch = vec![0; s.scratch];
-    generate(
-        &p,
-        &mut MeshBuffers {
-            positions: &mut m.positions,
-            hexes: &mut m.hexes,
-            quads: &mut m.quads,
-            node_quads: &mut m.node_quads,
-            scratch: &mut scratch,
-        },
-    )
-    .unwrap();
-    let first: [[f64; 3]; 8] = core::array::from_fn(|i| m.positions[m.hexes[0][i] as usize]);
-    m.elements = vec![hex_reference(&first).unwrap(); s.hexes];
-    let view = MeshView {
-        positions: &m.positions,
-        hexes: &m.hexes,
-        quads: &m.quads,
-        surface_nodes: m.surface,
-    };
-    compute_element_data(&view, &mut m.elements, &mut m.node_volume).unwrap();
-    m.batches = vec![ElementBatch::ZERO; batch_count(s.hexes)];
-    regroup(&m.elements, &mut m.batches).unwrap();
-    m
+/// The standard 1280-hex granule (radius 0.5 mm, 8x2) with its element
+/// data, as the CLI and the browser build it (`granbed-host`).
+fn standard_mesh() -> OwnedReference {
+    OwnedReference::sphere(0.5e-3, MeshLevel::STANDARD, false).expect("the standard mesh")
 }
 
 fn bench_elements(c: &mut Criterion) {
     let m = standard_mesh();
-    let mesh = ReferenceMesh {
-        mesh: MeshView {
-            positions: &m.positions,
-            hexes: &m.hexes,
-            quads: &m.quads,
-            surface_nodes: m.surface,
-        },
-        node_quads: &m.node_quads,
-        elements: &m.elements,
-        batches: &m.batches,
-        node_volume: &m.node_volume,
-    };
+    let mesh = m.view();
     let mat = GranuleType::B2.params().validate().unwrap();
     let mut group = c.benchmark_group("element_step");
     group.throughput(Throughput::Elements(m.hexes.len() as u64));
@@ -147,41 +90,18 @@ fn bench_elements(c: &mut Criterion) {
     group.finish();
 }
 
-/// The buffers of one granule, owned (the kernel's `GranuleBuffers`
-/// borrows them).
-struct GranuleStore {
-    x: Vec<[f64; 3]>,
-    v: Vec<[f64; 3]>,
-    v_star: Vec<[f64; 3]>,
-    x_pred: Vec<[f64; 3]>,
-    f_int: Vec<[f64; 3]>,
-    f_c: Vec<[f64; 3]>,
-    f_d: Vec<[f64; 3]>,
-    mass: Vec<f64>,
-    fixed: Vec<u8>,
-    cp_inv: Vec<granbed_kernel::tensor::Voigt>,
-}
-
-impl GranuleStore {
-    /// Positions, velocities and contact forces back to the given start;
-    /// the kernel's view of the buffers.
-    fn reset(&mut self, x: &[[f64; 3]], v: &[[f64; 3]], f_c: &[[f64; 3]]) -> GranuleBuffers<'_> {
-        self.x.copy_from_slice(x);
-        self.v.copy_from_slice(v);
-        self.f_c.copy_from_slice(f_c);
-        GranuleBuffers {
-            x: &mut self.x,
-            v: &mut self.v,
-            v_star: &mut self.v_star,
-            x_pred: &mut self.x_pred,
-            f_int: &mut self.f_int,
-            f_c: &mut self.f_c,
-            f_d: &mut self.f_d,
-            mass: &mut self.mass,
-            fixed: &mut self.fixed,
-            cp_inv: &mut self.cp_inv,
-        }
-    }
+/// `store`'s positions, velocities and contact forces back to the given
+/// start; the kernel's view of its buffers.
+fn reset<'a>(
+    store: &'a mut GranuleStore,
+    x: &[[f64; 3]],
+    v: &[[f64; 3]],
+    f_c: &[[f64; 3]],
+) -> GranuleBuffers<'a> {
+    store.x.copy_from_slice(x);
+    store.v.copy_from_slice(v);
+    store.f_c.copy_from_slice(f_c);
+    store.buffers()
 }
 
 /// One granule's step halves on the standard mesh, B2, selective mass
@@ -192,18 +112,7 @@ impl GranuleStore {
 /// (`predict_in`, `correct_in`). Reported per node-step (1 501 nodes).
 fn bench_granule_step(c: &mut Criterion) {
     let m = standard_mesh();
-    let mesh = ReferenceMesh {
-        mesh: MeshView {
-            positions: &m.positions,
-            hexes: &m.hexes,
-            quads: &m.quads,
-            surface_nodes: m.surface,
-        },
-        node_quads: &m.node_quads,
-        elements: &m.elements,
-        batches: &m.batches,
-        node_volume: &m.node_volume,
-    };
+    let mesh = m.view();
     let mat = GranuleType::B2.params().validate().unwrap();
     let settings = ElementSettings {
         kind: ElementKind::OnePoint,
@@ -211,7 +120,7 @@ fn bench_granule_step(c: &mut Criterion) {
         hourglass_kappa: 0.05,
     };
     let n = m.positions.len();
-    let first_surface = n - m.surface;
+    let first_surface = m.surface_range().start;
     let factor = 10.0;
     let mass: Vec<f64> = m
         .node_volume
@@ -251,18 +160,8 @@ fn bench_granule_step(c: &mut Criterion) {
         dt: 1e-6,
     };
     let start = vec![VOIGT_IDENTITY; m.hexes.len()];
-    let mut store = GranuleStore {
-        x: x0.clone(),
-        v: v0.clone(),
-        v_star: vec![[0.0; 3]; n],
-        x_pred: vec![[0.0; 3]; n],
-        f_int: vec![[0.0; 3]; n],
-        f_c: f_c0.clone(),
-        f_d: vec![[0.0; 3]; n],
-        mass: mass.clone(),
-        fixed: vec![0; n],
-        cp_inv: start.clone(),
-    };
+    let mut store = GranuleStore::new(&m, 1);
+    store.mass.copy_from_slice(&mass);
     // The frame the bed takes once per step for both halves.
     let frame = RigidFrame::of(&mass, &x0);
     let mut group = c.benchmark_group("granule_step");
@@ -275,7 +174,7 @@ fn bench_granule_step(c: &mut Criterion) {
                 // configuration of `frame`) every time, and from the virgin
                 // states (the corrector does not read them).
                 store.cp_inv.copy_from_slice(&start);
-                let mut b = store.reset(&x0, &v0, &f_c0);
+                let mut b = reset(&mut store, &x0, &v0, &f_c0);
                 let s = if framed {
                     predict_in(&frame, None, &mesh, &mat, &settings, &mut b, sizes, &loads)
                 } else {
@@ -286,7 +185,7 @@ fn bench_granule_step(c: &mut Criterion) {
         });
         group.bench_function(format!("correct_selective_x10{suffix}"), |bench| {
             bench.iter(|| {
-                let mut b = store.reset(&x0, &v0, &f_c0);
+                let mut b = reset(&mut store, &x0, &v0, &f_c0);
                 let w = if framed {
                     correct_in(&frame, &mut b, sizes, &loads)
                 } else {
