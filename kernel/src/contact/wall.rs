@@ -22,6 +22,7 @@
 use core::ops::Range;
 
 use crate::Real;
+use crate::contact::face_lists::check_len;
 use crate::contact::pair::{ContactError, UNIT_TOLERANCE, check_friction, check_param, check_step};
 use crate::contact::rigid::{RigidContact, RigidShift};
 
@@ -144,14 +145,9 @@ fn check_nodes(
     if nodes.is_empty() {
         return Ok(());
     }
-    match buffers.iter().find(|(_, len)| *len < nodes.end) {
-        Some(&(buffer, got)) => Err(ContactError::BufferLength {
-            buffer,
-            expected: nodes.end,
-            got,
-        }),
-        None => Ok(()),
-    }
+    buffers
+        .iter()
+        .try_for_each(|&(buffer, len)| check_len(buffer, len, nodes.end))
 }
 
 /// The buffers of `body` and a non-empty `share` against `nodes`.
