@@ -32,7 +32,8 @@ pub struct PairWork {
     /// The face lists of the pair's two passes.
     lists: PairLists,
     /// The constraints of the last search's first sweep and the pair they
-    /// belong to (the list is rebuilt by index), which the step's later
+    /// belong to (`None` after a rebuild moved the pair in the list), which
+    /// the step's later
     /// sweeps, and the steps up to the next search, re-measure instead of
     /// searching again ([`ContactPhase::detect`]).
     held: Vec<Constraint>,
@@ -169,8 +170,9 @@ pub struct ContactPhase {
     /// brought up to date (a sweep that did not search); the next search
     /// takes them first ([`Self::refresh_surfaces`]).
     stale: Vec<bool>,
-    /// Some pair of the list holds nothing of this step's first sweep (the
-    /// list was rebuilt in a later sweep): the later sweeps search.
+    /// Some pair of the list holds nothing of this step's first sweep (a
+    /// rebuild in a later sweep added a pair or moved one in the list): the
+    /// later sweeps search.
     unheld: bool,
     /// Per granule and node: contacts this step (mass sharing).
     pub(super) share: Vec<Vec<u16>>,
@@ -493,31 +495,31 @@ impl ContactPhase {
         // rebuilt them) and its sums of the step (before, a rebuild in a
         // later sweep gave a moved pair another pair's). What it holds it
         // keeps only where its place did not move: a moved pair searches
-        // again in its next sweep, as it always has. Held by pair instead,
-        // the published run searched 9 % less late in the compression, but
-        // the coarse stability suite passed 30 of its 36 beds instead of
-        // 33 (BENCHMARKS.md, session 41): the rebuild's searches stay.
+        // again in its next sweep, as it did when the work stayed by place.
+        // Held by pair instead, the published run searched 9 % less late in
+        // the compression, but the coarse stability suite passed 30 of its
+        // 36 beds instead of 33 (BENCHMARKS.md, session 41).
+        debug_assert_eq!(self.pairs.len(), self.work.len());
         let mut old = core::mem::take(&mut self.work);
         let mut unheld = false;
         self.work = out
             .iter()
             .enumerate()
-            .map(|(i, p)| {
-                let Some((k, w)) = self
-                    .pairs
-                    .binary_search(p)
-                    .ok()
-                    .and_then(|k| Some((k, old.get_mut(k)?)))
-                else {
-                    unheld = true;
-                    return PairWork::default();
-                };
-                let mut w = core::mem::take(w);
-                if k != i {
-                    w.hold(*p, false);
-                    unheld = true;
+            .map(|(i, p)| match self.pairs.binary_search(p) {
+                Ok(k) if k < old.len() => {
+                    let mut w = core::mem::take(&mut old[k]);
+                    if k != i {
+                        w.hold(*p, false);
+                        unheld = true;
+                    }
+                    w
                 }
-                w
+                // New to the list (or an old list that was not sorted:
+                // the pair then only starts afresh).
+                _ => {
+                    unheld = true;
+                    PairWork::default()
+                }
             })
             .collect();
         self.pairs = out;
@@ -540,14 +542,16 @@ impl ContactPhase {
     /// searched: it re-measures that sweep's constraints of the pair on the
     /// current x̃ at their contact points ([`regap`]), keeping those still
     /// penetrating (a pair held with none stays without any for the step).
-    /// Only a pair new to the list (a rebuild within the step) is searched.
+    /// Only a pair new to the list, or moved in it, by a rebuild within the
+    /// step is searched.
     ///
     /// With `hold` and `between` (a step between two searches,
     /// [`super::AssemblyParams::contact_search_interval`]) the first sweep
     /// does the same with what the last search held: a pair that holds
     /// constraints of the last step's first sweep (searched or held then)
     /// re-measures them; only a pair that holds nothing (new to the list
-    /// since) is searched, and what it finds is held from then on.
+    /// since, or moved in it) is searched, and what it finds is held from
+    /// then on.
     pub(super) fn detect(
         &mut self,
         granules: &[GranuleStore],
@@ -1008,6 +1012,27 @@ mod tests {
         (granules, p)
     }
 
+    /// A far above B, B touching C (overlap 0.02 R): the granules and their
+    /// contact phase after a first sweep (a search, holding), whose only
+    /// pair is (B, C).
+    fn a_far_and_b_touching_c(
+        mesh: &OwnedReference,
+        settings: &PairSettings,
+    ) -> (Vec<GranuleStore>, ContactPhase) {
+        let start = [
+            [0.0, 10.0 * R, 0.0],
+            [0.0; 3],
+            [2.0 * R - 0.02 * R, 0.0, 0.0],
+        ];
+        let granules = granules_at(mesh, &start);
+        let mut p = phase(&granules, mesh);
+        p.broad(&granules, mesh, settings.margin, true).unwrap();
+        p.detect(&granules, mesh, settings, true, true, false)
+            .unwrap();
+        assert_eq!(p.pairs(), &[GranulePair { a: 1, b: 2 }]);
+        (granules, p)
+    }
+
     /// Moves granule `g`'s x̃ by `d`.
     fn shift(g: &mut GranuleStore, d: [Real; 3]) {
         for x in &mut g.x_pred {
@@ -1146,19 +1171,7 @@ mod tests {
     fn a_pair_moved_by_a_rebuild_keeps_its_face_lists_and_searches() {
         let mesh = OwnedReference::sphere(R, MeshLevel::new(4, 1), false).unwrap();
         let settings = PairSettings::standard(0.1);
-        let overlap = 0.02 * R;
-        // A far above; B touching C. The pairs: (B, C) alone.
-        let start = [
-            [0.0, 10.0 * R, 0.0],
-            [0.0; 3],
-            [2.0 * R - overlap, 0.0, 0.0],
-        ];
-        let mut granules = granules_at(&mesh, &start);
-        let mut p = phase(&granules, &mesh);
-        p.broad(&granules, &mesh, settings.margin, true).unwrap();
-        p.detect(&granules, &mesh, &settings, true, true, false)
-            .unwrap();
-        assert_eq!(p.pairs(), &[GranulePair { a: 1, b: 2 }]);
+        let (mut granules, mut p) = a_far_and_b_touching_c(&mesh, &settings);
         assert!(
             !pair_constraints(&p, 1, 2).unwrap().is_empty(),
             "B and C touch"
@@ -1167,7 +1180,7 @@ mod tests {
 
         // The next step (between searches) puts A onto B: (A, B) comes
         // first in the rebuilt list and (B, C) moves to the second place.
-        shift(&mut granules[0], [0.0, -(8.0 * R + overlap), 0.0]);
+        shift(&mut granules[0], [0.0, -(8.0 * R + 0.02 * R), 0.0]);
         p.broad(&granules, &mesh, settings.margin, true).unwrap();
         p.detect(&granules, &mesh, &settings, true, true, true)
             .unwrap();
@@ -1192,18 +1205,8 @@ mod tests {
     fn a_steps_contacts_follow_their_pair_through_a_rebuild() {
         let mesh = OwnedReference::sphere(R, MeshLevel::new(4, 1), false).unwrap();
         let settings = PairSettings::standard(0.1);
-        let overlap = 0.02 * R;
-        let start = [
-            [0.0, 10.0 * R, 0.0],
-            [0.0; 3],
-            [2.0 * R - overlap, 0.0, 0.0],
-        ];
-        let mut granules = granules_at(&mesh, &start);
-        let mut p = phase(&granules, &mesh);
+        let (mut granules, mut p) = a_far_and_b_touching_c(&mesh, &settings);
         let dt2 = 1e-14;
-        p.broad(&granules, &mesh, settings.margin, true).unwrap();
-        p.detect(&granules, &mesh, &settings, true, true, false)
-            .unwrap();
         p.forces(&granules, &mesh, &settings, dt2, false, true)
             .unwrap();
         assert_eq!(p.contacts_per_granule(), [0, 1, 1]);
