@@ -31,13 +31,15 @@ pub struct PairWork {
     pub step: PairForce,
     /// The face lists of the pair's two passes.
     lists: PairLists,
-    /// The constraints of the last search's first sweep and the pair they
-    /// belong to (`None` after a rebuild moved the pair in the list), which
-    /// the step's later
-    /// sweeps, and the steps up to the next search, re-measure instead of
-    /// searching again ([`ContactPhase::detect`]).
+    /// The constraints of the last search's first sweep, which the step's
+    /// later sweeps, and the steps up to the next search, re-measure
+    /// instead of searching again ([`ContactPhase::detect`]), when
+    /// `holding`.
     held: Vec<Constraint>,
-    held_pair: Option<GranulePair>,
+    /// The pair holds `held` (false: nothing; the next sweep searches it —
+    /// a pair new to the list, moved in it by a rebuild, or searched
+    /// without holding).
+    holding: bool,
 }
 
 /// What a pair holds from the last search for the sweeps that follow
@@ -127,16 +129,15 @@ struct DetectScratch {
 }
 
 impl PairWork {
-    /// After a search of pair `p`: with `keep`, holds its constraints for
-    /// the step's later sweeps and the first sweeps of the steps up to the
-    /// next search; else forgets any held ones (a later sweep that
-    /// searched, or no holding).
-    fn hold(&mut self, p: GranulePair, keep: bool) {
+    /// After a search: with `keep`, holds the pair's constraints for the
+    /// step's later sweeps and the first sweeps of the steps up to the next
+    /// search; else forgets any held ones (a later sweep that searched, no
+    /// holding, or a pair moved in the list).
+    fn hold(&mut self, keep: bool) {
         self.held.clear();
-        self.held_pair = None;
+        self.holding = keep;
         if keep {
             self.held.extend_from_slice(&self.constraints[..self.count]);
-            self.held_pair = Some(p);
         }
     }
 
@@ -356,10 +357,9 @@ impl ContactPhase {
     /// holds nothing).
     pub(super) fn broad_state(&self) -> (Vec<GranulePair>, Vec<Bound>, Vec<HeldConstraints>) {
         let held = self
-            .pairs
+            .work
             .iter()
-            .zip(&self.work)
-            .map(|(p, w)| (w.held_pair == Some(*p)).then(|| w.held.clone()))
+            .map(|w| w.holding.then(|| w.held.clone()))
             .collect();
         (self.pairs.clone(), self.built.clone(), held)
     }
@@ -376,10 +376,10 @@ impl ContactPhase {
         self.pairs = pairs.to_vec();
         self.built = built.to_vec();
         self.work = vec![PairWork::default(); pairs.len()];
-        for ((w, p), h) in self.work.iter_mut().zip(pairs).zip(held) {
+        for (w, h) in self.work.iter_mut().zip(held) {
             if let Some(h) = h {
                 w.held.clone_from(h);
-                w.held_pair = Some(*p);
+                w.holding = true;
             }
         }
         self.index_pairs();
@@ -509,7 +509,7 @@ impl ContactPhase {
                 Ok(k) if k < old.len() => {
                     let mut w = core::mem::take(&mut old[k]);
                     if k != i {
-                        w.hold(*p, false);
+                        w.hold(false);
                         unheld = true;
                     }
                     w
@@ -566,14 +566,8 @@ impl ContactPhase {
         let reuse_held = hold && (!first || between);
         // A sweep searches some pair unless every pair re-measures: only
         // then does it need the boxes and anchors (else it marks them stale).
-        let searching = !reuse_held
-            || self.unheld
-            || (first
-                && !self
-                    .pairs
-                    .iter()
-                    .zip(&self.work)
-                    .all(|(p, w)| w.held_pair == Some(*p)));
+        let searching =
+            !reuse_held || self.unheld || (first && !self.work.iter().all(|w| w.holding));
         self.refresh_surfaces(granules, mesh, first, searching);
         let (boxes, bounds, quad_boxes) = (&self.boxes, &self.bounds, &self.quad_boxes);
         let (touched, anchors, epochs) = (&self.touched, &self.anchors, &self.epochs);
@@ -633,7 +627,7 @@ impl ContactPhase {
                     }
                     let body_a = body(&granules[a], mesh, (boxes[a], bounds[a], &quad_boxes[a]));
                     let body_b = body(&granules[b], mesh, (boxes[b], bounds[b], &quad_boxes[b]));
-                    if reuse_held && w.held_pair == Some(*p) {
+                    if reuse_held && w.holding {
                         if w.constraints.len() < w.held.len() {
                             w.constraints.resize(w.held.len(), Constraint::default());
                         }
@@ -645,7 +639,7 @@ impl ContactPhase {
                     builds += search(p, (&body_a, &body_b), &mut scratch, w)?;
                     // Every search, and only a search, renews what is held
                     // (the first sweep searches every pair).
-                    w.hold(*p, hold && first);
+                    w.hold(hold && first);
                     // Near constraints (a capture distance) are held only:
                     // the forces and counts take the penetrating ones.
                     if settings.capture > 0.0 {
