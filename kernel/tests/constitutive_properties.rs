@@ -94,9 +94,10 @@ proptest! {
             // the undeformed state they cancel to a τ far below μ, and
             // their round-off (≈ 10⁻¹⁶ μ a step) is what the two rotated
             // histories differ by. So the scale is the larger of |τ| and
-            // μ (relative to |τ| alone, an elastic history of 26 steps
-            // with |τ| ≈ 2 kPa differed by 1.26·10⁻¹² of |τ|: the
-            // regression file's case).
+            // μ. The regression file's case: an elastic history of 26
+            // steps of A3 (μ ≈ 385 kPa) whose |τ| ≈ 2 kPa differed by
+            // 2.4·10⁻⁹ Pa, 1.26·10⁻¹² of |τ| but 6·10⁻¹⁵ of μ; any frame
+            // dependence would be of the size of the strain times μ.
             let scale = up.tau.iter().fold(mat.mu, |m, x| m.max(x.abs()));
             for i in 0..6 {
                 prop_assert!(
