@@ -418,9 +418,9 @@ fn warnings(
         _ => {}
     }
     let mut why = Vec::new();
-    if let Some(a) = kawakita.a.filter(|&a| a > 1.0) {
+    if let Some(a) = kawakita.a.filter(|&a| !(a > 0.0 && a <= 1.0)) {
         why.push(format!(
-            "a = {a:.3} > 1 (a is the limiting strain, at most 1)"
+            "a = {a:.3} outside (0, 1] (a is the limiting strain)"
         ));
     }
     if let Some(inv_b) = kawakita.inv_b_pa.filter(|&x| x <= 0.0) {
