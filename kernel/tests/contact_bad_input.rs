@@ -196,7 +196,6 @@ fn sphere(shift: Real) -> Body {
     }
 }
 
-/// Calls `f` with the body's surface (its quad boxes computed here).
 /// A constraint of `b`'s first surface node against quad 0, 1 µm deep:
 /// valid in every field.
 fn penetrating_constraint(b: &Body) -> Constraint {
@@ -207,9 +206,11 @@ fn penetrating_constraint(b: &Body) -> Constraint {
         weights: [0.25; 4],
         normal: [0.0, 0.0, 1.0],
         gap: -1e-6,
+        watch: false,
     }
 }
 
+/// Calls `f` with the body's surface (its quad boxes computed here).
 fn with_surface<R>(b: &Body, f: impl FnOnce(SurfaceBody<'_>) -> R) -> R {
     let mut boxes = vec![Aabb::EMPTY; b.quads.len()];
     quad_bounds(&b.x, &b.quads, &mut boxes);

@@ -62,19 +62,44 @@ fn constraints(slave: &[Vec3], master: &[Vec3], master_quads: &[[u32; 4]]) -> Ve
     constraints_capturing(slave, master, master_quads, 0.0)
 }
 
-/// [`regap`] of `held` with `slave` (one quad) against `master`.
+/// [`regap`] of `held` with `slave` (one quad) against `master`, held
+/// constraints never re-projected.
 fn regapped(
     slave: &[Vec3],
     master: &[Vec3],
     master_quads: &[[u32; 4]],
     held: &[Constraint],
 ) -> Result<Vec<Constraint>, ContactError> {
+    regapped_with(slave, master, master_quads, held, &settings(0.0))
+}
+
+/// [`regap`] of `held` with `slave` (one quad) against `master` and
+/// `settings`.
+fn regapped_with(
+    slave: &[Vec3],
+    master: &[Vec3],
+    master_quads: &[[u32; 4]],
+    held: &[Constraint],
+    settings: &PairSettings,
+) -> Result<Vec<Constraint>, ContactError> {
     with_bodies(slave, master, master_quads, |a, b| {
         let mut out = vec![Constraint::default(); held.len()];
-        let n = regap(a, b, held, &mut out)?;
+        let n = regap(a, b, held, settings, &mut out)?;
         out.truncate(n);
         Ok(out)
     })
+}
+
+/// The tests' detection settings: single pass, a margin that covers the
+/// unit-sized scenes, capture distance `capture`, no watches, held
+/// constraints never re-projected.
+fn settings(capture: Real) -> PairSettings {
+    PairSettings {
+        margin: 0.5,
+        symmetric: false,
+        capture,
+        ..PairSettings::standard(0.0)
+    }
 }
 
 /// A slave quad in the plane z = `z`, corner (x, 0.5), facing −z.
@@ -111,16 +136,21 @@ fn constraints_capturing(
     master_quads: &[[u32; 4]],
     capture: Real,
 ) -> Vec<Constraint> {
+    detected(slave, master, master_quads, &settings(capture))
+}
+
+/// [`detect`] of `slave`'s nodes (one quad) against `master`'s quads with
+/// `settings`.
+fn detected(
+    slave: &[Vec3],
+    master: &[Vec3],
+    master_quads: &[[u32; 4]],
+    settings: &PairSettings,
+) -> Vec<Constraint> {
     with_bodies(slave, master, master_quads, |a, b| {
-        let settings = PairSettings {
-            margin: 0.5,
-            symmetric: false,
-            capture,
-            ..PairSettings::standard(0.0)
-        };
         let mut scratch = vec![CandidateFace::default(); master_quads.len()];
         let mut out = vec![Constraint::default(); 16];
-        let n = detect(a, b, &settings, &mut scratch, &mut out).unwrap();
+        let n = detect(a, b, settings, &mut scratch, &mut out).unwrap();
         out.truncate(n);
         out
     })
@@ -296,9 +326,151 @@ fn a_held_constraint_of_other_bodies_is_an_error() {
     let r = regapped(&slave, &master, &quads, &bad);
     assert_eq!(short_buffer(r), Some("slave positions"));
     let r = with_bodies(&slave, &master, &quads, |a, b| {
-        regap(a, b, &held, &mut [Constraint::default(); 2]).map(|_| Vec::new())
+        regap(a, b, &held, &settings(0.0), &mut [Constraint::default(); 2]).map(|_| Vec::new())
     });
     assert_eq!(short_buffer(r), Some("constraints"));
+}
+
+/// One flat face: z = 0 over the unit square, facing +z.
+fn flat_master() -> (Vec<Vec3>, Vec<[u32; 4]>) {
+    let x = vec![
+        [0.0, 0.0, 0.0],
+        [1.0, 0.0, 0.0],
+        [1.0, 1.0, 0.0],
+        [0.0, 1.0, 0.0],
+    ];
+    (x, vec![[0, 1, 2, 3]])
+}
+
+/// A node in front of a face's plane but just off the face (coming over its
+/// edge) gets a watch, with a capture distance and `watch_beside`: `regap`
+/// writes nothing for it while it stays off the face (even behind the
+/// plane's extension) and, once it has crossed the face, the constraint a
+/// new search finds. Without watches nothing is held for it, so the
+/// crossing goes unseen until the next search.
+#[test]
+fn a_node_coming_over_a_faces_edge_is_watched_and_held_once_it_crosses() {
+    let (master, quads) = flat_master();
+    let watching = PairSettings {
+        watch_beside: true,
+        ..settings(0.05)
+    };
+    // Nodes 0 and 1 at x = 1.05 (ξ = 1.1, just beyond the edge x = 1),
+    // nodes 2 and 3 at x = 1.15 (ξ = 1.3, beyond the reach of 0.25), all
+    // 0.01 in front of the plane.
+    let beside = slave_at(1.05, 0.01);
+    assert!(constraints_capturing(&beside, &master, &quads, 0.05).is_empty());
+    let held = detected(&beside, &master, &quads, &watching);
+    assert_eq!(
+        held.iter()
+            .map(|c| (c.slave, c.quad, c.watch))
+            .collect::<Vec<_>>(),
+        [(0, 0, true), (1, 0, true)],
+        "{held:?}"
+    );
+    assert!(
+        held.iter().all(|c| (c.gap - 0.01).abs() < 1e-12),
+        "{held:?}"
+    );
+    // Not contacts: what the forces take of them is nothing.
+    assert_eq!(penetrating(&mut held.clone()), 0);
+    // Behind the plane's extension but off the face: no constraint.
+    let behind_extension = slave_at(1.05, -0.004);
+    let none = regapped_with(&behind_extension, &master, &quads, &held, &watching).unwrap();
+    assert!(none.is_empty(), "{none:?}");
+    // Slid over the edge onto the face, 0.004 behind it: the search's
+    // constraints (nodes 2 and 3, still off the face, have none).
+    let crossed = slave_at(0.93, -0.004);
+    let found = regapped_with(&crossed, &master, &quads, &held, &watching).unwrap();
+    let fresh = constraints(&crossed, &master, &quads);
+    assert_eq!(found.len(), 2, "{found:?}");
+    assert_eq!(fresh.len(), 2, "{fresh:?}");
+    for (r, f) in found.iter().zip(&fresh) {
+        assert_eq!((r.slave, r.quad, r.watch), (f.slave, f.quad, false));
+        assert!((r.gap + 0.004).abs() < 1e-12, "gap {}", r.gap);
+        assert!((r.gap - f.gap).abs() < 1e-12, "{} vs {}", r.gap, f.gap);
+        for k in 0..4 {
+            assert!(
+                (r.weights[k] - f.weights[k]).abs() < 1e-12,
+                "{r:?} vs {f:?}"
+            );
+        }
+        for k in 0..3 {
+            assert!((r.normal[k] - f.normal[k]).abs() < 1e-12, "{r:?} vs {f:?}");
+        }
+    }
+}
+
+/// A twisted face z = 0.4 x y over the unit square (a bilinear patch: its
+/// normal (−0.4y, −0.4x, 1) turns across it), facing +z.
+fn twisted_master() -> (Vec<Vec3>, Vec<[u32; 4]>) {
+    let x = vec![
+        [0.0, 0.0, 0.0],
+        [1.0, 0.0, 0.0],
+        [1.0, 1.0, 0.4],
+        [0.0, 1.0, 0.0],
+    ];
+    (x, vec![[0, 1, 2, 3]])
+}
+
+/// A slave quad (facing down) over (c, c)–(c + 0.1, c + 0.1), each node
+/// `depth` below the twisted face.
+fn slave_under_twist(c: Real, depth: Real) -> [Vec3; 4] {
+    [(c, c), (c, c + 0.1), (c + 0.1, c + 0.1), (c + 0.1, c)]
+        .map(|(x, y)| [x, y, 0.4 * x * y - depth])
+}
+
+/// On a curved face the gap along the held normal misses how the face bends
+/// under a node that slides along it: slid from (0.2, 0.2) to (0.6, 0.6)
+/// and 0.002 behind the twisted face, the nodes measure clear of it at the
+/// held contact points, and are dropped. With `reproject_slide` below the
+/// slide they are projected afresh and held as a new search holds them;
+/// with it above, and for a node slid off its face, the held measure stays.
+#[test]
+fn a_held_contact_slid_along_a_curved_face_is_projected_afresh() {
+    let (master, quads) = twisted_master();
+    let held = constraints(&slave_under_twist(0.2, 0.001), &master, &quads);
+    assert_eq!(held.len(), 4, "{held:?}");
+    let moved = slave_under_twist(0.6, 0.002);
+    let fresh = constraints(&moved, &master, &quads);
+    assert_eq!(fresh.len(), 4, "{fresh:?}");
+    let first_order = regapped(&moved, &master, &quads, &held).unwrap();
+    assert!(first_order.is_empty(), "{first_order:?}");
+    let reproject = |slide| PairSettings {
+        reproject_slide: slide,
+        ..settings(0.0)
+    };
+    let again = regapped_with(&moved, &master, &quads, &held, &reproject(0.05)).unwrap();
+    assert_eq!(again.len(), 4, "{again:?}");
+    for (r, f) in again.iter().zip(&fresh) {
+        assert_eq!((r.slave, r.quad, r.watch), (f.slave, f.quad, false));
+        assert!((r.gap - f.gap).abs() < 1e-12, "{} vs {}", r.gap, f.gap);
+        for k in 0..4 {
+            assert!(
+                (r.weights[k] - f.weights[k]).abs() < 1e-12,
+                "{r:?} vs {f:?}"
+            );
+        }
+        for k in 0..3 {
+            assert!((r.normal[k] - f.normal[k]).abs() < 1e-12, "{r:?} vs {f:?}");
+        }
+    }
+    // A slide shorter than the setting: the held measure.
+    let short = regapped_with(&moved, &master, &quads, &held, &reproject(10.0)).unwrap();
+    assert!(short.is_empty(), "{short:?}");
+
+    // Off the face (flat face 1 of the folded master ends at x = 1.6):
+    // the held weights and normal, as without re-projection.
+    let (master, quads) = folded_master();
+    let slave = slave_at(1.3, 0.29);
+    let held = constraints(&slave, &master, &quads);
+    let off = slave_at(1.55, 0.296);
+    let plain = regapped(&off, &master, &quads, &held).unwrap();
+    assert_eq!(plain.len(), 4, "{plain:?}");
+    assert_eq!(
+        regapped_with(&off, &master, &quads, &held, &reproject(0.05)).unwrap()[2..],
+        plain[2..]
+    );
 }
 
 /// The contact area is estimated only when asked for: a slave quad of

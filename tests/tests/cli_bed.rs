@@ -308,6 +308,12 @@ fn a_stopped_run_resumes_to_the_same_bits() {
         state.held.iter().flatten().any(|h| !h.is_empty()),
         "the checkpoint holds no constraints"
     );
+    // Watches (nodes just beside a face at the search) among them, or
+    // their round trip goes untested.
+    assert!(
+        state.held.iter().flatten().flatten().any(|c| c.watch),
+        "the checkpoint holds no watch"
+    );
     let two_walls = summary(&parts)["wall_time_s"].as_f64().unwrap();
     assert!(
         two_walls > first_wall,

@@ -65,13 +65,15 @@ fn fnv1a(bytes: &[u8]) -> u64 {
     })
 }
 
-/// Rewrites the format-7 checkpoint in `dir` as format 6: without the
-/// trailing phase times and counters (a length-prefixed list of 3 floats,
-/// then 7 u64s), version 6, the checksum of the shorter payload.
+/// Rewrites the format-8 checkpoint in `dir` as format 6: without the
+/// trailing phase times and counters of format 7 (a length-prefixed list of
+/// 3 floats, then 7 u64s), version 6, the checksum of the shorter payload.
+/// (Format 8 differs from 7 only in the side values of watches, which the
+/// reader takes in any version.)
 fn downgrade_to_format_6(dir: &Path) {
     let path = dir.join(FILE_NAME);
     let bytes = std::fs::read(&path).unwrap();
-    assert_eq!(u32::from_le_bytes(bytes[16..20].try_into().unwrap()), 7);
+    assert_eq!(u32::from_le_bytes(bytes[16..20].try_into().unwrap()), 8);
     let payload = &bytes[36..bytes.len() - (8 + 3 * 8 + 7 * 8)];
     let mut out = bytes[..16].to_vec();
     out.extend_from_slice(&6u32.to_le_bytes());

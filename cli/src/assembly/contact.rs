@@ -631,7 +631,7 @@ impl ContactPhase {
                         if w.constraints.len() < w.held.len() {
                             w.constraints.resize(w.held.len(), Constraint::default());
                         }
-                        w.count = regap(&body_a, &body_b, &w.held, &mut w.constraints)?;
+                        w.count = regap(&body_a, &body_b, &w.held, settings, &mut w.constraints)?;
                         return Ok((scratch, builds, searches));
                     }
                     debug_assert!(!stale[a] && !stale[b], "pair {p:?} searched on stale boxes");

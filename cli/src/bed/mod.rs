@@ -207,6 +207,14 @@ pub struct BedArgs {
     #[arg(long, value_name = "C", allow_negative_numbers = true)]
     pub contact_capture: Option<f64>,
 
+    /// Override: on the steps between searches, a held contact whose node
+    /// has slid along its face by more than this fraction S of the element
+    /// size is projected on the face afresh, and nodes just beside a face
+    /// are watched (0 < S ≤ 1, or inf: neither; published 0.05). Allowed
+    /// with --resume.
+    #[arg(long, value_name = "S", allow_negative_numbers = true)]
+    pub held_reprojection: Option<f64>,
+
     /// Override: from this axial strain on every contact sweep searches,
     /// as with --hold-constraints false --contact-search-interval 1
     /// (0 ≤ C ≤ 1, 1: never; published 0.3). Allowed with --resume.
@@ -371,6 +379,9 @@ impl BedArgs {
         }
         if let Some(c) = self.contact_capture {
             scene.contact_capture = c;
+        }
+        if let Some(s) = self.held_reprojection {
+            scene.held_reprojection = s;
         }
         if let Some(c) = self.exact_contact_from_strain {
             scene.exact_contact_from_strain = c;

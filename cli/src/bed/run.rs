@@ -339,6 +339,8 @@ pub fn run_bed(
     params.hold_constraints = scene.hold_constraints;
     params.contact_search_interval = scene.contact_search_interval;
     params.contact.capture = scene.contact_capture * mesh.shortest_surface_edge();
+    params.contact.reproject_slide = scene.held_reprojection * mesh.shortest_surface_edge();
+    params.contact.watch_beside = scene.held_reprojection.is_finite();
     params.face_list_skin = scene.face_list_skin;
     params.max_node_speed_m_s = scene.watchdog_speed_ratio * scene.punch_speed_m_s;
     params.kinetic_energy_limit = scene.watchdog_energy_ratio;

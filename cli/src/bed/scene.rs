@@ -26,7 +26,8 @@ pub const MAX_PUNCH_SPEED_M_S: f64 = 10.0;
 pub const DEFAULT_SCENE: &str = r#"# granbed bed scene (format version 1). Units are in the field names.
 # A field left out takes its value from before the field existed: for the
 # numerics fields below (mass scaling, time_step_floor, hold_constraints,
-# contact_search_interval, contact_capture, sweep_tolerance) that is not the
+# contact_search_interval, contact_capture, held_reprojection, sweep_tolerance)
+# that is not the
 # published value, and granbed-cli bed warns with the values it uses.
 version = 1
 
@@ -123,6 +124,14 @@ contact_search_interval = 5
 # more). 0 (the value of scene files without this field): only overlapping
 # nodes are held.
 contact_capture = 0.1
+# On the steps between two searches, a held contact whose node has slid along
+# its face by more than this fraction of the element size is projected on the
+# face afresh (on a curved face the held gap misses ~s^2/2R), and a node that
+# lay just beside a face at the search (coming over its edge) is watched and
+# held once it crosses the face (0 < s <= 1; inf, the value of scene files
+# without this field: neither). With 0.05 the 30-granule stability suite's
+# overlaps between searches stay below 1 % of the element (BENCHMARKS.md).
+held_reprojection = 0.05
 # From this axial strain on, every contact sweep searches: hold_constraints
 # and contact_search_interval above apply before it only (0 <= C <= 1; 1:
 # never, the value of scene files without this field). They are speed
@@ -280,6 +289,13 @@ pub struct Scene {
     /// size, 0 ≤ c ≤ 0.1 (`PairSettings::capture`; absent: 0).
     #[serde(default)]
     pub contact_capture: f64,
+    /// Slide along its face, as a fraction of the element size, beyond
+    /// which a held contact is projected afresh on the steps between
+    /// searches; finite also watches the nodes just beside a face
+    /// (`PairSettings::reproject_slide`, `PairSettings::watch_beside`),
+    /// 0 < s ≤ 1 or ∞ (absent: ∞, neither, as before the field).
+    #[serde(default = "never_reproject")]
+    pub held_reprojection: f64,
     /// From this axial strain on every contact sweep searches
     /// (`AssemblyParams::exact_contact_from_s`), 0 ≤ C ≤ 1 (1 and absent:
     /// never).
@@ -316,6 +332,10 @@ fn never_strain() -> f64 {
 
 fn default_contact_search_interval() -> u32 {
     1
+}
+
+fn never_reproject() -> f64 {
+    f64::INFINITY
 }
 
 fn default_sweep_tolerance() -> f64 {
@@ -411,7 +431,7 @@ impl Scene {
         self.granule_type()?;
         self.mesh_level()?;
         self.element_kind()?;
-        let checks: [(bool, &str, f64, &str); 24] = [
+        let checks: [(bool, &str, f64, &str); 25] = [
             (
                 self.sweep_tolerance > 0.0 && self.sweep_tolerance <= 0.1,
                 "sweep_tolerance",
@@ -538,6 +558,13 @@ impl Scene {
                 "contact_capture",
                 self.contact_capture,
                 "0 <= c <= 0.1",
+            ),
+            (
+                (self.held_reprojection > 0.0 && self.held_reprojection <= 1.0)
+                    || self.held_reprojection == f64::INFINITY,
+                "held_reprojection",
+                self.held_reprojection,
+                "0 < s <= 1, or inf (never)",
             ),
             (
                 (0.0..=1.0).contains(&self.exact_contact_from_strain),
@@ -843,5 +870,26 @@ mod tests {
             .replace("contact_capture = 0.1\n", "");
         let old = Scene::from_toml(&text).unwrap();
         assert_eq!((old.contact_search_interval, old.contact_capture), (1, 0.0));
+        // Held contacts re-projected after a slide of 0.05 element
+        // (BENCHMARKS.md, "Held contacts projected afresh"); a scene file
+        // without the field never re-projects, and ∞ is allowed.
+        assert_eq!(Scene::published().held_reprojection, 0.05);
+        let text = DEFAULT_SCENE.replace("held_reprojection = 0.05\n", "");
+        assert_eq!(
+            Scene::from_toml(&text).unwrap().held_reprojection,
+            f64::INFINITY
+        );
+        let text = DEFAULT_SCENE.replace("held_reprojection = 0.05", "held_reprojection = inf");
+        assert!(Scene::from_toml(&text).is_ok());
+        for wrong in ["0.0", "1.5", "-inf", "nan"] {
+            let e = bad(
+                "held_reprojection = 0.05",
+                &format!("held_reprojection = {wrong}"),
+            );
+            assert!(
+                e.contains("`held_reprojection`") && e.contains("0 < s <= 1, or inf"),
+                "{e}"
+            );
+        }
     }
 }

@@ -50,21 +50,35 @@ pub struct PairSettings {
     /// that lies in front of a face by less than this (inside it, normals
     /// opposing) gets a *near* constraint, with gap ≥ 0, so that a driver
     /// that holds the constraints over steps without searching
-    /// ([`regap`]) sees it close. [`forces`] and [`mark_involvement`]
-    /// skip near constraints (a driver may hand them [`penetrating`]'s
-    /// part). 0: no near constraints (the detection as it was, bit for
-    /// bit).
+    /// ([`regap`]) sees it close. [`forces`] and [`mark_involvement`] skip
+    /// near constraints (and watches, below; gap ≥ 0: a driver may hand
+    /// them [`penetrating`]'s part). 0: none (the detection as it was, bit
+    /// for bit).
     pub capture: Real,
+    /// With a capture distance: a node that lies in front of a face's plane
+    /// by less than it but just off the face (by at most 0.25 in ξ or η: it
+    /// is coming over the face's edge), and has neither a contact nor a
+    /// near constraint, gets a *watch* ([`Constraint::watch`]) on the
+    /// nearest such face, which [`regap`] turns into a contact once the
+    /// node crosses the face. false: no watches (as before the field).
+    pub watch_beside: bool,
     /// Also estimate the contact area ([`PairForce::area`]): each
     /// constraint then evaluates its slave node's tributary area, which no
     /// force needs (false: the area is 0; the forces are the same bits).
     pub contact_area: bool,
+    /// How far a held constraint's node may slide along its face before
+    /// [`regap`] projects it on the face afresh, m (> 0; ∞: never, the
+    /// first-order gap as before): the tangential part of x̃_s − Σ Nᵢ x̃ᵢ.
+    /// On a curved face the gap along the held normal misses about
+    /// s²/(2R) after a slide s (R the face's radius of curvature).
+    pub reproject_slide: Real,
 }
 
 impl PairSettings {
     /// physics.md's choices: μ = `friction`, inside tolerance 1e-6, window
     /// 0.25 × face diagonal, 20 µm margin, symmetric two-pass; no capture
-    /// distance, no contact area.
+    /// distance, no watches, no contact area, held constraints never
+    /// re-projected.
     pub fn standard(friction: Real) -> Self {
         Self {
             friction,
@@ -74,6 +88,8 @@ impl PairSettings {
             capture: 0.0,
             symmetric: true,
             contact_area: false,
+            watch_beside: false,
+            reproject_slide: Real::INFINITY,
         }
     }
 }
@@ -137,8 +153,15 @@ pub struct Constraint {
     pub weights: [Real; 4],
     /// Master's outward unit normal at the contact point.
     pub normal: Vec3,
-    /// Signed gap n·(x̃_s − x_c) < 0, m.
+    /// Signed gap n·(x̃_s − x_c), m: < 0 for a contact, ≥ 0 for a near
+    /// constraint or a watch ([`PairSettings::capture`]).
     pub gap: Real,
+    /// A *watch* (a near constraint beside its face, see
+    /// [`PairSettings::capture`]): the node lay in front of the face's
+    /// plane but just off the face, so weights, normal and gap are those
+    /// of that outside projection (gap ≥ 0), and [`regap`] projects the
+    /// node onto the face afresh instead of re-measuring them.
+    pub watch: bool,
 }
 
 impl Default for Constraint {
@@ -151,6 +174,7 @@ impl Default for Constraint {
             weights: [0.0; 4],
             normal: [0.0; 3],
             gap: 0.0,
+            watch: false,
         }
     }
 }
@@ -591,6 +615,7 @@ fn detect_pass(
                 weights: c.projection.weights,
                 normal: c.projection.normal,
                 gap: c.projection.gap,
+                watch: c.watch,
             };
             count += 1;
         }
@@ -606,6 +631,8 @@ fn detect_pass(
 struct Hit {
     quad: u32,
     projection: QuadProjection,
+    /// A watch ([`Constraint::watch`]).
+    watch: bool,
 }
 
 /// The face node `s` of `slave` penetrates, by physics.md §5.2's tests:
@@ -638,6 +665,10 @@ fn closest_face<'c>(
     // The nearest face in front within the capture distance (a near
     // constraint, returned only when the node penetrates nothing).
     let mut near: Option<Hit> = None;
+    // With no near constraint either: the nearest face in front within the
+    // capture distance that the node lies just beside (off the face by at
+    // most `EDGE_REACH` in ξ or η: come over its edge), held as a watch.
+    let mut watch: Option<Hit> = None;
     let capture = settings.capture;
     let mut near_outside = false;
     // The sieve passes what projects within this reach of the face.
@@ -668,6 +699,22 @@ fn closest_face<'c>(
             near = Some(Hit {
                 quad: face.quad,
                 projection: pr,
+                watch: false,
+            });
+        }
+        if front > 0.0
+            && settings.watch_beside
+            && pr.gap >= 0.0
+            && pr.gap < front
+            && !pr.inside(settings.inside_tolerance)
+            && pr.inside(EDGE_REACH)
+            && watch.as_ref().is_none_or(|h| pr.gap < h.projection.gap)
+            && opposing(&pr.normal)
+        {
+            watch = Some(Hit {
+                quad: face.quad,
+                projection: pr,
+                watch: true,
             });
         }
         if !(pr.gap < 0.0 && pr.gap > -face.window) {
@@ -684,6 +731,7 @@ fn closest_face<'c>(
         let hit = Hit {
             quad: face.quad,
             projection: pr,
+            watch: false,
         };
         if best
             .as_ref()
@@ -713,11 +761,12 @@ fn closest_face<'c>(
             return best;
         }
     } else if !near_outside {
-        return near;
+        return near.or(watch);
     }
     concave_edge(&p, candidates)
         .filter(|h| opposing(&h.projection.normal))
         .or(near)
+        .or(watch)
 }
 
 /// Moves the penetrating constraints (gap < 0) of `constraints` to its
@@ -802,6 +851,7 @@ fn concave_edge<'c>(
     (pr.gap < 0.0 && pr.gap > -window).then_some(Hit {
         quad,
         projection: pr,
+        watch: false,
     })
 }
 
@@ -1116,6 +1166,21 @@ fn kinematic_force(
 /// written to `out` in their order (so a subsequence keeps [`detect`]'s
 /// order, which [`forces`] relies on), with the new gap. Returns how many.
 ///
+/// A constraint whose node has slid along the face by more than
+/// `settings.reproject_slide` (the tangential part of x̃_s − Σ Nᵢ x̃ᵢ) is
+/// projected on its face afresh while the node still lies on the face: it
+/// is written with the projection's weights, normal and gap if the node
+/// penetrates the face as a search would find it (inside, behind by less
+/// than the gap window, normals opposing), and dropped if it does not.
+/// Off the face, the held weights and normal measure it as before.
+///
+/// A watch ([`Constraint::watch`]: the node lay just beside its face at the
+/// search) is always projected afresh, and written, as an ordinary
+/// constraint, only once the node penetrates the face so. A node that comes
+/// over a face's edge between two searches is then held where a search
+/// would have found it, and no force acts on the face's extension beside
+/// it.
+///
 /// **Choice (physics.md §5.3 leaves the later Jacobi sweeps open):** a
 /// later sweep of a step corrects the contacts the step's search found
 /// rather than searching again. The gap is first-order exact in the
@@ -1128,6 +1193,7 @@ pub fn regap(
     a: &SurfaceBody<'_>,
     b: &SurfaceBody<'_>,
     held: &[Constraint],
+    settings: &PairSettings,
     out: &mut [Constraint],
 ) -> Result<usize, ContactError> {
     if out.len() < held.len() {
@@ -1157,6 +1223,13 @@ pub fn regap(
             .quads
             .get(c.quad as usize)
             .ok_or_else(|| short("master quads", c.quad, master.quads.len()))?;
+        if c.watch {
+            if let Some(Some(found)) = reprojected(slave, master, c, p, settings)? {
+                out[k] = found;
+                k += 1;
+            }
+            continue;
+        }
         let mut d = *p;
         for (&id, &wi) in quad.iter().zip(&c.weights) {
             let x = master
@@ -1168,12 +1241,58 @@ pub fn regap(
             }
         }
         let gap = dot(&c.normal, &d);
+        let slid = {
+            let t: Vec3 = core::array::from_fn(|i| d[i] - gap * c.normal[i]);
+            dot(&t, &t) > settings.reproject_slide * settings.reproject_slide
+        };
+        if slid && let Some(fresh) = reprojected(slave, master, c, p, settings)? {
+            if let Some(found) = fresh {
+                out[k] = found;
+                k += 1;
+            }
+            continue;
+        }
         if gap < 0.0 {
             out[k] = Constraint { gap, ..*c };
             k += 1;
         }
     }
     Ok(k)
+}
+
+/// Held constraint `c` of [`regap`] projected afresh at the slave's
+/// position `p`: `None` when the node lies off the face, else `Some` of
+/// the face's constraint if the node penetrates it as a search would find
+/// it (inside, behind by less than the gap window, normals opposing). A
+/// corner or slave id outside the bodies is an error.
+fn reprojected(
+    slave: &SurfaceBody<'_>,
+    master: &SurfaceBody<'_>,
+    c: &Constraint,
+    p: &Vec3,
+    settings: &PairSettings,
+) -> Result<Option<Option<Constraint>>, ContactError> {
+    let q = c.quad as usize;
+    let corners = master.corners(q).ok_or_else(|| master.quad_error(q))?;
+    let Some(pr) = project(p, &corners) else {
+        return Ok(None);
+    };
+    if !pr.inside(settings.inside_tolerance) {
+        return Ok(None);
+    }
+    let window = settings.window_fraction * face_diagonal(&corners);
+    if !(pr.gap < 0.0 && pr.gap > -window) {
+        return Ok(Some(None));
+    }
+    let s = c.slave as usize;
+    let ns = slave.node_normal(s)?;
+    Ok(Some((dot(&ns, &pr.normal) < 0.0).then_some(Constraint {
+        weights: pr.weights,
+        normal: pr.normal,
+        gap: pr.gap,
+        watch: false,
+        ..*c
+    })))
 }
 
 /// Shared mass m/max(1, n) of node `i` (`share` empty: no sharing).
