@@ -331,6 +331,17 @@ fn a_held_constraint_of_other_bodies_is_an_error() {
     assert_eq!(short_buffer(r), Some("constraints"));
 }
 
+/// `r`, written by `regap`, is the ordinary constraint `f` a search finds
+/// on the same configuration: the same node and face, and weights, normal
+/// and gap to round-off.
+fn assert_found_as_a_search_finds(r: &Constraint, f: &Constraint) {
+    assert_eq!((r.slave, r.quad, r.watch), (f.slave, f.quad, false));
+    assert!((r.gap - f.gap).abs() < 1e-12, "{} vs {}", r.gap, f.gap);
+    let close = |a: &[Real], b: &[Real]| a.iter().zip(b).all(|(x, y)| (x - y).abs() < 1e-12);
+    assert!(close(&r.weights, &f.weights), "{r:?} vs {f:?}");
+    assert!(close(&r.normal, &f.normal), "{r:?} vs {f:?}");
+}
+
 /// One flat face: z = 0 over the unit square, facing +z.
 fn flat_master() -> (Vec<Vec3>, Vec<[u32; 4]>) {
     let x = vec![
@@ -386,18 +397,8 @@ fn a_node_coming_over_a_faces_edge_is_watched_and_held_once_it_crosses() {
     assert_eq!(found.len(), 2, "{found:?}");
     assert_eq!(fresh.len(), 2, "{fresh:?}");
     for (r, f) in found.iter().zip(&fresh) {
-        assert_eq!((r.slave, r.quad, r.watch), (f.slave, f.quad, false));
         assert!((r.gap + 0.004).abs() < 1e-12, "gap {}", r.gap);
-        assert!((r.gap - f.gap).abs() < 1e-12, "{} vs {}", r.gap, f.gap);
-        for k in 0..4 {
-            assert!(
-                (r.weights[k] - f.weights[k]).abs() < 1e-12,
-                "{r:?} vs {f:?}"
-            );
-        }
-        for k in 0..3 {
-            assert!((r.normal[k] - f.normal[k]).abs() < 1e-12, "{r:?} vs {f:?}");
-        }
+        assert_found_as_a_search_finds(r, f);
     }
 }
 
@@ -443,17 +444,7 @@ fn a_held_contact_slid_along_a_curved_face_is_projected_afresh() {
     let again = regapped_with(&moved, &master, &quads, &held, &reproject(0.05)).unwrap();
     assert_eq!(again.len(), 4, "{again:?}");
     for (r, f) in again.iter().zip(&fresh) {
-        assert_eq!((r.slave, r.quad, r.watch), (f.slave, f.quad, false));
-        assert!((r.gap - f.gap).abs() < 1e-12, "{} vs {}", r.gap, f.gap);
-        for k in 0..4 {
-            assert!(
-                (r.weights[k] - f.weights[k]).abs() < 1e-12,
-                "{r:?} vs {f:?}"
-            );
-        }
-        for k in 0..3 {
-            assert!((r.normal[k] - f.normal[k]).abs() < 1e-12, "{r:?} vs {f:?}");
-        }
+        assert_found_as_a_search_finds(r, f);
     }
     // A slide shorter than the setting: the held measure.
     let short = regapped_with(&moved, &master, &quads, &held, &reproject(10.0)).unwrap();

@@ -689,33 +689,21 @@ fn closest_face<'c>(
         let Some(pr) = project(&p, &face.corners) else {
             continue;
         };
-        if front > 0.0
-            && pr.gap >= 0.0
-            && pr.gap < front
-            && pr.inside(settings.inside_tolerance)
-            && near.as_ref().is_none_or(|h| pr.gap < h.projection.gap)
-            && opposing(&pr.normal)
-        {
-            near = Some(Hit {
-                quad: face.quad,
-                projection: pr,
-                watch: false,
-            });
-        }
-        if front > 0.0
-            && settings.watch_beside
-            && pr.gap >= 0.0
-            && pr.gap < front
-            && !pr.inside(settings.inside_tolerance)
-            && pr.inside(EDGE_REACH)
-            && watch.as_ref().is_none_or(|h| pr.gap < h.projection.gap)
-            && opposing(&pr.normal)
-        {
-            watch = Some(Hit {
-                quad: face.quad,
-                projection: pr,
-                watch: true,
-            });
+        if front > 0.0 && pr.gap >= 0.0 && pr.gap < front {
+            // In front within the capture distance: inside the face a near
+            // constraint, just beside it a watch; the nearest of each kind.
+            let beside = !pr.inside(settings.inside_tolerance);
+            let slot = if beside { &mut watch } else { &mut near };
+            if (!beside || (settings.watch_beside && pr.inside(EDGE_REACH)))
+                && slot.as_ref().is_none_or(|h| pr.gap < h.projection.gap)
+                && opposing(&pr.normal)
+            {
+                *slot = Some(Hit {
+                    quad: face.quad,
+                    projection: pr,
+                    watch: beside,
+                });
+            }
         }
         if !(pr.gap < 0.0 && pr.gap > -face.window) {
             continue;
