@@ -383,6 +383,12 @@ fn a_node_coming_over_a_faces_edge_is_watched_and_held_once_it_crosses() {
         held.iter().all(|c| (c.gap - 0.01).abs() < 1e-12),
         "{held:?}"
     );
+    // No capture distance, no watches.
+    let uncaptured = PairSettings {
+        watch_beside: true,
+        ..settings(0.0)
+    };
+    assert!(detected(&beside, &master, &quads, &uncaptured).is_empty());
     // Not contacts: what the forces take of them is nothing.
     assert_eq!(penetrating(&mut held.clone()), 0);
     // Behind the plane's extension but off the face: no constraint.
@@ -400,6 +406,9 @@ fn a_node_coming_over_a_faces_edge_is_watched_and_held_once_it_crosses() {
         assert!((r.gap + 0.004).abs() < 1e-12, "gap {}", r.gap);
         assert_found_as_a_search_finds(r, f);
     }
+    // Re-measured with watches switched off (a run resumed so): dropped.
+    let off = regapped_with(&crossed, &master, &quads, &held, &settings(0.05)).unwrap();
+    assert!(off.is_empty(), "{off:?}");
 }
 
 /// A twisted face z = 0.4 x y over the unit square (a bilinear patch: its

@@ -198,14 +198,16 @@ fn a_scene_file_without_the_newer_fields_names_the_values_it_runs_with() {
         .replace("time_step_floor = 1.0\n", "")
         .replace("hold_constraints = true\n", "")
         .replace("contact_search_interval = 5\n", "")
+        .replace("held_reprojection = 0.05\n", "")
         .replace("exact_contact_from_strain = 0.3\n", "");
     let old = scene_file("old", &text);
     let r = bed(&["--print-scene", "--scene", old.to_str().unwrap()]);
     assert_eq!(r.code, 0, "{}", r.stderr);
     for needle in [
         "warning: scene",
-        "omits contact_search_interval, exact_contact_from_strain, hold_constraints, \
-         time_step_floor",
+        "omits contact_search_interval, exact_contact_from_strain, held_reprojection, \
+         hold_constraints, time_step_floor",
+        "held_reprojection = inf (published 0.05)",
         "time_step_floor = 0.0 (published 1.0)",
         "hold_constraints = false (published true)",
         "contact_search_interval = 1 (published 5)",

@@ -57,7 +57,8 @@ pub const FILE_NAME: &str = "checkpoint.bin";
 /// step, and the summary says so.
 ///
 /// 8: a held constraint's first float may also be 2 or 3: a watch
-/// (`Constraint::watch`) on side A or B. Older files hold none.
+/// (`Constraint::watch`) on side A or B. Older builds wrote none; the
+/// reader takes the values in any version (the layout is that of 7).
 pub const VERSION: u32 = 8;
 /// The oldest version read.
 const OLDEST_VERSION: u32 = 2;

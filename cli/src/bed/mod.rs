@@ -55,7 +55,7 @@ Output, in --out DIR (created if missing):
                    interrupted, warnings (also on stderr, with --quiet too: a
                    final strain past the target by more than an output
                    interval, overlap above 1 % of the element, a Kawakita fit
-                   with a > 1, 1/b <= 0 or R^2 < 0.9, scene fields left out
+                   with a outside (0, 1], 1/b <= 0 or R^2 < 0.9, scene fields left out
                    whose old values are not the published ones), version
   vtk/bed_<k>.vtu  VTU snapshots at the scene's snapshot_strains (a fresh run
                    first removes those an earlier run left): every granule's
@@ -207,11 +207,12 @@ pub struct BedArgs {
     #[arg(long, value_name = "C", allow_negative_numbers = true)]
     pub contact_capture: Option<f64>,
 
-    /// Override: on the steps between searches, a held contact whose node
-    /// has slid along its face by more than this fraction S of the element
-    /// size is projected on the face afresh, and nodes just beside a face
-    /// are watched (0 < S ≤ 1, or inf: neither; published 0.05). Allowed
-    /// with --resume.
+    /// Override: where a pair re-measures the contacts it holds (later
+    /// sweeps, and the steps between two searches), a held contact whose
+    /// node has slid along its face by more than this fraction S of the
+    /// element size is projected on the face afresh, and (with a capture
+    /// distance) nodes just beside a face are watched (0 < S ≤ 1, or inf:
+    /// neither; published 0.05). Allowed with --resume.
     #[arg(long, value_name = "S", allow_negative_numbers = true)]
     pub held_reprojection: Option<f64>,
 

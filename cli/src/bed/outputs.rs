@@ -354,6 +354,25 @@ pub fn summary<'a>(scene: &'a Scene, run: &BedRun) -> Summary<'a> {
 /// the criterion of `granbed-cli study stability` (issue #9's).
 pub const OVERLAP_WARNING_REL: Real = crate::study::stability::MAX_PENETRATION_REL;
 
+/// Why the Kawakita fit `k` does not describe a bed, if it does not: a
+/// outside (0, 1] (a limiting strain; NaN included), 1/b ≤ 0, R² below
+/// [`KAWAKITA_MIN_R_SQUARED`]. Empty for a fit inside the law's regime.
+fn kawakita_doubts(k: &KawakitaSummary) -> Vec<String> {
+    let mut why = Vec::new();
+    if let Some(a) = k.a.filter(|&a| !(a > 0.0 && a <= 1.0)) {
+        why.push(format!(
+            "a = {a:.3} outside (0, 1] (a is the limiting strain)"
+        ));
+    }
+    if let Some(inv_b) = k.inv_b_pa.filter(|&x| x <= 0.0) {
+        why.push(format!("1/b = {inv_b:.3e} Pa <= 0"));
+    }
+    if let Some(r2) = k.r_squared.filter(|&r| r < KAWAKITA_MIN_R_SQUARED) {
+        why.push(format!("R^2 = {r2:.3} < {KAWAKITA_MIN_R_SQUARED}"));
+    }
+    why
+}
+
 /// The summary's warnings: `run.warnings`, then those its figures call
 /// for.
 fn warnings(
@@ -417,18 +436,7 @@ fn warnings(
         }
         _ => {}
     }
-    let mut why = Vec::new();
-    if let Some(a) = kawakita.a.filter(|&a| !(a > 0.0 && a <= 1.0)) {
-        why.push(format!(
-            "a = {a:.3} outside (0, 1] (a is the limiting strain)"
-        ));
-    }
-    if let Some(inv_b) = kawakita.inv_b_pa.filter(|&x| x <= 0.0) {
-        why.push(format!("1/b = {inv_b:.3e} Pa <= 0"));
-    }
-    if let Some(r2) = kawakita.r_squared.filter(|&r| r < KAWAKITA_MIN_R_SQUARED) {
-        why.push(format!("R^2 = {r2:.3} < {KAWAKITA_MIN_R_SQUARED}"));
-    }
+    let why = kawakita_doubts(kawakita);
     if !why.is_empty() {
         w.push(format!(
             "the Kawakita fit over C >= 0.25 ({} points) does not describe this bed: {}; its a \
@@ -543,5 +551,44 @@ impl Progress {
     /// Removes the bar.
     pub fn finish(&self) {
         self.bar.finish();
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// a must be a limiting strain in (0, 1]: 1 and 0.4 pass, 0, a
+    /// negative a, a > 1 and NaN are doubted, each by name; 1/b ≤ 0 and a
+    /// low R² too.
+    #[test]
+    fn a_kawakita_fit_outside_the_laws_regime_is_doubted() {
+        let fit = |a: Real, inv_b: Real, r2: Real| KawakitaSummary {
+            a: Some(a),
+            inv_b_pa: Some(inv_b),
+            r_squared: Some(r2),
+            points: 11,
+        };
+        for a in [1.0, 0.4] {
+            assert!(kawakita_doubts(&fit(a, 2e5, 0.99)).is_empty(), "a = {a}");
+        }
+        for a in [0.0, -6.8, 3.48, Real::NAN] {
+            let why = kawakita_doubts(&fit(a, 2e5, 0.99));
+            assert_eq!(why.len(), 1, "a = {a}: {why:?}");
+            assert!(why[0].contains("outside (0, 1]"), "{why:?}");
+        }
+        let why = kawakita_doubts(&fit(0.5, -1.0, 0.5));
+        assert!(
+            why[0].contains("1/b") && why[1].contains("R^2 = 0.500 < 0.9"),
+            "{why:?}"
+        );
+        // No fit (too few points): nothing to doubt.
+        let none = KawakitaSummary {
+            a: None,
+            inv_b_pa: None,
+            r_squared: None,
+            points: 2,
+        };
+        assert!(kawakita_doubts(&none).is_empty());
     }
 }

@@ -26,9 +26,9 @@ pub const MAX_PUNCH_SPEED_M_S: f64 = 10.0;
 pub const DEFAULT_SCENE: &str = r#"# granbed bed scene (format version 1). Units are in the field names.
 # A field left out takes its value from before the field existed: for the
 # numerics fields below (mass scaling, time_step_floor, hold_constraints,
-# contact_search_interval, contact_capture, held_reprojection, sweep_tolerance)
-# that is not the
-# published value, and granbed-cli bed warns with the values it uses.
+# contact_search_interval, contact_capture, held_reprojection,
+# sweep_tolerance) that is not the published value, and granbed-cli bed warns
+# with the values it uses.
 version = 1
 
 # Granules: a standard type A1...C3 (A/B/C: yield stress 10/30/100 kPa;
@@ -124,13 +124,15 @@ contact_search_interval = 5
 # more). 0 (the value of scene files without this field): only overlapping
 # nodes are held.
 contact_capture = 0.1
-# On the steps between two searches, a held contact whose node has slid along
-# its face by more than this fraction of the element size is projected on the
-# face afresh (on a curved face the held gap misses ~s^2/2R), and a node that
-# lay just beside a face at the search (coming over its edge) is watched and
-# held once it crosses the face (0 < s <= 1; inf, the value of scene files
-# without this field: neither). With 0.05 the 30-granule stability suite's
-# overlaps between searches stay below 1 % of the element (BENCHMARKS.md).
+# Where a pair re-measures the contacts it holds (later sweeps, and the steps
+# between two searches), a held contact whose node has slid along its face by
+# more than this fraction of the element size is projected on the face afresh
+# (on a curved face the held gap misses ~s^2/2R), and, with a capture
+# distance, a node that lay just beside a face at the search (coming over its
+# edge) is watched and held once it crosses the face (0 < s <= 1; inf, the
+# value of scene files without this field: neither). With 0.05 the 30-granule
+# stability suite to 30 % keeps its overlaps below 1 % of the element
+# (BENCHMARKS.md).
 held_reprojection = 0.05
 # From this axial strain on, every contact sweep searches: hold_constraints
 # and contact_search_interval above apply before it only (0 <= C <= 1; 1:

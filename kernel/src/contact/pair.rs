@@ -67,8 +67,9 @@ pub struct PairSettings {
     /// force needs (false: the area is 0; the forces are the same bits).
     pub contact_area: bool,
     /// How far a held constraint's node may slide along its face before
-    /// [`regap`] projects it on the face afresh, m (> 0; ∞: never, the
-    /// first-order gap as before): the tangential part of x̃_s − Σ Nᵢ x̃ᵢ.
+    /// [`regap`] projects it on the face afresh, m (> 0; 0 or less: at
+    /// every call; ∞ or NaN: never, the first-order gap as before): the
+    /// tangential part of x̃_s − Σ Nᵢ x̃ᵢ.
     /// On a curved face the gap along the held normal misses about
     /// s²/(2R) after a slide s (R the face's radius of curvature).
     pub reproject_slide: Real,
@@ -1164,7 +1165,8 @@ fn kinematic_force(
 ///
 /// A watch ([`Constraint::watch`]: the node lay just beside its face at the
 /// search) is always projected afresh, and written, as an ordinary
-/// constraint, only once the node penetrates the face so. A node that comes
+/// constraint, only once the node penetrates the face so (with
+/// `settings.watch_beside` false, never). A node that comes
 /// over a face's edge between two searches is then held where a search
 /// would have found it, and no force acts on the face's extension beside
 /// it.
@@ -1212,6 +1214,11 @@ pub fn regap(
             .get(c.quad as usize)
             .ok_or_else(|| short("master quads", c.quad, master.quads.len()))?;
         if c.watch {
+            // Watches held from a search with them, re-measured without
+            // (a run resumed with them switched off): dropped.
+            if !settings.watch_beside {
+                continue;
+            }
             if let Some(Some(found)) = reprojected(slave, master, c, p, settings)? {
                 out[k] = found;
                 k += 1;
