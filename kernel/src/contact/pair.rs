@@ -76,6 +76,14 @@ pub struct PairSettings {
 }
 
 impl PairSettings {
+    /// The gap window g_max of the face with corners `corners`, m: the
+    /// [`Self::window_fraction`] of its longer diagonal. A node deeper
+    /// behind the face is no contact of it.
+    #[inline]
+    fn window(&self, corners: &[Vec3; 4]) -> Real {
+        self.window_fraction * face_diagonal(corners)
+    }
+
     /// physics.md's choices: μ = `friction`, inside tolerance 1e-6, window
     /// 0.25 × face diagonal, 20 µm margin, symmetric two-pass; no capture
     /// distance, no watches, no contact area, held constraints never
@@ -546,7 +554,7 @@ fn detect_pass(
                 pass.clear();
                 return Err(master.quad_error(q));
             };
-            let window = settings.window_fraction * face_diagonal(&corners);
+            let window = settings.window(&corners);
             scratch[faces] = CandidateFace {
                 quad: q as u32,
                 corners,
@@ -1219,7 +1227,7 @@ pub fn regap(
             if !settings.watch_beside {
                 continue;
             }
-            if let Some(Some(found)) = reprojected(slave, master, c, p, settings)? {
+            if let Reprojection::Contact(found) = reprojected(slave, master, c, p, settings)? {
                 out[k] = found;
                 k += 1;
             }
@@ -1240,12 +1248,16 @@ pub fn regap(
             let t: Vec3 = core::array::from_fn(|i| d[i] - gap * c.normal[i]);
             dot(&t, &t) > settings.reproject_slide * settings.reproject_slide
         };
-        if slid && let Some(fresh) = reprojected(slave, master, c, p, settings)? {
-            if let Some(found) = fresh {
-                out[k] = found;
-                k += 1;
+        if slid {
+            match reprojected(slave, master, c, p, settings)? {
+                Reprojection::OffFace => {}
+                Reprojection::Clear => continue,
+                Reprojection::Contact(found) => {
+                    out[k] = found;
+                    k += 1;
+                    continue;
+                }
             }
-            continue;
         }
         if gap < 0.0 {
             out[k] = Constraint { gap, ..*c };
@@ -1255,39 +1267,50 @@ pub fn regap(
     Ok(k)
 }
 
-/// Held constraint `c` of [`regap`] projected afresh at the slave's
-/// position `p`: `None` when the node lies off the face, else `Some` of
-/// the face's constraint if the node penetrates it as a search would find
-/// it (inside, behind by less than the gap window, normals opposing). A
-/// corner or slave id outside the bodies is an error.
+/// What a held constraint projected afresh on its face finds
+/// ([`reprojected`]).
+enum Reprojection {
+    /// The node lies off the face (or the projection failed).
+    OffFace,
+    /// On the face, but no contact a search would find: in front of it,
+    /// deeper than the gap window, or with normals not opposing.
+    Clear,
+    /// The face's contact, with the projection's weights, normal and gap.
+    Contact(Constraint),
+}
+
+/// Held constraint `c` of [`regap`] projected afresh on its face at the
+/// slave's position `p`, with a search's tests (inside the face, behind it
+/// by less than the gap window, normals opposing). A corner or slave id
+/// outside the bodies is an error.
 fn reprojected(
     slave: &SurfaceBody<'_>,
     master: &SurfaceBody<'_>,
     c: &Constraint,
     p: &Vec3,
     settings: &PairSettings,
-) -> Result<Option<Option<Constraint>>, ContactError> {
+) -> Result<Reprojection, ContactError> {
     let q = c.quad as usize;
     let corners = master.corners(q).ok_or_else(|| master.quad_error(q))?;
-    let Some(pr) = project(p, &corners) else {
-        return Ok(None);
+    let Some(pr) = project(p, &corners).filter(|pr| pr.inside(settings.inside_tolerance)) else {
+        return Ok(Reprojection::OffFace);
     };
-    if !pr.inside(settings.inside_tolerance) {
-        return Ok(None);
+    if !(pr.gap < 0.0 && pr.gap > -settings.window(&corners)) {
+        return Ok(Reprojection::Clear);
     }
-    let window = settings.window_fraction * face_diagonal(&corners);
-    if !(pr.gap < 0.0 && pr.gap > -window) {
-        return Ok(Some(None));
-    }
-    let s = c.slave as usize;
-    let ns = slave.node_normal(s)?;
-    Ok(Some((dot(&ns, &pr.normal) < 0.0).then_some(Constraint {
-        weights: pr.weights,
-        normal: pr.normal,
-        gap: pr.gap,
-        watch: false,
-        ..*c
-    })))
+    let ns = slave.node_normal(c.slave as usize)?;
+    // Normals opposing (a NaN opposes nothing).
+    Ok(if dot(&ns, &pr.normal) < 0.0 {
+        Reprojection::Contact(Constraint {
+            weights: pr.weights,
+            normal: pr.normal,
+            gap: pr.gap,
+            watch: false,
+            ..*c
+        })
+    } else {
+        Reprojection::Clear
+    })
 }
 
 /// Shared mass m/max(1, n) of node `i` (`share` empty: no sharing).
