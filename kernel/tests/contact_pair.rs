@@ -303,32 +303,78 @@ fn held_constraints_are_re_measured_on_the_moved_configuration() {
 }
 
 /// A held constraint that does not fit the bodies (an id beyond their
-/// nodes or quads), or an output shorter than the held list, is an error,
-/// not a panic.
+/// nodes or quads) is an `IdOutOfRange` naming where the id was read, on
+/// every path that measures it (the held measure, a watch, a re-projection
+/// after a slide); an output shorter than the held list is a
+/// `BufferLength`. Errors, not panics.
 #[test]
 fn a_held_constraint_of_other_bodies_is_an_error() {
     let (master, quads) = folded_master();
     let slave = slave_at(1.3, 0.29);
     let held = constraints(&slave, &master, &quads);
-    // The buffer a `BufferLength` error names (None: another outcome).
-    let short_buffer = |r: Result<Vec<Constraint>, ContactError>| match r {
-        Err(ContactError::BufferLength { buffer, .. }) => Some(buffer),
+    // The buffer and id an `IdOutOfRange` error names (None: another
+    // outcome).
+    let out_of_range = |r: Result<Vec<Constraint>, ContactError>| match r {
+        Err(ContactError::IdOutOfRange { buffer, id, .. }) => Some((buffer, id)),
         _ => None,
     };
     let mut bad = held.clone();
     bad[1].quad = 7;
     let r = regapped(&slave, &master, &quads, &bad);
-    assert_eq!(short_buffer(r), Some("master quads"));
+    assert_eq!(out_of_range(r), Some(("held.quad", 7)));
     bad[1] = Constraint {
         slave: 9,
         ..held[1]
     };
     let r = regapped(&slave, &master, &quads, &bad);
-    assert_eq!(short_buffer(r), Some("slave positions"));
+    assert_eq!(out_of_range(r), Some(("held.slave", 9)));
+    // A corner of the held face beyond the master's nodes, measured as
+    // held, as a watch and as a slid constraint re-projected.
+    let mut broken = quads.clone();
+    broken[1][3] = 99;
+    assert_eq!(
+        out_of_range(regapped(&slave, &master, &broken, &held)),
+        Some(("quads", 99))
+    );
+    let watched: Vec<Constraint> = held
+        .iter()
+        .map(|c| Constraint { watch: true, ..*c })
+        .collect();
+    let watching = PairSettings {
+        watch_beside: true,
+        ..settings(0.05)
+    };
+    assert_eq!(
+        out_of_range(regapped_with(&slave, &master, &broken, &watched, &watching)),
+        Some(("quads", 99))
+    );
+    let reprojecting = PairSettings {
+        reproject_slide: 0.0,
+        ..settings(0.0)
+    };
+    assert_eq!(
+        out_of_range(regapped_with(
+            &slave,
+            &master,
+            &broken,
+            &held,
+            &reprojecting
+        )),
+        Some(("quads", 99))
+    );
     let r = with_bodies(&slave, &master, &quads, |a, b| {
-        regap(a, b, &held, &settings(0.0), &mut [Constraint::default(); 2]).map(|_| Vec::new())
+        regap(a, b, &held, &settings(0.0), &mut [Constraint::default(); 2])
     });
-    assert_eq!(short_buffer(r), Some("constraints"));
+    assert!(
+        matches!(
+            r,
+            Err(ContactError::BufferLength {
+                buffer: "constraints",
+                ..
+            })
+        ),
+        "{r:?}"
+    );
 }
 
 /// `r`, written by `regap`, is the ordinary constraint `f` a search finds
@@ -409,6 +455,73 @@ fn a_node_coming_over_a_faces_edge_is_watched_and_held_once_it_crosses() {
     // Re-measured with watches switched off (a run resumed so): dropped.
     let off = regapped_with(&crossed, &master, &quads, &held, &settings(0.05)).unwrap();
     assert!(off.is_empty(), "{off:?}");
+}
+
+/// Two faces facing +z, not connected: face 0 in z = `z0` over x ∈ [`x0`,
+/// `x0` + 1], face 1 in z = `z1` over x ∈ [`x1`, `x1` + 1], both over
+/// y ∈ [0, 1].
+fn two_faces(x0: Real, z0: Real, x1: Real, z1: Real) -> (Vec<Vec3>, Vec<[u32; 4]>) {
+    let face = |x: Real, z: Real| {
+        [
+            [x, 0.0, z],
+            [x + 1.0, 0.0, z],
+            [x + 1.0, 1.0, z],
+            [x, 1.0, z],
+        ]
+    };
+    let mut nodes = face(x0, z0).to_vec();
+    nodes.extend(face(x1, z1));
+    (nodes, vec![[0, 1, 2, 3], [4, 5, 6, 7]])
+}
+
+/// One held constraint per node, in this order of precedence: a near
+/// constraint (in front of a face and on it) wins over a watch (in front of
+/// a face and just beside it), even a watch on a nearer face; among the
+/// faces a node lies just beside, the nearest gets the watch, wherever it
+/// stands in the face list.
+#[test]
+fn a_near_constraint_wins_over_a_watch_and_the_nearest_face_is_watched() {
+    let watching = PairSettings {
+        watch_beside: true,
+        ..settings(0.05)
+    };
+    let held_on = |master: &[Vec3], quads: &[[u32; 4]], slave: &[Vec3]| {
+        detected(slave, master, quads, &watching)
+            .iter()
+            .map(|c| (c.slave, c.quad, c.watch))
+            .collect::<Vec<_>>()
+    };
+    // Nodes 0 and 1 at x = 1.05, z = 0.01: just beside face 0 (z = 0, x
+    // up to 1) 0.01 in front of its plane, and on face 1 (z = −0.02, x
+    // from 1.0) 0.03 in front of it. Nodes 2 and 3 at x = 1.15 are beyond
+    // face 0's reach and on face 1.
+    let slave = slave_at(1.05, 0.01);
+    let (master, quads) = two_faces(0.0, 0.0, 1.0, -0.02);
+    let held = detected(&slave, &master, &quads, &watching);
+    assert_eq!(
+        held.iter()
+            .map(|c| (c.slave, c.quad, c.watch))
+            .collect::<Vec<_>>(),
+        [(0, 1, false), (1, 1, false), (2, 1, false), (3, 1, false)],
+        "{held:?}"
+    );
+    assert!(
+        held.iter().all(|c| (c.gap - 0.03).abs() < 1e-12),
+        "{held:?}"
+    );
+    // Both faces beside nodes 0 and 1 (x up to 1): the nearer, face 1 at
+    // z = 0 (0.01 in front), is watched, not face 0 at z = −0.02 (0.03),
+    // listed first; and so with the list the other way round.
+    let (master, quads) = two_faces(0.0, -0.02, 0.0, 0.0);
+    assert_eq!(
+        held_on(&master, &quads, &slave),
+        [(0, 1, true), (1, 1, true)]
+    );
+    let (master, quads) = two_faces(0.0, 0.0, 0.0, -0.02);
+    assert_eq!(
+        held_on(&master, &quads, &slave),
+        [(0, 0, true), (1, 0, true)]
+    );
 }
 
 /// A twisted face z = 0.4 x y over the unit square (a bilinear patch: its

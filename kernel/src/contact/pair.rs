@@ -1187,6 +1187,11 @@ fn kinematic_force(
 /// without a held constraint is found by the next step's search. A NaN
 /// gap is no penetration here (the driver's checks of the motion report
 /// a non-finite state).
+///
+/// Errors: `out` shorter than `held` ([`ContactError::BufferLength`]); a
+/// held constraint's slave or quad id, or a corner id of its quad, outside
+/// the bodies ([`ContactError::IdOutOfRange`], buffer `held.slave`,
+/// `held.quad` or `quads`, whichever path measures the constraint).
 pub fn regap(
     a: &SurfaceBody<'_>,
     b: &SurfaceBody<'_>,
@@ -1202,25 +1207,26 @@ pub fn regap(
         });
     }
     let mut k = 0;
-    for c in held {
+    for (index, c) in held.iter().enumerate() {
         let (slave, master) = match c.side {
             Side::A => (a, b),
             Side::B => (b, a),
         };
         // A constraint of other bodies: its ids lie outside these.
-        let short = |buffer, id: u32, got| ContactError::BufferLength {
+        let out_of = |buffer, at, id: u32, len| ContactError::IdOutOfRange {
             buffer,
-            expected: (id as usize).saturating_add(1),
-            got,
+            index: at,
+            id,
+            len,
         };
         let p = slave
             .x_pred
             .get(c.slave as usize)
-            .ok_or_else(|| short("slave positions", c.slave, slave.x_pred.len()))?;
+            .ok_or_else(|| out_of("held.slave", index, c.slave, slave.x_pred.len()))?;
         let quad = master
             .quads
             .get(c.quad as usize)
-            .ok_or_else(|| short("master quads", c.quad, master.quads.len()))?;
+            .ok_or_else(|| out_of("held.quad", index, c.quad, master.quads.len()))?;
         if c.watch {
             // Watches held from a search with them, re-measured without
             // (a run resumed with them switched off): dropped.
@@ -1238,7 +1244,7 @@ pub fn regap(
             let x = master
                 .x_pred
                 .get(id as usize)
-                .ok_or_else(|| short("master positions", id, master.x_pred.len()))?;
+                .ok_or_else(|| out_of("quads", c.quad as usize, id, master.x_pred.len()))?;
             for (dk, xk) in d.iter_mut().zip(x) {
                 *dk -= wi * xk;
             }
