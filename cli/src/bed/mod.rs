@@ -54,7 +54,8 @@ Output, in --out DIR (created if missing):
                    hourglass / internal work, energy residual, peak memory,
                    interrupted, warnings (also on stderr, with --quiet too: a
                    final strain past the target by more than an output
-                   interval, overlap above 1 % of the element, a Kawakita fit
+                   interval, overlap above 1 % of the element, an element
+                   folded at a Gauss point (J <= 0), a Kawakita fit
                    with a outside (0, 1], 1/b <= 0 or R^2 < 0.9, scene fields left out
                    whose old values are not the published ones), version
   vtk/bed_<k>.vtu  VTU snapshots at the scene's snapshot_strains (a fresh run

@@ -436,6 +436,17 @@ fn warnings(
         }
         _ => {}
     }
+    if let Some((from, min)) =
+        first_fold(run.samples.iter().map(|s| (s.strain, s.min_gauss_jacobian)))
+    {
+        w.push(format!(
+            "an element folded at a Gauss point from C = {from:.3} on (smallest Gauss-point \
+             Jacobian ratio {min:.3} at the output rows; `study stability` accepts only > 0): \
+             the one-point element's hourglass control (hourglass_kappa = {}) let a granule's \
+             mesh fold, and the figures past that strain are doubtful. {FOLD_REMEDIES}",
+            scene.hourglass_kappa
+        ));
+    }
     let why = kawakita_doubts(kawakita);
     if !why.is_empty() {
         w.push(format!(
@@ -456,6 +467,32 @@ fn warnings(
         ));
     }
     w
+}
+
+/// What avoids a folded element, as measured (BENCHMARKS.md, "A folded
+/// element warned about").
+const FOLD_REMEDIES: &str = "On a 30-granule C3 bed of 4x1 granules whose element folded \
+     at C = 0.595, each of these reached C = 0.6 without a fold: the 8x2 mesh (the published \
+     one), hourglass_kappa = 0.1 (the pressure 5.6 % higher at C = 0.3) and element = \"fbar\" \
+     (no hourglass modes); physical masses past C = 0.3 did not.";
+
+/// The strain of the first output row whose smallest Gauss-point Jacobian
+/// ratio is ≤ 0 (an element folded), and the smallest ratio of all rows;
+/// `None` if no row folded. `rows`: (C, min Gauss-point J) per output row;
+/// a NaN ratio (no deformable granule yet) is no fold.
+fn first_fold(rows: impl Iterator<Item = (Real, Real)>) -> Option<(Real, Real)> {
+    let mut fold: Option<(Real, Real)> = None;
+    for (strain, j) in rows {
+        if j <= 0.0 {
+            fold = Some(match fold {
+                Some((from, min)) => (from, min.min(j)),
+                None => (strain, j),
+            });
+        } else if let Some((_, min)) = &mut fold {
+            *min = min.min(j);
+        }
+    }
+    fold
 }
 
 /// The R² below which the Kawakita fit is warned about.
@@ -590,5 +627,54 @@ mod tests {
             points: 2,
         };
         assert!(kawakita_doubts(&none).is_empty());
+    }
+
+    /// A row with a Gauss-point Jacobian ratio ≤ 0 is a fold: the first
+    /// such row's strain and the smallest ratio of all rows (a row that
+    /// recovered included) are reported; NaN rows and positive ratios are
+    /// not folds.
+    #[test]
+    fn the_first_folded_row_and_the_smallest_ratio_are_reported() {
+        let rows = [(0.1, Real::NAN), (0.2, 0.4), (0.3, 0.01)];
+        assert_eq!(first_fold(rows.into_iter()), None);
+        let rows = [(0.1, 0.5), (0.55, -0.01), (0.575, 0.02), (0.6, -0.03)];
+        assert_eq!(first_fold(rows.into_iter()), Some((0.55, -0.03)));
+        assert_eq!(first_fold([(0.2, 0.0)].into_iter()), Some((0.2, 0.0)));
+    }
+
+    /// A run whose output rows saw a folded element says so in its
+    /// summary's warnings, with the strain of the first folded row; a run
+    /// without one does not.
+    #[test]
+    fn a_folded_element_is_warned_about_in_the_summary() {
+        use crate::bed::run::{BedRun, BedSample};
+        let run = |gauss: [Real; 4]| {
+            BedRun::of_samples(
+                gauss
+                    .iter()
+                    .enumerate()
+                    .map(|(i, &min_gauss_jacobian)| BedSample {
+                        strain: 0.1 * i as Real,
+                        min_jacobian: 0.9,
+                        min_gauss_jacobian,
+                        ..BedSample::default()
+                    })
+                    .collect(),
+            )
+        };
+        let scene = Scene::published();
+        let folded = |w: &[String]| {
+            w.iter()
+                .find(|w| w.contains("folded at a Gauss point"))
+                .cloned()
+        };
+        let w = summary(&scene, &run([1.0, 0.5, -0.02, 0.01])).warnings;
+        let warning = folded(&w).unwrap_or_else(|| panic!("{w:?}"));
+        assert!(
+            warning.contains("from C = 0.200") && warning.contains("ratio -0.020"),
+            "{warning}"
+        );
+        let w = summary(&scene, &run([1.0, 0.5, 0.2, 0.01])).warnings;
+        assert_eq!(folded(&w), None, "{w:?}");
     }
 }

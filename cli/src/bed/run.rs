@@ -159,6 +159,41 @@ pub struct BedRun {
     pub added_mass: AddedMass,
 }
 
+#[cfg(test)]
+impl BedRun {
+    /// A finished run with these `samples` of one granule of one hex in a
+    /// bed and die of unit size, nothing else recorded: for unit tests of
+    /// what is made of a run's samples.
+    pub(crate) fn of_samples(samples: Vec<BedSample>) -> Self {
+        let strain_reached = samples.last().map_or(0.0, |s| s.strain);
+        Self {
+            samples,
+            bed_height_m: 1.0,
+            die_radius_m: 1.0,
+            granules: 1,
+            hexes_per_granule: 1,
+            element_size_m: 1.0,
+            steps: 0,
+            strain_reached,
+            element_steps: 0,
+            pour_wall_time_s: 0.0,
+            wall_time_s: 0.0,
+            rate_change_rel: None,
+            phase_times: Default::default(),
+            counters_from_step: 0,
+            solid_volume_m3: 1.0,
+            threads: 1,
+            stopped: false,
+            interrupted: false,
+            resumed_past_end: false,
+            warnings: Vec::new(),
+            error: None,
+            checkpoint_strain: None,
+            added_mass: Default::default(),
+        }
+    }
+}
+
 /// What variable mass scaling ([`crate::assembly::AssemblyParams::time_step_floor`])
 /// did to a run, at its end.
 #[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize)]

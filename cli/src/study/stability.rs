@@ -593,38 +593,17 @@ mod tests {
 
     #[test]
     fn the_worst_of_several_beds_is_taken_per_row() {
-        let run = |j: [Real; 3]| BedRun {
-            samples: j
-                .iter()
-                .enumerate()
-                .map(|(i, &min_jacobian)| BedSample {
-                    strain: 0.1 * i as Real,
-                    min_jacobian,
-                    ..BedSample::default()
-                })
-                .collect(),
-            bed_height_m: 1.0,
-            die_radius_m: 1.0,
-            granules: 1,
-            hexes_per_granule: 1,
-            element_size_m: 1.0,
-            steps: 0,
-            strain_reached: 0.2,
-            element_steps: 0,
-            pour_wall_time_s: 0.0,
-            wall_time_s: 0.0,
-            rate_change_rel: None,
-            phase_times: Default::default(),
-            counters_from_step: 0,
-            solid_volume_m3: 1.0,
-            threads: 1,
-            stopped: false,
-            interrupted: false,
-            resumed_past_end: false,
-            warnings: Vec::new(),
-            error: None,
-            checkpoint_strain: None,
-            added_mass: Default::default(),
+        let run = |j: [Real; 3]| {
+            BedRun::of_samples(
+                j.iter()
+                    .enumerate()
+                    .map(|(i, &min_jacobian)| BedSample {
+                        strain: 0.1 * i as Real,
+                        min_jacobian,
+                        ..BedSample::default()
+                    })
+                    .collect(),
+            )
         };
         let (a, b) = (run([1.0, 0.8, 0.9]), run([1.0, 0.9, 0.7]));
         let w = worst(&[&a, &b], |s| s.min_jacobian, true);
