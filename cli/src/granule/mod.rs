@@ -280,9 +280,10 @@ pub struct GranuleArgs {
     #[arg(long)]
     pub rate_check: bool,
 
-    /// Threads for --types (one type per thread; 0 = all cores). Results
-    /// do not depend on it; wall times may.
-    #[arg(short = 'j', long, value_name = "N", default_value_t = 0)]
+    /// Threads for --types (one type per thread; 0 = all cores, at most
+    /// 4096). Results do not depend on it; wall times may.
+    #[arg(short = 'j', long, value_name = "N", default_value_t = 0, allow_negative_numbers = true,
+          value_parser = crate::numbers::whole::<usize>(0, 4096))]
     pub threads: usize,
 
     /// No progress bars and no summary lines on stderr (errors are still

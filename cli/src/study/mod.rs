@@ -114,8 +114,9 @@ pub struct WorkPrecisionArgs {
     #[arg(long, value_name = "N")]
     pub pours: Option<u64>,
 
-    /// bed-small: worker threads (0 = all cores).
-    #[arg(short = 'j', long, value_name = "N", default_value_t = 0)]
+    /// bed-small: worker threads (0 = all cores; at most 4096).
+    #[arg(short = 'j', long, value_name = "N", default_value_t = 0, allow_negative_numbers = true,
+          value_parser = crate::numbers::whole::<usize>(0, 4096))]
     pub threads: usize,
 
     /// granule: several granule types instead of --type (`all` or a comma
@@ -201,8 +202,9 @@ pub struct StabilityArgs {
     #[arg(long, value_name = "R")]
     pub time_step_floor: Option<f64>,
 
-    /// Worker threads of the bed runs (0 = all cores).
-    #[arg(short = 'j', long, value_name = "N", default_value_t = 0)]
+    /// Worker threads of the bed runs (0 = all cores; at most 4096).
+    #[arg(short = 'j', long, value_name = "N", default_value_t = 0, allow_negative_numbers = true,
+          value_parser = crate::numbers::whole::<usize>(0, 4096))]
     pub threads: usize,
 
     /// No progress lines on stderr.
