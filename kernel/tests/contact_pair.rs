@@ -209,6 +209,18 @@ fn a_node_beside_a_near_face_is_not_held_against_a_far_side_face() {
     let slave = slave_at(1.02, -0.005);
     let found = constraints(&slave, &master, &quads);
     assert!(found.is_empty(), "far-side contacts: {found:?}");
+    // Without the normal test (`nearest_penetrated_face`) the nearest
+    // surface still decides, for the node's normal either way.
+    let nearest = PairSettings {
+        nearest_penetrated_face: true,
+        ..settings(0.0)
+    };
+    let mut turned = slave;
+    turned.reverse();
+    for s in [slave, turned] {
+        let found = detected(&s, &master, &quads, &nearest);
+        assert!(found.is_empty(), "far-side contacts: {found:?}");
+    }
 }
 
 #[test]
@@ -522,6 +534,52 @@ fn a_near_constraint_wins_over_a_watch_and_the_nearest_face_is_watched() {
         held_on(&master, &quads, &slave),
         [(0, 0, true), (1, 0, true)]
     );
+}
+
+/// A node inside a face and behind it, with no other face near, whose own
+/// averaged normal does not oppose the face (the slave quad faces +z, as
+/// the face does: a fold of a strongly compressed granule): physics.md's
+/// normal test holds nothing against it; `nearest_penetrated_face` holds
+/// it as any penetrating node, in a search and in a held constraint's
+/// re-projection after a slide.
+#[test]
+fn a_node_whose_normal_turned_away_is_held_against_the_face_it_is_behind() {
+    let (master, quads) = flat_master();
+    // slave_at's corners in the other order: its normal is +z.
+    let turned = |x: Real, z: Real| {
+        let mut q = slave_at(x, z);
+        q.reverse();
+        q
+    };
+    let behind = turned(0.3, -0.004);
+    assert!(constraints(&behind, &master, &quads).is_empty());
+    let nearest = PairSettings {
+        nearest_penetrated_face: true,
+        ..settings(0.0)
+    };
+    let held = detected(&behind, &master, &quads, &nearest);
+    assert_eq!(held.len(), 4, "{held:?}");
+    assert!(
+        held.iter()
+            .all(|c| c.quad == 0 && (c.gap + 0.004).abs() < 1e-12),
+        "{held:?}"
+    );
+    // The same nodes slid along the face, 0.006 behind it: re-projected,
+    // they are kept with the new gap; under the normal test, dropped.
+    let slid = turned(0.5, -0.006);
+    let reproject = |nearest_penetrated_face| PairSettings {
+        reproject_slide: 0.0,
+        nearest_penetrated_face,
+        ..settings(0.0)
+    };
+    let kept = regapped_with(&slid, &master, &quads, &held, &reproject(true)).unwrap();
+    assert_eq!(kept.len(), 4, "{kept:?}");
+    assert!(
+        kept.iter().all(|c| (c.gap + 0.006).abs() < 1e-12),
+        "{kept:?}"
+    );
+    let dropped = regapped_with(&slid, &master, &quads, &held, &reproject(false)).unwrap();
+    assert!(dropped.is_empty(), "{dropped:?}");
 }
 
 /// A twisted face z = 0.4 x y over the unit square (a bilinear patch: its

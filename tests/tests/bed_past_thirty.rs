@@ -38,7 +38,10 @@ fn beds_that_overlapped_at_sixty_percent_pass_the_stability_judgement() {
 }
 
 /// The same beds held throughout do overlap: without the switch the test
-/// above could not fail.
+/// above could not fail. (B2 seed 3 overlapped by more than 10 % of the
+/// element while folded nodes went unheld; since they are held,
+/// `nearest_penetrated_face`, by 4.0 %: still four times the suite's
+/// limit.)
 #[test]
 fn held_throughout_the_same_bed_overlaps() {
     let scene = Scene {
@@ -47,5 +50,36 @@ fn held_throughout_the_same_bed_overlaps() {
     };
     let (record, _) = run_bed_case(&scene).unwrap();
     let overlap = record.max_penetration_rel_element.unwrap();
-    assert!(!record.passed && overlap > 0.1, "overlap {overlap}");
+    assert!(!record.passed && overlap > 0.02, "overlap {overlap}");
+}
+
+/// The nearest penetrated face acts in these beds: with physics.md's
+/// normal test on every hit instead, nodes at the folds of the flattened
+/// granules go unheld past about 45 % and the bed takes another path (the
+/// overlap measure, the same detection, barely sees them: BENCHMARKS.md,
+/// "Overlaps the detection did not see"). Before the first such node
+/// both runs are the same.
+#[test]
+fn folded_nodes_held_by_the_nearest_face_change_the_bed_past_thirty() {
+    let with = suite_bed("A3", 1);
+    let without = Scene {
+        nearest_penetrated_face: false,
+        ..with.clone()
+    };
+    let pressures = |scene: &Scene| {
+        let (_, run) = run_bed_case(scene).unwrap();
+        run.samples
+            .iter()
+            .map(|s| (s.strain, s.upper_pressure_pa))
+            .collect::<Vec<_>>()
+    };
+    let (a, b) = (pressures(&with), pressures(&without));
+    let early = |rows: &[(f64, f64)]| {
+        rows.iter()
+            .filter(|r| r.0 <= 0.3)
+            .copied()
+            .collect::<Vec<_>>()
+    };
+    assert_eq!(early(&a), early(&b));
+    assert_ne!(a.last(), b.last());
 }

@@ -85,7 +85,7 @@ fn scene_fields_out_of_range_or_contradicting_are_named() {
         &print(&rows),
         &[
             "`output_strain_interval` = 0.5",
-            "0 < interval <= final_strain",
+            "1e-6 <= interval <= final_strain",
         ],
     );
     let shots = DEFAULT_SCENE.replace(
@@ -199,6 +199,7 @@ fn a_scene_file_without_the_newer_fields_names_the_values_it_runs_with() {
         .replace("hold_constraints = true\n", "")
         .replace("contact_search_interval = 5\n", "")
         .replace("held_reprojection = 0.05\n", "")
+        .replace("nearest_penetrated_face = true\n", "")
         .replace("exact_contact_from_strain = 0.3\n", "");
     let old = scene_file("old", &text);
     let r = bed(&["--print-scene", "--scene", old.to_str().unwrap()]);
@@ -206,7 +207,8 @@ fn a_scene_file_without_the_newer_fields_names_the_values_it_runs_with() {
     for needle in [
         "warning: scene",
         "omits contact_search_interval, exact_contact_from_strain, held_reprojection, \
-         hold_constraints, time_step_floor",
+         hold_constraints, nearest_penetrated_face, time_step_floor",
+        "nearest_penetrated_face = false (published true)",
         "held_reprojection = inf (published 0.05)",
         "time_step_floor = 0.0 (published 1.0)",
         "hold_constraints = false (published true)",

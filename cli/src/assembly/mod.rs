@@ -169,6 +169,11 @@ pub struct AssemblyParams {
     /// overlapped by up to 44 % of the element; BENCHMARKS.md, "The
     /// 30-granule suite at 60 %").
     pub exact_contact_from_s: Real,
+    /// [`Self::sweep_tolerance_m`] from [`Self::exact_contact_from_s`] on,
+    /// m (> 0): far past 30 % the overlaps the sweeps leave reach the
+    /// tolerance itself, and a tighter one there costs the steps before
+    /// nothing.
+    pub exact_sweep_tolerance_m: Real,
     /// Skin of the per-node face lists, as a fraction of the reference
     /// mesh's mean surface-face diagonal: a pair's lists are rebuilt once a
     /// surface node of either granule has moved this far from where they
@@ -228,6 +233,7 @@ impl AssemblyParams {
             hold_constraints: false,
             contact_search_interval: 1,
             exact_contact_from_s: Real::INFINITY,
+            exact_sweep_tolerance_m: 0.05e-6,
             face_list_skin: FACE_LIST_SKIN,
         }
     }
@@ -780,6 +786,18 @@ impl<'m> Assembly<'m> {
     pub fn searches_step(&self, step: u64) -> bool {
         self.time >= self.params.exact_contact_from_s
             || step.is_multiple_of(u64::from(self.params.contact_search_interval.max(1)))
+    }
+
+    /// The sweep tolerance of the step starting now, m
+    /// ([`AssemblyParams::sweep_tolerance_m`], from
+    /// [`AssemblyParams::exact_contact_from_s`] on
+    /// [`AssemblyParams::exact_sweep_tolerance_m`]).
+    pub fn sweep_tolerance_m(&self) -> Real {
+        if self.time >= self.params.exact_contact_from_s {
+            self.params.exact_sweep_tolerance_m
+        } else {
+            self.params.sweep_tolerance_m
+        }
     }
 
     /// Whether the step starting now holds its constraints between

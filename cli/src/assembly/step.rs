@@ -871,11 +871,12 @@ impl Assembly<'_> {
                 .iter()
                 .map(|w| w.result.min_gap)
                 .fold(0.0, Real::min);
-            if deepest > -p.sweep_tolerance_m {
+            let tolerance = self.sweep_tolerance_m();
+            if deepest > -tolerance {
                 break;
             }
             if p.local_sweeps {
-                self.contact.narrow_to_deep_pairs(p.sweep_tolerance_m);
+                self.contact.narrow_to_deep_pairs(tolerance);
             }
         }
         self.frames = frames;

@@ -217,6 +217,21 @@ pub struct BedArgs {
     #[arg(long, value_name = "S", allow_negative_numbers = true)]
     pub held_reprojection: Option<f64>,
 
+    /// Override: a node behind faces it projects inside is held against
+    /// the nearest of them whatever its own normal (true, published), or
+    /// only against faces its normal opposes (false: physics.md's test,
+    /// under which nodes at folds of a strongly compressed granule sank
+    /// unseen). Allowed with --resume.
+    #[arg(long, value_name = "BOOL")]
+    pub nearest_penetrated_face: Option<bool>,
+
+    /// Override: the sweep tolerance from the exact-contact strain
+    /// (--exact-contact-from-strain) on, as a fraction of the element size
+    /// (0 < t ≤ 0.1; published 0.005, scene files without the field:
+    /// --sweep-tolerance's). Allowed with --resume.
+    #[arg(long, value_name = "T", allow_negative_numbers = true)]
+    pub exact_sweep_tolerance: Option<f64>,
+
     /// Override: from this axial strain on every contact sweep searches,
     /// as with --hold-constraints false --contact-search-interval 1
     /// (0 ≤ C ≤ 1, 1: never; published 0.3). Allowed with --resume.
@@ -227,6 +242,8 @@ pub struct BedArgs {
     /// the outputs go to DIR. Only --strain, --stop-at-strain,
     /// --time-step-safety, --mass-scaling, --sweep-tolerance,
     /// --hold-constraints, --contact-search-interval, --contact-capture,
+    /// --held-reprojection, --nearest-penetrated-face,
+    /// --exact-sweep-tolerance,
     /// --exact-contact-from-strain, --face-list-skin,
     /// --time-step-floor, --max-mass-factor, -j and --quiet may be given
     /// with it.
@@ -384,6 +401,12 @@ impl BedArgs {
         }
         if let Some(s) = self.held_reprojection {
             scene.held_reprojection = s;
+        }
+        if let Some(n) = self.nearest_penetrated_face {
+            scene.nearest_penetrated_face = n;
+        }
+        if let Some(t) = self.exact_sweep_tolerance {
+            scene.exact_sweep_tolerance = Some(t);
         }
         if let Some(c) = self.exact_contact_from_strain {
             scene.exact_contact_from_strain = c;

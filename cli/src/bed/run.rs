@@ -363,6 +363,7 @@ pub fn run_bed(
     params.damping_ratio = scene.damping_ratio;
     params.contact_sweeps = scene.contact_sweeps;
     params.sweep_tolerance_m = scene.sweep_tolerance * mesh.shortest_surface_edge();
+    params.exact_sweep_tolerance_m = scene.exact_sweep_tolerance() * mesh.shortest_surface_edge();
     params.mass_scaling = scene.mass_scaling;
     params.selective_mass_scaling = scene.selective_mass_scaling;
     params.selective_mass_ratio = scene.selective_mass_ratio;
@@ -376,6 +377,7 @@ pub fn run_bed(
     params.contact.capture = scene.contact_capture * mesh.shortest_surface_edge();
     params.contact.reproject_slide = scene.held_reprojection * mesh.shortest_surface_edge();
     params.contact.watch_beside = scene.held_reprojection.is_finite();
+    params.contact.nearest_penetrated_face = scene.nearest_penetrated_face;
     params.face_list_skin = scene.face_list_skin;
     params.max_node_speed_m_s = scene.watchdog_speed_ratio * scene.punch_speed_m_s;
     params.kinetic_energy_limit = scene.watchdog_energy_ratio;

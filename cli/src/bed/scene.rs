@@ -20,6 +20,16 @@ pub const SCENE_VERSION: u32 = 1;
 /// so); a bed is quasi-static only far below it (the published 0.05).
 pub const MAX_PUNCH_SPEED_M_S: f64 = 10.0;
 
+/// The widest die, in granule diameters: the pour's lattice and neighbour
+/// grid grow with its square (a die a million diameters wide was accepted
+/// and ran the pour out of memory).
+pub const MAX_DIE_DIAMETERS: f64 = 1000.0;
+
+/// The smallest output and checkpoint strain interval: the run steps its
+/// next output strain forward by the interval, and an interval below the
+/// round-off of the strain never got past it.
+pub const MIN_STRAIN_INTERVAL: f64 = 1e-6;
+
 /// The published scene (physics.md §6 and the paper's bed): 1000 B2
 /// granules of 1280 hexes poured into an 11.3 mm die (seed 1), the upper
 /// punch at 50 mm/s to 30 % axial strain, friction 0.1, ξ = 0.5.
@@ -27,7 +37,7 @@ pub const DEFAULT_SCENE: &str = r#"# granbed bed scene (format version 1). Units
 # A field left out takes its value from before the field existed: for the
 # numerics fields below (mass scaling, time_step_floor, hold_constraints,
 # contact_search_interval, contact_capture, held_reprojection,
-# sweep_tolerance) that is not the published value, and granbed-cli bed warns
+# nearest_penetrated_face, sweep_tolerance) that is not the published value, and granbed-cli bed warns
 # with the values it uses.
 version = 1
 
@@ -134,6 +144,14 @@ contact_capture = 0.1
 # stability suite to 30 % keeps its overlaps below 1 % of the element
 # (BENCHMARKS.md).
 held_reprojection = 0.05
+# A node behind faces it projects inside (within the gap window) is held
+# against the nearest of them whatever its own averaged normal; false: only
+# against faces its normal opposes (physics.md's test, the value of scene
+# files without this field). Far past 30 % a compressed granule's surface
+# folds at some nodes, whose normals then turn away from the face they press
+# into: under the normal test they sank into their neighbours by up to half
+# an element, unseen by the contact and by the overlap measure (BENCHMARKS.md).
+nearest_penetrated_face = true
 # From this axial strain on, every contact sweep searches: hold_constraints
 # and contact_search_interval above apply before it only (0 <= C <= 1; 1:
 # never, the value of scene files without this field). They are speed
@@ -148,6 +166,13 @@ exact_contact_from_strain = 0.3
 # than 0.005 (the value of scene files without this field) and leaves
 # overlaps of up to ~0.6 % of the element (BENCHMARKS.md).
 sweep_tolerance = 0.01
+# The sweep tolerance from exact_contact_from_strain (above) on (0 < t <= 0.1;
+# the value of scene files without this field: sweep_tolerance). Far past
+# 30 % the overlaps left reach the tolerance itself: with 0.01 two of the
+# 30-granule suite's beds overlapped by 1.00 and 1.05 % at 60 %, with 0.005
+# by 0.46 and 0.44 % (BENCHMARKS.md); the steps before the switch keep
+# sweep_tolerance.
+exact_sweep_tolerance = 0.005
 # Skin of the contact search's per-node face lists, as a fraction of the mean
 # surface-face diagonal: a pair's lists are rebuilt once a node has moved this
 # far (0: try every face near the overlap every sweep). The results are the
@@ -298,6 +323,11 @@ pub struct Scene {
     /// 0 < s ≤ 1 or ∞ (absent: ∞, neither, as before the field).
     #[serde(default = "never_reproject")]
     pub held_reprojection: f64,
+    /// A node behind faces it projects inside is held against the nearest
+    /// whatever its own normal (`PairSettings::nearest_penetrated_face`;
+    /// absent: false, physics.md's normal test, as before the field).
+    #[serde(default)]
+    pub nearest_penetrated_face: bool,
     /// From this axial strain on every contact sweep searches
     /// (`AssemblyParams::exact_contact_from_s`), 0 ≤ C ≤ 1 (1 and absent:
     /// never).
@@ -310,6 +340,11 @@ pub struct Scene {
     /// is 0.01).
     #[serde(default = "default_sweep_tolerance")]
     pub sweep_tolerance: f64,
+    /// The sweep tolerance from `exact_contact_from_strain` on, 0 < t ≤ 0.1
+    /// of the element size (`AssemblyParams::exact_sweep_tolerance_m`;
+    /// absent: `sweep_tolerance`, as before the field).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub exact_sweep_tolerance: Option<f64>,
     /// Skin of the contact search's face lists, 0 ≤ s ≤ 1 of the mean
     /// surface-face diagonal, 0 = none (absent: the default); the same
     /// bits for any value.
@@ -433,11 +468,18 @@ impl Scene {
         self.granule_type()?;
         self.mesh_level()?;
         self.element_kind()?;
-        let checks: [(bool, &str, f64, &str); 25] = [
+        let exact_sweep_tolerance = self.exact_sweep_tolerance();
+        let checks: [(bool, &str, f64, &str); 26] = [
             (
                 self.sweep_tolerance > 0.0 && self.sweep_tolerance <= 0.1,
                 "sweep_tolerance",
                 self.sweep_tolerance,
+                "0 < t <= 0.1",
+            ),
+            (
+                exact_sweep_tolerance > 0.0 && exact_sweep_tolerance <= 0.1,
+                "exact_sweep_tolerance",
+                exact_sweep_tolerance,
                 "0 < t <= 0.1",
             ),
             (
@@ -501,10 +543,10 @@ impl Scene {
                 "> 0",
             ),
             (
-                self.checkpoint_strain_interval > 0.0,
+                self.checkpoint_strain_interval >= MIN_STRAIN_INTERVAL,
                 "checkpoint_strain_interval",
                 self.checkpoint_strain_interval,
-                "> 0",
+                ">= 1e-6",
             ),
             (
                 (1..=100_000).contains(&self.granules),
@@ -519,10 +561,11 @@ impl Scene {
                 "0 < d < 2000",
             ),
             (
-                self.die_diameter_mm > 4.0 * self.diameter_mm && self.die_diameter_mm.is_finite(),
+                self.die_diameter_mm > 4.0 * self.diameter_mm
+                    && self.die_diameter_mm <= MAX_DIE_DIAMETERS * self.diameter_mm,
                 "die_diameter_mm",
                 self.die_diameter_mm,
-                "more than 4 granule diameters",
+                "more than 4 and at most 1000 granule diameters",
             ),
             (
                 self.punch_speed_m_s > 0.0 && self.punch_speed_m_s <= MAX_PUNCH_SPEED_M_S,
@@ -537,11 +580,11 @@ impl Scene {
                 "0 < C <= 0.9",
             ),
             (
-                self.output_strain_interval > 0.0
+                self.output_strain_interval >= MIN_STRAIN_INTERVAL
                     && self.output_strain_interval <= self.final_strain,
                 "output_strain_interval",
                 self.output_strain_interval,
-                "0 < interval <= final_strain",
+                "1e-6 <= interval <= final_strain",
             ),
             (
                 (0.0..=2.0).contains(&self.damping_ratio),
@@ -716,6 +759,13 @@ impl Scene {
         Ok((scene, notes))
     }
 
+    /// The sweep tolerance from `exact_contact_from_strain` on, of the
+    /// element size: `exact_sweep_tolerance`, or `sweep_tolerance` where
+    /// the scene has none.
+    pub fn exact_sweep_tolerance(&self) -> f64 {
+        self.exact_sweep_tolerance.unwrap_or(self.sweep_tolerance)
+    }
+
     /// Rejects snapshot strains beyond the final strain, naming the field.
     pub fn check_snapshots(&self) -> anyhow::Result<()> {
         if let Some(c) = self
@@ -844,6 +894,42 @@ mod tests {
         assert!(bad("mesh = \"8x2\"", "mesh = \"3x1\"").contains("`mesh`"));
         assert!(bad("friction = 0.1", "friction = -1").contains("material.friction"));
         assert!(bad("seed = 1", "seed = 1\ncolour = 3").contains("colour"));
+        // A die a million granule diameters wide ran the pour out of
+        // memory; intervals below the strain's round-off never ended.
+        let e = bad("die_diameter_mm = 11.3", "die_diameter_mm = 1e6");
+        assert!(
+            e.contains("`die_diameter_mm`") && e.contains("at most 1000"),
+            "{e}"
+        );
+        assert!(
+            Scene::from_toml(
+                &DEFAULT_SCENE.replace("die_diameter_mm = 11.3", "die_diameter_mm = 1000")
+            )
+            .is_ok()
+        );
+        for (from, to, field) in [
+            (
+                "output_strain_interval = 0.005",
+                "output_strain_interval = 1e-12",
+                "`output_strain_interval`",
+            ),
+            (
+                "checkpoint_strain_interval = 0.05",
+                "checkpoint_strain_interval = 1e-20",
+                "`checkpoint_strain_interval`",
+            ),
+        ] {
+            let e = bad(from, to);
+            assert!(e.contains(field) && e.contains("1e-6"), "{e}");
+        }
+        let e = bad(
+            "exact_sweep_tolerance = 0.005",
+            "exact_sweep_tolerance = 0.5",
+        );
+        assert!(
+            e.contains("`exact_sweep_tolerance`") && e.contains("0 < t <= 0.1"),
+            "{e}"
+        );
         assert!(bad("final_strain = 0.3", "final_strain = 1.5").contains("`final_strain`"));
         for k in ["0", "11"] {
             let line = format!("contact_search_interval = {k}");
@@ -883,6 +969,19 @@ mod tests {
         );
         let text = DEFAULT_SCENE.replace("held_reprojection = 0.05", "held_reprojection = inf");
         assert!(Scene::from_toml(&text).is_ok());
+        // Penetrating nodes held against the nearest face whatever their
+        // normal; a scene file without the field keeps physics.md's test.
+        assert!(Scene::published().nearest_penetrated_face);
+        let text = DEFAULT_SCENE.replace("nearest_penetrated_face = true\n", "");
+        assert!(!Scene::from_toml(&text).unwrap().nearest_penetrated_face);
+        // Past the exact-contact strain a tighter sweep tolerance; a scene
+        // file without the field keeps its sweep_tolerance there too.
+        assert_eq!(Scene::published().exact_sweep_tolerance(), 0.005);
+        let text = DEFAULT_SCENE.replace("exact_sweep_tolerance = 0.005\n", "");
+        assert_eq!(
+            Scene::from_toml(&text).unwrap().exact_sweep_tolerance(),
+            0.01
+        );
         for wrong in ["0.0", "1.5", "-inf", "nan"] {
             let e = bad(
                 "held_reprojection = 0.05",

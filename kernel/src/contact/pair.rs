@@ -73,6 +73,21 @@ pub struct PairSettings {
     /// On a curved face the gap along the held normal misses about
     /// s²/(2R) after a slide s (R the face's radius of curvature).
     pub reproject_slide: Real,
+    /// **Choice (deviates from physics.md §5.2):** a node behind faces it
+    /// projects inside (within the gap window) is held against the nearest
+    /// of them, the smallest |g|, whatever its own averaged normal, where
+    /// physics.md also asks n_s·n < 0. Far past 30 % a granule's surface
+    /// folds at some nodes, whose averaged normal then turns up to 90° and
+    /// more from the face they press into: those nodes failed the normal
+    /// test while inside the other granule (a winding-number check), no
+    /// contact held them, and they sank by up to half an element unseen,
+    /// as the overlap measure uses the same detection (BENCHMARKS.md,
+    /// "Overlaps the detection did not see"). The far-side faces the
+    /// normal test was to reject are still rejected: by the gap window and
+    /// by the check that no other face lies nearer. Near constraints,
+    /// watches and concave edges keep the normal test. false: the normal
+    /// test on every hit (physics.md, as before the field).
+    pub nearest_penetrated_face: bool,
 }
 
 impl PairSettings {
@@ -85,9 +100,9 @@ impl PairSettings {
     }
 
     /// physics.md's choices: μ = `friction`, inside tolerance 1e-6, window
-    /// 0.25 × face diagonal, 20 µm margin, symmetric two-pass; no capture
-    /// distance, no watches, no contact area, held constraints never
-    /// re-projected.
+    /// 0.25 × face diagonal, 20 µm margin, symmetric two-pass, the normal
+    /// test on every hit; no capture distance, no watches, no contact
+    /// area, held constraints never re-projected.
     pub fn standard(friction: Real) -> Self {
         Self {
             friction,
@@ -99,6 +114,7 @@ impl PairSettings {
             contact_area: false,
             watch_beside: false,
             reproject_slide: Real::INFINITY,
+            nearest_penetrated_face: false,
         }
     }
 }
@@ -722,7 +738,7 @@ fn closest_face<'c>(
             near_outside |= pr.inside(EDGE_REACH);
             continue;
         }
-        if !opposing(&pr.normal) {
+        if !(settings.nearest_penetrated_face || opposing(&pr.normal)) {
             continue;
         }
         let hit = Hit {
@@ -1287,7 +1303,8 @@ enum Reprojection {
 
 /// Held constraint `c` of [`regap`] projected afresh on its face at the
 /// slave's position `p`, with a search's tests (inside the face, behind it
-/// by less than the gap window, normals opposing). A corner or slave id
+/// by less than the gap window, normals opposing unless
+/// [`PairSettings::nearest_penetrated_face`]). A corner or slave id
 /// outside the bodies is an error.
 fn reprojected(
     slave: &SurfaceBody<'_>,
@@ -1304,9 +1321,11 @@ fn reprojected(
     if !(pr.gap < 0.0 && pr.gap > -settings.window(&corners)) {
         return Ok(Reprojection::Clear);
     }
-    let ns = slave.node_normal(c.slave as usize)?;
-    // Normals opposing (a NaN opposes nothing).
-    Ok(if dot(&ns, &pr.normal) < 0.0 {
+    // Normals opposing (a NaN opposes nothing), unless a search would
+    // take the face whatever the node's normal.
+    let taken = settings.nearest_penetrated_face
+        || dot(&slave.node_normal(c.slave as usize)?, &pr.normal) < 0.0;
+    Ok(if taken {
         Reprojection::Contact(Constraint {
             weights: pr.weights,
             normal: pr.normal,
