@@ -400,15 +400,21 @@ fn assert_found_as_a_search_finds(r: &Constraint, f: &Constraint) {
     assert!(close(&r.normal, &f.normal), "{r:?} vs {f:?}");
 }
 
-/// One flat face: z = 0 over the unit square, facing +z.
-fn flat_master() -> (Vec<Vec3>, Vec<[u32; 4]>) {
+/// One face over the unit square, facing +z, its corner (1, 1) lifted to
+/// z = `lift` (the others at z = 0): flat for 0, else twisted.
+fn unit_face(lift: Real) -> (Vec<Vec3>, Vec<[u32; 4]>) {
     let x = vec![
         [0.0, 0.0, 0.0],
         [1.0, 0.0, 0.0],
-        [1.0, 1.0, 0.0],
+        [1.0, 1.0, lift],
         [0.0, 1.0, 0.0],
     ];
     (x, vec![[0, 1, 2, 3]])
+}
+
+/// One flat face: z = 0 over the unit square, facing +z.
+fn flat_master() -> (Vec<Vec3>, Vec<[u32; 4]>) {
+    unit_face(0.0)
 }
 
 /// A node in front of a face's plane but just off the face (coming over its
@@ -585,13 +591,7 @@ fn a_node_whose_normal_turned_away_is_held_against_the_face_it_is_behind() {
 /// A twisted face z = 0.4 x y over the unit square (a bilinear patch: its
 /// normal (−0.4y, −0.4x, 1) turns across it), facing +z.
 fn twisted_master() -> (Vec<Vec3>, Vec<[u32; 4]>) {
-    let x = vec![
-        [0.0, 0.0, 0.0],
-        [1.0, 0.0, 0.0],
-        [1.0, 1.0, 0.4],
-        [0.0, 1.0, 0.0],
-    ];
-    (x, vec![[0, 1, 2, 3]])
+    unit_face(0.4)
 }
 
 /// A slave quad (facing down) over (c, c)–(c + 0.1, c + 0.1), each node
