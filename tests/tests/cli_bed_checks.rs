@@ -200,15 +200,17 @@ fn a_scene_file_without_the_newer_fields_names_the_values_it_runs_with() {
         .replace("contact_search_interval = 5\n", "")
         .replace("held_reprojection = 0.05\n", "")
         .replace("nearest_penetrated_face = true\n", "")
+        .replace("exact_sweep_tolerance = 0.005\n", "")
         .replace("exact_contact_from_strain = 0.3\n", "");
     let old = scene_file("old", &text);
     let r = bed(&["--print-scene", "--scene", old.to_str().unwrap()]);
     assert_eq!(r.code, 0, "{}", r.stderr);
     for needle in [
         "warning: scene",
-        "omits contact_search_interval, exact_contact_from_strain, held_reprojection, \
-         hold_constraints, nearest_penetrated_face, time_step_floor",
+        "omits contact_search_interval, exact_contact_from_strain, exact_sweep_tolerance, \
+         held_reprojection, hold_constraints, nearest_penetrated_face, time_step_floor",
         "nearest_penetrated_face = false (published true)",
+        "exact_sweep_tolerance = 0.01 (published 0.005)",
         "held_reprojection = inf (published 0.05)",
         "time_step_floor = 0.0 (published 1.0)",
         "hold_constraints = false (published true)",

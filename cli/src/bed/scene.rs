@@ -37,7 +37,8 @@ pub const DEFAULT_SCENE: &str = r#"# granbed bed scene (format version 1). Units
 # A field left out takes its value from before the field existed: for the
 # numerics fields below (mass scaling, time_step_floor, hold_constraints,
 # contact_search_interval, contact_capture, held_reprojection,
-# nearest_penetrated_face, sweep_tolerance) that is not the published value, and granbed-cli bed warns
+# nearest_penetrated_face, sweep_tolerance, exact_sweep_tolerance) that is not the
+# published value, and granbed-cli bed warns
 # with the values it uses.
 version = 1
 
@@ -170,8 +171,8 @@ sweep_tolerance = 0.01
 # the value of scene files without this field: sweep_tolerance). Far past
 # 30 % the overlaps left reach the tolerance itself: with 0.01 two of the
 # 30-granule suite's beds overlapped by 1.00 and 1.05 % at 60 %, with 0.005
-# by 0.46 and 0.44 % (BENCHMARKS.md); the steps before the switch keep
-# sweep_tolerance.
+# from 30 % on by 0.54 and 0.51 % (BENCHMARKS.md); the steps before the
+# switch keep sweep_tolerance.
 exact_sweep_tolerance = 0.005
 # Skin of the contact search's per-node face lists, as a fraction of the mean
 # surface-face diagonal: a pair's lists are rebuilt once a node has moved this
@@ -788,13 +789,17 @@ impl Scene {
     /// keep the older files' runs as they were (`[material]` is not
     /// listed: absent, the type's preset applies).
     pub fn omitted_fields(&self, text: &str) -> Vec<OmittedField> {
-        let (Ok(given), Ok(published), Ok(toml::Value::Table(own))) = (
+        let (Ok(given), Ok(published), Ok(toml::Value::Table(mut own))) = (
             toml::from_str::<toml::Table>(text),
             toml::from_str::<toml::Table>(DEFAULT_SCENE),
             toml::Value::try_from(self),
         ) else {
             return Vec::new();
         };
+        // An absent exact_sweep_tolerance is not written; its value is
+        // sweep_tolerance's.
+        own.entry("exact_sweep_tolerance")
+            .or_insert(toml::Value::Float(self.exact_sweep_tolerance()));
         published
             .iter()
             .filter(|(field, _)| field.as_str() != "material" && !given.contains_key(*field))
