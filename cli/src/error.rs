@@ -33,6 +33,32 @@ impl fmt::Display for InputError {
 
 impl core::error::Error for InputError {}
 
+/// A rejected field of an input file (a scene's `die_diameter_mm`, …):
+/// its message names the field and the allowed range, and it is a usage
+/// error like [`InputError`]. The field is kept apart so that a command
+/// whose flag set the field can name the flag instead.
+#[derive(Debug, Clone, PartialEq)]
+pub struct FieldError {
+    /// The field's name in the file.
+    pub field: &'static str,
+    /// The rejected value as text.
+    pub value: String,
+    /// The allowed range, in the field's units.
+    pub allowed: String,
+}
+
+impl fmt::Display for FieldError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(
+            f,
+            "scene field `{}` = {} is out of range (allowed: {})",
+            self.field, self.value, self.allowed
+        )
+    }
+}
+
+impl core::error::Error for FieldError {}
+
 /// A usage error with `message` (which should name the flag).
 pub fn input_error(message: impl Into<String>) -> anyhow::Error {
     anyhow::Error::new(InputError(message.into()))
@@ -42,7 +68,9 @@ pub fn input_error(message: impl Into<String>) -> anyhow::Error {
 pub fn is_usage_error(err: &anyhow::Error) -> bool {
     err.downcast_ref::<clap::Error>().is_some()
         || err.downcast_ref::<InputError>().is_some()
-        || err.chain().any(|e| e.is::<InputError>())
+        || err
+            .chain()
+            .any(|e| e.is::<InputError>() || e.is::<FieldError>())
 }
 
 /// True if `err` comes from writing to a closed pipe.

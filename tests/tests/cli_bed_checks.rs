@@ -73,9 +73,28 @@ fn scene_fields_out_of_range_or_contradicting_are_named() {
     };
     // The punch speed is bounded as granule's platen speed is.
     let fast = DEFAULT_SCENE.replace("punch_speed_m_s = 0.05", "punch_speed_m_s = 1e9");
-    rejected(&print(&fast), &["`punch_speed_m_s`", "0 < v <= 10 m/s"]);
+    rejected(&print(&fast), &["`punch_speed_m_s`", "1e-4 <= v <= 10 m/s"]);
     let limit = DEFAULT_SCENE.replace("punch_speed_m_s = 0.05", "punch_speed_m_s = 10.0");
     assert_eq!(print(&limit).code, 0);
+    // So slow that the speed watchdog would stop the settled bed at once.
+    let slow = DEFAULT_SCENE.replace("punch_speed_m_s = 0.05", "punch_speed_m_s = 1e-6");
+    rejected(
+        &print(&slow),
+        &["`punch_speed_m_s` = 0.000001", "1e-4 <= v"],
+    );
+    let limit = DEFAULT_SCENE.replace("punch_speed_m_s = 0.05", "punch_speed_m_s = 1e-4");
+    assert_eq!(print(&limit).code, 0);
+    // The rate check's second run at half of it would be below the limit.
+    let path = scene_file("slowest", &limit);
+    rejected(
+        &bed(&[
+            "--print-scene",
+            "--rate-check",
+            "--scene",
+            path.to_str().unwrap(),
+        ]),
+        &["`--rate-check` needs a punch speed of at least 0.0002 m/s"],
+    );
     // Output rows and snapshots within the final strain.
     let rows = DEFAULT_SCENE.replace(
         "output_strain_interval = 0.005",
@@ -102,7 +121,30 @@ fn scene_fields_out_of_range_or_contradicting_are_named() {
     // --strain below the output interval names both.
     rejected(
         &bed(&["--print-scene", "--strain", "0.003"]),
-        &["`--strain 0.003`", "output_strain_interval"],
+        &[
+            "`--strain 0.003` rejected",
+            "`output_strain_interval` = 0.005",
+        ],
+    );
+    // A flag that breaks another field's check is named with that field,
+    // and both flags where both are given.
+    rejected(
+        &bed(&["--print-scene", "--hold-constraints", "false"]),
+        &[
+            "`--hold-constraints false` rejected",
+            "`contact_search_interval` = 5",
+            "1 unless hold_constraints = true",
+        ],
+    );
+    rejected(
+        &bed(&[
+            "--print-scene",
+            "--contact-search-interval",
+            "3",
+            "--hold-constraints",
+            "false",
+        ]),
+        &["`--contact-search-interval 3` with `--hold-constraints false` rejected"],
     );
     // --strain drops the snapshots past it, so the scene printed reads
     // back as a scene file.
@@ -118,22 +160,22 @@ fn every_numeric_flag_takes_a_minus_and_names_its_range() {
     let cases: [(&str, &[&str]); 17] = [
         ("--granules", &["'--granules <N>'", "1..=100000"]),
         ("--seed", &["'--seed <SEED>'", "0..=18446744073709551615"]),
-        ("--strain", &["`final_strain` = -1", "0 < C <= 0.9"]),
+        ("--strain", &["`--strain -1`", "0 < C <= 0.9"]),
         (
             "--die-diameter-mm",
-            &["`die_diameter_mm` = -1", "more than 4"],
+            &["`--die-diameter-mm -1`", "more than 4"],
         ),
         (
             "--hourglass-kappa",
-            &["`hourglass_kappa` = -1", "0 <= kappa <= 1"],
+            &["`--hourglass-kappa -1`", "0 <= kappa <= 1"],
         ),
         (
             "--sweep-tolerance",
-            &["`sweep_tolerance` = -1", "0 < t <= 0.1"],
+            &["`--sweep-tolerance -1`", "0 < t <= 0.1"],
         ),
         (
             "--face-list-skin",
-            &["`face_list_skin` = -1", "0 <= s <= 1"],
+            &["`--face-list-skin -1`", "0 <= s <= 1"],
         ),
         (
             "--contact-search-interval",
@@ -141,29 +183,29 @@ fn every_numeric_flag_takes_a_minus_and_names_its_range() {
         ),
         (
             "--contact-capture",
-            &["`contact_capture` = -1", "0 <= c <= 0.1"],
+            &["`--contact-capture -1`", "0 <= c <= 0.1"],
         ),
         (
             "--exact-contact-from-strain",
-            &["`exact_contact_from_strain` = -1", "0 <= C <= 1 (1: never)"],
+            &["`--exact-contact-from-strain -1`", "0 <= C <= 1 (1: never)"],
         ),
         ("--stop-at-strain", &["`--stop-at-strain -1`", "0 < C <="]),
-        ("--mass-scaling", &["`mass_scaling` = -1", "1 <= F <= 1e6"]),
+        ("--mass-scaling", &["`--mass-scaling -1`", "1 <= F <= 1e6"]),
         (
             "--selective-mass-ratio",
-            &["`selective_mass_ratio` = -1", ">= 1"],
+            &["`--selective-mass-ratio -1`", ">= 1"],
         ),
         (
             "--time-step-safety",
-            &["`time_step_safety` = -1", "0 < C <= 2"],
+            &["`--time-step-safety -1`", "0 < C <= 2"],
         ),
         (
             "--time-step-floor",
-            &["`time_step_floor` = -1", "0 <= r <= 1"],
+            &["`--time-step-floor -1`", "0 <= r <= 1"],
         ),
         (
             "--max-mass-factor",
-            &["`max_mass_factor` = -1", "1 <= k <= 1e6"],
+            &["`--max-mass-factor -1`", "1 <= k <= 1e6"],
         ),
         ("-j", &["'--threads <N>'", "0..=4096"]),
     ];

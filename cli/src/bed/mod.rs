@@ -324,6 +324,58 @@ pub struct BedArgs {
     pub quiet: bool,
 }
 
+/// The scene field a `bed` override flag sets (`--die-diameter-mm` sets
+/// `die_diameter_mm`; two flags are named otherwise).
+fn field_of_flag(flag: &str) -> String {
+    match flag {
+        "--strain" => "final_strain".to_owned(),
+        "--type" => "granule_type".to_owned(),
+        other => other.trim_start_matches("--").replace('-', "_"),
+    }
+}
+
+/// A scene that failed its checks (`e`), reported by the override flags
+/// that set the failing field or a field its check depends on (`given`:
+/// each flag applied and its value): "`--die-diameter-mm 0.001` is out of
+/// range (allowed: …; scene field `die_diameter_mm`)". An error no flag
+/// caused is returned as it is.
+fn flag_error(e: anyhow::Error, given: &[(&'static str, String)]) -> anyhow::Error {
+    let Some(f) = e.downcast_ref::<crate::error::FieldError>() else {
+        return e;
+    };
+    // The fields a check reads besides its own.
+    let related: &[&str] = match f.field {
+        "output_strain_interval" | "snapshot_strains" => &["final_strain"],
+        "contact_search_interval" => &["hold_constraints"],
+        "die_diameter_mm" => &["diameter_mm"],
+        _ => &[],
+    };
+    let own = given
+        .iter()
+        .find(|(flag, _)| field_of_flag(flag) == f.field);
+    let others: Vec<String> = given
+        .iter()
+        .filter(|(flag, _)| related.contains(&field_of_flag(flag).as_str()))
+        .map(|(flag, v)| format!("`{flag} {v}`"))
+        .collect();
+    let message = match (own, others.is_empty()) {
+        (Some((flag, v)), true) => format!(
+            "`{flag} {v}` is out of range (allowed: {}; scene field `{}`)",
+            f.allowed, f.field
+        ),
+        (_, false) => {
+            let mut flags: Vec<String> = own
+                .iter()
+                .map(|(flag, v)| format!("`{flag} {v}`"))
+                .collect();
+            flags.extend(others);
+            format!("{} rejected: {f}", flags.join(" with "))
+        }
+        (None, true) => return e,
+    };
+    crate::error::input_error(message)
+}
+
 impl BedArgs {
     /// The scene: the checkpoint's, the file or the published one, with
     /// the overrides, validated.
@@ -345,16 +397,26 @@ impl BedArgs {
             (Some(path), None) => Scene::read_with_notes(path)?,
             (None, None) => (Scene::published(), Vec::new()),
         };
-        if let Some(t) = self.granule_type {
-            scene.granule_type = t.name().to_string();
+        // Each override given is applied and remembered as the flag and
+        // its value, so that a field it set that fails the scene's checks
+        // is reported by the flag.
+        let mut given: Vec<(&'static str, String)> = Vec::new();
+        macro_rules! set {
+            ($arg:ident, $flag:literal, |$v:ident| $apply:expr) => {
+                if let Some($v) = self.$arg {
+                    $apply;
+                    given.push(($flag, $v.to_string()));
+                }
+            };
+            ($arg:ident, $flag:literal) => {
+                set!($arg, $flag, |v| scene.$arg = v)
+            };
         }
-        if let Some(n) = self.granules {
-            scene.granules = n;
-        }
-        if let Some(m) = self.mesh {
-            scene.mesh = m.to_string();
-        }
-        if let Some(c) = self.strain {
+        set!(granule_type, "--type", |t| scene.granule_type =
+            t.name().to_string());
+        set!(granules, "--granules");
+        set!(mesh, "--mesh", |m| scene.mesh = m.to_string());
+        set!(strain, "--strain", |c| {
             scene.final_strain = c;
             // Snapshots past the end are never written: a fresh run's scene
             // (printed, or kept in its checkpoint) leaves them out, so that it
@@ -362,80 +424,34 @@ impl BedArgs {
             if resume.is_none() {
                 scene.snapshot_strains.retain(|&s| s <= c);
             }
-        }
-        if let Some(s) = self.seed {
-            scene.seed = s;
-        }
-        if let Some(d) = self.die_diameter_mm {
-            scene.die_diameter_mm = d;
-        }
+        });
+        set!(seed, "--seed");
+        set!(die_diameter_mm, "--die-diameter-mm");
+        // A value clap parsed from its list: no check can reject it.
         if let Some(e) = self.element {
             scene.element = scene::element_name(e.into()).to_owned();
         }
-        if let Some(k) = self.hourglass_kappa {
-            scene.hourglass_kappa = k;
-        }
-        if let Some(f) = self.mass_scaling {
-            scene.mass_scaling = f;
-        }
-        if let Some(s) = self.selective_mass_scaling {
-            scene.selective_mass_scaling = s;
-        }
-        if let Some(r) = self.selective_mass_ratio {
-            scene.selective_mass_ratio = r;
-        }
-        if let Some(r) = self.rigid_until_touched {
-            scene.rigid_until_touched = r;
-        }
-        if let Some(l) = self.local_sweeps {
-            scene.local_sweeps = l;
-        }
-        if let Some(h) = self.hold_constraints {
-            scene.hold_constraints = h;
-        }
-        if let Some(k) = self.contact_search_interval {
-            scene.contact_search_interval = k;
-        }
-        if let Some(c) = self.contact_capture {
-            scene.contact_capture = c;
-        }
-        if let Some(s) = self.held_reprojection {
-            scene.held_reprojection = s;
-        }
-        if let Some(n) = self.nearest_penetrated_face {
-            scene.nearest_penetrated_face = n;
-        }
-        if let Some(t) = self.exact_sweep_tolerance {
-            scene.exact_sweep_tolerance = Some(t);
-        }
-        if let Some(c) = self.exact_contact_from_strain {
-            scene.exact_contact_from_strain = c;
-        }
-        if let Some(c) = self.time_step_safety {
-            scene.time_step_safety = c;
-        }
-        if let Some(r) = self.time_step_floor {
-            scene.time_step_floor = r;
-        }
-        if let Some(k) = self.max_mass_factor {
-            scene.max_mass_factor = k;
-        }
-        if let Some(s) = self.face_list_skin {
-            scene.face_list_skin = s;
-        }
-        if let Some(t) = self.sweep_tolerance {
-            scene.sweep_tolerance = t;
-        }
-        scene.validate().map_err(|e| match self.strain {
-            // The one check --strain can fail besides its own range.
-            Some(c) if format!("{e}").contains("`output_strain_interval`") => {
-                e.context(crate::error::InputError(format!(
-                    "`--strain {c}` is below the scene's output_strain_interval {}",
-                    scene.output_strain_interval
-                )))
-            }
-            _ => e,
-        })?;
+        set!(hourglass_kappa, "--hourglass-kappa");
+        set!(mass_scaling, "--mass-scaling");
+        set!(selective_mass_scaling, "--selective-mass-scaling");
+        set!(selective_mass_ratio, "--selective-mass-ratio");
+        set!(rigid_until_touched, "--rigid-until-touched");
+        set!(local_sweeps, "--local-sweeps");
+        set!(hold_constraints, "--hold-constraints");
+        set!(contact_search_interval, "--contact-search-interval");
+        set!(contact_capture, "--contact-capture");
+        set!(held_reprojection, "--held-reprojection");
+        set!(nearest_penetrated_face, "--nearest-penetrated-face");
+        set!(exact_sweep_tolerance, "--exact-sweep-tolerance", |t| {
+            scene.exact_sweep_tolerance = Some(t)
+        });
+        set!(exact_contact_from_strain, "--exact-contact-from-strain");
+        set!(time_step_safety, "--time-step-safety");
+        set!(time_step_floor, "--time-step-floor");
+        set!(max_mass_factor, "--max-mass-factor");
+        set!(face_list_skin, "--face-list-skin");
+        set!(sweep_tolerance, "--sweep-tolerance");
+        scene.validate().map_err(|e| flag_error(e, &given))?;
         Ok((scene, notes))
     }
 
@@ -457,6 +473,17 @@ impl BedArgs {
                 "`--stop-at-strain {c}` is out of range (allowed: 0 < C <= the final strain {})",
                 scene.final_strain
             ))));
+        }
+        // The rate check's run takes half the speed, which must be a
+        // scene's speed too (its checkpoint resumes as one).
+        if self.rate_check && 0.5 * scene.punch_speed_m_s < scene::MIN_PUNCH_SPEED_M_S {
+            return Err(crate::error::input_error(format!(
+                "`--rate-check` needs a punch speed of at least {} m/s (its second run takes \
+                 half the speed, at least {} m/s); the scene's punch_speed_m_s is {}",
+                2.0 * scene::MIN_PUNCH_SPEED_M_S,
+                scene::MIN_PUNCH_SPEED_M_S,
+                scene.punch_speed_m_s
+            )));
         }
         if self.print_scene {
             let text = if self.scene.is_none() && scene == Scene::published() {

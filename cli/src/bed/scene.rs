@@ -8,7 +8,7 @@ use granbed_kernel::material::{GranuleType, Material, MaterialParams};
 use serde::{Deserialize, Serialize};
 
 use crate::assembly::MAX_CONTACT_SEARCH_INTERVAL;
-use crate::error::InputError;
+use crate::error::{FieldError, InputError};
 use crate::model::{MeshLevel, OwnedReference};
 
 /// The format version this build reads and writes.
@@ -19,6 +19,14 @@ pub const SCENE_VERSION: u32 = 1;
 /// the punch by more than an output interval on a small bed (the run says
 /// so); a bed is quasi-static only far below it (the published 0.05).
 pub const MAX_PUNCH_SPEED_M_S: f64 = 10.0;
+
+/// The slowest punch accepted, m/s (the published scene's speed / 500):
+/// the run's steps grow as 1/v (the published scene at this speed would
+/// take about 500 × its 17 minutes), and the speed watchdog's limit,
+/// `watchdog_speed_ratio` × v, falls below the speeds the granules still
+/// settle at after the pour (at 1e-6 m/s a 15-granule bed stopped at step
+/// 26 on a node at 2.1 mm/s; at 1e-4 it ran).
+pub const MIN_PUNCH_SPEED_M_S: f64 = 1.0e-4;
 
 /// The widest die, in granule diameters: the pour's lattice and neighbour
 /// grid grow with its square (a die a million diameters wide was accepted
@@ -241,7 +249,8 @@ pub struct Scene {
     pub seed: u64,
     /// Die diameter, mm.
     pub die_diameter_mm: f64,
-    /// Upper-punch speed, m/s, 0 < v ≤ [`MAX_PUNCH_SPEED_M_S`].
+    /// Upper-punch speed, m/s, [`MIN_PUNCH_SPEED_M_S`] ≤ v ≤
+    /// [`MAX_PUNCH_SPEED_M_S`].
     pub punch_speed_m_s: f64,
     /// Axial strain at which the run ends, 0 < C ≤ 0.9.
     pub final_strain: f64,
@@ -433,10 +442,12 @@ fn default_watchdog_speed_ratio() -> f64 {
     2000.0
 }
 
-fn invalid(field: &str, value: impl core::fmt::Display, allowed: &str) -> anyhow::Error {
-    anyhow::Error::new(InputError(format!(
-        "scene field `{field}` = {value} is out of range (allowed: {allowed})"
-    )))
+fn invalid(field: &'static str, value: impl core::fmt::Display, allowed: &str) -> anyhow::Error {
+    anyhow::Error::new(FieldError {
+        field,
+        value: value.to_string(),
+        allowed: allowed.to_owned(),
+    })
 }
 
 impl Scene {
@@ -569,10 +580,10 @@ impl Scene {
                 "more than 4 and at most 1000 granule diameters",
             ),
             (
-                self.punch_speed_m_s > 0.0 && self.punch_speed_m_s <= MAX_PUNCH_SPEED_M_S,
+                (MIN_PUNCH_SPEED_M_S..=MAX_PUNCH_SPEED_M_S).contains(&self.punch_speed_m_s),
                 "punch_speed_m_s",
                 self.punch_speed_m_s,
-                "0 < v <= 10 m/s, the platen speed limit of `granbed-cli granule`",
+                "1e-4 <= v <= 10 m/s (10: the platen speed limit of `granbed-cli granule`)",
             ),
             (
                 self.final_strain > 0.0 && self.final_strain <= 0.9,
