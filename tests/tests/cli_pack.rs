@@ -291,7 +291,7 @@ fn quiet_prints_nothing() {
 
 #[test]
 fn bad_input_exits_2_naming_the_flag() {
-    let cases: [(&[&str], &str); 15] = [
+    let cases: [(&[&str], &str); 19] = [
         // Whole numbers: the flag and the allowed range, whatever the typo.
         (
             &["--granules", "0"],
@@ -321,6 +321,23 @@ fn bad_input_exits_2_naming_the_flag() {
         (&["--seed", "1.5"], "'--seed <SEED>': not a whole number"),
         (&["--diameter-mm", "0"], "`--diameter-mm 0`"),
         (&["--youngs-modulus-mpa", "-5"], "`--youngs-modulus-mpa -5`"),
+        // Too soft to rest without deep overlaps, too stiff to finish.
+        (
+            &["--youngs-modulus-mpa", "1e-12"],
+            "`--youngs-modulus-mpa 1e-12` is out of range (allowed: 1 <= E <= 1e5 MPa)",
+        ),
+        (
+            &["--youngs-modulus-mpa", "1e9"],
+            "(allowed: 1 <= E <= 1e5 MPa)",
+        ),
+        (
+            &["--die-diameter-mm", "1e-9"],
+            "allowed: more than 4 granule diameters, here more than 4 mm for `--diameter-mm 1`",
+        ),
+        (
+            &["--diameter-mm", "3000"],
+            "`--diameter-mm 3000` is out of range (allowed: 0 < d < 2000 mm)",
+        ),
         (&["--max-time-s", "0.2"], "`--max-time-s 0.2`"),
         (&["--friction", "-1"], "`--friction -1`"),
         (&["--eta0", "1.5"], "`--eta0 1.5`"),
