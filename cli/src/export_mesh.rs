@@ -31,8 +31,8 @@ pub struct ExportMeshArgs {
     /// YSYM, ZSYM on the symmetry planes.
     #[arg(long)]
     pub octant: bool,
-    /// Granule diameter, mm (> 0).
-    #[arg(long, default_value_t = 1.0)]
+    /// Granule diameter, mm (0.001 ≤ d ≤ 1000).
+    #[arg(long, default_value_t = 1.0, allow_negative_numbers = true)]
     pub diameter_mm: f64,
     /// Length unit of the node coordinates.
     #[arg(long, value_enum, default_value = "m")]
@@ -61,13 +61,7 @@ fn c3d8_face(slots: [usize; 4]) -> Option<&'static str> {
 impl ExportMeshArgs {
     /// Runs the export.
     pub fn run(&self, streams: &mut Streams<'_>) -> anyhow::Result<()> {
-        if !(self.diameter_mm > 0.0 && self.diameter_mm.is_finite()) {
-            return Err(crate::error::input_error(format!(
-                "`--diameter-mm {}`: allowed range is a finite diameter > 0",
-                self.diameter_mm
-            )));
-        }
-        let radius = 0.5e-3 * self.diameter_mm;
+        let radius = crate::granule::radius_of_diameter_mm(self.diameter_mm)?;
         let mesh = OwnedReference::sphere(radius, self.mesh, self.octant)?;
         let scale = match self.length_unit {
             LengthUnit::M => 1.0,

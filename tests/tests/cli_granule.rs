@@ -319,8 +319,13 @@ fn platens_carry_equal_forces() {
 fn bad_input_names_the_flag() {
     let dir = out_dir("bad");
     let out = dir.to_str().unwrap();
-    let cases: [(&[&str], &str); 11] = [
+    let cases: [(&[&str], &str); 13] = [
         (&["--strain", "0"], "--strain"),
+        (
+            &["--diameter-mm", "0"],
+            "`--diameter-mm 0` is out of range (allowed: 0.001 <= d <= 1000 mm)",
+        ),
+        (&["--diameter-mm", "1e300"], "`--diameter-mm 1e300`"),
         (&["--strain", "0.95"], "--strain"),
         (&["--speed-mm-s", "-1"], "--speed-mm-s"),
         (&["--gravity"], "--gravity"),
@@ -358,6 +363,56 @@ fn bad_input_names_the_flag() {
     let missing = cli(&["granule"]);
     assert_eq!(missing.code, 2);
     assert!(missing.stderr.contains("--out"), "{}", missing.stderr);
+}
+
+/// `--diameter-mm`: without gravity the equations of motion are
+/// unchanged when lengths and time are scaled together (velocities,
+/// strains and stresses stay), and the element time step scales with the
+/// mesh. So a granule of twice the diameter at the same platen speed takes
+/// the same steps to the same strains, with the same σ_est and four times
+/// the force, up to round-off (2·10⁻¹⁰ measured; 10⁻⁸ allowed). A radius
+/// not passed to the mesh, or a step not scaled with it, fails this.
+#[test]
+fn a_granule_twice_the_size_is_the_same_experiment_scaled() {
+    let (small, large) = (out_dir("d1"), out_dir("d2"));
+    granule_ok(&small, &QUICK);
+    let mut args = QUICK.to_vec();
+    args.extend_from_slice(&["--diameter-mm", "2"]);
+    granule_ok(&large, &args);
+    let (a, b) = (summary(&small), summary(&large));
+    assert_eq!(number(&a, "diameter_m"), 1.0e-3);
+    assert_eq!(number(&b, "diameter_m"), 2.0e-3);
+    assert_eq!(a["steps"], b["steps"]);
+    assert_close(
+        "sigma_est_pa",
+        number(&b, "sigma_est_pa"),
+        number(&a, "sigma_est_pa"),
+        1e-8,
+        0.0,
+    );
+    let (ta, tb) = (
+        Table::read(&small.join("force_displacement.csv")),
+        Table::read(&large.join("force_displacement.csv")),
+    );
+    let (fa, fb) = (ta.num("force_n"), tb.num("force_n"));
+    let (sa, sb) = (ta.num("strain"), tb.num("strain"));
+    assert_eq!(fa.len(), fb.len());
+    let peak = fa.iter().fold(0.0f64, |m, f| m.max(f.abs()));
+    assert!(peak > 0.0);
+    for i in 0..fa.len() {
+        assert!(
+            (sb[i] - sa[i]).abs() < 1e-9,
+            "row {i}: strain {} vs {}",
+            sb[i],
+            sa[i]
+        );
+        assert!(
+            (fb[i] - 4.0 * fa[i]).abs() <= 1e-8 * 4.0 * peak,
+            "row {i}: force {} vs 4 × {}",
+            fb[i],
+            fa[i]
+        );
+    }
 }
 
 /// `--mass-scaling F`: √F fewer steps, the same curve within the rate
@@ -504,6 +559,51 @@ fn identical_runs_write_identical_files() {
 /// the wave speed) driven to 90 % strain inverts an element within a few
 /// dozen steps. The rows so far, the summary with its error and the plot
 /// are kept, and the message names type, step, strain and element.
+/// Without hourglass control (κ = 0) the coarse granule folds (at 25 %
+/// strain): the time step cannot be estimated on a folded element, and
+/// the error names the element, its Jacobian ratio, the step and the
+/// strain, on stderr and in the summary.
+#[test]
+fn a_folded_element_is_named() {
+    let dir = out_dir("folded");
+    let out = dir.to_str().unwrap();
+    let run = cli(&[
+        "granule",
+        "--quiet",
+        "--out",
+        out,
+        "--mesh",
+        "4x1",
+        "--hourglass-kappa",
+        "0",
+        "--strain",
+        "0.3",
+    ]);
+    assert_eq!(run.code, 1, "{}", run.stderr);
+    let s = summary(&dir);
+    let error = s["error"].as_str().expect("summary has the error");
+    for part in [
+        "step ",
+        "(strain 0.",
+        "folded or inverted",
+        "Jacobian ratio -",
+    ] {
+        assert!(error.contains(part), "{part:?} missing from {error}");
+        assert!(
+            run.stderr.contains(part),
+            "{part:?} missing from {}",
+            run.stderr
+        );
+    }
+    let element: usize = error
+        .split("element ")
+        .nth(1)
+        .and_then(|rest| rest.split(' ').next())
+        .and_then(|n| n.parse().ok())
+        .unwrap_or_else(|| panic!("no element number in {error}"));
+    assert!(element < 20, "the octant 4x1 mesh has 20 hexes: {element}");
+}
+
 #[test]
 fn kernel_failure_keeps_partial_results() {
     let dir = out_dir("failure");

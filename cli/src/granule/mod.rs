@@ -40,6 +40,24 @@ use summary::{RunSetup, Summary, symmetry_name};
 /// Radius of the simulated granule, m (the published 1 mm granule).
 pub const GRANULE_RADIUS_M: Real = 0.5e-3;
 
+/// The granule diameters `--diameter-mm` accepts (`granule`,
+/// `export-mesh`), mm: those of the browser calculator, 1 µm to 1 m.
+pub const DIAMETER_RANGE_MM: [f64; 2] = [1.0e-3, 1.0e3];
+
+/// The radius, m, of a granule of `--diameter-mm d`, or the usage error
+/// naming the flag and [`DIAMETER_RANGE_MM`].
+pub fn radius_of_diameter_mm(d: f64) -> anyhow::Result<Real> {
+    let [lo, hi] = DIAMETER_RANGE_MM;
+    if !(lo..=hi).contains(&d) {
+        return Err(InputError(format!(
+            "`--diameter-mm {}` is out of range (allowed: {lo} <= d <= {hi} mm)",
+            crate::numbers::short(d)
+        ))
+        .into());
+    }
+    Ok(0.5e-3 * d)
+}
+
 /// Gravity of `--gravity`, m/s².
 pub const GRAVITY_M_S2: Real = 9.81;
 
@@ -50,7 +68,7 @@ Output, in --out DIR (created if missing; with --types in DIR/<TYPE>/ per type):
                           every --output-strain of platen approach:
     time_s                simulated time, s
     displacement_m        platen approach x (both platens together), m
-    strain                x / d (d = 1 mm granule diameter)
+    strain                x / d (d: --diameter-mm, 1 mm by default)
     force_n               mean of the upper and lower platen force, N
     force_upper_n         upper platen force, averaged over the sample interval, N
     force_lower_n         lower platen force (= upper in octant mode), N
@@ -187,6 +205,18 @@ pub struct GranuleArgs {
     /// 4x1 the coarse 160-hex one.
     #[arg(long, default_value = "8x2")]
     pub mesh: MeshLevel,
+
+    /// Granule diameter d, mm (0.001 ≤ d ≤ 1000). Strains are platen
+    /// approach / d. A granule of k × d at the same platen speed in mm/s
+    /// is the same experiment scaled (the same stresses at each strain,
+    /// forces × k²) as long as there is no gravity.
+    #[arg(
+        long,
+        value_name = "MM",
+        default_value_t = 1.0,
+        allow_negative_numbers = true
+    )]
+    pub diameter_mm: f64,
 
     /// Simulated part of the granule.
     #[arg(long, value_enum, default_value_t = SymmetryArg::Octant)]
@@ -451,7 +481,8 @@ impl GranuleArgs {
     /// `--types`), writes the outputs and the summary lines.
     pub fn run(&self, streams: &mut Streams<'_>) -> anyhow::Result<()> {
         let octant = self.symmetry == SymmetryArg::Octant;
-        let mesh = OwnedReference::sphere(GRANULE_RADIUS_M, self.mesh, octant)?;
+        let radius = radius_of_diameter_mm(self.diameter_mm)?;
+        let mesh = OwnedReference::sphere(radius, self.mesh, octant)?;
         let jobs = self.jobs(&mesh)?;
         for dir in core::iter::once(&self.out).chain(jobs.iter().map(|j| &j.dir)) {
             std::fs::create_dir_all(dir)

@@ -29,6 +29,7 @@ use crate::granule::dynamics::{GranuleBuffers, Loads, StepSizes, correct, predic
 use crate::granule::forces::{
     ElementKind, ElementSettings, ForcesError, check_element_buffers, elastic_energy,
 };
+use crate::granule::quality::{WorstElement, worst_element};
 use crate::granule::timestep::{
     Linearisation, PowerIterationBuffers, TimeStepControl, TimeStepMethod, power_start,
 };
@@ -259,13 +260,18 @@ pub enum SceneError {
         /// What the pass refused.
         error: ContactError,
     },
-    /// The motion became non-finite or an element inverted while the time
-    /// step was re-estimated.
+    /// The motion became non-finite, or an element inverted or folded so
+    /// that the time step could not be estimated.
     Unstable {
         /// Step number.
         step: u64,
         /// Strain reached.
         strain: Real,
+        /// The element with the smallest Gauss-point Jacobian ratio at
+        /// that moment ([`worst_element`]): ≤ 0 where it folded or
+        /// inverted, NaN where a node's position is not finite. `None` for
+        /// a mesh without elements.
+        worst: Option<WorstElement>,
     },
 }
 
@@ -298,10 +304,34 @@ impl fmt::Display for SceneError {
                 f,
                 "step {step} (strain {strain:.4}): platen contact: {error}"
             ),
-            Self::Unstable { step, strain } => write!(
-                f,
-                "step {step} (strain {strain:.4}): motion became non-finite or an element inverted"
-            ),
+            Self::Unstable {
+                step,
+                strain,
+                worst,
+            } => {
+                write!(f, "step {step} (strain {strain:.4}): ")?;
+                match worst {
+                    Some(w) if w.ratio.is_nan() => write!(
+                        f,
+                        "the motion became non-finite (element {} has a node at a non-finite \
+                         position)",
+                        w.element
+                    ),
+                    Some(w) if w.ratio <= 0.0 => write!(
+                        f,
+                        "element {} folded or inverted (smallest Gauss-point Jacobian ratio \
+                         {:.3e} <= 0)",
+                        w.element, w.ratio
+                    ),
+                    Some(w) => write!(
+                        f,
+                        "the motion became unstable (no element inverted; the most distorted, \
+                         element {}, has a Gauss-point Jacobian ratio of {:.3e})",
+                        w.element, w.ratio
+                    ),
+                    None => write!(f, "the motion became non-finite"),
+                }
+            }
         }
     }
 }
@@ -611,9 +641,10 @@ impl<'a> PlatenScene<'a> {
         };
         let dt = time_step
             .estimate(&mesh, &mat, &params.elements, &at, &mut power)
-            .ok_or(SceneError::Unstable {
+            .ok_or_else(|| SceneError::Unstable {
                 step: 0,
                 strain: 0.0,
+                worst: worst_element(&mesh, buf.x),
             })?;
         let (force_scale, energy_scale) = if params.symmetry == Symmetry::Octant {
             (4.0, 8.0)
@@ -758,11 +789,21 @@ impl<'a> PlatenScene<'a> {
             steps: self.step,
             dt_s: self.dt,
             min_j: self.min_j,
-            min_gauss_jacobian: crate::granule::quality::worst_element(&self.mesh, self.buf.x)
+            min_gauss_jacobian: worst_element(&self.mesh, self.buf.x)
                 .map_or(Real::NAN, |w| w.ratio),
             max_node_speed_m_s,
             penetration_m,
             energy: self.ledger,
+        }
+    }
+
+    /// The error of a step that went unstable at `strain`, naming the
+    /// element that folded (or the first with a non-finite node).
+    fn unstable(&self, strain: Real) -> SceneError {
+        SceneError::Unstable {
+            step: self.step,
+            strain,
+            worst: worst_element(&self.mesh, self.buf.x),
         }
     }
 
@@ -774,10 +815,6 @@ impl<'a> PlatenScene<'a> {
     /// Advances one step. Returns a sample when an output interval ends.
     pub fn step(&mut self) -> Result<Option<PlatenSample>, SceneError> {
         let strain = self.strain();
-        let unstable = SceneError::Unstable {
-            step: self.step,
-            strain,
-        };
         if self.step > 0
             && self
                 .step
@@ -798,7 +835,7 @@ impl<'a> PlatenScene<'a> {
                     &at,
                     &mut self.power,
                 )
-                .ok_or(unstable)?;
+                .ok_or_else(|| self.unstable(strain))?;
         }
         let sizes = StepSizes {
             dt_prev: self.dt_prev,
@@ -886,7 +923,7 @@ impl<'a> PlatenScene<'a> {
             math::max(self.window_max_speed_squared, w.max_speed_squared);
         let kinetic = w.kinetic;
         if !kinetic.is_finite() {
-            return Err(unstable);
+            return Err(self.unstable(strain));
         }
         let s = self.energy_scale;
         let l = &mut self.ledger;
