@@ -555,10 +555,23 @@ fn identical_runs_write_identical_files() {
     }
 }
 
-/// Regression guard for the failure path: a platen at 10 m/s (a third of
-/// the wave speed) driven to 90 % strain inverts an element within a few
-/// dozen steps. The rows so far, the summary with its error and the plot
-/// are kept, and the message names type, step, strain and element.
+/// Runs `granbed-cli granule --quiet --out DIR --mesh 4x1 ARGS` and
+/// asserts that the kernel stopped it (status 1).
+fn granule_fails(dir: &Path, args: &[&str]) -> Run {
+    let mut argv = vec![
+        "granule",
+        "--quiet",
+        "--out",
+        dir.to_str().unwrap(),
+        "--mesh",
+        "4x1",
+    ];
+    argv.extend_from_slice(args);
+    let run = cli(&argv);
+    assert_eq!(run.code, 1, "{}", run.stderr);
+    run
+}
+
 /// Without hourglass control (κ = 0) the coarse granule folds (at 25 %
 /// strain): the time step cannot be estimated on a folded element, and
 /// the error names the element, its Jacobian ratio, the step and the
@@ -566,20 +579,7 @@ fn identical_runs_write_identical_files() {
 #[test]
 fn a_folded_element_is_named() {
     let dir = out_dir("folded");
-    let out = dir.to_str().unwrap();
-    let run = cli(&[
-        "granule",
-        "--quiet",
-        "--out",
-        out,
-        "--mesh",
-        "4x1",
-        "--hourglass-kappa",
-        "0",
-        "--strain",
-        "0.3",
-    ]);
-    assert_eq!(run.code, 1, "{}", run.stderr);
+    let run = granule_fails(&dir, &["--hourglass-kappa", "0", "--strain", "0.3"]);
     let s = summary(&dir);
     let error = s["error"].as_str().expect("summary has the error");
     for part in [
@@ -604,23 +604,14 @@ fn a_folded_element_is_named() {
     assert!(element < 20, "the octant 4x1 mesh has 20 hexes: {element}");
 }
 
+/// Regression guard for the failure path: a platen at 10 m/s (a third of
+/// the wave speed) driven to 90 % strain inverts an element within a few
+/// dozen steps. The rows so far, the summary with its error and the plot
+/// are kept, and the message names type, step, strain and element.
 #[test]
 fn kernel_failure_keeps_partial_results() {
     let dir = out_dir("failure");
-    let out = dir.to_str().unwrap();
-    let run = cli(&[
-        "granule",
-        "--quiet",
-        "--out",
-        out,
-        "--mesh",
-        "4x1",
-        "--speed-mm-s",
-        "10000",
-        "--strain",
-        "0.9",
-    ]);
-    assert_eq!(run.code, 1, "{}", run.stderr);
+    let run = granule_fails(&dir, &["--speed-mm-s", "10000", "--strain", "0.9"]);
     for part in ["granule B2", "step ", "strain ", "element ", "summary.json"] {
         assert!(
             run.stderr.contains(part),

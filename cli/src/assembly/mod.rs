@@ -23,6 +23,7 @@
 
 mod contact;
 pub mod die;
+pub mod overlap;
 mod step;
 
 use granbed_kernel::Real;

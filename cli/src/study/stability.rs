@@ -8,13 +8,18 @@
 //! rows: an hourglass-distorted hex folds there first), the largest
 //! nodal speed over the punch (platen) speed, the deepest granule–granule
 //! (granule–platen) overlap at the output rows over the element size (the
-//! shortest surface edge of the reference mesh), the energy-ledger residual
+//! shortest surface edge of the reference mesh) as the contact detection
+//! reports it, the deepest overlap measured by geometry alone at every
+//! [`PROBE_INTERVAL`] of strain (beds; [`Assembly::hidden_overlap`]: the
+//! winding number of each neighbour's closed surface, which shares none of
+//! the detection's choices and so catches what it misses), the
+//! energy-ledger residual
 //! over the punch (platen) work, the hourglass energy over the internal
 //! work, the error that stopped the run if any, and the wall time.
 //!
 //! A run passes when it reaches its strain without an error, no element
 //! inverted or folded (both Jacobians > 0), the residual is below 1 % of the punch work
-//! and the overlap below 1 % of the element size. granbed neither rejects
+//! and both overlaps below 1 % of the element size. granbed neither rejects
 //! nor repairs steps: a step that fails stops the run (with a checkpoint in
 //! `bed`), so "rejected or repaired steps" is 0 for every run that passes
 //! and the error column says what stopped one that did not.
@@ -27,6 +32,8 @@ use granbed_kernel::material::GranuleType;
 use granbed_kernel::scene::platens::{PlatenParams, PlatenSample};
 
 use super::StabilityArgs;
+use crate::assembly::Assembly;
+use crate::assembly::overlap::Overlap;
 use crate::bed::outputs::summary;
 use crate::bed::run::{BedObserver, BedRun, BedSample, RunControl, run_bed};
 use crate::bed::scene::Scene;
@@ -51,11 +58,16 @@ pub const PLOT_FILES: [&str; 4] = [
 
 /// Largest energy residual / punch work of a passing run.
 pub const MAX_RESIDUAL_REL: Real = 0.01;
-/// Largest overlap / element size of a passing run.
+/// Largest overlap / element size of a passing run (either measure).
 pub const MAX_PENETRATION_REL: Real = 0.01;
 
+/// Strain between two probes of a bed's overlap by geometry
+/// ([`Assembly::hidden_overlap`]), from this strain on: the hidden
+/// overlaps of session 43 began at C = 0.445–0.595 and stayed.
+pub const PROBE_INTERVAL: Real = 0.05;
+
 /// Columns of [`CSV_FILE`].
-pub const COLUMNS: [&str; 16] = [
+pub const COLUMNS: [&str; 17] = [
     "kind",
     "type",
     "seed",
@@ -66,6 +78,7 @@ pub const COLUMNS: [&str; 16] = [
     "min_gauss_jacobian",
     "max_node_speed_ratio",
     "max_penetration_rel_element",
+    "max_hidden_overlap_rel_element",
     "energy_residual_rel",
     "hourglass_to_internal",
     "rejected_steps",
@@ -96,8 +109,12 @@ pub struct Record {
     pub min_gauss_jacobian: Real,
     /// Largest nodal speed / punch (platen) speed.
     pub max_node_speed_ratio: Option<Real>,
-    /// Deepest overlap / element size.
+    /// Deepest overlap / element size, as the contact detection reports it.
     pub max_penetration_rel_element: Option<Real>,
+    /// Deepest overlap / element size measured by geometry alone at the
+    /// probes (beds; `None` for granules, whose platens are planes the
+    /// detection cannot miss).
+    pub max_hidden_overlap_rel_element: Option<Real>,
     /// |energy residual| / punch (platen) work.
     pub energy_residual_rel: Option<Real>,
     /// Hourglass energy / internal work at the end.
@@ -124,11 +141,15 @@ impl Record {
                 .is_some_and(|r| r < MAX_RESIDUAL_REL)
             && self
                 .max_penetration_rel_element
-                .is_some_and(|r| r < MAX_PENETRATION_REL);
+                .is_some_and(|r| r < MAX_PENETRATION_REL)
+            && (self.kind != "bed"
+                || self
+                    .max_hidden_overlap_rel_element
+                    .is_some_and(|r| r < MAX_PENETRATION_REL));
         self
     }
 
-    fn row(&self) -> [Field; 16] {
+    fn row(&self) -> [Field; 17] {
         let opt = |x: Option<Real>| Field::Real(x.unwrap_or(Real::NAN));
         [
             Field::Text(self.kind),
@@ -141,6 +162,7 @@ impl Record {
             self.min_gauss_jacobian.into(),
             opt(self.max_node_speed_ratio),
             opt(self.max_penetration_rel_element),
+            opt(self.max_hidden_overlap_rel_element),
             opt(self.energy_residual_rel),
             opt(self.hourglass_to_internal),
             Field::Int(self.rejected_steps),
@@ -168,6 +190,47 @@ impl BedObserver for Silent {
     }
 }
 
+/// A bed run's observer that measures the overlap by geometry
+/// ([`Assembly::hidden_overlap`]) at every snapshot and keeps the deepest.
+#[derive(Default)]
+pub(crate) struct OverlapProbe {
+    /// The deepest found so far, and the strain where.
+    pub deepest: Overlap,
+    /// The strain of `deepest`.
+    pub strain: Real,
+    /// Probes taken.
+    pub probes: usize,
+}
+
+impl BedObserver for OverlapProbe {
+    fn sample(&mut self, _: &BedSample, _: f64) {}
+
+    fn snapshot(
+        &mut self,
+        strain: Real,
+        asm: &Assembly<'_>,
+        _: &OwnedReference,
+    ) -> anyhow::Result<()> {
+        let found = asm.hidden_overlap();
+        self.probes += 1;
+        if found.depth_m > self.deepest.depth_m || found.depth_m.is_nan() {
+            (self.deepest, self.strain) = (found, strain);
+        }
+        Ok(())
+    }
+}
+
+/// The strains at which the suite probes a bed's overlap: every
+/// [`PROBE_INTERVAL`] up to `final_strain`, and `final_strain` itself.
+pub fn probe_strains(final_strain: Real) -> Vec<Real> {
+    let mut strains: Vec<Real> = (1..)
+        .map(|k| k as Real * PROBE_INTERVAL)
+        .take_while(|&c| c < final_strain - 1e-9)
+        .collect();
+    strains.push(final_strain);
+    strains
+}
+
 /// The bed scene of the suite for `granule_type` and `seed`.
 pub fn bed_scene(args: &StabilityArgs, granule_type: GranuleType, seed: u64) -> Scene {
     let published = Scene::published();
@@ -176,6 +239,9 @@ pub fn bed_scene(args: &StabilityArgs, granule_type: GranuleType, seed: u64) -> 
         sweep_tolerance: args.sweep_tolerance.unwrap_or(published.sweep_tolerance),
         mass_scaling: args.mass_scaling.unwrap_or(published.mass_scaling),
         time_step_floor: args.time_step_floor.unwrap_or(published.time_step_floor),
+        nearest_penetrated_face: args
+            .nearest_penetrated_face
+            .unwrap_or(published.nearest_penetrated_face),
         watchdog_speed_ratio: args
             .watchdog_speed_ratio
             .unwrap_or(published.watchdog_speed_ratio),
@@ -192,8 +258,16 @@ pub fn bed_scene(args: &StabilityArgs, granule_type: GranuleType, seed: u64) -> 
 
 /// Runs one bed of the suite; its samples are returned for the plots.
 pub fn run_bed_case(scene: &Scene) -> anyhow::Result<(Record, BedRun)> {
-    let run = run_bed(scene, &RunControl::default(), &mut Silent)?;
+    // The probes of the overlap by geometry ([`OverlapProbe`]) are taken
+    // at the snapshots, which change nothing else in a run.
+    let probed = Scene {
+        snapshot_strains: probe_strains(scene.final_strain),
+        ..scene.clone()
+    };
+    let mut probe = OverlapProbe::default();
+    let run = run_bed(&probed, &RunControl::default(), &mut probe)?;
     let s = summary(scene, &run);
+    let element = scene.granule_mesh()?.shortest_surface_edge();
     let record = Record {
         kind: "bed",
         granule_type: scene.granule_type()?.name(),
@@ -205,6 +279,11 @@ pub fn run_bed_case(scene: &Scene) -> anyhow::Result<(Record, BedRun)> {
         min_gauss_jacobian: s.min_gauss_jacobian,
         max_node_speed_ratio: s.max_node_speed_ratio,
         max_penetration_rel_element: s.max_penetration_rel_element,
+        max_hidden_overlap_rel_element: if probe.probes == 0 {
+            None
+        } else {
+            finite_ratio(probe.deepest.depth_m, element)
+        },
         energy_residual_rel: s.energy_residual_rel,
         hourglass_to_internal: s.hourglass_to_internal,
         rejected_steps: 0,
@@ -255,6 +334,7 @@ pub fn run_granule_case(
         // The platens approach at `approach_speed_m_s`; each moves at half.
         max_node_speed_ratio: finite_ratio(max_speed, 0.5 * params.approach_speed_m_s),
         max_penetration_rel_element: finite_ratio(penetration, reference.shortest_surface_edge()),
+        max_hidden_overlap_rel_element: None,
         energy_residual_rel: finite_ratio(e.residual().abs(), e.platen_work),
         hourglass_to_internal: finite_ratio(e.hourglass, e.internal_work),
         rejected_steps: 0,
@@ -327,7 +407,7 @@ impl StabilityArgs {
             if !self.quiet {
                 writeln!(
                     streams.stderr,
-                    "stability: {} {} seed {}: C = {:.3}, min J {:.3}, overlap {:.2e} of h, \
+                    "stability: {} {} seed {}: C = {:.3}, min J {:.3}, overlap {:.2e} of h{}, \
                      residual {:.1e}, {:.1} s{}",
                     r.kind,
                     r.granule_type,
@@ -335,6 +415,14 @@ impl StabilityArgs {
                     r.final_strain,
                     r.min_jacobian.min(r.min_gauss_jacobian),
                     r.max_penetration_rel_element.unwrap_or(Real::NAN),
+                    if r.kind == "bed" {
+                        format!(
+                            " (by geometry {:.2e})",
+                            r.max_hidden_overlap_rel_element.unwrap_or(Real::NAN)
+                        )
+                    } else {
+                        String::new()
+                    },
                     r.energy_residual_rel.unwrap_or(Real::NAN),
                     r.wall_time_s,
                     if r.passed { "" } else { "  FAILED" }
@@ -535,6 +623,7 @@ mod tests {
             min_gauss_jacobian: 0.4,
             max_node_speed_ratio: Some(3.0),
             max_penetration_rel_element: Some(0.009),
+            max_hidden_overlap_rel_element: Some(0.009),
             energy_residual_rel: Some(0.009),
             hourglass_to_internal: Some(0.1),
             rejected_steps: 0,
@@ -584,7 +673,25 @@ mod tests {
                 max_penetration_rel_element: None,
                 ..good()
             },
+            Record {
+                max_hidden_overlap_rel_element: Some(0.011),
+                ..good()
+            },
+            Record {
+                max_hidden_overlap_rel_element: None,
+                ..good()
+            },
         ];
+        // A granule between platens has no probe by geometry.
+        assert!(
+            Record {
+                kind: "granule",
+                max_hidden_overlap_rel_element: None,
+                ..good()
+            }
+            .judge()
+            .passed
+        );
         for r in fails {
             let judged = r.clone().judge();
             assert!(!judged.passed, "{r:?} passed");
