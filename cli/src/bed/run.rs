@@ -346,6 +346,38 @@ fn pour_params(scene: &Scene, material: &granbed_kernel::material::Material) -> 
     pour
 }
 
+/// The assembly's parameters for `scene` on its granule `mesh`: every
+/// numerical field of the scene, lengths given as fractions of the element
+/// size (`mesh.shortest_surface_edge()`) made metres. All but the time of
+/// the exact-contact strain (`exact_contact_from_s`, left at the
+/// standard's), which needs the die.
+pub fn assembly_params(scene: &Scene, mesh: &OwnedReference) -> anyhow::Result<AssemblyParams> {
+    let mut params = AssemblyParams::standard(scene.material()?, scene.element_settings()?);
+    let element = mesh.shortest_surface_edge();
+    params.damping_ratio = scene.damping_ratio;
+    params.contact_sweeps = scene.contact_sweeps;
+    params.sweep_tolerance_m = scene.sweep_tolerance * element;
+    params.exact_sweep_tolerance_m = scene.exact_sweep_tolerance() * element;
+    params.mass_scaling = scene.mass_scaling;
+    params.selective_mass_scaling = scene.selective_mass_scaling;
+    params.selective_mass_ratio = scene.selective_mass_ratio;
+    params.time_step_safety = scene.time_step_safety;
+    params.time_step_floor = scene.time_step_floor;
+    params.max_mass_factor = scene.max_mass_factor;
+    params.rigid_until_touched = scene.rigid_until_touched;
+    params.local_sweeps = scene.local_sweeps;
+    params.hold_constraints = scene.hold_constraints;
+    params.contact_search_interval = scene.contact_search_interval;
+    params.contact.capture = scene.contact_capture * element;
+    params.contact.reproject_slide = scene.held_reprojection * element;
+    params.contact.watch_beside = scene.held_reprojection.is_finite();
+    params.contact.nearest_penetrated_face = scene.nearest_penetrated_face;
+    params.face_list_skin = scene.face_list_skin;
+    params.max_node_speed_m_s = scene.watchdog_speed_ratio * scene.punch_speed_m_s;
+    params.kinetic_energy_limit = scene.watchdog_energy_ratio;
+    Ok(params)
+}
+
 /// Runs `scene` from `control`'s checkpoint, else its packing, else a
 /// fresh pour, reporting to `observer`. Errors before the first step
 /// (pour failed, bad setup, packing or checkpoint unfit) are returned; an
@@ -358,29 +390,7 @@ pub fn run_bed(
     let material = scene.material()?;
     let radius = scene.radius_m();
     let mesh = scene.granule_mesh()?;
-    let elements = scene.element_settings()?;
-    let mut params = AssemblyParams::standard(material, elements);
-    params.damping_ratio = scene.damping_ratio;
-    params.contact_sweeps = scene.contact_sweeps;
-    params.sweep_tolerance_m = scene.sweep_tolerance * mesh.shortest_surface_edge();
-    params.exact_sweep_tolerance_m = scene.exact_sweep_tolerance() * mesh.shortest_surface_edge();
-    params.mass_scaling = scene.mass_scaling;
-    params.selective_mass_scaling = scene.selective_mass_scaling;
-    params.selective_mass_ratio = scene.selective_mass_ratio;
-    params.time_step_safety = scene.time_step_safety;
-    params.time_step_floor = scene.time_step_floor;
-    params.max_mass_factor = scene.max_mass_factor;
-    params.rigid_until_touched = scene.rigid_until_touched;
-    params.local_sweeps = scene.local_sweeps;
-    params.hold_constraints = scene.hold_constraints;
-    params.contact_search_interval = scene.contact_search_interval;
-    params.contact.capture = scene.contact_capture * mesh.shortest_surface_edge();
-    params.contact.reproject_slide = scene.held_reprojection * mesh.shortest_surface_edge();
-    params.contact.watch_beside = scene.held_reprojection.is_finite();
-    params.contact.nearest_penetrated_face = scene.nearest_penetrated_face;
-    params.face_list_skin = scene.face_list_skin;
-    params.max_node_speed_m_s = scene.watchdog_speed_ratio * scene.punch_speed_m_s;
-    params.kinetic_energy_limit = scene.watchdog_energy_ratio;
+    let mut params = assembly_params(scene, &mesh)?;
     // Where the run starts: a fresh pour, or a checkpoint's state.
     let (die, placed, resumed, pour_wall_time_s) = match &control.resume {
         Some(c) => {
@@ -666,4 +676,82 @@ pub fn run_bed(
         rate_change_rel: None,
         added_mass: AddedMass::of(&asm),
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Every numerical field of a scene reaches the assembly: each set to a
+    /// value the standard parameters (what an unwired field keeps) do not
+    /// have, and found again (lengths as fractions of the element size).
+    #[test]
+    fn every_scene_field_reaches_the_assembly() {
+        let standard = AssemblyParams::standard(
+            Scene::published().material().unwrap(),
+            Scene::published().element_settings().unwrap(),
+        );
+        assert!(!standard.selective_mass_scaling && !standard.contact.nearest_penetrated_face);
+        let scene = Scene {
+            granule_type: "C3".to_owned(),
+            mesh: "4x1".to_owned(),
+            element: "fbar".to_owned(),
+            hourglass_kappa: 0.07,
+            damping_ratio: 0.3,
+            contact_sweeps: 7,
+            sweep_tolerance: 0.02,
+            exact_sweep_tolerance: Some(0.003),
+            mass_scaling: 12.0,
+            selective_mass_scaling: true,
+            selective_mass_ratio: 4.0,
+            time_step_safety: 0.6,
+            time_step_floor: 0.4,
+            max_mass_factor: 3.0,
+            rigid_until_touched: false,
+            local_sweeps: false,
+            hold_constraints: true,
+            contact_search_interval: 3,
+            contact_capture: 0.07,
+            held_reprojection: 0.2,
+            nearest_penetrated_face: true,
+            face_list_skin: 0.3,
+            watchdog_speed_ratio: 50.0,
+            watchdog_energy_ratio: 8.0,
+            punch_speed_m_s: 0.02,
+            ..Scene::published()
+        };
+        scene.validate().unwrap();
+        let mesh = scene.granule_mesh().unwrap();
+        let h = mesh.shortest_surface_edge();
+        let p = assembly_params(&scene, &mesh).unwrap();
+        assert_eq!(p.material, scene.material().unwrap());
+        assert_eq!(p.elements, scene.element_settings().unwrap());
+        assert_eq!(p.elements.hourglass_kappa, 0.07);
+        assert_eq!(p.damping_ratio, 0.3);
+        assert_eq!(p.contact_sweeps, 7);
+        assert_eq!(p.sweep_tolerance_m, 0.02 * h);
+        assert_eq!(p.exact_sweep_tolerance_m, 0.003 * h);
+        assert_eq!(p.mass_scaling, 12.0);
+        assert!(p.selective_mass_scaling);
+        assert_eq!(p.selective_mass_ratio, 4.0);
+        assert_eq!(p.time_step_safety, 0.6);
+        assert_eq!(p.time_step_floor, 0.4);
+        assert_eq!(p.max_mass_factor, 3.0);
+        assert!(!p.rigid_until_touched && !p.local_sweeps && p.hold_constraints);
+        assert_eq!(p.contact_search_interval, 3);
+        assert_eq!(p.contact.capture, 0.07 * h);
+        assert_eq!(p.contact.reproject_slide, 0.2 * h);
+        assert!(p.contact.watch_beside);
+        assert!(p.contact.nearest_penetrated_face);
+        assert_eq!(p.face_list_skin, 0.3);
+        assert_eq!(p.max_node_speed_m_s, 50.0 * 0.02);
+        assert_eq!(p.kinetic_energy_limit, 8.0);
+        // No re-projection, no watch.
+        let never = Scene {
+            held_reprojection: Real::INFINITY,
+            ..scene
+        };
+        let p = assembly_params(&never, &mesh).unwrap();
+        assert!(!p.contact.watch_beside && p.contact.reproject_slide.is_infinite());
+    }
 }
