@@ -68,6 +68,47 @@ pub fn short(x: f64) -> String {
     }
 }
 
+/// A value as a message shows it: a float [`short`], anything else as
+/// it displays.
+pub trait Shown {
+    /// The text of the value.
+    fn shown(&self) -> String;
+}
+
+impl Shown for f64 {
+    fn shown(&self) -> String {
+        short(*self)
+    }
+}
+
+impl<T: Shown + ?Sized> Shown for &T {
+    fn shown(&self) -> String {
+        (**self).shown()
+    }
+}
+
+/// [`Shown`] as [`ToString`] for the types that are not floats.
+macro_rules! shown_as_displayed {
+    ($($t:ty),*) => {
+        $(impl Shown for $t {
+            fn shown(&self) -> String {
+                self.to_string()
+            }
+        })*
+    };
+}
+
+shown_as_displayed!(
+    u32,
+    u64,
+    usize,
+    bool,
+    str,
+    String,
+    granbed_kernel::material::GranuleType,
+    crate::model::MeshLevel
+);
+
 #[cfg(test)]
 mod short_tests {
     use super::short;
@@ -83,5 +124,7 @@ mod short_tests {
         assert_eq!(short(0.001), "0.001");
         assert_eq!(short(100000.0), "100000");
         assert_eq!(short(1e6), "1e6");
+        assert_eq!(super::Shown::shown(&&1e300), "1e300");
+        assert_eq!(super::Shown::shown("one-point"), "one-point");
     }
 }

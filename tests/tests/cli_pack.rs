@@ -291,7 +291,7 @@ fn quiet_prints_nothing() {
 
 #[test]
 fn bad_input_exits_2_naming_the_flag() {
-    let cases: [(&[&str], &str); 19] = [
+    let cases: [(&[&str], &str); 21] = [
         // Whole numbers: the flag and the allowed range, whatever the typo.
         (
             &["--granules", "0"],
@@ -336,7 +336,17 @@ fn bad_input_exits_2_naming_the_flag() {
         ),
         (
             &["--diameter-mm", "3000"],
-            "`--diameter-mm 3000` is out of range (allowed: 0 < d < 2000 mm)",
+            "`--diameter-mm 3000` is out of range (allowed: 0.001 <= d < 2000 mm)",
+        ),
+        // Vast or tiny sizes are refused before the lattice is walked
+        // (they ran for ever).
+        (
+            &["--diameter-mm", "1e-160"],
+            "`--diameter-mm 1e-160` is out of range",
+        ),
+        (
+            &["--die-diameter-mm", "1e200"],
+            "`--die-diameter-mm 1e200` is too wide",
         ),
         (&["--max-time-s", "0.2"], "`--max-time-s 0.2`"),
         (&["--friction", "-1"], "`--friction -1`"),

@@ -14,7 +14,8 @@ use super::Assembly;
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct Overlap {
     /// Its depth: the distance to the other granule's surface, m (0 if no
-    /// node is inside another granule; NaN if a position is not finite).
+    /// node is inside another granule; NaN if a surface node's position is
+    /// not finite, which it then names, with `inside` its own granule).
     pub depth_m: Real,
     /// The granule whose node it is.
     pub granule: usize,
@@ -48,6 +49,21 @@ impl Assembly<'_> {
     pub fn hidden_overlap(&self) -> Overlap {
         let surface = self.mesh.surface_range();
         let quads = &self.mesh.quads;
+        // A surface node that is not finite has no depth, and its
+        // granule's box would leave it out: reported as it is.
+        for (g, granule) in self.granules.iter().enumerate() {
+            let bad = granule.x[surface.clone()]
+                .iter()
+                .position(|p| !p.iter().all(|c| c.is_finite()));
+            if let Some(i) = bad {
+                return Overlap {
+                    depth_m: Real::NAN,
+                    granule: g,
+                    node: surface.start + i,
+                    inside: g,
+                };
+            }
+        }
         let boxes: Vec<Aabb> = self
             .granules
             .iter()
@@ -55,9 +71,7 @@ impl Assembly<'_> {
             .collect();
         let pairs: Vec<(usize, usize)> = (0..boxes.len())
             .flat_map(|a| (a + 1..boxes.len()).map(move |b| (a, b)))
-            .filter(|&(a, b)| {
-                boxes[a].overlaps(&boxes[b]) || boxes[a].is_empty() || boxes[b].is_empty()
-            })
+            .filter(|&(a, b)| boxes[a].overlaps(&boxes[b]))
             .collect();
         pairs
             .par_iter()
@@ -67,17 +81,12 @@ impl Assembly<'_> {
                     let (x, y) = (&self.granules[g].x, &self.granules[other].x);
                     for node in surface.clone() {
                         let p = &x[node];
-                        let finite = p.iter().all(|c| c.is_finite());
-                        if finite && !boxes[other].contains(p) {
+                        if !boxes[other].contains(p) {
                             continue;
                         }
                         // A mesh whose quads name nodes it does not have
-                        // cannot be measured: NaN, like a non-finite node.
-                        let depth_m = if finite {
-                            depth_inside(p, y, quads).unwrap_or(Real::NAN)
-                        } else {
-                            Real::NAN
-                        };
+                        // cannot be measured: NaN.
+                        let depth_m = depth_inside(p, y, quads).unwrap_or(Real::NAN);
                         deepest = deepest.deeper(Overlap {
                             depth_m,
                             granule: g,
@@ -107,7 +116,8 @@ mod tests {
     /// other granule. The measure by geometry finds that depth (less the
     /// tilt of the facets around the pole: 0.963 δ on the coarse mesh), as
     /// the contact detection does to 10⁻⁴ δ, and nothing when the granules
-    /// are δ apart.
+    /// are δ apart (on a diagonal, so that their boxes overlap and their
+    /// nodes are tested). A NaN node is reported as such.
     #[test]
     fn two_granules_pressed_together_overlap_by_what_they_were_pushed() {
         let mesh = OwnedReference::sphere(0.5e-3, MeshLevel::new(4, 1), false).unwrap();
@@ -119,8 +129,12 @@ mod tests {
         };
         let params = AssemblyParams::standard(material, elements);
         let delta = 1.0e-5;
-        for (distance, want) in [(1.0e-3 - delta, delta), (1.0e-3 + delta, 0.0)] {
-            let placements = [0.0, distance].map(|c| Placement::at([c, 0.0, 0.0]));
+        let (close, apart) = (1.0e-3 - delta, 1.0e-3 + delta);
+        // Apart along a diagonal, whose boxes overlap, so that the
+        // granules' nodes are tested against each other.
+        let diagonal = apart / Real::sqrt(2.0);
+        for (centre, want) in [([close, 0.0, 0.0], delta), ([diagonal, diagonal, 0.0], 0.0)] {
+            let placements = [Placement::at([0.0; 3]), Placement::at(centre)];
             let asm = Assembly::new(params, &mesh, &placements, Vec::new()).unwrap();
             let found = asm.hidden_overlap();
             let detected = -asm.penetration().unwrap();
@@ -142,5 +156,12 @@ mod tests {
             let x = asm.granules()[found.granule].x[found.node];
             assert!(x[1].abs() < 1e-12 && x[2].abs() < 1e-12, "the pole: {x:?}");
         }
+        let placements = [Placement::at([0.0; 3]), Placement::at([3e-3, 0.0, 0.0])];
+        let mut asm = Assembly::new(params, &mesh, &placements, Vec::new()).unwrap();
+        let last = mesh.positions.len() - 1;
+        asm.granules_mut()[1].x[last][0] = Real::NAN;
+        let found = asm.hidden_overlap();
+        assert!(found.depth_m.is_nan());
+        assert_eq!((found.granule, found.node), (1, last));
     }
 }

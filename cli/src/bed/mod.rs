@@ -347,7 +347,6 @@ fn flag_error(e: anyhow::Error, given: &[(&'static str, String)]) -> anyhow::Err
     let related: &[&str] = match f.field {
         "output_strain_interval" | "snapshot_strains" => &["final_strain"],
         "contact_search_interval" => &["hold_constraints"],
-        "die_diameter_mm" => &["diameter_mm"],
         _ => &[],
     };
     let own = given
@@ -405,7 +404,7 @@ impl BedArgs {
             ($arg:ident, $flag:literal, |$v:ident| $apply:expr) => {
                 if let Some($v) = self.$arg {
                     $apply;
-                    given.push(($flag, $v.to_string()));
+                    given.push(($flag, crate::numbers::Shown::shown(&$v)));
                 }
             };
             ($arg:ident, $flag:literal) => {

@@ -10,6 +10,7 @@ use serde::{Deserialize, Serialize};
 use crate::assembly::MAX_CONTACT_SEARCH_INTERVAL;
 use crate::error::{FieldError, InputError};
 use crate::model::{MeshLevel, OwnedReference};
+use crate::numbers::Shown;
 
 /// The format version this build reads and writes.
 pub const SCENE_VERSION: u32 = 1;
@@ -442,10 +443,10 @@ fn default_watchdog_speed_ratio() -> f64 {
     2000.0
 }
 
-fn invalid(field: &'static str, value: impl core::fmt::Display, allowed: &str) -> anyhow::Error {
+fn invalid(field: &'static str, value: impl Shown, allowed: &str) -> anyhow::Error {
     anyhow::Error::new(FieldError {
         field,
-        value: value.to_string(),
+        value: value.shown(),
         allowed: allowed.to_owned(),
     })
 }

@@ -229,7 +229,7 @@ pub struct PackArgs {
     )]
     pub die_diameter_mm: Millimetres,
 
-    /// Granule diameter d, mm (0 < d < 2000). The initial lattice spacing,
+    /// Granule diameter d, mm (0.001 ≤ d < 2000). The initial lattice spacing,
     /// jitter and neighbour-list skin scale with it.
     #[arg(
         long,
@@ -240,8 +240,9 @@ pub struct PackArgs {
     pub diameter_mm: Millimetres,
 
     /// Young's modulus E_DE of the Hertz–Mindlin contacts, MPa
-    /// (1 ≤ E ≤ 1e5): stiffer than the granule so that resting overlaps
-    /// stay below 0.3 µm. The time step scales as E_DE^(−2/5).
+    /// (1 ≤ E ≤ 1e5): the default 100 MPa is stiffer than the granule so
+    /// that resting overlaps stay below 0.3 µm (about 8 µm at 1 MPa). The
+    /// time step scales as E_DE^(−2/5).
     #[arg(
         long,
         value_name = "MPA",
@@ -322,11 +323,12 @@ impl PackArgs {
                 self.granules
             ),
             "radius" => format!(
-                "`--diameter-mm {d}` is out of range (allowed: 0 < d < {MAX_DIAMETER_MM} mm)"
+                "`--diameter-mm {d}` is out of range (allowed: {} <= d < {MAX_DIAMETER_MM} mm)",
+                crate::granule::DIAMETER_RANGE_MM[0]
             ),
             // The kernel's second test of the die: wide enough, but no
             // lattice site fits.
-            "die_radius" if allowed != "> 2 diameters" => format!(
+            "die_radius" if allowed == "wide enough for one lattice site" => format!(
                 "`--die-diameter-mm {}` is too narrow for granules of `--diameter-mm {d}`: no \
                  site of the insertion lattice (spacing {} mm) fits in it",
                 self.die_diameter_mm,
@@ -391,9 +393,10 @@ impl PackArgs {
         if !(lo..=hi).contains(&self.youngs_modulus_mpa.given) {
             return Err(self.youngs_modulus_range_error());
         }
-        if !(self.diameter_mm.given > 0.0 && self.diameter_mm.given < MAX_DIAMETER_MM) {
+        let smallest = crate::granule::DIAMETER_RANGE_MM[0];
+        if !(self.diameter_mm.given >= smallest && self.diameter_mm.given < MAX_DIAMETER_MM) {
             return Err(input_error(format!(
-                "`--diameter-mm {}` is out of range (allowed: 0 < d < {MAX_DIAMETER_MM} mm)",
+                "`--diameter-mm {}` is out of range (allowed: {smallest} <= d < {MAX_DIAMETER_MM} mm)",
                 self.diameter_mm
             )));
         }
@@ -404,10 +407,10 @@ impl PackArgs {
             )));
         }
         // One layer of the grid first: the kernel's checks walk the lattice
-        // sites of a layer, which takes long in a vast die. (Not finite:
-        // a zero or invalid diameter, which the kernel rejects.)
+        // sites of a layer, which takes long in a vast die (a count that
+        // overflowed to infinity, from a die of 1e200 mm, is too wide too).
         let layer = grid_cells(params, 0.0);
-        if layer.is_finite() && layer > MAX_GRID_CELLS as f64 {
+        if layer.is_nan() || layer > MAX_GRID_CELLS as f64 {
             return Err(self.too_wide(layer));
         }
         run::check(*params).map_err(|e| self.pour_error(e))?;
@@ -434,9 +437,14 @@ impl PackArgs {
     /// The usage error of a neighbour grid of about `cells` cells, more
     /// than [`MAX_GRID_CELLS`].
     fn too_wide(&self, cells: f64) -> anyhow::Error {
+        let count = if cells.is_finite() {
+            format!("about {cells:.3e}")
+        } else {
+            "more than a float counts".to_owned()
+        };
         input_error(format!(
             "`--die-diameter-mm {}` is too wide for granules of `--diameter-mm {}`: the \
-             neighbour grid would need about {cells:.3e} cells (at most {MAX_GRID_CELLS})",
+             neighbour grid would need {count} cells (at most {MAX_GRID_CELLS})",
             self.die_diameter_mm, self.diameter_mm
         ))
     }

@@ -194,10 +194,8 @@ impl BedObserver for Silent {
 /// ([`Assembly::hidden_overlap`]) at every snapshot and keeps the deepest.
 #[derive(Default)]
 pub(crate) struct OverlapProbe {
-    /// The deepest found so far, and the strain where.
+    /// The deepest found so far (the first NaN, once there is one).
     pub deepest: Overlap,
-    /// The strain of `deepest`.
-    pub strain: Real,
     /// Probes taken.
     pub probes: usize,
 }
@@ -205,16 +203,13 @@ pub(crate) struct OverlapProbe {
 impl BedObserver for OverlapProbe {
     fn sample(&mut self, _: &BedSample, _: f64) {}
 
-    fn snapshot(
-        &mut self,
-        strain: Real,
-        asm: &Assembly<'_>,
-        _: &OwnedReference,
-    ) -> anyhow::Result<()> {
+    fn snapshot(&mut self, _: Real, asm: &Assembly<'_>, _: &OwnedReference) -> anyhow::Result<()> {
         let found = asm.hidden_overlap();
         self.probes += 1;
-        if found.depth_m > self.deepest.depth_m || found.depth_m.is_nan() {
-            (self.deepest, self.strain) = (found, strain);
+        if !self.deepest.depth_m.is_nan()
+            && (found.depth_m > self.deepest.depth_m || found.depth_m.is_nan())
+        {
+            self.deepest = found;
         }
         Ok(())
     }

@@ -85,8 +85,10 @@ fn norm(a: &Vec3) -> Real {
     math::sqrt(dot(a, a))
 }
 
-/// The signed solid angle of triangle (a, b, c) seen from `p`, sr
-/// (positive where the triangle winds counter-clockwise seen from `p`).
+/// The signed solid angle of triangle (a, b, c) seen from `p`, sr:
+/// positive where its normal (b − a) × (c − a) points away from `p` (the
+/// triangle winds clockwise seen from `p`), so that the outward faces of a
+/// closed surface give +4π about a point inside.
 fn solid_angle(p: &Vec3, a: &Vec3, b: &Vec3, c: &Vec3) -> Real {
     let (a, b, c) = (sub(a, p), sub(b, p), sub(c, p));
     let (la, lb, lc) = (norm(&a), norm(&b), norm(&c));
@@ -215,9 +217,15 @@ pub fn winding_number(p: &Vec3, x: &[Vec3], quads: &[[u32; 4]]) -> Result<Real, 
 /// m: its distance to the surface (the [`SUBDIVISIONS`]-fold triangulated
 /// one; quads whose box is farther than the nearest triangle found so far
 /// are skipped, which changes nothing) where the winding number's magnitude
-/// exceeds ½, else 0.
+/// exceeds ½, else 0; NaN where the winding number is (a position not
+/// finite).
 pub fn depth_inside(p: &Vec3, x: &[Vec3], quads: &[[u32; 4]]) -> Result<Real, NodeOutOfRange> {
-    if math::abs(winding_number(p, x, quads)?) <= 0.5 {
+    let w = winding_number(p, x, quads)?;
+    if w.is_nan() {
+        // A position that is not finite: no depth to give.
+        return Ok(Real::NAN);
+    }
+    if math::abs(w) <= 0.5 {
         return Ok(0.0);
     }
     let mut nearest = Real::INFINITY;
@@ -313,15 +321,32 @@ mod tests {
 
     /// A warped (non-planar) quad surface: the winding number of a closed
     /// surface is ±1 inside however its faces bend. A cube whose top is
-    /// pushed down at one corner, probed just inside and outside there.
+    /// pushed down at one corner, probed just inside and outside there —
+    /// and at z = 0.66, between the bilinear top (0.676 at x = y = 0.9) and
+    /// its two corner triangles (0.64): inside, which only the subdivided
+    /// face tells (with the corner triangles alone it reads 0).
     #[test]
     fn a_warped_closed_surface_still_winds_once() {
         let (mut x, q) = cube();
         x[7] = [1.0, 1.0, 0.6];
-        let inside = winding_number(&[0.9, 0.9, 0.55], &x, &q).unwrap();
-        let outside = winding_number(&[0.9, 0.9, 0.75], &x, &q).unwrap();
-        assert!((inside - 1.0).abs() < 1e-12, "{inside}");
-        assert!(outside.abs() < 1e-12, "{outside}");
+        for (p, want) in [
+            ([0.9, 0.9, 0.55], 1.0),
+            ([0.9, 0.9, 0.66], 1.0),
+            ([0.9, 0.9, 0.75], 0.0),
+        ] {
+            let w = winding_number(&p, &x, &q).unwrap();
+            assert!((w - want).abs() < 1e-12, "{p:?}: {w}");
+        }
+        let d = depth_inside(&[0.9, 0.9, 0.66], &x, &q).unwrap();
+        assert!(d > 0.0 && d < 0.016, "{d}");
+    }
+
+    /// A position that is not finite gives NaN, not a plausible depth.
+    #[test]
+    fn a_non_finite_surface_gives_nan() {
+        let (mut x, q) = cube();
+        x[6][2] = Real::NAN;
+        assert!(depth_inside(&[0.5; 3], &x, &q).unwrap().is_nan());
     }
 
     #[test]
