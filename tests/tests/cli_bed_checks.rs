@@ -160,7 +160,7 @@ fn every_numeric_flag_takes_a_minus_and_names_its_range() {
         ("--strain", &["`--strain -1`", "0 < C <= 0.9"]),
         (
             "--die-diameter-mm",
-            &["`--die-diameter-mm -1`", "more than 4"],
+            &["`--die-diameter-mm -1`", "more than 4", "4 < D <= 1000 mm"],
         ),
         (
             "--hourglass-kappa",

@@ -482,6 +482,14 @@ impl Scene {
         self.mesh_level()?;
         self.element_kind()?;
         let exact_sweep_tolerance = self.exact_sweep_tolerance();
+        let d = self.diameter_mm;
+        let die_range = format!(
+            "more than 4 and at most 1000 granule diameters: {} < D <= {} mm for granules of \
+             diameter_mm = {}",
+            (4.0 * d).shown(),
+            (MAX_DIE_DIAMETERS * d).shown(),
+            d.shown()
+        );
         let checks: [(bool, &str, f64, &str); 26] = [
             (
                 self.sweep_tolerance > 0.0 && self.sweep_tolerance <= 0.1,
@@ -578,7 +586,7 @@ impl Scene {
                     && self.die_diameter_mm <= MAX_DIE_DIAMETERS * self.diameter_mm,
                 "die_diameter_mm",
                 self.die_diameter_mm,
-                "more than 4 and at most 1000 granule diameters",
+                &die_range,
             ),
             (
                 (MIN_PUNCH_SPEED_M_S..=MAX_PUNCH_SPEED_M_S).contains(&self.punch_speed_m_s),
