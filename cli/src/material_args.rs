@@ -25,7 +25,7 @@ pub struct MaterialArgs {
     #[arg(long = "type", value_name = "TYPE", default_value = "B2")]
     pub granule_type: GranuleType,
 
-    /// Young's modulus E of the granule skeleton, Pa (finite, > 0).
+    /// Young's modulus E of the granule skeleton, Pa (1e-3 ≤ E ≤ 1e13).
     #[arg(long, value_name = "PA", allow_negative_numbers = true)]
     pub youngs_modulus_pa: Option<f64>,
 
@@ -33,7 +33,7 @@ pub struct MaterialArgs {
     #[arg(long, value_name = "NU", allow_negative_numbers = true)]
     pub poisson_ratio: Option<f64>,
 
-    /// Yield stress σy of the solid (Kirchhoff measure), Pa (> 0; `inf`
+    /// Yield stress σy of the solid (Kirchhoff measure), Pa (≥ 1e-3; `inf`
     /// makes the material purely elastic).
     #[arg(long, value_name = "PA", allow_negative_numbers = true)]
     pub yield_stress_pa: Option<f64>,
@@ -44,7 +44,7 @@ pub struct MaterialArgs {
     pub eta0: Option<f64>,
 
     /// Yield-surface pressure constant cp of a1(η) = cp(1 − η²),
-    /// dimensionless (finite, ≥ 0).
+    /// dimensionless (0 ≤ cp ≤ 1e3).
     #[arg(long, value_name = "CP", allow_negative_numbers = true)]
     pub cp: Option<f64>,
 
@@ -53,7 +53,8 @@ pub struct MaterialArgs {
     #[arg(long, value_name = "ETA", allow_negative_numbers = true)]
     pub eta_c: Option<f64>,
 
-    /// True (solid) density of the granule material, kg/m³ (finite, > 0);
+    /// True (solid) density of the granule material, kg/m³
+    /// (1e-3 ≤ ρ ≤ 1e5);
     /// the granule's density is η0 times this.
     #[arg(long, value_name = "KG_M3", allow_negative_numbers = true)]
     pub true_density_kg_m3: Option<f64>,

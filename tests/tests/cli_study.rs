@@ -496,15 +496,86 @@ fn element_time_measures_the_element_loop_on_a_checkpoint() {
     assert_eq!(t.text("path"), ["Scalar"]);
     assert!(t.num("median_ns_per_element_step")[0] > 0.0);
 
-    let bad = cli(&["study", "element-time", dir_s, "--passes", "0"]);
-    assert_ne!(bad.code, 0);
-    assert!(
-        bad.stderr.contains("--passes") && bad.stderr.contains("1 to 1000"),
-        "{}",
-        bad.stderr
-    );
+    for passes in ["0", "-1", "4294967296"] {
+        let bad = cli(&["study", "element-time", dir_s, "--passes", passes]);
+        assert_eq!(bad.code, 2);
+        assert!(
+            bad.stderr.contains("--passes") && bad.stderr.contains("1..=1000"),
+            "{}",
+            bad.stderr
+        );
+    }
     let empty = common::fresh_dir("cli_study", "element_time_empty");
     let missing = cli(&["study", "element-time", empty.to_str().unwrap()]);
     assert_ne!(missing.code, 0);
     assert!(missing.stderr.contains("checkpoint"), "{}", missing.stderr);
+}
+
+/// The studies check every setting before anything runs, and a rejected
+/// value names its flag and the allowed range (exit status 2): the
+/// single granules' strain, the beds' scene fields set by the flags,
+/// whole-number ranges, the bed-only flags given to the granule study, and
+/// a material override that only a later type of `--types` rejects.
+#[test]
+fn the_studies_name_a_bad_flag_before_running() {
+    let dir = common::fresh_dir("cli_study", "bad_flags");
+    let out = dir.to_str().unwrap();
+    let cases: [(&[&str], &str); 8] = [
+        (
+            &["stability", "--granule-strain", "0.95"],
+            "`--granule-strain 0.95` is out of range (allowed: 0 < C <= 0.9)",
+        ),
+        (
+            &["stability", "--granule-strain", "nan"],
+            "`--granule-strain NaN`",
+        ),
+        (
+            &["stability", "--strain", "-1"],
+            "`--strain -1` is out of range (allowed: 0 < C <= 0.9",
+        ),
+        (
+            &["stability", "--mass-scaling", "0.5"],
+            "`--mass-scaling 0.5` is out of range (allowed: 1 <= F <= 1e6",
+        ),
+        (
+            &["stability", "--contact-sweeps", "0"],
+            "whole numbers 1..=50",
+        ),
+        (
+            &["work-precision", "--granules", "15"],
+            "`--granules` is for `--scene bed-small`",
+        ),
+        (
+            &[
+                "work-precision",
+                "--scene",
+                "bed-small",
+                "--die-diameter-mm",
+                "1",
+            ],
+            "`--die-diameter-mm 1` is out of range",
+        ),
+        (
+            &["work-precision", "--types", "B2,A1", "--eta-c", "0.7"],
+            "`--eta0` (preset A1 value 0.6) rejected",
+        ),
+    ];
+    for (args, needle) in cases {
+        let mut argv = vec!["study"];
+        argv.extend_from_slice(args);
+        argv.extend_from_slice(&["--out", out]);
+        let run = cli(&argv);
+        assert_eq!(run.code, 2, "{args:?}: {}", run.stderr);
+        assert!(
+            run.stderr.contains(needle),
+            "{args:?}: `{needle}` not in {}",
+            run.stderr
+        );
+        // Nothing ran: no study line on stderr.
+        assert!(
+            !run.stderr.contains("study:") && !run.stderr.contains("stability:"),
+            "{}",
+            run.stderr
+        );
+    }
 }

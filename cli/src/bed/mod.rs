@@ -339,7 +339,7 @@ fn field_of_flag(flag: &str) -> String {
 /// each flag applied and its value): "`--die-diameter-mm 0.001` is out of
 /// range (allowed: …; scene field `die_diameter_mm`)". An error no flag
 /// caused is returned as it is.
-fn flag_error(e: anyhow::Error, given: &[(&'static str, String)]) -> anyhow::Error {
+pub fn flag_error(e: anyhow::Error, given: &[(&'static str, String)]) -> anyhow::Error {
     let Some(f) = e.downcast_ref::<crate::error::FieldError>() else {
         return e;
     };

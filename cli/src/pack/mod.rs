@@ -142,7 +142,8 @@ pub struct PackMaterialArgs {
     #[arg(long, value_name = "ETA", allow_negative_numbers = true)]
     pub eta0: Option<f64>,
 
-    /// True (solid) density of the granule material, kg/m³ (finite, > 0);
+    /// True (solid) density of the granule material, kg/m³
+    /// (1e-3 ≤ ρ ≤ 1e5);
     /// the spheres' density is η0 times this.
     #[arg(long, value_name = "KG_M3", allow_negative_numbers = true)]
     pub true_density_kg_m3: Option<f64>,

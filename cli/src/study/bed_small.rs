@@ -21,6 +21,7 @@ use crate::bed::outputs::kawakita;
 use crate::bed::run::{Packing, RunControl, pour, run_bed};
 use crate::bed::scene::{MaterialOverrides, Scene};
 use crate::model::MeshLevel;
+use crate::numbers::Shown;
 use crate::output::Streams;
 
 /// The small bed's size: granules, die diameter in mm, final strain,
@@ -226,6 +227,21 @@ pub fn study(args: &WorkPrecisionArgs, streams: &mut Streams<'_>) -> anyhow::Res
     }
     let mesh = args.mesh.unwrap_or(MeshLevel::new(4, 1));
     let (reference, grid) = bed_grid(mesh, args.quick);
+    // The material and the bed before anything runs, errors naming the
+    // flags (the material's overrides, then the bed's size).
+    args.material.material()?;
+    let given: Vec<(&'static str, String)> = [
+        ("--granules", args.granules.map(|n| n.shown())),
+        ("--die-diameter-mm", args.die_diameter_mm.map(|d| d.shown())),
+        ("--strain", args.strain.map(|c| c.shown())),
+    ]
+    .into_iter()
+    .filter_map(|(flag, v)| v.map(|v| (flag, v)))
+    .collect();
+    scene_for(args, size, &grid[0], 1)
+        .validate()
+        .map_err(|e| crate::bed::flag_error(e, &given))
+        .context("the study's bed")?;
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(args.threads)
         .build()

@@ -61,7 +61,8 @@ pub struct ElementTimeArgs {
     pub checkpoint: PathBuf,
 
     /// Timed passes over the bed, 1..=1000.
-    #[arg(long, value_name = "N", default_value_t = 7)]
+    #[arg(long, value_name = "N", default_value_t = 7, allow_negative_numbers = true,
+          value_parser = crate::numbers::whole::<u32>(1, 1000))]
     pub passes: u32,
 
     /// The one-point element loop's code path (F-bar runs element by

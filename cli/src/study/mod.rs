@@ -95,16 +95,20 @@ pub struct WorkPrecisionArgs {
     #[arg(long)]
     pub quick: bool,
 
-    /// bed-small: granules per bed (default 125; 15 with --quick).
-    #[arg(long, value_name = "N")]
+    /// bed-small: granules per bed (1..=100000; default 125; 15 with
+    /// --quick).
+    #[arg(long, value_name = "N", allow_negative_numbers = true,
+          value_parser = crate::numbers::whole::<usize>(1, 100_000))]
     pub granules: Option<usize>,
 
-    /// bed-small: die diameter, mm (default 5.65; 4.2 with --quick).
-    #[arg(long, value_name = "MM")]
+    /// bed-small: die diameter, mm (more than 4 and at most 1000 granule
+    /// diameters; default 5.65; 4.2 with --quick).
+    #[arg(long, value_name = "MM", allow_negative_numbers = true)]
     pub die_diameter_mm: Option<f64>,
 
-    /// bed-small: final axial strain (default 0.3; 0.1 with --quick).
-    #[arg(long, value_name = "C")]
+    /// bed-small: final axial strain (0 < C ≤ 0.9; default 0.3; 0.1 with
+    /// --quick).
+    #[arg(long, value_name = "C", allow_negative_numbers = true)]
     pub strain: Option<f64>,
 
     /// bed-small: mesh level of the granules (default 4x1).
@@ -113,7 +117,8 @@ pub struct WorkPrecisionArgs {
 
     /// bed-small: poured beds for the spread, 2..=10 (default 3; 2 with
     /// --quick).
-    #[arg(long, value_name = "N")]
+    #[arg(long, value_name = "N", allow_negative_numbers = true,
+          value_parser = crate::numbers::whole::<u64>(2, 10))]
     pub pours: Option<u64>,
 
     /// bed-small: worker threads (0 = all cores; at most 4096).
@@ -152,56 +157,74 @@ pub struct StabilityArgs {
     pub types: TypeList,
 
     /// Beds per type, poured with seeds 1…N (1 ≤ N ≤ 10).
-    #[arg(long, value_name = "N", default_value_t = 3, value_parser = clap::value_parser!(u64).range(1..=10))]
+    #[arg(long, value_name = "N", default_value_t = 3, allow_negative_numbers = true,
+          value_parser = crate::numbers::whole::<u64>(1, 10))]
     pub beds: u64,
 
-    /// Granules per bed.
-    #[arg(long, value_name = "N", default_value_t = 30)]
+    /// Granules per bed (1 ≤ N ≤ 100000).
+    #[arg(long, value_name = "N", default_value_t = 30, allow_negative_numbers = true,
+          value_parser = crate::numbers::whole::<usize>(1, 100_000))]
     pub granules: usize,
 
     /// Mesh level of the bed granules.
     #[arg(long, value_name = "NxM", default_value = "4x1")]
     pub mesh: MeshLevel,
 
-    /// Die diameter, mm.
-    #[arg(long, value_name = "MM", default_value_t = 5.0)]
+    /// Die diameter, mm (more than 4 and at most 1000 granule diameters).
+    #[arg(
+        long,
+        value_name = "MM",
+        default_value_t = 5.0,
+        allow_negative_numbers = true
+    )]
     pub die_diameter_mm: f64,
 
-    /// Final axial strain of the beds.
-    #[arg(long, value_name = "C", default_value_t = 0.6)]
+    /// Final axial strain of the beds (0 < C ≤ 0.9).
+    #[arg(
+        long,
+        value_name = "C",
+        default_value_t = 0.6,
+        allow_negative_numbers = true
+    )]
     pub strain: f64,
 
     /// Mesh level of the single granules (octant).
     #[arg(long, value_name = "NxM", default_value = "8x2")]
     pub granule_mesh: MeshLevel,
 
-    /// Final platen strain x/d of the single granules (0 < C < 1).
-    #[arg(long, value_name = "C", default_value_t = 0.7)]
+    /// Final platen strain x/d of the single granules (0 < C ≤ 0.9).
+    #[arg(
+        long,
+        value_name = "C",
+        default_value_t = 0.7,
+        allow_negative_numbers = true
+    )]
     pub granule_strain: f64,
 
     /// Override the beds' maximum contact sweeps per step (1..=50; default:
     /// the published scene's), to show what the sweeps buy.
-    #[arg(long, value_name = "N")]
+    #[arg(long, value_name = "N", allow_negative_numbers = true,
+          value_parser = crate::numbers::whole::<u32>(1, 50))]
     pub contact_sweeps: Option<u32>,
 
     /// Override the beds' speed watchdog (× punch speed; default: the
-    /// published scene's).
-    #[arg(long, value_name = "R")]
+    /// published scene's; 1 ≤ r ≤ 1e9).
+    #[arg(long, value_name = "R", allow_negative_numbers = true)]
     pub watchdog_speed_ratio: Option<f64>,
 
     /// Override the beds' contact-sweep tolerance (fraction of the element
     /// size, 0 < t ≤ 0.1; default: the published scene's).
-    #[arg(long, value_name = "T")]
+    #[arg(long, value_name = "T", allow_negative_numbers = true)]
     pub sweep_tolerance: Option<f64>,
 
     /// Override the beds' mass scaling, 1 ≤ F ≤ 1e6 (default: the
     /// published scene's, selective with its ratio limit).
-    #[arg(long, value_name = "F")]
+    #[arg(long, value_name = "F", allow_negative_numbers = true)]
     pub mass_scaling: Option<f64>,
 
     /// Override the beds' time-step floor of variable mass scaling,
     /// 0 ≤ r ≤ 1 (0: off; default: the published scene's).
-    #[arg(long, value_name = "R")]
+    #[arg(long, value_name = "R", allow_negative_numbers = true)]
     pub time_step_floor: Option<f64>,
 
     /// Override the beds' rule for a node behind several faces (default:

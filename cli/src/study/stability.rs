@@ -387,10 +387,59 @@ struct Report<'a> {
     runs: &'a [Record],
 }
 
+/// The largest platen strain of a single granule (the kernel's).
+pub const MAX_GRANULE_STRAIN: Real = 0.9;
+
 impl StabilityArgs {
+    /// The flags that set the beds' scene fields, with their values (for
+    /// errors that name the flag: `crate::bed::flag_error`).
+    fn scene_flags(&self) -> Vec<(&'static str, String)> {
+        use crate::numbers::Shown;
+        let mut given = vec![
+            ("--granules", self.granules.shown()),
+            ("--die-diameter-mm", self.die_diameter_mm.shown()),
+            ("--strain", self.strain.shown()),
+        ];
+        let optional = [
+            ("--watchdog-speed-ratio", self.watchdog_speed_ratio),
+            ("--sweep-tolerance", self.sweep_tolerance),
+            ("--mass-scaling", self.mass_scaling),
+            ("--time-step-floor", self.time_step_floor),
+        ];
+        given.extend(
+            optional
+                .iter()
+                .filter_map(|(f, v)| v.map(|v| (*f, v.shown()))),
+        );
+        if let Some(n) = self.contact_sweeps {
+            given.push(("--contact-sweeps", n.shown()));
+        }
+        given
+    }
+
+    /// Checks every run's settings before anything runs: the single
+    /// granules' strain and each type's bed scene, an error naming the flag.
+    pub fn validate(&self) -> anyhow::Result<()> {
+        if !(self.granule_strain > 0.0 && self.granule_strain <= MAX_GRANULE_STRAIN) {
+            return Err(crate::error::input_error(format!(
+                "`--granule-strain {}` is out of range (allowed: 0 < C <= {MAX_GRANULE_STRAIN})",
+                crate::numbers::short(self.granule_strain)
+            )));
+        }
+        let given = self.scene_flags();
+        for &t in &self.types.0 {
+            bed_scene(self, t, 1)
+                .validate()
+                .map_err(|e| crate::bed::flag_error(e, &given))
+                .with_context(|| format!("the suite's bed scene of {t}"))?;
+        }
+        Ok(())
+    }
+
     /// Runs the suite, writes the table and the plots, and fails (after
     /// writing them) if any run did not pass.
     pub fn run(&self, streams: &mut Streams<'_>) -> anyhow::Result<()> {
+        self.validate()?;
         let pool = rayon::ThreadPoolBuilder::new()
             .num_threads(self.threads)
             .build()?;

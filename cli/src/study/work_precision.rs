@@ -658,6 +658,20 @@ impl WorkPrecisionArgs {
             )
             .into());
         }
+        if self.scene == StudyScene::Granule {
+            let bed_only = [
+                ("--granules", self.granules.is_some()),
+                ("--die-diameter-mm", self.die_diameter_mm.is_some()),
+                ("--strain", self.strain.is_some()),
+                ("--mesh", self.mesh.is_some()),
+                ("--pours", self.pours.is_some()),
+            ];
+            if let Some((flag, _)) = bed_only.iter().find(|(_, given)| *given) {
+                return Err(crate::error::input_error(format!(
+                    "`{flag}` is for `--scene bed-small` (the granule study has its own grid)"
+                )));
+            }
+        }
         std::fs::create_dir_all(&self.out)
             .with_context(|| format!("cannot create output directory `{}`", self.out.display()))?;
         let study = match self.scene {
@@ -700,13 +714,21 @@ impl WorkPrecisionArgs {
             None => vec![self.material.granule_type],
         };
         let (reference_setting, grid) = granule_grid(self.quick);
+        // Every type's material first: an override one type rejects stops
+        // the study before anything runs.
+        let materials = types
+            .iter()
+            .map(|&granule_type| {
+                MaterialArgs {
+                    granule_type,
+                    ..self.material
+                }
+                .material()
+            })
+            .collect::<anyhow::Result<Vec<_>>>()?;
         let mut per_type = Vec::with_capacity(types.len());
-        for &granule_type in &types {
-            let material = MaterialArgs {
-                granule_type,
-                ..self.material
-            }
-            .material()?;
+        for (&granule_type, material) in types.iter().zip(&materials) {
+            let material = *material;
             let reference = run_granule(&reference_setting, &material)?;
             say(self.quiet, "reference", &reference, streams)?;
             let mut runs = Vec::with_capacity(grid.len());
