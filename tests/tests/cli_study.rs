@@ -401,6 +401,34 @@ fn study_compare_measures_two_finished_runs() {
     ]);
     assert_ne!(run.code, 0);
     assert!(run.stderr.contains("compression.csv"), "{}", run.stderr);
+    // A directory with the files but not a bed run's: refused, not NaN.
+    std::fs::copy(x10.join("compression.csv"), empty.join("compression.csv")).unwrap();
+    for summary in ["{}", r#"{"steps": "abc", "wall_time_s": -1}"#] {
+        std::fs::write(empty.join("summary.json"), summary).unwrap();
+        let run = cli(&[
+            "study",
+            "compare",
+            x10.to_str().unwrap(),
+            empty.to_str().unwrap(),
+        ]);
+        assert_ne!(run.code, 0);
+        assert!(
+            run.stderr
+                .contains("not the summary of a `granbed-cli bed` run"),
+            "{}",
+            run.stderr
+        );
+    }
+    std::fs::copy(x10.join("summary.json"), empty.join("summary.json")).unwrap();
+    std::fs::write(empty.join("compression.csv"), "strain,upper_pressure_pa\n").unwrap();
+    let run = cli(&[
+        "study",
+        "compare",
+        x10.to_str().unwrap(),
+        empty.to_str().unwrap(),
+    ]);
+    assert_ne!(run.code, 0);
+    assert!(run.stderr.contains("has 0 rows"), "{}", run.stderr);
     let run = cli(&["study", "compare", "--window", "0.3,0.1", "a", "b"]);
     assert_eq!(run.code, 2);
     assert!(run.stderr.contains("--window"), "{}", run.stderr);

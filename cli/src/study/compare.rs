@@ -56,6 +56,27 @@ impl RunRecord {
         else {
             bail!("{}: not a JSON object", json_path.display());
         };
+        // What every `granbed-cli bed` summary has; a directory without it
+        // is not a bed run, and would compare as NaN.
+        for key in ["steps", "wall_time_s"] {
+            if !summary
+                .get(key)
+                .and_then(Value::as_f64)
+                .is_some_and(|x| x >= 0.0)
+            {
+                bail!(
+                    "{} is not the summary of a `granbed-cli bed` run: no number `{key}` >= 0",
+                    json_path.display()
+                );
+            }
+        }
+        if curve.len() < 2 {
+            bail!(
+                "{} has {} rows: not the profile of a `granbed-cli bed` run",
+                csv_path.display(),
+                curve.len()
+            );
+        }
         Ok(Self { curve, summary })
     }
 
