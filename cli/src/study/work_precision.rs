@@ -672,10 +672,26 @@ impl WorkPrecisionArgs {
                 )));
             }
         }
+        // Every type's material first: an override one type rejects stops
+        // the study before anything runs or is written.
+        let types = match &self.types {
+            Some(list) => list.0.clone(),
+            None => vec![self.material.granule_type],
+        };
+        let materials = types
+            .iter()
+            .map(|&granule_type| {
+                MaterialArgs {
+                    granule_type,
+                    ..self.material
+                }
+                .material()
+            })
+            .collect::<anyhow::Result<Vec<_>>>()?;
         std::fs::create_dir_all(&self.out)
             .with_context(|| format!("cannot create output directory `{}`", self.out.display()))?;
         let study = match self.scene {
-            StudyScene::Granule => self.granule_study(streams)?,
+            StudyScene::Granule => self.granule_study(&types, &materials, streams)?,
             StudyScene::BedSmall => super::bed_small::study(self, streams)?,
         };
         let rows = rows(&study.reference, &study.runs, &study.errors, study.spread);
@@ -707,27 +723,17 @@ impl WorkPrecisionArgs {
         Ok(())
     }
 
-    /// The single-granule study, of one type or (`--types`) of several.
-    fn granule_study(&self, streams: &mut Streams<'_>) -> anyhow::Result<StudyRuns> {
-        let types = match &self.types {
-            Some(list) => list.0.clone(),
-            None => vec![self.material.granule_type],
-        };
+    /// The single-granule study of `types` (one, or several with
+    /// `--types`), each with its validated material.
+    fn granule_study(
+        &self,
+        types: &[GranuleType],
+        materials: &[Material],
+        streams: &mut Streams<'_>,
+    ) -> anyhow::Result<StudyRuns> {
         let (reference_setting, grid) = granule_grid(self.quick);
-        // Every type's material first: an override one type rejects stops
-        // the study before anything runs.
-        let materials = types
-            .iter()
-            .map(|&granule_type| {
-                MaterialArgs {
-                    granule_type,
-                    ..self.material
-                }
-                .material()
-            })
-            .collect::<anyhow::Result<Vec<_>>>()?;
         let mut per_type = Vec::with_capacity(types.len());
-        for (&granule_type, material) in types.iter().zip(&materials) {
+        for (&granule_type, material) in types.iter().zip(materials) {
             let material = *material;
             let reference = run_granule(&reference_setting, &material)?;
             say(self.quiet, "reference", &reference, streams)?;
