@@ -54,6 +54,39 @@ pub mod study;
 pub mod vtk;
 
 pub use command::{Cli, Command};
+
+/// `args` with every value that is a negative number clap would take for a
+/// flag (`-1e-3`, `-.5`, `-inf`: clap's `allow_negative_numbers` knows only
+/// digits, one dot and an unsigned exponent) joined to the long flag before
+/// it: `--strain -1e-3` becomes `--strain=-1e-3`. Nothing else changes: a
+/// word that parses as a number is never a flag of this program, and a
+/// flag that takes no value then says so itself.
+pub fn numeric_values_joined<I, T>(args: I) -> Vec<OsString>
+where
+    I: IntoIterator<Item = T>,
+    T: Into<OsString>,
+{
+    let mut out: Vec<OsString> = Vec::new();
+    for arg in args.into_iter().map(Into::into) {
+        let negative_number = arg
+            .to_str()
+            .is_some_and(|s| s.starts_with('-') && s.parse::<f64>().is_ok());
+        let after_long_flag = out
+            .last()
+            .and_then(|f| f.to_str())
+            .is_some_and(|f| f.len() > 2 && f.starts_with("--") && !f.contains('='));
+        if negative_number && after_long_flag {
+            let flag = out.pop().unwrap_or_default();
+            let mut joined = flag;
+            joined.push("=");
+            joined.push(&arg);
+            out.push(joined);
+        } else {
+            out.push(arg);
+        }
+    }
+    out
+}
 pub use output::Streams;
 
 /// Parses `args` (the first item is the program name, as in
@@ -68,7 +101,7 @@ where
     I: IntoIterator<Item = T>,
     T: Into<OsString> + Clone,
 {
-    let cli = match Cli::try_parse_from(args) {
+    let cli = match Cli::try_parse_from(numeric_values_joined(args)) {
         Ok(cli) => cli,
         // --help and --version arrive as "errors" meant for stdout.
         Err(e) if !e.use_stderr() => {
@@ -79,4 +112,39 @@ where
         Err(e) => return Err(e.into()),
     };
     cli.command.run(&mut Streams { stdout, stderr })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::numeric_values_joined;
+
+    /// Negative numbers clap would not take as values are joined to the
+    /// long flag before them; everything else is left as it is.
+    #[test]
+    fn negative_numbers_are_joined_to_their_flag() {
+        let joined = |args: &[&str]| -> Vec<String> {
+            numeric_values_joined(args.iter().copied())
+                .into_iter()
+                .map(|a| a.into_string().unwrap())
+                .collect()
+        };
+        assert_eq!(
+            joined(&["granbed-cli", "point", "--strain", "-1e-3", "--steps", "10"]),
+            ["granbed-cli", "point", "--strain=-1e-3", "--steps", "10"]
+        );
+        assert_eq!(
+            joined(&["x", "--a", "-.5", "--b", "-inf"]),
+            ["x", "--a=-.5", "--b=-inf"]
+        );
+        // Already joined, after a short flag, a word, or no flag at all.
+        for args in [
+            &["x", "--a=-1", "-2"][..],
+            &["x", "-j", "-1"],
+            &["x", "--a", "-b"],
+            &["x", "-1e-3"],
+            &["x", "--", "-1"],
+        ] {
+            assert_eq!(joined(args), args, "{args:?}");
+        }
+    }
 }

@@ -331,3 +331,33 @@ fn kernel_failure_keeps_rows_and_names_the_step() {
         code => panic!("status {code}: {}", run.stderr),
     }
 }
+
+/// Negative values in every spelling a float takes reach the flag: clap
+/// alone took `-1e-3`, `-.5` and `-inf` for short options ("unexpected
+/// argument '-1'"). Shear to −γ is shear to γ mirrored: the same pressure.
+#[test]
+fn negative_values_in_any_spelling_reach_the_flag() {
+    let pressure = |strain: &str| {
+        let run = point_ok(&["--path", "shear", "--strain", strain, "--steps", "20"]);
+        Table::parse(&run.stdout)
+            .num("pressure_pa")
+            .last()
+            .copied()
+            .unwrap()
+    };
+    assert_eq!(pressure("-1e-3"), pressure("1e-3"));
+    assert_eq!(pressure("-.5"), pressure("0.5"));
+    let run = cli(&[
+        "point",
+        "--path",
+        "shear",
+        "--poisson-ratio",
+        "-1e-1",
+        "--strain",
+        "0.01",
+    ]);
+    assert_eq!(run.code, 0, "{}", run.stderr);
+    let run = cli(&["point", "--path", "shear", "--strain", "-inf"]);
+    assert_eq!(run.code, 2);
+    assert!(run.stderr.contains("--strain"), "{}", run.stderr);
+}
