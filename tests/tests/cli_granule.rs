@@ -319,7 +319,7 @@ fn platens_carry_equal_forces() {
 fn bad_input_names_the_flag() {
     let dir = out_dir("bad");
     let out = dir.to_str().unwrap();
-    let cases: [(&[&str], &str); 13] = [
+    let cases: [(&[&str], &str); 14] = [
         (&["--strain", "0"], "--strain"),
         (
             &["--diameter-mm", "0"],
@@ -338,6 +338,7 @@ fn bad_input_names_the_flag() {
             "`--rate-check` needs `--strain` above 0.02",
         ),
         (&["--types", "A1,X9"], "--types"),
+        (&["--types", "all,A1"], "`all` stands alone"),
         (&["--type", "A1", "--types", "B2"], "--types"),
     ];
     for (args, flag) in cases {

@@ -165,9 +165,12 @@ impl FromStr for TypeList {
         }
         let mut types = Vec::new();
         for name in s.split(',').map(str::trim) {
+            if name.eq_ignore_ascii_case("all") {
+                return Err("`all` stands alone, not in a list".to_owned());
+            }
             let t: GranuleType = name
                 .parse()
-                .map_err(|e| format!("`{name}`: {e}, or `all`"))?;
+                .map_err(|e| format!("`{name}`: {e}, or `all` alone"))?;
             if types.contains(&t) {
                 return Err(format!("{t} is listed twice"));
             }
