@@ -81,6 +81,24 @@ fn scene_fields_out_of_range_or_contradicting_are_named() {
     rejected(&print(&slow), &["`punch_speed_m_s` = 1e-6", "1e-4 <= v"]);
     let limit = DEFAULT_SCENE.replace("punch_speed_m_s = 0.05", "punch_speed_m_s = 1e-4");
     assert_eq!(print(&limit).code, 0);
+    // More granules than the pour's insertion lattice holds within 1 m
+    // (they were poured for hours); a wider die takes them.
+    rejected(
+        &bed(&["--print-scene", "--granules", "100000"]),
+        &[
+            "`--granules 100000` is out of range",
+            "at most 1 m tall",
+            "1.88595 m",
+        ],
+    );
+    let wide = bed(&[
+        "--print-scene",
+        "--granules",
+        "5000",
+        "--die-diameter-mm",
+        "30",
+    ]);
+    assert_eq!(wide.code, 0, "{}", wide.stderr);
     // The rate check's second run at half of it would be below the limit.
     let path = scene_file("slowest", &limit);
     rejected(

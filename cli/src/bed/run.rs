@@ -331,7 +331,10 @@ pub struct RunControl {
 }
 
 /// The pour's parameters for `scene`.
-fn pour_params(scene: &Scene, material: &granbed_kernel::material::Material) -> PourParams {
+pub(crate) fn pour_params(
+    scene: &Scene,
+    material: &granbed_kernel::material::Material,
+) -> PourParams {
     let radius = scene.radius_m();
     let mut pour = PourParams::standard(material.density0, scene.seed);
     let scale = radius / pour.radius;

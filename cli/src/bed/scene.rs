@@ -661,7 +661,20 @@ impl Scene {
         {
             bail!(invalid("snapshot_strains", c, "each 0 <= C <= 0.9"));
         }
-        self.material()?;
+        // The pour's insertion lattice must stand at most as tall as `pack`
+        // allows (a taller column, e.g. 100000 granules in the published
+        // die, 1.5 m, poured for hours).
+        let material = self.material()?;
+        let fill = crate::bed::run::pour_params(self, &material).fill_height();
+        if fill.is_nan() || fill > crate::pack::MAX_INSERTION_HEIGHT_M {
+            let allowed = format!(
+                "as many as stand at most {} m tall on the pour's insertion lattice in this die \
+                 (these would stand {} m)",
+                crate::pack::MAX_INSERTION_HEIGHT_M,
+                fill.shown()
+            );
+            bail!(invalid("granules", self.granules, &allowed));
+        }
         Ok(())
     }
 
