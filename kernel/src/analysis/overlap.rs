@@ -33,6 +33,8 @@
 //! only points inside the other body's bounding box.
 
 use crate::Real;
+use crate::contact::quad::{Vec3, axpy, cross, dot, norm, sub};
+use crate::contact::surface::Aabb;
 use crate::math;
 
 /// Sub-quads per quad edge.
@@ -59,32 +61,6 @@ impl core::fmt::Display for NodeOutOfRange {
 
 impl core::error::Error for NodeOutOfRange {}
 
-type Vec3 = [Real; 3];
-
-#[inline]
-fn sub(a: &Vec3, b: &Vec3) -> Vec3 {
-    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
-}
-
-#[inline]
-fn dot(a: &Vec3, b: &Vec3) -> Real {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-}
-
-#[inline]
-fn cross(a: &Vec3, b: &Vec3) -> Vec3 {
-    [
-        a[1] * b[2] - a[2] * b[1],
-        a[2] * b[0] - a[0] * b[2],
-        a[0] * b[1] - a[1] * b[0],
-    ]
-}
-
-#[inline]
-fn norm(a: &Vec3) -> Real {
-    math::sqrt(dot(a, a))
-}
-
 /// The signed solid angle of triangle (a, b, c) seen from `p`, sr:
 /// positive where its normal (b − a) × (c − a) points away from `p` (the
 /// triangle winds clockwise seen from `p`), so that the outward faces of a
@@ -103,7 +79,6 @@ fn triangle_distance(p: &Vec3, a: &Vec3, b: &Vec3, c: &Vec3) -> Real {
     let (ab, ac, ap) = (sub(b, a), sub(c, a), sub(p, a));
     let (d1, d2) = (dot(&ab, &ap), dot(&ac, &ap));
     let at = |q: Vec3| norm(&sub(p, &q));
-    let along = |o: &Vec3, e: &Vec3, t: Real| [o[0] + t * e[0], o[1] + t * e[1], o[2] + t * e[2]];
     if d1 <= 0.0 && d2 <= 0.0 {
         return at(*a);
     }
@@ -114,7 +89,7 @@ fn triangle_distance(p: &Vec3, a: &Vec3, b: &Vec3, c: &Vec3) -> Real {
     }
     let vc = d1 * d4 - d3 * d2;
     if vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0 {
-        return at(along(a, &ab, d1 / (d1 - d3)));
+        return at(axpy(d1 / (d1 - d3), &ab, a));
     }
     let cp = sub(p, c);
     let (d5, d6) = (dot(&ab, &cp), dot(&ac, &cp));
@@ -123,12 +98,12 @@ fn triangle_distance(p: &Vec3, a: &Vec3, b: &Vec3, c: &Vec3) -> Real {
     }
     let vb = d5 * d2 - d1 * d6;
     if vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0 {
-        return at(along(a, &ac, d2 / (d2 - d6)));
+        return at(axpy(d2 / (d2 - d6), &ac, a));
     }
     let va = d3 * d6 - d5 * d4;
     if va <= 0.0 && (d4 - d3) >= 0.0 && (d5 - d6) >= 0.0 {
         let bc = sub(c, b);
-        return at(along(b, &bc, (d4 - d3) / ((d4 - d3) + (d5 - d6))));
+        return at(axpy((d4 - d3) / ((d4 - d3) + (d5 - d6)), &bc, b));
     }
     let denominator = va + vb + vc;
     let (v, w) = (vb / denominator, vc / denominator);
@@ -146,24 +121,6 @@ fn corners(x: &[Vec3], quad: usize, q: &[u32; 4]) -> Result<[Vec3; 4], NodeOutOf
         *corner = *x.get(node as usize).ok_or(NodeOutOfRange { quad, node })?;
     }
     Ok(out)
-}
-
-/// The corners' bounding box: it holds the whole bilinear quad (which lies
-/// in the corners' convex hull) and every triangle of [`fine_triangles`].
-fn bounds(c: &[Vec3; 4]) -> (Vec3, Vec3) {
-    let lo = core::array::from_fn(|k| {
-        math::min(math::min(c[0][k], c[1][k]), math::min(c[2][k], c[3][k]))
-    });
-    let hi = core::array::from_fn(|k| {
-        math::max(math::max(c[0][k], c[1][k]), math::max(c[2][k], c[3][k]))
-    });
-    (lo, hi)
-}
-
-/// Distance from `p` to the box (`lo`, `hi`), m (0 inside).
-fn box_distance(p: &Vec3, (lo, hi): &(Vec3, Vec3)) -> Real {
-    let d: Vec3 = core::array::from_fn(|k| math::max(0.0, math::max(lo[k] - p[k], p[k] - hi[k])));
-    norm(&d)
 }
 
 /// Calls `f` with the [`SUBDIVISIONS`]² × 2 triangles of the bilinear quad
@@ -204,7 +161,7 @@ pub fn winding_number(p: &Vec3, x: &[Vec3], quads: &[[u32; 4]]) -> Result<Real, 
     let mut sum = 0.0;
     for (quad, q) in quads.iter().enumerate() {
         let c = corners(x, quad, q)?;
-        if box_distance(p, &bounds(&c)) > 0.0 {
+        if Aabb::of_points(&c).distance_to(p) > 0.0 {
             sum += solid_angle(p, &c[0], &c[1], &c[2]) + solid_angle(p, &c[0], &c[2], &c[3]);
         } else {
             fine_triangles(&c, |a, b, t| sum += solid_angle(p, a, b, t));
@@ -231,7 +188,7 @@ pub fn depth_inside(p: &Vec3, x: &[Vec3], quads: &[[u32; 4]]) -> Result<Real, No
     let mut nearest = Real::INFINITY;
     for (quad, q) in quads.iter().enumerate() {
         let c = corners(x, quad, q)?;
-        if box_distance(p, &bounds(&c)) >= nearest {
+        if Aabb::of_points(&c).distance_to(p) >= nearest {
             continue;
         }
         fine_triangles(&c, |a, b, t| {
