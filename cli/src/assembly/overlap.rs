@@ -26,9 +26,9 @@ pub struct Overlap {
 }
 
 impl Overlap {
-    /// The deeper of two (the first on a tie; NaN wins, so that a
-    /// non-finite state is reported, not hidden).
-    fn deeper(self, other: Overlap) -> Overlap {
+    /// The deeper of two (the first on a tie; a NaN wins and, once held,
+    /// stays, so that a non-finite state is reported, not hidden).
+    pub fn deeper(self, other: Overlap) -> Overlap {
         if other.depth_m > self.depth_m || (other.depth_m.is_nan() && !self.depth_m.is_nan()) {
             other
         } else {

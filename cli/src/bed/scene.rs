@@ -484,8 +484,9 @@ impl Scene {
         let exact_sweep_tolerance = self.exact_sweep_tolerance();
         let d = self.diameter_mm;
         let die_range = format!(
-            "more than 4 and at most 1000 granule diameters: {} < D <= {} mm for granules of \
+            "more than 4 and at most {} granule diameters: {} < D <= {} mm for granules of \
              diameter_mm = {}",
+            MAX_DIE_DIAMETERS.shown(),
             (4.0 * d).shown(),
             (MAX_DIE_DIAMETERS * d).shown(),
             d.shown()

@@ -323,18 +323,7 @@ impl PackArgs {
                 "`--granules {}` is out of range (allowed: whole numbers 1..=100000)",
                 self.granules
             ),
-            "radius" => format!(
-                "`--diameter-mm {d}` is out of range (allowed: {} <= d < {MAX_DIAMETER_MM} mm)",
-                crate::granule::DIAMETER_RANGE_MM[0]
-            ),
-            // The kernel's second test of the die: wide enough, but no
-            // lattice site fits.
-            "die_radius" if allowed == "wide enough for one lattice site" => format!(
-                "`--die-diameter-mm {}` is too narrow for granules of `--diameter-mm {d}`: no \
-                 site of the insertion lattice (spacing {} mm) fits in it",
-                self.die_diameter_mm,
-                self.params_spacing_mm()
-            ),
+            "radius" => return self.diameter_range_error(),
             "die_radius" => format!(
                 "`--die-diameter-mm {}` is out of range (allowed: more than 4 granule \
                  diameters, here more than {} mm for `--diameter-mm {d}`)",
@@ -361,10 +350,14 @@ impl PackArgs {
         input_error(message)
     }
 
-    /// The insertion lattice's spacing for these options, mm.
-    fn params_spacing_mm(&self) -> f64 {
-        let standard = PourParams::standard(1.0, 0);
-        standard.lattice_spacing * (0.5 * self.diameter_mm.si / standard.radius) * 1e3
+    /// The usage error of a `--diameter-mm` outside 0.001 ≤ d <
+    /// [`MAX_DIAMETER_MM`].
+    fn diameter_range_error(&self) -> anyhow::Error {
+        input_error(format!(
+            "`--diameter-mm {}` is out of range (allowed: {} <= d < {MAX_DIAMETER_MM} mm)",
+            self.diameter_mm,
+            crate::granule::DIAMETER_RANGE_MM[0]
+        ))
     }
 
     /// The usage error of a `--youngs-modulus-mpa` outside
@@ -394,12 +387,9 @@ impl PackArgs {
         if !(lo..=hi).contains(&self.youngs_modulus_mpa.given) {
             return Err(self.youngs_modulus_range_error());
         }
-        let smallest = crate::granule::DIAMETER_RANGE_MM[0];
-        if !(self.diameter_mm.given >= smallest && self.diameter_mm.given < MAX_DIAMETER_MM) {
-            return Err(input_error(format!(
-                "`--diameter-mm {}` is out of range (allowed: {smallest} <= d < {MAX_DIAMETER_MM} mm)",
-                self.diameter_mm
-            )));
+        let d = self.diameter_mm.given;
+        if !(crate::granule::DIAMETER_RANGE_MM[0]..MAX_DIAMETER_MM).contains(&d) {
+            return Err(self.diameter_range_error());
         }
         if !self.die_diameter_mm.si.is_finite() {
             return Err(input_error(format!(

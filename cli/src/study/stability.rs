@@ -62,7 +62,7 @@ pub const MAX_RESIDUAL_REL: Real = 0.01;
 pub const MAX_PENETRATION_REL: Real = 0.01;
 
 /// Strain between two probes of a bed's overlap by geometry
-/// ([`Assembly::hidden_overlap`]), from this strain on: the hidden
+/// ([`Assembly::hidden_overlap`]), the first at this strain: the hidden
 /// overlaps of session 43 began at C = 0.445–0.595 and stayed.
 pub const PROBE_INTERVAL: Real = 0.05;
 
@@ -204,13 +204,8 @@ impl BedObserver for OverlapProbe {
     fn sample(&mut self, _: &BedSample, _: f64) {}
 
     fn snapshot(&mut self, _: Real, asm: &Assembly<'_>, _: &OwnedReference) -> anyhow::Result<()> {
-        let found = asm.hidden_overlap();
+        self.deepest = self.deepest.deeper(asm.hidden_overlap());
         self.probes += 1;
-        if !self.deepest.depth_m.is_nan()
-            && (found.depth_m > self.deepest.depth_m || found.depth_m.is_nan())
-        {
-            self.deepest = found;
-        }
         Ok(())
     }
 }
