@@ -1,6 +1,7 @@
 //! SIGINT and SIGTERM (and SIGHUP) during `granbed-cli bed`: the handler
-//! only sets [`INTERRUPT`]; the run checks it after every step, and once
-//! it is set finishes that step, writes a checkpoint (atomically, as every
+//! only sets [`INTERRUPT`]; the run checks it after every step (the pour
+//! at each of its rest checks, and stops there with nothing to keep), and
+//! once it is set finishes that step, writes a checkpoint (atomically, as every
 //! checkpoint) and the outputs so far (`compression.csv`, `summary.json`
 //! with `"interrupted": true`), says how to resume, and the process exits
 //! with status 130. A second signal ends the process at once.
@@ -32,7 +33,8 @@ pub fn install() -> Result<(), ctrlc::Error> {
         }
         eprintln!(
             "\ngranbed-cli: interrupted; finishing the current step, then writing a checkpoint \
-             and the outputs so far (interrupt again to quit at once, losing them)"
+             and the outputs so far (a pour stops at its next rest check, with nothing to keep; \
+             interrupt again to quit at once, losing them)"
         );
     })
 }

@@ -24,7 +24,7 @@ fn small_die() -> (DieScene, Vec<[Real; 3]>, AssemblyParams) {
     let mut pour = PourParams::standard(material.density0, 1);
     pour.granules = 40;
     pour.die_radius = 2.5e-3;
-    let poured = run_pour(pour, &mut |_, _| {}).unwrap();
+    let poured = run_pour(pour, &mut |_, _| core::ops::ControlFlow::Continue(())).unwrap();
     assert!(poured.error.is_none(), "{:?}", poured.error);
     let scene = DieScene::new(&poured.positions, R, pour.die_radius, 50e-3);
     let elements = ElementSettings {

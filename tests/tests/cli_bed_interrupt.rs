@@ -20,9 +20,10 @@ use common::{Table, cli, number, summary};
 use granbed_cli::assembly::Assembly;
 use granbed_cli::bed::Scene;
 use granbed_cli::bed::checkpoint::{Checkpoint, FILE_NAME};
-use granbed_cli::bed::run::{BedObserver, BedSample, RunControl, run_bed};
+use granbed_cli::bed::run::{BedObserver, BedSample, RunControl, pour, run_bed};
 use granbed_cli::model::OwnedReference;
 use granbed_cli::signal::INTERRUPT;
+use granbed_kernel::dem::pour::PourStatus;
 
 fn out_dir(name: &str) -> PathBuf {
     common::fresh_dir("cli_bed_interrupt", name)
@@ -247,4 +248,79 @@ fn an_interrupted_run_keeps_its_work_and_resumes_to_the_same_bits() {
     assert_eq!(r.code, 130, "{}", r.stderr);
     assert!(r.stderr.contains("nothing to resume"), "{}", r.stderr);
     assert!(!fresh.join(FILE_NAME).exists());
+}
+
+/// Sets `flag` at the pour's `checks`-th rest check and counts the pour's
+/// checks and the compression's rows it sees.
+struct InterruptPour {
+    checks: usize,
+    seen: usize,
+    rows: usize,
+    flag: &'static AtomicBool,
+}
+
+impl BedObserver for InterruptPour {
+    fn sample(&mut self, _: &BedSample, _: f64) {
+        self.rows += 1;
+    }
+
+    fn snapshot(&mut self, _: f64, _: &Assembly<'_>, _: &OwnedReference) -> anyhow::Result<()> {
+        Ok(())
+    }
+
+    fn pour(&mut self, _: &PourStatus, _: f64) {
+        self.seen += 1;
+        if self.seen == self.checks {
+            self.flag.store(true, Ordering::SeqCst);
+        }
+    }
+}
+
+/// An interrupt during the pour (SIGINT in a pour of thousands of spheres,
+/// which runs for minutes) stops it at its next rest check, not at its
+/// end: the run returns `Interrupted` naming the pour, compresses nothing
+/// and writes no checkpoint. (A flag of its own: not the CLI's.)
+#[test]
+fn an_interrupt_during_the_pour_stops_it_at_its_next_check() {
+    static FLAG: AtomicBool = AtomicBool::new(false);
+    let printed = cli(&[&["bed", "--print-scene"][..], &SMALL].concat());
+    let scene = Scene::from_toml(&printed.stdout).unwrap();
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(1)
+        .build()
+        .unwrap();
+    // The pour left alone takes more than two rest checks.
+    let mut checks = 0;
+    pool.install(|| pour(&scene, Some(&FLAG), &mut |_, _| checks += 1))
+        .unwrap();
+    assert!(checks > 2, "the pour must outlast two checks ({checks})");
+
+    let dir = out_dir("pour");
+    std::fs::create_dir_all(&dir).unwrap();
+    let control = RunControl {
+        checkpoint_dir: Some(dir.clone()),
+        interrupt: Some(&FLAG),
+        ..RunControl::default()
+    };
+    let mut observer = InterruptPour {
+        checks: 2,
+        seen: 0,
+        rows: 0,
+        flag: &FLAG,
+    };
+    let err = pool
+        .install(|| run_bed(&scene, &control, &mut observer))
+        .unwrap_err();
+    assert!(
+        err.chain()
+            .any(|e| e.is::<granbed_cli::signal::Interrupted>()),
+        "{err:#}"
+    );
+    assert!(format!("{err:#}").contains("during the pour"), "{err:#}");
+    assert_eq!(
+        observer.seen, 2,
+        "the pour went on past the check that saw the flag"
+    );
+    assert_eq!(observer.rows, 0);
+    assert!(!dir.join(FILE_NAME).exists());
 }

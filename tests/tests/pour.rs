@@ -1,9 +1,11 @@
 //! Oracles of the discrete-element pour (physics.md §6): rebound height,
 //! force balance of a settled bed, determinism, and resting overlaps.
 
+use core::ops::ControlFlow;
+
 use granbed_cli::model::PourStore;
 use granbed_kernel::Real;
-use granbed_kernel::dem::pour::{PourParams, PourScene};
+use granbed_kernel::dem::pour::{PourError, PourParams, PourScene};
 
 /// §6 oracle 1: a sphere dropped on the floor with restitution e rebounds to
 /// e²h, within 1 % (gravity during the 30 µs contact and the time step
@@ -64,7 +66,9 @@ fn settle(
     p.granules = granules;
     let mut store = PourStore::new(&p);
     let mut scene = PourScene::new(p, store.buffers()).unwrap();
-    let status = scene.run_to_rest(5000, &mut |_| {}).unwrap();
+    let status = scene
+        .run_to_rest(5000, &mut |_| ControlFlow::Continue(()))
+        .unwrap();
     let x = scene.positions().to_vec();
     (x, status, p)
 }
@@ -119,7 +123,9 @@ fn published_bed_on_a_fixed_seed() {
     let p = PourParams::standard(1200.0, 1);
     let mut store = PourStore::new(&p);
     let mut scene = PourScene::new(p, store.buffers()).unwrap();
-    let s = scene.run_to_rest(5000, &mut |_| {}).unwrap();
+    let s = scene
+        .run_to_rest(5000, &mut |_| ControlFlow::Continue(()))
+        .unwrap();
     let x = scene.positions().to_vec();
     let h = bed_height(&x, p.radius);
     let phi = packing_fraction(x.len(), p.radius, p.die_radius, h);
@@ -139,4 +145,50 @@ fn published_bed_on_a_fixed_seed() {
     );
     assert!((0.52..=0.58).contains(&phi), "packing fraction {phi}");
     assert!(((s.floor_force + s.wall_friction_z) / weight - 1.0).abs() < 1e-3);
+}
+
+/// A pour stopped by its caller (a host's interrupt) stops at the check
+/// that asked, with [`PourError::Stopped`] naming the steps taken, keeps
+/// its state, and run to rest again ends with the bits of a pour never
+/// stopped.
+#[test]
+fn a_stopped_pour_goes_on_to_the_same_bits() {
+    let mut p = PourParams::standard(1200.0, 3);
+    p.granules = 30;
+    let check = 2000;
+    let never_stopped = {
+        let mut store = PourStore::new(&p);
+        let mut scene = PourScene::new(p, store.buffers()).unwrap();
+        let s = scene
+            .run_to_rest(check, &mut |_| ControlFlow::Continue(()))
+            .unwrap();
+        (scene.positions().to_vec(), s.steps)
+    };
+    let mut store = PourStore::new(&p);
+    let mut scene = PourScene::new(p, store.buffers()).unwrap();
+    let mut checks = 0;
+    let stopped = scene.run_to_rest(check, &mut |_| {
+        checks += 1;
+        if checks == 2 {
+            ControlFlow::Break(())
+        } else {
+            ControlFlow::Continue(())
+        }
+    });
+    match stopped {
+        Err(PourError::Stopped { steps, time }) => {
+            assert_eq!(steps, 2 * check);
+            assert_eq!(time, scene.status().time);
+        }
+        other => panic!("expected a stop at the second check, got {other:?}"),
+    }
+    assert!(
+        never_stopped.1 > 2 * check,
+        "the pour must outlast two checks"
+    );
+    let s = scene
+        .run_to_rest(check, &mut |_| ControlFlow::Continue(()))
+        .unwrap();
+    assert_eq!(s.steps, never_stopped.1);
+    assert_eq!(scene.positions(), &never_stopped.0[..]);
 }

@@ -574,6 +574,7 @@ impl BedArgs {
             snapshots::remove_old(out)?;
         }
         let mut observer = Observer {
+            pour: PourSpinner::new(self.quiet, scene)?,
             progress: outputs::Progress::new(self.quiet, scene.final_strain, label),
             snapshots: snapshots::SnapshotWriter::new(
                 out,
@@ -589,6 +590,7 @@ impl BedArgs {
         std::fs::create_dir_all(out)
             .with_context(|| format!("cannot create output directory `{}`", out.display()))?;
         let result = pool.install(|| run::run_bed(scene, &control, &mut observer));
+        observer.pour.finish();
         observer.progress.finish();
         let mut result = result?;
         result.warnings.extend_from_slice(notes);
@@ -709,9 +711,17 @@ impl BedArgs {
         let pour_type = types[pour_index];
         std::fs::create_dir_all(&self.out)
             .with_context(|| format!("cannot create output directory `{}`", self.out.display()))?;
-        let packing = pool
-            .install(|| run::pour(&scenes[pour_index]))
-            .with_context(|| format!("the pour (sphere density of type {pour_type})"))?;
+        let mut spinner = PourSpinner::new(self.quiet, &scenes[pour_index])?;
+        let packing = pool.install(|| {
+            run::pour(
+                &scenes[pour_index],
+                Some(&crate::signal::INTERRUPT),
+                &mut |s, t| spinner.update(s, t),
+            )
+        });
+        spinner.finish();
+        let packing =
+            packing.with_context(|| format!("the pour (sphere density of type {pour_type})"))?;
         if crate::signal::INTERRUPT.load(core::sync::atomic::Ordering::SeqCst) {
             return Err(anyhow::Error::new(crate::signal::Interrupted(
                 "interrupted during the pour: nothing was compressed".to_owned(),
@@ -801,13 +811,19 @@ fn interrupted(result: &run::BedRun, dir: &std::path::Path, what: &str) -> anyho
 
 /// What the command does with the run as it goes.
 struct Observer {
+    pour: PourSpinner,
     progress: outputs::Progress,
     snapshots: snapshots::SnapshotWriter,
 }
 
 impl run::BedObserver for Observer {
     fn sample(&mut self, sample: &run::BedSample, elapsed_s: f64) {
+        self.pour.finish();
         self.progress.update(sample, elapsed_s);
+    }
+
+    fn pour(&mut self, status: &granbed_kernel::dem::pour::PourStatus, elapsed_s: f64) {
+        self.pour.update(status, elapsed_s);
     }
 
     fn snapshot(
@@ -817,5 +833,44 @@ impl run::BedObserver for Observer {
         mesh: &crate::model::OwnedReference,
     ) -> anyhow::Result<()> {
         self.snapshots.write(strain, assembly, mesh)
+    }
+}
+
+/// `pack`'s progress line for the pour of a bed (on stderr when it is a
+/// terminal and not `--quiet`), drawn from the pour's first rest check and
+/// removed when the compression's bar takes over.
+struct PourSpinner {
+    quiet: bool,
+    granules: usize,
+    max_time_s: f64,
+    bar: Option<crate::pack::progress::Progress>,
+}
+
+impl PourSpinner {
+    /// The spinner of `scene`'s pour, not drawn yet.
+    fn new(quiet: bool, scene: &Scene) -> anyhow::Result<Self> {
+        Ok(Self {
+            quiet,
+            granules: scene.granules,
+            max_time_s: run::pour_params(scene, &scene.material()?).max_time,
+            bar: None,
+        })
+    }
+
+    /// Shows the pour's state `status`, `elapsed_s` into it.
+    fn update(&mut self, status: &granbed_kernel::dem::pour::PourStatus, elapsed_s: f64) {
+        let (quiet, granules, max_time_s) = (self.quiet, self.granules, self.max_time_s);
+        self.bar
+            .get_or_insert_with(|| {
+                crate::pack::progress::Progress::new(quiet, granules, max_time_s)
+            })
+            .update(status, elapsed_s);
+    }
+
+    /// Removes the line, if drawn.
+    fn finish(&mut self) {
+        if let Some(bar) = self.bar.take() {
+            bar.finish();
+        }
     }
 }

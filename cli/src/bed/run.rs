@@ -3,6 +3,7 @@
 //! time-averaged state every output interval. Nothing here depends on
 //! clap, so the tests drive exactly this code.
 
+use core::ops::ControlFlow;
 use core::sync::atomic::{AtomicBool, Ordering};
 use std::path::PathBuf;
 use std::time::Instant;
@@ -13,7 +14,7 @@ use granbed_kernel::analysis::bed::{
     GranuleShape, bed_density, coordination_number, coordination_number_with_walls, granule_shape,
     surface_geometry,
 };
-use granbed_kernel::dem::pour::PourParams;
+use granbed_kernel::dem::pour::{PourError, PourParams, PourStatus};
 
 use super::checkpoint::{self, Checkpoint};
 use super::scene::Scene;
@@ -277,6 +278,10 @@ pub trait BedObserver {
         assembly: &Assembly<'_>,
         mesh: &OwnedReference,
     ) -> anyhow::Result<()>;
+
+    /// The pour's state at one of its rest checks, `elapsed_s` into it
+    /// (for progress; a fresh run's pour only). Nothing by default.
+    fn pour(&mut self, _status: &PourStatus, _elapsed_s: f64) {}
 }
 
 /// A poured bed: the hand-over from the pour to the compression, made
@@ -295,13 +300,38 @@ pub struct Packing {
 
 /// Pours the bed of `scene` (its granule type sets the sphere density).
 /// An error names why the pour failed.
-pub fn pour(scene: &Scene) -> anyhow::Result<Packing> {
+///
+/// `on_check` sees the pour's state at each of its rest checks, with the
+/// wall time so far, s. Once `interrupt` is set, the pour stops at its next
+/// rest check (every [`crate::pack::run::CHECK_EVERY`] steps, a fraction
+/// of a second) with [`crate::signal::Interrupted`]: nothing was
+/// compressed, so there is nothing to keep.
+pub fn pour(
+    scene: &Scene,
+    interrupt: Option<&AtomicBool>,
+    on_check: &mut dyn FnMut(&PourStatus, f64),
+) -> anyhow::Result<Packing> {
     let material = scene.material()?;
     let pour = pour_params(scene, &material);
     let start = Instant::now();
-    let poured = run_pour(pour, &mut |_, _| {}).map_err(anyhow::Error::new)?;
-    if let Some(e) = poured.error {
-        return Err(anyhow::Error::new(e).context("the pour did not come to rest"));
+    let poured = run_pour(pour, &mut |s, t| {
+        on_check(s, t);
+        if interrupt.is_some_and(|f| f.load(Ordering::SeqCst)) {
+            ControlFlow::Break(())
+        } else {
+            ControlFlow::Continue(())
+        }
+    })
+    .map_err(anyhow::Error::new)?;
+    match poured.error {
+        None => {}
+        Some(PourError::Stopped { time, steps }) => {
+            return Err(anyhow::Error::new(crate::signal::Interrupted(format!(
+                "interrupted during the pour ({steps} steps, {time:.4} s simulated): nothing was \
+                 compressed, and there is nothing to resume (no checkpoint written)"
+            ))));
+        }
+        Some(e) => return Err(anyhow::Error::new(e).context("the pour did not come to rest")),
     }
     Ok(Packing {
         centres: poured.positions,
@@ -325,8 +355,9 @@ pub struct RunControl {
     pub stop_at_strain: Option<Real>,
     /// Stop (after the current step, with a checkpoint) once this is set:
     /// the CLI passes [`crate::signal::INTERRUPT`], which its SIGINT and
-    /// SIGTERM handler sets. A fresh run that finds it set after the pour
-    /// stops before its first step with [`crate::signal::Interrupted`].
+    /// SIGTERM handler sets. A fresh run's pour stops at its next rest
+    /// check ([`pour`]); a run that finds it set after the pour stops
+    /// before its first step, both with [`crate::signal::Interrupted`].
     pub interrupt: Option<&'static AtomicBool>,
 }
 
@@ -406,7 +437,7 @@ pub fn run_bed(
             let packing = match &control.packing {
                 Some(p) => p,
                 None => {
-                    poured = pour(scene)?;
+                    poured = pour(scene, control.interrupt, &mut |s, t| observer.pour(s, t))?;
                     &poured
                 }
             };

@@ -450,7 +450,12 @@ impl PackArgs {
         std::fs::create_dir_all(&self.out)
             .with_context(|| format!("cannot create output directory `{}`", self.out.display()))?;
         let bar = progress::Progress::new(self.quiet, params.granules, params.max_time);
-        let result = run::run_pour(params, &mut |s, t| bar.update(s, t));
+        // No stop: `pack` keeps the default SIGINT handling (it has no
+        // finished work to save before its outputs).
+        let result = run::run_pour(params, &mut |s, t| {
+            bar.update(s, t);
+            core::ops::ControlFlow::Continue(())
+        });
         bar.finish();
         let result = result.map_err(|e| self.pour_error(e))?;
         let setup = summary::PackSetup {

@@ -2,6 +2,7 @@
 //! kernel's [`PourScene`], stepped with [`PourScene::run_to_rest`], and the
 //! final state copied out. Nothing here depends on clap.
 
+use core::ops::ControlFlow;
 use std::time::Instant;
 
 use granbed_kernel::Real;
@@ -73,19 +74,21 @@ pub fn sphere_pairs(pairs: &[Pair], spheres: usize) -> Vec<(usize, usize)> {
 /// Pours `params` to rest.
 ///
 /// `on_check` sees the state every [`CHECK_EVERY`] steps, with the wall
-/// time since the start in seconds (for progress reports).
+/// time since the start in seconds (for progress reports), and may stop
+/// the pour there ([`ControlFlow::Break`]: [`PourError::Stopped`] in the
+/// result).
 ///
 /// Returns `Err` only if the scene cannot be set up; an error while
 /// stepping ends the run and is returned inside the [`PourResult`].
 pub fn run_pour(
     params: PourParams,
-    on_check: &mut dyn FnMut(&PourStatus, f64),
+    on_check: &mut dyn FnMut(&PourStatus, f64) -> ControlFlow<()>,
 ) -> Result<PourResult, PourError> {
     let mut store = PourStore::new(&params);
     let start = Instant::now();
     let mut scene = PourScene::new(params, store.buffers())?;
     let outcome = scene.run_to_rest(CHECK_EVERY, &mut |s| {
-        on_check(s, start.elapsed().as_secs_f64());
+        on_check(s, start.elapsed().as_secs_f64())
     });
     let wall_time_s = start.elapsed().as_secs_f64();
     let (status, error) = match outcome {

@@ -249,7 +249,7 @@ pub fn study(args: &WorkPrecisionArgs, streams: &mut Streams<'_>) -> anyhow::Res
     let poured = |seed: u64| -> anyhow::Result<Packing> {
         let scene = scene_for(args, size, &grid[0], seed);
         scene.validate().context("the study's bed")?;
-        pool.install(|| pour(&scene))
+        pool.install(|| pour(&scene, None, &mut |_, _| {}))
             .with_context(|| format!("the pour of seed {seed}"))
     };
     let first = poured(1)?;

@@ -5,6 +5,7 @@
 //! bed bit for bit.
 
 use core::fmt;
+use core::ops::ControlFlow;
 
 use crate::Real;
 use crate::dem::contact::{ContactLanes, ContactLaw, hertz_beta, hertz_mindlin_lanes};
@@ -295,6 +296,14 @@ pub enum PourError {
         /// Step number.
         step: u64,
     },
+    /// The caller's `on_check` of [`PourScene::run_to_rest`] asked it to
+    /// stop before the spheres came to rest (the scene keeps its state).
+    Stopped {
+        /// Simulated time, s.
+        time: Real,
+        /// Steps taken.
+        steps: u64,
+    },
 }
 
 impl fmt::Display for PourError {
@@ -323,6 +332,10 @@ impl fmt::Display for PourError {
                 "the spheres did not come to rest within {time} s (largest speed {max_speed:e} m/s)"
             ),
             Self::Unstable { step } => write!(f, "step {step}: the motion became non-finite"),
+            Self::Stopped { time, steps } => write!(
+                f,
+                "stopped by the caller at {time} s ({steps} steps), before the spheres came to rest"
+            ),
         }
     }
 }
@@ -799,21 +812,32 @@ impl<'a> PourScene<'a> {
         }
     }
 
-    /// Steps until the spheres are at rest (checked every `check` steps,
-    /// with `on_check` called for progress) or `max_time` passes.
+    /// Steps until the spheres are at rest (checked every `check` steps)
+    /// or `max_time` passes. `on_check` sees the state at every check (for
+    /// progress) and may stop the pour there by returning
+    /// [`ControlFlow::Break`] ([`PourError::Stopped`]; a host's interrupt:
+    /// a pour of many spheres runs for minutes), unless it is at rest
+    /// there. A stopped scene keeps its state: `run_to_rest` again goes on
+    /// as if it had not stopped.
     pub fn run_to_rest(
         &mut self,
         check: u64,
-        on_check: &mut dyn FnMut(&PourStatus),
+        on_check: &mut dyn FnMut(&PourStatus) -> ControlFlow<()>,
     ) -> Result<PourStatus, PourError> {
         loop {
             for _ in 0..check.max(1) {
                 self.step()?;
             }
             let s = self.status();
-            on_check(&s);
+            let flow = on_check(&s);
             if s.settled {
                 return Ok(s);
+            }
+            if flow.is_break() {
+                return Err(PourError::Stopped {
+                    time: s.time,
+                    steps: s.steps,
+                });
             }
             if s.time > self.p.max_time {
                 return Err(PourError::NotSettled {
