@@ -114,6 +114,14 @@ fn a_small_bed_runs_end_to_end_and_is_thread_independent() {
         number(&s, "max_penetration_rel_element") < 0.01,
         "overlap {deepest:e} m"
     );
+    // And by geometry at the end (the check of the detection, which
+    // shares none of its choices): below 1 % too, measured (not null).
+    let hidden = &s["final_hidden_overlap"];
+    let rel = number(hidden, "rel_element");
+    assert!((0.0..0.01).contains(&rel), "by geometry {hidden}");
+    if rel > 0.0 {
+        assert_ne!(hidden["granule"], hidden["inside_granule"], "{hidden}");
+    }
     // Nodes touching the punch move with it: the fastest node is at least
     // as fast once the punch carries load.
     let speed = table.num("max_node_speed_m_s");

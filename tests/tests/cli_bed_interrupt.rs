@@ -170,6 +170,12 @@ fn an_interrupted_run_keeps_its_work_and_resumes_to_the_same_bits() {
     assert_eq!(second.state.steps, run.steps + 1);
     let s = summary(&parts);
     assert_eq!(s["interrupted"], true);
+    // No overlap check after an interrupt: the user asked to stop.
+    assert!(
+        s["final_hidden_overlap"].is_null(),
+        "{}",
+        s["final_hidden_overlap"]
+    );
     assert!(
         s["warnings"][0]
             .as_str()
@@ -192,6 +198,7 @@ fn an_interrupted_run_keeps_its_work_and_resumes_to_the_same_bits() {
     );
     let s = summary(&parts);
     assert_eq!(s["interrupted"], false);
+    assert!(s["final_hidden_overlap"]["rel_element"].is_number());
     assert_eq!(s["steps"], whole_summary["steps"]);
     assert_eq!(number(&s, "cost_figures_from_step"), 0.0);
     for key in COUNTED {

@@ -519,6 +519,7 @@ impl BedArgs {
             checkpoint_dir: Some(out.clone()),
             stop_at_strain: self.stop_at_strain,
             interrupt: Some(&crate::signal::INTERRUPT),
+            check_final_overlap: true,
         };
         let mut result = self.compress(&pool, &scene, control, &out, "bed", &notes, streams)?;
         if result.interrupted {
@@ -745,6 +746,7 @@ impl BedArgs {
                 checkpoint_dir: Some(dir.clone()),
                 stop_at_strain: None,
                 interrupt: Some(&crate::signal::INTERRUPT),
+                check_final_overlap: true,
             };
             let label = format!("bed {t}");
             let result = self

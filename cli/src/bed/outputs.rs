@@ -201,6 +201,11 @@ pub struct Summary<'a> {
     /// That overlap / the shortest surface edge of the reference mesh
     /// (the contact tolerance is 1 % of it).
     pub max_penetration_rel_element: Option<Real>,
+    /// The overlap measured by geometry at the end of the run (the check of
+    /// the contact detection that `max_penetration_*` reports, sharing none
+    /// of its choices); null if not measured (a run stopped by an error or
+    /// an interrupt).
+    pub final_hidden_overlap: Option<HiddenOverlapSummary>,
     /// Hourglass energy / internal work at the end.
     pub hourglass_to_internal: Option<Real>,
     /// |ledger residual| / punch work.
@@ -251,6 +256,38 @@ pub fn kawakita(samples: &[BedSample]) -> KawakitaSummary {
             r_squared: None,
             points: samples.iter().filter(|s| s.strain >= 0.25).count(),
         },
+    }
+}
+
+/// `summary.json`'s record of [`super::run::HiddenOverlap`].
+#[derive(Clone, Copy, Debug, Serialize)]
+pub struct HiddenOverlapSummary {
+    /// Depth of the deepest surface node inside another granule, m (0: no
+    /// node inside another granule; NaN: a surface node is not finite).
+    pub depth_m: Real,
+    /// That depth / the shortest surface edge of the reference mesh.
+    pub rel_element: Option<Real>,
+    /// The granule whose surface node it is (when the depth is not 0).
+    pub granule: usize,
+    /// The node, an index into the granule's nodes.
+    pub node: usize,
+    /// The granule it lies inside.
+    pub inside_granule: usize,
+    /// Wall time of the measurement, s (not in `wall_time_s`).
+    pub wall_time_s: f64,
+}
+
+impl HiddenOverlapSummary {
+    /// The record of `h` in a run whose element size is `element_m`.
+    fn of(h: &super::run::HiddenOverlap, element_m: Real) -> Self {
+        Self {
+            depth_m: h.deepest.depth_m,
+            rel_element: finite_ratio(h.deepest.depth_m, element_m),
+            granule: h.deepest.granule,
+            node: h.deepest.node,
+            inside_granule: h.deepest.inside,
+            wall_time_s: h.wall_time_s,
+        }
     }
 }
 
@@ -338,6 +375,9 @@ pub fn summary<'a>(scene: &'a Scene, run: &BedRun) -> Summary<'a> {
         ),
         max_penetration_m,
         max_penetration_rel_element,
+        final_hidden_overlap: run
+            .hidden_overlap
+            .map(|h| HiddenOverlapSummary::of(&h, run.element_size_m)),
         hourglass_to_internal: finite_ratio(e.hourglass, e.internal_work),
         energy_residual_rel: finite_ratio(e.residual().abs(), e.punch_work),
         contact_loss_rel: finite_ratio(e.contact_loss(), e.punch_work),
@@ -423,11 +463,7 @@ fn warnings(
     match max_penetration_rel {
         Some(r) if r > OVERLAP_WARNING_REL => w.push(format!(
             "granules overlap by up to {:.1} % of the element size ({max_penetration_m:.3e} m), \
-             more than the {} % that `study stability` accepts: searching in every contact \
-             sweep (`--exact-contact-from-strain C` from an earlier strain C, or \
-             `--hold-constraints false --contact-search-interval 1` throughout) resolves it at \
-             a higher cost (on 30-granule 4x1 beds to 60 %, held throughout: 26-44 % of the \
-             element; searching from 30 %: 0.7-0.8 %, at 2.7-3.9 times the wall time)",
+             more than the {} % that `study stability` accepts: {OVERLAP_REMEDY}",
             100.0 * r,
             100.0 * OVERLAP_WARNING_REL
         )),
@@ -435,6 +471,30 @@ fn warnings(
             w.push("the granule overlap could not be measured (NaN)".to_owned());
         }
         _ => {}
+    }
+    if let Some(h) = &run.hidden_overlap {
+        let d = h.deepest;
+        match finite_ratio(d.depth_m, run.element_size_m) {
+            Some(r) if r > OVERLAP_WARNING_REL => w.push(format!(
+                "measured by geometry at the end of the run, node {} of granule {} lies {:.1} % \
+                 of the element size ({:.3e} m) inside granule {}, more than the {} % that \
+                 `study stability` accepts (the contact detection read at most {:.2} % at the \
+                 output rows): {OVERLAP_REMEDY}",
+                d.node,
+                d.granule,
+                100.0 * r,
+                d.depth_m,
+                d.inside,
+                100.0 * OVERLAP_WARNING_REL,
+                100.0 * max_penetration_rel.unwrap_or(Real::NAN)
+            )),
+            None if d.depth_m.is_nan() => w.push(format!(
+                "the overlap by geometry could not be measured at the end of the run: node {} of \
+                 granule {} is not finite",
+                d.node, d.granule
+            )),
+            _ => {}
+        }
     }
     if let Some((from, min)) =
         first_fold(run.samples.iter().map(|s| (s.strain, s.min_gauss_jacobian)))
@@ -468,6 +528,14 @@ fn warnings(
     }
     w
 }
+
+/// What resolves overlaps above [`OVERLAP_WARNING_REL`], as measured
+/// (BENCHMARKS.md, "Searching in every contact sweep from 30 %").
+const OVERLAP_REMEDY: &str = "searching in every contact sweep \
+     (`--exact-contact-from-strain C` from an earlier strain C, or `--hold-constraints false \
+     --contact-search-interval 1` throughout) resolves it at a higher cost (on 30-granule 4x1 \
+     beds to 60 %, held throughout: 26-44 % of the element; searching from 30 %: 0.7-0.8 %, at \
+     2.7-3.9 times the wall time)";
 
 /// What avoids a folded element, as measured (BENCHMARKS.md, "A folded
 /// element warned about").
@@ -676,5 +744,59 @@ mod tests {
         );
         let w = summary(&scene, &run([1.0, 0.5, 0.2, 0.01])).warnings;
         assert_eq!(folded(&w), None, "{w:?}");
+    }
+
+    /// The overlap by geometry at the end of a run is recorded in the
+    /// summary and warned about above 1 % of the element, naming the node,
+    /// its granule and the granule it is inside; at 0.5 % it is recorded,
+    /// not warned about; a non-finite node is named; a run that did not
+    /// measure it records null.
+    #[test]
+    fn the_overlap_by_geometry_is_recorded_and_warned_about() {
+        use crate::assembly::overlap::Overlap;
+        use crate::bed::run::{BedRun, BedSample, HiddenOverlap};
+        let run = |depth_m: Option<Real>| {
+            let mut run = BedRun::of_samples(vec![BedSample::default()]);
+            run.element_size_m = 1e-4;
+            run.hidden_overlap = depth_m.map(|depth_m| HiddenOverlap {
+                deepest: Overlap {
+                    depth_m,
+                    granule: 7,
+                    node: 123,
+                    inside: 9,
+                },
+                wall_time_s: 0.5,
+            });
+            run
+        };
+        let scene = Scene::published();
+        let geometry = |w: &[String]| w.iter().find(|w| w.contains("by geometry")).cloned();
+        let deep = summary(&scene, &run(Some(2e-6)));
+        let record = deep.final_hidden_overlap.unwrap();
+        assert!((record.rel_element.unwrap() - 0.02).abs() < 1e-15);
+        assert_eq!(
+            (record.granule, record.node, record.inside_granule),
+            (7, 123, 9)
+        );
+        let warning = geometry(&deep.warnings).unwrap_or_else(|| panic!("{:?}", deep.warnings));
+        assert!(
+            warning.contains("node 123 of granule 7 lies 2.0 %")
+                && warning.contains("inside granule 9"),
+            "{warning}"
+        );
+        let shallow = summary(&scene, &run(Some(0.5e-6)));
+        assert!((shallow.final_hidden_overlap.unwrap().rel_element.unwrap() - 0.005).abs() < 1e-15);
+        assert_eq!(geometry(&shallow.warnings), None, "{:?}", shallow.warnings);
+        let bad = summary(&scene, &run(Some(Real::NAN)));
+        let warning = geometry(&bad.warnings).unwrap_or_else(|| panic!("{:?}", bad.warnings));
+        assert!(
+            warning.contains("node 123 of granule 7 is not finite"),
+            "{warning}"
+        );
+        let none = summary(&scene, &run(None));
+        assert!(none.final_hidden_overlap.is_none());
+        assert_eq!(geometry(&none.warnings), None);
+        let json = serde_json::to_value(&none).unwrap();
+        assert!(json["final_hidden_overlap"].is_null());
     }
 }
