@@ -624,24 +624,36 @@ pub fn summary_line(scene: &Scene, run: &BedRun) -> String {
 
 /// The progress bar of a bed run on stderr (hidden with `--quiet` or when
 /// stderr is not a terminal): strain as the position, with pressure,
-/// coordination number, steps per second and the ETA.
+/// coordination number, steps per second and the ETA. Drawn from the
+/// run's first row on, so that a fresh run's pour shows its own line
+/// alone (`bed`'s pour spinner).
 pub struct Progress {
-    bar: StrainBar,
+    quiet: bool,
+    final_strain: Real,
+    label: String,
+    bar: Option<StrainBar>,
 }
 
 impl Progress {
-    /// A bar up to `final_strain`, its line starting with `label`.
+    /// A bar up to `final_strain`, its line starting with `label`; not
+    /// drawn before its first [`Progress::update`].
     pub fn new(quiet: bool, final_strain: Real, label: &str) -> Self {
-        let bar = ProgressBar::with_draw_target(None, draw_target(quiet));
-        let template = "{prefix} [{elapsed_precise}] {bar:30} C {msg} (ETA {eta})";
         Self {
-            bar: StrainBar::new(bar, template, label, final_strain),
+            quiet,
+            final_strain,
+            label: label.to_owned(),
+            bar: None,
         }
     }
 
     /// Shows sample `s`, taken `elapsed_s` into the compression.
-    pub fn update(&self, s: &BedSample, elapsed_s: f64) {
-        self.bar.show(
+    pub fn update(&mut self, s: &BedSample, elapsed_s: f64) {
+        let bar = self.bar.get_or_insert_with(|| {
+            let bar = ProgressBar::with_draw_target(None, draw_target(self.quiet));
+            let template = "{prefix} [{elapsed_precise}] {bar:30} C {msg} (ETA {eta})";
+            StrainBar::new(bar, template, &self.label, self.final_strain)
+        });
+        bar.show(
             s.strain,
             format!(
                 "{:.3}, P {:.1} kPa, Z {:.2}, {:.0} steps/s",
@@ -653,9 +665,11 @@ impl Progress {
         );
     }
 
-    /// Removes the bar.
+    /// Removes the bar, if drawn.
     pub fn finish(&self) {
-        self.bar.finish();
+        if let Some(bar) = &self.bar {
+            bar.finish();
+        }
     }
 }
 
