@@ -192,6 +192,19 @@ fn truncated_checkpoints_are_refused_with_a_reason() {
     }
 }
 
+/// Bytes after the payload are named as such, not as a truncation: the
+/// file was appended to.
+#[test]
+fn bytes_after_the_payload_are_named() {
+    let (_, bytes) = base_checkpoint();
+    let mut b = bytes.clone();
+    b.extend_from_slice(b"garbage");
+    let e = read(&write_checkpoint("appended", &b)).unwrap_err();
+    assert!(e.contains("7 bytes after its"), "{e}");
+    let e = read(&write_checkpoint("cut", &bytes[..bytes.len() - 3])).unwrap_err();
+    assert!(e.contains("truncated"), "{e}");
+}
+
 #[test]
 fn a_wrong_version_is_named() {
     let (_, bytes) = base_checkpoint();

@@ -623,8 +623,17 @@ impl Checkpoint {
         let len = u64::from_le_bytes(bytes[20..28].try_into().unwrap_or_default());
         let sum = u64::from_le_bytes(bytes[28..36].try_into().unwrap_or_default());
         let payload = &bytes[36..];
-        if payload.len() as u64 != len {
-            return Err(bad("truncated"));
+        if (payload.len() as u64) < len {
+            return Err(bad(&format!(
+                "truncated ({} of its {len} payload bytes)",
+                payload.len()
+            )));
+        }
+        if payload.len() as u64 > len {
+            return Err(bad(&format!(
+                "{} bytes after its {len}-byte payload (appended to, or two files in one)",
+                payload.len() as u64 - len
+            )));
         }
         if fnv1a(payload) != sum {
             return Err(bad("checksum mismatch"));
