@@ -299,3 +299,33 @@ fn sigma_est_converges_with_the_mesh() {
     assert!(fine.abs() < coarse.abs() / 3.0, "not converging: {sigma:?}");
     assert!((sigma[2] / sigma[1] - 1.0).abs() < 0.03, "{sigma:?}");
 }
+
+/// A mesh that claims more surface nodes than it has nodes is refused by
+/// the scene, naming the field: it had been accepted, and the first step
+/// panicked slicing the surface (found by an embedding audit).
+#[test]
+fn a_scene_refuses_an_inconsistent_mesh() {
+    use granbed_kernel::mesh::octant::MeshView;
+    use granbed_kernel::mesh::reference::ReferenceMesh;
+    use granbed_kernel::scene::platens::SceneError;
+    let m = mesh(MeshLevel::STANDARD, true);
+    let p = PlatenParams::standard(GranuleType::B2.params().validate().unwrap());
+    let mut store = PlatenStore::new(&m, 1);
+    let v = m.view();
+    let bad = ReferenceMesh {
+        mesh: MeshView {
+            surface_nodes: v.mesh.positions.len() + 1,
+            ..v.mesh
+        },
+        ..v
+    };
+    assert_eq!(bad.first_surface_node(), 0);
+    let e = PlatenScene::new(p, bad, store.buffers())
+        .err()
+        .expect("an inconsistent mesh must be refused");
+    assert!(matches!(e, SceneError::Mesh(_)), "{e}");
+    assert!(e.to_string().contains("surface_nodes"), "{e}");
+    // The same mesh as it is runs.
+    let mut scene = PlatenScene::new(p, v, store.buffers()).unwrap();
+    scene.step().unwrap();
+}

@@ -28,9 +28,15 @@ pub struct ReferenceMesh<'a> {
 }
 
 impl ReferenceMesh<'_> {
-    /// Index of the first outer surface node.
+    /// Index of the first outer surface node (0 for a mesh claiming more
+    /// surface nodes than nodes, which [`MeshView::check`] refuses).
+    ///
+    /// [`MeshView::check`]: crate::mesh::octant::MeshView::check
     pub fn first_surface_node(&self) -> usize {
-        self.mesh.positions.len() - self.mesh.surface_nodes
+        self.mesh
+            .positions
+            .len()
+            .saturating_sub(self.mesh.surface_nodes)
     }
 
     /// Total reference volume Σ V0, m³.

@@ -36,6 +36,7 @@ use crate::granule::timestep::{
 use crate::material::Material;
 use crate::math;
 use crate::mesh::reference::ReferenceMesh;
+use crate::mesh::sphere::MeshError;
 
 /// Which part of the granule is simulated.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -230,6 +231,10 @@ pub enum SceneError {
         /// Allowed range.
         allowed: &'static str,
     },
+    /// The mesh is not consistent ([`crate::mesh::octant::MeshView::check`]:
+    /// more surface nodes than nodes, or a hex or quad naming a node it
+    /// does not have).
+    Mesh(MeshError),
     /// A buffer has the wrong length.
     BufferLength {
         /// Buffer name as in [`PlatenBuffers`].
@@ -283,6 +288,7 @@ impl fmt::Display for SceneError {
                 value,
                 allowed,
             } => write!(f, "invalid `{field}` = {value}: allowed range is {allowed}"),
+            Self::Mesh(e) => write!(f, "the mesh: {e}"),
             Self::BufferLength {
                 buffer,
                 expected,
@@ -587,6 +593,9 @@ impl<'a> PlatenScene<'a> {
             });
         }
         check_len("node_volume", mesh.node_volume.len(), nodes)?;
+        // Its surface is the last `surface_nodes` nodes (the platens'
+        // contact); the element check below covers the hexes' ids only.
+        mesh.mesh.check().map_err(SceneError::Mesh)?;
         check_element_buffers(
             &mesh,
             params.elements.points_per_element(),
