@@ -205,6 +205,24 @@ fn bytes_after_the_payload_are_named() {
     assert!(e.contains("truncated"), "{e}");
 }
 
+/// A state that is not positive definite (its determinant positive) is
+/// refused on reading, naming the granule and the element: the element
+/// loop tests only the determinant.
+#[test]
+fn an_indefinite_state_in_a_checkpoint_is_named() {
+    let (dir, _) = base_checkpoint();
+    let mut ck = read(dir).unwrap();
+    ck.state.granules[1].cp_inv[3] = [-1.0, -1.0, 1.0, 0.0, 0.0, 0.0];
+    let edited = common::fresh_dir("fuzz_files", "indefinite");
+    std::fs::create_dir_all(&edited).unwrap();
+    ck.write(&edited).unwrap();
+    let e = read(&edited).unwrap_err();
+    assert!(
+        e.contains("granule 1, element state 3") && e.contains("not positive definite"),
+        "{e}"
+    );
+}
+
 #[test]
 fn a_wrong_version_is_named() {
     let (_, bytes) = base_checkpoint();

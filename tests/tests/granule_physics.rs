@@ -329,3 +329,47 @@ fn a_scene_refuses_an_inconsistent_mesh() {
     let mut scene = PlatenScene::new(p, v, store.buffers()).unwrap();
     scene.step().unwrap();
 }
+
+/// The yield tolerance is checked where the element passes and the scene
+/// take their settings, naming the field: NaN, negative or looser than
+/// 1e-6 is refused (a negative one had sent an elastic point to the
+/// corrector, which reported no convergence); 0 and the default pass.
+#[test]
+fn a_bad_yield_tolerance_is_refused_by_name() {
+    use granbed_kernel::granule::forces::{ForcesError, internal_forces};
+    use granbed_kernel::scene::platens::SceneError;
+    let m = mesh(MeshLevel::STANDARD, true);
+    let v = m.view();
+    let mat = GranuleType::B2.params().validate().unwrap();
+    for (tol, ok) in [
+        (1e-12, true),
+        (0.0, true),
+        (1e-6, true),
+        (Real::NAN, false),
+        (-1e-9, false),
+        (1e-3, false),
+    ] {
+        let mut p = PlatenParams::standard(mat);
+        p.elements.update.yield_tolerance = tol;
+        let mut store = PlatenStore::new(&m, 1);
+        match PlatenScene::new(p, v, store.buffers()).map(|_| ()) {
+            Ok(()) => assert!(ok, "{tol} accepted by the scene"),
+            Err(SceneError::InvalidParameter { field, .. }) => {
+                assert!(!ok, "{tol} refused by the scene");
+                assert_eq!(field, "yield_tolerance");
+            }
+            Err(e) => panic!("{tol}: {e}"),
+        }
+        let x = v.mesh.positions.to_vec();
+        let mut cp_inv = vec![[1.0, 1.0, 1.0, 0.0, 0.0, 0.0]; v.mesh.hexes.len()];
+        let mut f = vec![[0.0; 3]; x.len()];
+        match internal_forces(&v, &mat, &p.elements, &x, &mut cp_inv, &mut f) {
+            Ok(_) => assert!(ok, "{tol} accepted by the element pass"),
+            Err(ForcesError::InvalidParameter { field, .. }) => {
+                assert!(!ok, "{tol} refused by the element pass");
+                assert_eq!(field, "yield_tolerance");
+            }
+            Err(e) => panic!("{tol}: {e}"),
+        }
+    }
+}

@@ -481,6 +481,15 @@ impl Checkpoint {
                 })
             })
             .collect::<anyhow::Result<Vec<_>>>()?;
+        // The element loop tests only det C_p⁻¹ (the kernel's own states
+        // are positive definite); a state read from a file is tested in
+        // full once.
+        for (g, granule) in granules.iter().enumerate() {
+            for (e, c) in granule.cp_inv.iter().enumerate() {
+                granbed_kernel::constitutive::update::check_state(c)
+                    .with_context(|| format!("granule {g}, element state {e}"))?;
+            }
+        }
         let np = d.len(8)?;
         let pairs = (0..np)
             .map(|_| {

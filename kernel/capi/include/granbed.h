@@ -46,7 +46,8 @@
 // det F ≤ 0: the point or element is inverted.
 #define GRANBED_ERR_INVERTED 5
 
-// The stored plastic state C_p⁻¹ is corrupt (det ≤ 0 or not finite).
+// The stored plastic state C_p⁻¹ is corrupt (not positive definite, or
+// its determinant not finite).
 #define GRANBED_ERR_INVALID_STATE 6
 
 // The return map did not reach the yield surface.

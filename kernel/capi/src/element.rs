@@ -1,6 +1,7 @@
 //! The one-point hex element for a batch of elements: reference data once,
 //! then nodal forces per step.
 
+use granbed_kernel::constitutive::update::check_state;
 use granbed_kernel::element::force::hex_forces;
 use granbed_kernel::element::reference::{HexReference, hex_reference};
 
@@ -185,7 +186,10 @@ pub unsafe extern "C" fn granbed_hex_forces(
             let t = tau.as_deref_mut().and_then(|t| t.get_mut(6 * k..6 * k + 6));
             let record = info.as_deref_mut().and_then(|i| i.get_mut(k));
             let result = if reference_ok(r) {
-                hex_forces(&mat, &opts, kappa, &decode(r), &coords(x), c)
+                // The element tests only det C_p⁻¹; a caller's state is
+                // checked in full first.
+                check_state(c)
+                    .and_then(|()| hex_forces(&mat, &opts, kappa, &decode(r), &coords(x), c))
                     .map_err(|e| update_status(&e))
             } else {
                 Err(GRANBED_ERR_INVALID_ARGUMENT)

@@ -17,7 +17,8 @@ pub const GRANBED_ERR_INVALID_ARGUMENT: i32 = 3;
 pub const GRANBED_ERR_NON_FINITE: i32 = 4;
 /// det F ≤ 0: the point or element is inverted.
 pub const GRANBED_ERR_INVERTED: i32 = 5;
-/// The stored plastic state C_p⁻¹ is corrupt (det ≤ 0 or not finite).
+/// The stored plastic state C_p⁻¹ is corrupt (not positive definite, or
+/// its determinant not finite).
 pub const GRANBED_ERR_INVALID_STATE: i32 = 6;
 /// The return map did not reach the yield surface.
 pub const GRANBED_ERR_NO_CONVERGENCE: i32 = 7;
@@ -52,7 +53,9 @@ pub extern "C" fn granbed_status_message(code: i32) -> *const c_char {
         GRANBED_ERR_INVALID_ARGUMENT => c"an argument is outside its documented range",
         GRANBED_ERR_NON_FINITE => c"a deformation gradient or coordinate is not finite",
         GRANBED_ERR_INVERTED => c"inverted element or point: det F <= 0",
-        GRANBED_ERR_INVALID_STATE => c"invalid plastic state: det Cp^-1 <= 0 or not finite",
+        GRANBED_ERR_INVALID_STATE => {
+            c"invalid plastic state: Cp^-1 not positive definite, or its determinant not finite"
+        }
         GRANBED_ERR_NO_CONVERGENCE => c"the return map did not converge",
         GRANBED_ERR_DEGENERATE => c"degenerate quad or hex",
         GRANBED_ERR_POINT_FAILED => c"at least one point or element failed (see its status)",

@@ -24,8 +24,27 @@ pub struct UpdateOptions {
     /// after the return, set det b^e = (J^e)². `false` reproduces the
     /// published algorithm literally (spurious dilatation under shear).
     pub volume_fix: bool,
-    /// A trial state with φ ≤ `yield_tolerance`·(2/3)a2σy² is elastic.
+    /// A trial state with φ ≤ `yield_tolerance`·(2/3)a2σy² is elastic
+    /// (dimensionless, 0 ≤ tolerance ≤ [`MAX_YIELD_TOLERANCE`]). Not
+    /// checked per point; the element passes and scenes check it once
+    /// ([`UpdateOptions::yield_tolerance_is_valid`]). A negative or NaN
+    /// tolerance sends admissible states to the corrector, which then
+    /// reports [`UpdateError::NoConvergence`].
     pub yield_tolerance: Real,
+}
+
+/// The largest [`UpdateOptions::yield_tolerance`] accepted: the corrector's
+/// fallback accepts a residual up to [`super::return_map::FALLBACK_RESIDUAL_MAX`],
+/// and a looser elastic test would let states that much outside the yield
+/// surface pass as elastic.
+pub const MAX_YIELD_TOLERANCE: Real = 1.0e-6;
+
+impl UpdateOptions {
+    /// Whether `yield_tolerance` lies in 0 ≤ tolerance ≤
+    /// [`MAX_YIELD_TOLERANCE`] (NaN does not).
+    pub fn yield_tolerance_is_valid(&self) -> bool {
+        (0.0..=MAX_YIELD_TOLERANCE).contains(&self.yield_tolerance)
+    }
 }
 
 impl Default for UpdateOptions {
@@ -112,7 +131,8 @@ pub enum UpdateError {
         /// det F.
         j: Real,
     },
-    /// det C_p⁻¹ ≤ 0 (or not finite): the stored state is corrupt.
+    /// The stored state C_p⁻¹ is corrupt: its determinant is not in
+    /// (0, ∞), or ([`check_state`]) it is not positive definite.
     InvalidState {
         /// det C_p⁻¹.
         det: Real,
@@ -131,7 +151,11 @@ impl fmt::Display for UpdateError {
         match self {
             Self::NonFinite => f.write_str("deformation gradient is not finite"),
             Self::InvertedDeformation { j } => write!(f, "inverted element: det F = {j:e}"),
-            Self::InvalidState { det } => write!(f, "invalid plastic state: det Cp^-1 = {det:e}"),
+            Self::InvalidState { det } => write!(
+                f,
+                "invalid plastic state: Cp^-1 is not positive definite with a finite determinant \
+                 (det Cp^-1 = {det:e})"
+            ),
             Self::NoConvergence {
                 residual,
                 iterations,
@@ -148,7 +172,9 @@ impl core::error::Error for UpdateError {}
 /// Result of a successful update.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct PointUpdate {
-    /// Kirchhoff stress τ at the end of the step, Pa, Voigt order.
+    /// Kirchhoff stress τ at the end of the step, Pa, Voigt order
+    /// `[xx, yy, zz, yz, xz, xy]`, positive in tension (the pressure
+    /// [`crate::tensor::pressure`] is positive in compression).
     pub tau: Voigt,
     /// Diagnostics.
     pub info: UpdateInfo,
@@ -291,6 +317,32 @@ pub fn input_is_valid(f_finite: bool, j: Real, det_cp_inv: Real, eta: Real) -> b
     f_finite & (j > 0.0) & (det_cp_inv > 0.0) & (det_cp_inv < Real::INFINITY) & eta.is_finite()
 }
 
+/// Checks a stored state C_p⁻¹ supplied from outside the kernel: it must
+/// be symmetric positive definite (its leading minors C11, C11 C22 − C12²
+/// and det C_p⁻¹ all > 0, Sylvester's criterion) with a finite
+/// determinant; [`UpdateError::InvalidState`] otherwise (a NaN entry
+/// fails).
+///
+/// [`update_point`] and [`update_point_rows`] (hence the F-bar element's
+/// points) check their state with it. The one-point element's paths test
+/// only the determinant per element ([`check_input`]): the kernel's own returns leave C_p⁻¹ = F⁻¹ b^e F⁻ᵀ
+/// positive definite, and the full test cost the element loop about 1 %
+/// of its instructions (BENCHMARKS.md, session 45), so a host that loads
+/// states from elsewhere checks them once with this (the C ABI does, per
+/// element). A state with a positive determinant but two negative
+/// eigenvalues had passed the determinant's test (an embedding audit).
+pub fn check_state(cp_inv: &Voigt) -> Result<(), UpdateError> {
+    let det = tensor::det(cp_inv);
+    // Voigt [xx, yy, zz, yz, xz, xy]: C12 is entry 5.
+    let minor2 = cp_inv[0] * cp_inv[1] - cp_inv[5] * cp_inv[5];
+    let definite = cp_inv[0] > 0.0 && minor2 > 0.0 && det > 0.0 && det < Real::INFINITY;
+    if definite {
+        Ok(())
+    } else {
+        Err(UpdateError::InvalidState { det })
+    }
+}
+
 /// Whether a trial state with yield function `phi_tr` and scale
 /// (2/3)a2σy² `scale` yields: not `φ ≤ tol·scale`. Not `φ > tol·scale`: a
 /// NaN φ (overflowed trial state) must go to the corrector, which reports
@@ -322,6 +374,21 @@ pub fn update_point(
 /// [`update_point`] with F given as rows.
 #[inline]
 pub fn update_point_rows(
+    mat: &Material,
+    opts: &UpdateOptions,
+    f: &Rows<Real>,
+    cp_inv: &mut Voigt,
+) -> Result<PointUpdate, UpdateError> {
+    check_state(cp_inv)?;
+    update_checked_state(mat, opts, f, cp_inv)
+}
+
+/// [`update_point_rows`] without [`check_state`]: the update of an element
+/// ([`crate::element::force::hex_forces`]), whose state only the
+/// determinant's test of [`check_input`] checks, as the element batch
+/// does, so that every element path refuses the same states.
+#[inline]
+pub(crate) fn update_checked_state(
     mat: &Material,
     opts: &UpdateOptions,
     f: &Rows<Real>,
@@ -536,6 +603,53 @@ mod tests {
     use crate::lanes::Lanes;
     use crate::material::GranuleType;
     use crate::tensor::VOIGT_IDENTITY;
+
+    /// A state from outside must be positive definite with a finite
+    /// determinant: the point update refuses one with a positive
+    /// determinant but two negative eigenvalues, one whose 2×2 leading
+    /// minor is negative, one with a NaN or an infinite determinant, and
+    /// leaves it untouched; the identity and a sheared positive definite
+    /// state pass. The element's own test is the determinant alone
+    /// ([`check_input`]), which the first two pass.
+    #[test]
+    fn a_state_that_is_not_positive_definite_is_refused() {
+        let mat = GranuleType::B2.params().validate().unwrap();
+        let opts = UpdateOptions::default();
+        let f = [[0.99, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
+        for bad in [
+            [-1.0, -1.0, 1.0, 0.0, 0.0, 0.0],
+            [1.0, 1.0, -3.0, 0.0, 0.0, 2.0],
+            [1.0, 1.0, Real::NAN, 0.0, 0.0, 0.0],
+            [1.0, 1.0, Real::INFINITY, 0.0, 0.0, 0.0],
+        ] {
+            assert!(
+                matches!(check_state(&bad), Err(UpdateError::InvalidState { .. })),
+                "{bad:?}"
+            );
+            let mut c = bad;
+            let e = update_point_rows(&mat, &opts, &f, &mut c).unwrap_err();
+            assert!(
+                matches!(e, UpdateError::InvalidState { .. }),
+                "{bad:?}: {e}"
+            );
+            assert_eq!(c.map(Real::to_bits), bad.map(Real::to_bits));
+        }
+        for bad in [
+            [-1.0, -1.0, 1.0, 0.0, 0.0, 0.0],
+            [1.0, 1.0, -3.0, 0.0, 0.0, 2.0],
+        ] {
+            let t = trial(&mat, &f, &bad);
+            assert!(
+                t.det_cp_inv > 0.0 && check_input(true, &t).is_ok(),
+                "{bad:?}"
+            );
+        }
+        for good in [VOIGT_IDENTITY, [1.2, 0.9, 1.0, 0.05, -0.1, 0.2]] {
+            assert_eq!(check_state(&good), Ok(()));
+            let mut c = good;
+            update_point_rows(&mat, &opts, &f, &mut c).unwrap();
+        }
+    }
 
     /// [`returned_state`] over lanes gives every returned lane the bits of
     /// the scalar [`plastic_return`] (as the element batch uses it), with

@@ -7,7 +7,7 @@
 //! f^hg_I = k Σ q_α (1 + |q_α|²/s²) γ0_αI, E_hg = Σ (k/2)|q_α|² (1 + |q_α|²/(2s²)).
 
 use crate::Real;
-use crate::constitutive::update::update_point_rows;
+use crate::constitutive::update::update_checked_state;
 use crate::constitutive::{UpdateError, UpdateInfo, UpdateOptions};
 use crate::element::hex8::HexCoords;
 use crate::element::reference::HexReference;
@@ -47,7 +47,8 @@ pub struct HexForces {
     pub hourglass_energy: Real,
     /// J = det F̄ (current volume / reference volume).
     pub j: Real,
-    /// Kirchhoff stress at the element's point, Pa.
+    /// Kirchhoff stress at the element's point, Pa, Voigt order
+    /// `[xx, yy, zz, yz, xz, xy]`, positive in tension.
     pub tau: Voigt,
     /// Constitutive diagnostics.
     pub info: UpdateInfo,
@@ -190,10 +191,18 @@ pub fn nodal_forces_into<T: Num>(
 /// Forces of one element at current node positions `x` (m).
 ///
 /// * `cp_inv`: in/out, the element's C_p⁻¹ (start → end of step); untouched
-///   on error.
+///   on error. Symmetric positive definite, as the kernel's own returns
+///   leave it: only its determinant is tested here, as in every element
+///   path ([`crate::constitutive::update::check_state`] tests a state
+///   loaded from elsewhere fully).
 /// * `kappa`: hourglass coefficient κ (dimensionless, 0 ≤ κ ≤ 1; not
 ///   checked here, per element: [`crate::granule::forces::internal_forces`]
 ///   and the C ABI check it once per call — a NaN gives NaN forces).
+/// * `r`: the element's reference data as
+///   [`crate::element::reference::hex_reference`] makes it (which refuses
+///   an inverted element). Not checked here either: a reference made by
+///   hand with a non-finite volume or gradient gives non-finite forces;
+///   the C ABI's `granbed_hex_forces` checks it.
 ///
 /// [`crate::element::batch`] evaluates several elements side by side with
 /// the same bits.
@@ -208,7 +217,7 @@ pub fn hex_forces(
     cp_inv: &mut Voigt,
 ) -> Result<HexForces, UpdateError> {
     let F = mean_gradient_rows(&r.b0, x);
-    let up = update_point_rows(mat, opts, &F, cp_inv)?;
+    let up = update_checked_state(mat, opts, &F, cp_inv)?;
     let j = det_rows(&F);
     let mut f = [[0.0; 3]; 8];
     let hourglass_energy = nodal_forces_into(

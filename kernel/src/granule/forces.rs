@@ -22,6 +22,9 @@ pub enum ElementKind {
     FBar,
 }
 
+/// The range of [`UpdateOptions::yield_tolerance`] as the checks name it.
+pub const YIELD_TOLERANCE_RANGE: &str = "0 <= tolerance <= 1e-6";
+
 /// Element-loop settings of a granule.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct ElementSettings {
@@ -35,17 +38,25 @@ pub struct ElementSettings {
 
 impl ElementSettings {
     /// [`ForcesError::InvalidParameter`] unless 0 ≤ κ ≤ 1 (a NaN κ made
-    /// every force NaN, a negative one a negative hourglass energy).
+    /// every force NaN, a negative one a negative hourglass energy) and
+    /// the yield tolerance is valid
+    /// ([`UpdateOptions::yield_tolerance_is_valid`]).
     pub fn check(&self) -> Result<(), ForcesError> {
-        if (0.0..=1.0).contains(&self.hourglass_kappa) {
-            Ok(())
-        } else {
-            Err(ForcesError::InvalidParameter {
+        if !(0.0..=1.0).contains(&self.hourglass_kappa) {
+            return Err(ForcesError::InvalidParameter {
                 field: "hourglass_kappa",
                 value: self.hourglass_kappa,
                 allowed: "0 <= kappa <= 1",
-            })
+            });
         }
+        if !self.update.yield_tolerance_is_valid() {
+            return Err(ForcesError::InvalidParameter {
+                field: "yield_tolerance",
+                value: self.update.yield_tolerance,
+                allowed: YIELD_TOLERANCE_RANGE,
+            });
+        }
+        Ok(())
     }
 
     /// Integration points, hence C_p⁻¹ states, per element: 1 or 8.

@@ -129,7 +129,7 @@ impl PlatenParams {
                 power_iterations,
             } => (power_interval, power_iterations),
         };
-        let checks: [(bool, &'static str, Real, &'static str); 12] = [
+        let checks: [(bool, &'static str, Real, &'static str); 13] = [
             (
                 power_interval >= 1,
                 "power_interval",
@@ -190,6 +190,12 @@ impl PlatenParams {
                 "hourglass_kappa",
                 self.elements.hourglass_kappa,
                 "0 <= kappa <= 1",
+            ),
+            (
+                self.elements.update.yield_tolerance_is_valid(),
+                "yield_tolerance",
+                self.elements.update.yield_tolerance,
+                crate::granule::forces::YIELD_TOLERANCE_RANGE,
             ),
             (
                 self.gravity_m_s2 >= 0.0

@@ -72,6 +72,10 @@ int main(void) {
     double corrupt[6] = {-1, 1, 1, 0, 0, 0};
     expect("corrupt state", granbed_update_points(&p, 1, 1, f, corrupt, 0, tau, NULL, st), GRANBED_ERR_POINT_FAILED);
     expect("corrupt state code", st[0], GRANBED_ERR_INVALID_STATE);
+    /* det > 0, but two negative eigenvalues: not positive definite. */
+    double indefinite[6] = {-1, -1, 1, 0, 0, 0};
+    expect("indefinite state", granbed_update_points(&p, 1, 1, f, indefinite, 0, tau, NULL, st), GRANBED_ERR_POINT_FAILED);
+    expect("indefinite state code", st[0], GRANBED_ERR_INVALID_STATE);
 
     /* Elements and contact. */
     double flat[24] = {0};
@@ -152,6 +156,12 @@ int main(void) {
         }
         granbed_state_init(1, cp);
         expect("good reference", granbed_hex_forces(&p, 1, 0.05, 1, good, x, cp, fe, NULL, NULL, est), GRANBED_OK);
+        /* A state with det > 0 that is not positive definite. */
+        const double indefinite[6] = {-1, -1, 1, 0, 0, 0};
+        memcpy(cp, indefinite, sizeof cp);
+        expect("indefinite element state", granbed_hex_forces(&p, 1, 0.05, 1, good, x, cp, fe, NULL, NULL, est),
+               GRANBED_ERR_POINT_FAILED);
+        expect("indefinite element state code", est[0], GRANBED_ERR_INVALID_STATE);
     }
     expect("vumat nstatev 5", granbed_vumat(1, 5, 8, NULL, NULL, NULL, NULL, NULL, NULL), GRANBED_ERR_INVALID_ARGUMENT);
     if (strcmp(granbed_status_message(12345), "unknown status code") != 0) {
