@@ -152,6 +152,19 @@ fn node_face_force_rejects_bad_scalars_naming_the_field() {
         ..c
     };
     assert_eq!(field(node_face_force(&skew, 1.0, 0.3, 1e-16)), "weights");
+    // Summing to 1 but off the face.
+    let off = NodeFace {
+        weights: [2.0, -1.0, 0.0, 0.0],
+        ..c
+    };
+    assert_eq!(field(node_face_force(&off, 1.0, 0.3, 1e-16)), "weights");
+    // Finite inputs whose force overflows: refused, not an infinite force.
+    let huge = NodeFace {
+        gap: -1e300,
+        ..c
+    };
+    assert_eq!(field(node_face_force(&huge, 1.0, 0.3, 1e-300)), "gap");
+    assert!(node_face_force(&huge, 1.0, 0.3, 1e-16).is_ok());
     assert_eq!(
         field(node_face_force(
             &with(|c| c.gap = Real::NAN),

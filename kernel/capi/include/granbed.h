@@ -1,3 +1,13 @@
+/*
+ * granbed's C ABI. Units are SI (m, s, kg, N, Pa). Stresses are positive
+ * in tension (the pressure -tr(sigma)/3 positive in compression).
+ * Symmetric tensors are in Voigt order [xx, yy, zz, yz, xz, xy] everywhere
+ * except in granbed_vumat, which takes Abaqus' order [11, 22, 33, 12, 23, 31].
+ * Every function but granbed_version and granbed_status_message returns a
+ * GRANBED_* status (granbed_status_message names it); none aborts on bad
+ * numbers.
+ */
+
 #ifndef GRANBED_H
 #define GRANBED_H
 
@@ -13,9 +23,11 @@
 // must satisfy | |n| − 1 | ≤ this, the weights |Σ Nᵢ − 1| ≤ this.
 #define GRANBED_UNIT_TOLERANCE 1e-6
 
-// Doubles per element in the reference array of `granbed_hex_reference`:
-// V0 (1), B0 (8 nodes × xyz = 24), γ0 (4 modes × 8 nodes = 32), the
-// hourglass geometry factor V0 Σ|B0_I|²/3 (1), the lumped node volumes (8).
+// Doubles per element in the reference array of `granbed_hex_reference`,
+// in this order: V0 (m³, 1), B0, the mean gradients (1/V0)∫∇N_I dV (1/m, 24 as
+// `[node][xyz]`), γ0, the hourglass shape vectors (dimensionless, 32 as
+// `[mode][node]`), the hourglass geometry factor V0 Σ|B0_I|²/3 (m, 1),
+// the lumped node volumes (m³, 8 as `[node]`).
 #define GRANBED_HEX_REFERENCE_LEN 66
 
 // Default hourglass coefficient κ of the kernel.
@@ -40,7 +52,8 @@
 // step, a mass, a granule type name).
 #define GRANBED_ERR_INVALID_ARGUMENT 3
 
-// A deformation gradient or coordinate is NaN or infinite.
+// An input (a deformation gradient, coordinate, weight, normal or gap)
+// is NaN or infinite, or a result would overflow.
 #define GRANBED_ERR_NON_FINITE 4
 
 // det F ≤ 0: the point or element is inverted.
@@ -114,8 +127,8 @@ typedef struct GranbedNodeFace {
   double master_x_n[4][3];
   // Master corners predicted, `[corner][xyz]`, m.
   double master_x_pred[4][3];
-  // Bilinear weights of the corners at the contact point (Σ = 1 within
-  // `GRANBED_UNIT_TOLERANCE`).
+  // Bilinear weights of the corners at the contact point (each in
+  // [0, 1] and Σ = 1, within `GRANBED_UNIT_TOLERANCE`).
   double weights[4];
   // The master face's outward unit normal at the contact point
   // (| |n| − 1 | ≤ `GRANBED_UNIT_TOLERANCE`).
@@ -221,12 +234,14 @@ int32_t granbed_project_node_on_quad(const double *p,
 // writes a zero force (never a pull).
 //
 // Returns `GRANBED_OK`; `GRANBED_ERR_NON_FINITE` (a position, a weight, a
-// normal component or the gap is NaN or infinite); or
+// normal component or the gap is NaN or infinite, or the force would
+// overflow: |gap| m_eff / Δt² beyond the range of a double); or
 // `GRANBED_ERR_INVALID_ARGUMENT`: a mass not finite or ≤ 0 (every master
 // corner's, whatever its weight), w, μ or Δt² outside its range, a
 // normal whose length differs from 1 by more than
 // `GRANBED_UNIT_TOLERANCE` (a zero normal included), or weights whose sum
-// differs from 1 by more than `GRANBED_UNIT_TOLERANCE`. On an error `out`
+// differs from 1, or one of which lies outside [0, 1], by more than
+// `GRANBED_UNIT_TOLERANCE` (a point off the face). On an error `out`
 // is not written.
 //
 // # Safety
@@ -246,6 +261,9 @@ int32_t granbed_node_face_force(const struct GranbedNodeFace *c,
 // * `reference`: out, n×`GRANBED_HEX_REFERENCE_LEN`.
 // * `element_status`: out, n codes (`GRANBED_ERR_DEGENERATE` for a hex
 //   with a non-positive Gauss-point Jacobian, `GRANBED_ERR_NON_FINITE`).
+//
+// Returns `GRANBED_OK`, `GRANBED_ERR_POINT_FAILED` (some hex failed: see
+// its `element_status`) or an argument error.
 //
 // # Safety
 // Pointers to arrays of the documented lengths, outputs not overlapping.

@@ -1,7 +1,7 @@
 //! Node-to-quad projection and the kinematic contact force of one
 //! node-to-face constraint (physics.md §5.2–§5.4).
 
-use granbed_kernel::contact::pair::{NodeFace, node_face_force};
+use granbed_kernel::contact::pair::{ContactError, NodeFace, node_face_force};
 use granbed_kernel::contact::quad::project;
 
 use crate::buffers::{input, one, one_mut, status};
@@ -96,8 +96,8 @@ pub struct GranbedNodeFace {
     pub master_x_n: [[f64; 3]; 4],
     /// Master corners predicted, `[corner][xyz]`, m.
     pub master_x_pred: [[f64; 3]; 4],
-    /// Bilinear weights of the corners at the contact point (Σ = 1 within
-    /// `GRANBED_UNIT_TOLERANCE`).
+    /// Bilinear weights of the corners at the contact point (each in
+    /// [0, 1] and Σ = 1, within `GRANBED_UNIT_TOLERANCE`).
     pub weights: [f64; 4],
     /// The master face's outward unit normal at the contact point
     /// (| |n| − 1 | ≤ `GRANBED_UNIT_TOLERANCE`).
@@ -143,12 +143,14 @@ const _: () = assert!(GRANBED_UNIT_TOLERANCE == granbed_kernel::contact::pair::U
 /// writes a zero force (never a pull).
 ///
 /// Returns `GRANBED_OK`; `GRANBED_ERR_NON_FINITE` (a position, a weight, a
-/// normal component or the gap is NaN or infinite); or
+/// normal component or the gap is NaN or infinite, or the force would
+/// overflow: |gap| m_eff / Δt² beyond the range of a double); or
 /// `GRANBED_ERR_INVALID_ARGUMENT`: a mass not finite or ≤ 0 (every master
 /// corner's, whatever its weight), w, μ or Δt² outside its range, a
 /// normal whose length differs from 1 by more than
 /// `GRANBED_UNIT_TOLERANCE` (a zero normal included), or weights whose sum
-/// differs from 1 by more than `GRANBED_UNIT_TOLERANCE`. On an error `out`
+/// differs from 1, or one of which lies outside [0, 1], by more than
+/// `GRANBED_UNIT_TOLERANCE` (a point off the face). On an error `out`
 /// is not written.
 ///
 /// # Safety
@@ -190,10 +192,13 @@ pub unsafe extern "C" fn granbed_node_face_force(
             normal: c.normal,
             gap: c.gap,
         };
-        // The kernel checks the masses, w, μ, Δt², the weights' sum and
-        // the normal's length (the positions are finite here).
-        let r = node_face_force(&node, weight, friction, dt_squared)
-            .map_err(|_| GRANBED_ERR_INVALID_ARGUMENT)?;
+        // The kernel checks the masses, w, μ, Δt², the weights (their sum,
+        // each in [0, 1]) and the normal's length (the positions are finite
+        // here); it names the gap only when the force overflows.
+        let r = node_face_force(&node, weight, friction, dt_squared).map_err(|e| match e {
+            ContactError::InvalidParameter { field: "gap", .. } => GRANBED_ERR_NON_FINITE,
+            _ => GRANBED_ERR_INVALID_ARGUMENT,
+        })?;
         *out = GranbedNodeFaceForce {
             slave: r.force,
             master: c.weights.map(|w| r.force.map(|v| -w * v)),

@@ -13,9 +13,11 @@ use crate::status::{
 };
 use crate::update::{GranbedPointInfo, options};
 
-/// Doubles per element in the reference array of `granbed_hex_reference`:
-/// V0 (1), B0 (8 nodes × xyz = 24), γ0 (4 modes × 8 nodes = 32), the
-/// hourglass geometry factor V0 Σ|B0_I|²/3 (1), the lumped node volumes (8).
+/// Doubles per element in the reference array of `granbed_hex_reference`,
+/// in this order: V0 (m³, 1), B0, the mean gradients (1/V0)∫∇N_I dV (1/m, 24 as
+/// `[node][xyz]`), γ0, the hourglass shape vectors (dimensionless, 32 as
+/// `[mode][node]`), the hourglass geometry factor V0 Σ|B0_I|²/3 (m, 1),
+/// the lumped node volumes (m³, 8 as `[node]`).
 pub const GRANBED_HEX_REFERENCE_LEN: usize = 66;
 
 /// Default hourglass coefficient κ of the kernel.
@@ -76,6 +78,9 @@ fn coords(x: &[f64; 24]) -> [[f64; 3]; 8] {
 /// * `reference`: out, n×`GRANBED_HEX_REFERENCE_LEN`.
 /// * `element_status`: out, n codes (`GRANBED_ERR_DEGENERATE` for a hex
 ///   with a non-positive Gauss-point Jacobian, `GRANBED_ERR_NON_FINITE`).
+///
+/// Returns `GRANBED_OK`, `GRANBED_ERR_POINT_FAILED` (some hex failed: see
+/// its `element_status`) or an argument error.
 ///
 /// # Safety
 /// Pointers to arrays of the documented lengths, outputs not overlapping.

@@ -13,7 +13,8 @@ pub const GRANBED_ERR_INVALID_PARAMETER: i32 = 2;
 /// A non-material argument is outside its range (a flag, a count, a time
 /// step, a mass, a granule type name).
 pub const GRANBED_ERR_INVALID_ARGUMENT: i32 = 3;
-/// A deformation gradient or coordinate is NaN or infinite.
+/// An input (a deformation gradient, coordinate, weight, normal or gap)
+/// is NaN or infinite, or a result would overflow.
 pub const GRANBED_ERR_NON_FINITE: i32 = 4;
 /// det F ≤ 0: the point or element is inverted.
 pub const GRANBED_ERR_INVERTED: i32 = 5;
@@ -51,7 +52,7 @@ pub extern "C" fn granbed_status_message(code: i32) -> *const c_char {
             c"a material parameter is outside its range (granbed_material_check names it)"
         }
         GRANBED_ERR_INVALID_ARGUMENT => c"an argument is outside its documented range",
-        GRANBED_ERR_NON_FINITE => c"a deformation gradient or coordinate is not finite",
+        GRANBED_ERR_NON_FINITE => c"an input is not finite, or a result would overflow",
         GRANBED_ERR_INVERTED => c"inverted element or point: det F <= 0",
         GRANBED_ERR_INVALID_STATE => {
             c"invalid plastic state: Cp^-1 not positive definite, or its determinant not finite"

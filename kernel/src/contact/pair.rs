@@ -1041,8 +1041,9 @@ pub(crate) fn check_step(friction: Real, dt_squared: Real) -> Result<(), Contact
 /// outside 0 < w ≤ 1; `friction` not finite or < 0; `dt_squared` not
 /// finite or ≤ 0; a mass (`slave_mass`, any of `master_mass`, also one
 /// whose weight is 0) not finite or ≤ 0; a non-finite position or gap; the
-/// `weights` not finite or |Σ Nᵢ − 1| > [`UNIT_TOLERANCE`]; the `normal`
-/// not finite or | |n| − 1 | > [`UNIT_TOLERANCE`].
+/// `weights` not finite, |Σ Nᵢ − 1| > [`UNIT_TOLERANCE`] or a weight
+/// outside [0, 1] by more than it; the `normal` not finite or | |n| − 1 |
+/// > [`UNIT_TOLERANCE`]; a force that overflows (named as the `gap`).
 pub fn node_face_force(
     c: &NodeFace,
     weight: Real,
@@ -1086,6 +1087,16 @@ pub fn node_face_force(
         sum,
         "finite, summing to 1 within 1e-6",
     )?;
+    // The weights of a point on the face: each in [0, 1] (within the
+    // tolerance). (2, −1, 0, 0) sums to 1 but lies off the face.
+    for &w in &c.weights {
+        check_param(
+            (-UNIT_TOLERANCE..=1.0 + UNIT_TOLERANCE).contains(&w),
+            "weights",
+            w,
+            "each in [0, 1] within 1e-6 (a point on the face)",
+        )?;
+    }
     let len = norm(&c.normal);
     check_param(
         abs(len - 1.0) <= UNIT_TOLERANCE,
@@ -1113,9 +1124,16 @@ pub fn node_face_force(
         normal: &c.normal,
         gap: c.gap,
     };
-    Ok(kinematic_force(
-        &spot, increment, weight, friction, dt_squared,
-    ))
+    let out = kinematic_force(&spot, increment, weight, friction, dt_squared);
+    // Finite inputs can still overflow: |g| m_eff / Δt² beyond the range
+    // of f64 (a gap of 1e300 m in a step of 1e-150 s).
+    check_param(
+        out.force.iter().all(|v| v.is_finite()) && out.normal.is_finite(),
+        "gap",
+        c.gap,
+        "a gap whose force |gap| m_eff / dt_squared is finite",
+    )?;
+    Ok(out)
 }
 
 /// What [`kinematic_force`] needs besides the motion of the step.

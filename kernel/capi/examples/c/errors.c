@@ -129,6 +129,14 @@ int main(void) {
     expect("weights summing to 1.5", granbed_node_face_force(&c, 1.0, 0.3, 1e-16, &out),
            GRANBED_ERR_INVALID_ARGUMENT);
     c.weights[1] = 0;
+    c.weights[0] = 2;
+    c.weights[1] = -1;
+    expect("weights off the face", granbed_node_face_force(&c, 1.0, 0.3, 1e-16, &out),
+           GRANBED_ERR_INVALID_ARGUMENT);
+    c.weights[0] = 1;
+    c.weights[1] = 0;
+    c.gap = -1e300;
+    expect("overflowing force", granbed_node_face_force(&c, 1.0, 0.3, 1e-300, &out), GRANBED_ERR_NON_FINITE);
     c.gap = NAN;
     expect("NaN gap", granbed_node_face_force(&c, 1.0, 0.3, 1e-16, &out), GRANBED_ERR_NON_FINITE);
 
