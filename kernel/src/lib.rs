@@ -33,6 +33,11 @@
 /// The one scalar type of the kernel.
 pub type Real = f64;
 
+/// The nalgebra this kernel is built with (its 3×3 matrices,
+/// [`tensor::Mat3`], appear in the API): a caller uses it without pinning
+/// a version of its own.
+pub use nalgebra;
+
 pub mod analysis;
 pub mod constitutive;
 pub mod contact;

@@ -159,10 +159,7 @@ fn node_face_force_rejects_bad_scalars_naming_the_field() {
     };
     assert_eq!(field(node_face_force(&off, 1.0, 0.3, 1e-16)), "weights");
     // Finite inputs whose force overflows: refused, not an infinite force.
-    let huge = NodeFace {
-        gap: -1e300,
-        ..c
-    };
+    let huge = NodeFace { gap: -1e300, ..c };
     assert_eq!(field(node_face_force(&huge, 1.0, 0.3, 1e-300)), "gap");
     assert!(node_face_force(&huge, 1.0, 0.3, 1e-16).is_ok());
     assert_eq!(

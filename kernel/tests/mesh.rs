@@ -197,7 +197,18 @@ fn bad_resolutions_and_buffers_are_errors() {
         Err(MeshError::InvalidResolution { n: 7, m: 2 })
     );
     assert!(SphereMeshParams::new(R, 8, 0).size().is_err());
-    assert!(SphereMeshParams::new(-R, 8, 2).size().is_err());
+    for radius in [-R, 0.0, Real::NAN, Real::INFINITY] {
+        assert!(
+            matches!(
+                SphereMeshParams::new(radius, 8, 2).size(),
+                Err(MeshError::InvalidParameter {
+                    field: "radius",
+                    ..
+                })
+            ),
+            "radius {radius}"
+        );
+    }
     let p = SphereMeshParams::standard();
     let s = p.size().unwrap();
     let mut pos = vec![[0.0; 3]; s.nodes - 1];

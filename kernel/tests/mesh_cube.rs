@@ -221,7 +221,7 @@ fn node_quads_are_consistent() {
 fn bad_input_is_an_error() {
     assert!(matches!(
         cube_size(0),
-        Err(MeshError::InvalidResolution { n: 0, .. })
+        Err(MeshError::InvalidParameter { field: "n", .. })
     ));
     assert!(cube_size(100_000).is_err());
     let size = cube_size(2).unwrap();
@@ -241,7 +241,7 @@ fn bad_input_is_an_error() {
         assert!(
             matches!(
                 generate_cube(side, 2, &mut out),
-                Err(MeshError::InvalidResolution { .. })
+                Err(MeshError::InvalidParameter { field: "side", .. })
             ),
             "side {side}"
         );

@@ -355,9 +355,13 @@ pub fn yields(opts: &UpdateOptions, phi_tr: Real, scale: Real) -> bool {
 
 /// Updates one integration point to the end-of-step deformation gradient.
 ///
-/// * `f_np1`: deformation gradient F_{n+1} (reference → current).
-/// * `cp_inv`: in: C_p⁻¹ at the start of the step; out: at the end. Left
-///   untouched on error and on elastic steps.
+/// * `f_np1`: deformation gradient F_{n+1} (reference → current), an
+///   nalgebra matrix ([`crate::nalgebra`], the kernel's own version); as
+///   plain rows `[[F11, F12, F13], …]`, [`update_point_rows`].
+/// * `cp_inv`: in: C_p⁻¹ at the start of the step (Voigt
+///   `[xx, yy, zz, yz, xz, xy]`, symmetric positive definite: the identity
+///   for a virgin point; [`check_state`]); out: at the end. Left untouched
+///   on error and on elastic steps.
 ///
 /// Returns the Kirchhoff stress and diagnostics, or an [`UpdateError`]; never
 /// panics.

@@ -206,6 +206,12 @@ pub fn nodal_forces_into<T: Num>(
 ///
 /// [`crate::element::batch`] evaluates several elements side by side with
 /// the same bits.
+///
+/// One point sees only the mean deformation F̄: an element folded by an
+/// hourglass mode while F̄ stays regular (J > 0) is not an error here. The
+/// smallest Gauss-point Jacobian ratio, which sees it, is
+/// [`crate::granule::quality::worst_element`]'s (from reference
+/// determinants taken once per mesh).
 #[allow(non_snake_case)]
 #[inline]
 pub fn hex_forces(

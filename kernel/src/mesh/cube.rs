@@ -17,13 +17,19 @@ use crate::mesh::sphere::{MeshBuffers, MeshError, MeshSize};
 
 /// Largest divisions per edge (keeps node ids in `u32` with room to spare).
 pub const MAX_DIVISIONS: u32 = 256;
+// The range is spelled out in `cube_size`'s error.
+const _: () = assert!(MAX_DIVISIONS == 256);
 
 /// Buffer sizes of a cube with `n` divisions per edge, or
-/// [`MeshError::InvalidResolution`] (with m = 0) unless 1 ≤ n ≤
+/// [`MeshError::InvalidParameter`] (`n`) unless 1 ≤ n ≤
 /// [`MAX_DIVISIONS`]. `scratch` is one entry per lattice point.
 pub fn cube_size(n: u32) -> Result<MeshSize, MeshError> {
     if !(1..=MAX_DIVISIONS).contains(&n) {
-        return Err(MeshError::InvalidResolution { n, m: 0 });
+        return Err(MeshError::InvalidParameter {
+            field: "n",
+            value: Real::from(n),
+            allowed: "1 <= n <= 256 divisions per edge",
+        });
     }
     let n = n as usize;
     let surface = 6 * n * n + 2;
@@ -50,13 +56,17 @@ fn check_len(buffer: &'static str, got: usize, expected: usize) -> Result<(), Me
 
 /// Generates the cube of side `side` (m, finite and > 0) with `n` divisions
 /// per edge into `out` (sized by [`cube_size`]). Returns the sizes written;
-/// an invalid `n` or `side` gives [`MeshError::InvalidResolution`] (m = 0),
+/// an invalid `n` or `side` gives [`MeshError::InvalidParameter`] naming it,
 /// a wrong buffer length [`MeshError::BufferLength`]. Every element corner
 /// is checked for det J > 0.
 pub fn generate_cube(side: Real, n: u32, out: &mut MeshBuffers<'_>) -> Result<MeshSize, MeshError> {
     let size = cube_size(n)?;
     if !(side > 0.0 && side.is_finite()) {
-        return Err(MeshError::InvalidResolution { n, m: 0 });
+        return Err(MeshError::InvalidParameter {
+            field: "side",
+            value: side,
+            allowed: "finite, > 0 m",
+        });
     }
     check_len("positions", out.positions.len(), size.nodes)?;
     check_len("hexes", out.hexes.len(), size.hexes)?;

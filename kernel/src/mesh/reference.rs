@@ -21,6 +21,11 @@ pub struct ReferenceMesh<'a> {
     /// `elements` regrouped for the batched one-point element
     /// ([`crate::element::batch::regroup`], `batch_count(hexes)` long), or
     /// empty to have each batch gather its lanes (slower, the same bits).
+    /// It must be regrouped from these `elements`: the element loop checks
+    /// only its length and the volumes of its first and last batch (a
+    /// full comparison would cost what regrouping saves), so the data of
+    /// another mesh with equal volumes there, e.g. a rotated copy, would
+    /// be used and give wrong forces.
     pub batches: &'a [ElementBatch],
     /// Lumped volume share of each node (Σ over its elements), m³; nodal
     /// mass = ρ0 × this.

@@ -55,15 +55,19 @@ impl SphereMeshParams {
     /// Buffer sizes this mesh needs, or an error for an invalid resolution.
     pub fn size(&self) -> Result<MeshSize, MeshError> {
         let (n, m) = (self.n as usize, self.m as usize);
-        let ok = self.n.is_multiple_of(2)
-            && (2..=64).contains(&self.n)
-            && (1..=32).contains(&self.m)
-            && self.radius > 0.0
-            && self.radius.is_finite();
+        let ok =
+            self.n.is_multiple_of(2) && (2..=64).contains(&self.n) && (1..=32).contains(&self.m);
         if !ok {
             return Err(MeshError::InvalidResolution {
                 n: self.n,
                 m: self.m,
+            });
+        }
+        if !(self.radius > 0.0 && self.radius.is_finite()) {
+            return Err(MeshError::InvalidParameter {
+                field: "radius",
+                value: self.radius,
+                allowed: "finite, > 0 m",
             });
         }
         let surface = 6 * n * n + 2;
@@ -109,12 +113,22 @@ pub struct MeshSize {
 /// Why a mesh could not be generated.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum MeshError {
-    /// n odd or out of 2..=64, m out of 1..=32, or a bad radius.
+    /// The sphere's n odd or out of 2..=64, or m out of 1..=32.
     InvalidResolution {
         /// Core divisions.
         n: u32,
         /// Shell layers.
         m: u32,
+    },
+    /// A scalar out of its range: the sphere's radius, the cube's divisions
+    /// or side.
+    InvalidParameter {
+        /// The argument or field.
+        field: &'static str,
+        /// The value given.
+        value: Real,
+        /// The allowed range.
+        allowed: &'static str,
     },
     /// A buffer has the wrong length.
     BufferLength {
@@ -151,8 +165,13 @@ impl fmt::Display for MeshError {
         match self {
             Self::InvalidResolution { n, m } => write!(
                 f,
-                "invalid sphere mesh resolution n = {n}, m = {m}: n must be even in 2..=64, m in 1..=32, radius > 0"
+                "invalid sphere mesh resolution n = {n}, m = {m}: n must be even in 2..=64, m in 1..=32"
             ),
+            Self::InvalidParameter {
+                field,
+                value,
+                allowed,
+            } => write!(f, "invalid mesh `{field}` = {value}: allowed {allowed}"),
             Self::BufferLength {
                 buffer,
                 expected,
