@@ -198,6 +198,24 @@ typedef struct GranbedParamError {
   double value;
 } GranbedParamError;
 
+// The constants derived from validated material parameters, SI units:
+// what an explicit host needs beside the stresses, e.g. a stable time
+// step Δt ≤ h / `wave_speed_m_s` for an element of size h.
+typedef struct GranbedMaterialDerived {
+  // Lamé's first parameter λ = Eν/((1+ν)(1−2ν)), Pa.
+  double lambda_pa;
+  // Shear modulus μ = E/(2(1+ν)), Pa.
+  double mu_pa;
+  // Bulk modulus K = λ + 2μ/3, Pa.
+  double bulk_pa;
+  // P-wave modulus λ + 2μ, Pa (the hourglass stiffness is κ times it).
+  double p_wave_pa;
+  // Reference density ρ0 = η0 ρ_true of the porous granule, kg/m³.
+  double density0_kg_m3;
+  // Dilatational wave speed c_d = √((λ + 2μ)/ρ0), m/s.
+  double wave_speed_m_s;
+} GranbedMaterialDerived;
+
 #ifdef __cplusplus
 extern "C" {
 #endif // __cplusplus
@@ -330,6 +348,21 @@ int32_t granbed_material_preset(const char *name, struct GranbedMaterialParams *
 // NULL or points to a writable `GranbedParamError`.
 int32_t granbed_material_check(const struct GranbedMaterialParams *params,
                                struct GranbedParamError *error);
+
+// Writes the constants derived from `params` (checked as
+// `granbed_material_check` does) to `out`.
+//
+// Returns `GRANBED_OK`, `GRANBED_ERR_NULL_POINTER`, or
+// `GRANBED_ERR_INVALID_PARAMETER` (the rejection written to `error` when
+// it is not NULL; `out` is then not written).
+//
+// # Safety
+// `params` is NULL or points to a `GranbedMaterialParams`; `out` is NULL
+// or points to a writable `GranbedMaterialDerived`; `error` is NULL or
+// points to a writable `GranbedParamError`.
+int32_t granbed_material_derived(const struct GranbedMaterialParams *params,
+                                 struct GranbedMaterialDerived *out,
+                                 struct GranbedParamError *error);
 
 // Writes the initial plastic state C_p⁻¹ = identity of `n` points to
 // `cp_inv` (n×6, Voigt xx yy zz yz xz xy).

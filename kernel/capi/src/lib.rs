@@ -2,7 +2,8 @@
 //! # granbed-capi
 //!
 //! The C ABI of `granbed-kernel`, for finite-element codes in C, C++ and
-//! Fortran: material validation, state initialisation, the porous
+//! Fortran: material validation and derived constants, state
+//! initialisation, the porous
 //! elastoplastic update for a batch of points, the one-point hex element
 //! for a batch of elements, and the node-to-quad projection and kinematic
 //! contact force. The header is `include/granbed.h` (cbindgen); the

@@ -175,6 +175,61 @@ pub unsafe extern "C" fn granbed_material_check(
     })())
 }
 
+/// The constants derived from validated material parameters, SI units:
+/// what an explicit host needs beside the stresses, e.g. a stable time
+/// step Δt ≤ h / `wave_speed_m_s` for an element of size h.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct GranbedMaterialDerived {
+    /// Lamé's first parameter λ = Eν/((1+ν)(1−2ν)), Pa.
+    pub lambda_pa: f64,
+    /// Shear modulus μ = E/(2(1+ν)), Pa.
+    pub mu_pa: f64,
+    /// Bulk modulus K = λ + 2μ/3, Pa.
+    pub bulk_pa: f64,
+    /// P-wave modulus λ + 2μ, Pa (the hourglass stiffness is κ times it).
+    pub p_wave_pa: f64,
+    /// Reference density ρ0 = η0 ρ_true of the porous granule, kg/m³.
+    pub density0_kg_m3: f64,
+    /// Dilatational wave speed c_d = √((λ + 2μ)/ρ0), m/s.
+    pub wave_speed_m_s: f64,
+}
+
+/// Writes the constants derived from `params` (checked as
+/// `granbed_material_check` does) to `out`.
+///
+/// Returns `GRANBED_OK`, `GRANBED_ERR_NULL_POINTER`, or
+/// `GRANBED_ERR_INVALID_PARAMETER` (the rejection written to `error` when
+/// it is not NULL; `out` is then not written).
+///
+/// # Safety
+/// `params` is NULL or points to a `GranbedMaterialParams`; `out` is NULL
+/// or points to a writable `GranbedMaterialDerived`; `error` is NULL or
+/// points to a writable `GranbedParamError`.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn granbed_material_derived(
+    params: *const GranbedMaterialParams,
+    out: *mut GranbedMaterialDerived,
+    error: *mut GranbedParamError,
+) -> i32 {
+    status((|| {
+        // SAFETY (all three): the caller's contract.
+        let params = unsafe { one(params) }?;
+        let out = unsafe { one_mut(out) }?;
+        let error = unsafe { error.as_mut() };
+        let m = validated(params, error)?;
+        *out = GranbedMaterialDerived {
+            lambda_pa: m.lambda,
+            mu_pa: m.mu,
+            bulk_pa: m.bulk,
+            p_wave_pa: m.p_wave_modulus(),
+            density0_kg_m3: m.density0,
+            wave_speed_m_s: granbed_kernel::math::sqrt(m.p_wave_modulus() / m.density0),
+        };
+        Ok(GRANBED_OK)
+    })())
+}
+
 /// Writes the initial plastic state C_p⁻¹ = identity of `n` points to
 /// `cp_inv` (n×6, Voigt xx yy zz yz xz xy).
 ///

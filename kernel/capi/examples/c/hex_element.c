@@ -6,7 +6,10 @@
  *  2. a rigid rotation of the deformed cube rotates the forces with it
  *     (objectivity);
  *  3. two elements in one batch, one inverted: per-element status codes,
- *     the good one still computed.
+ *     the good one still computed;
+ *  4. the derived constants (granbed_material_derived): a small uniaxial
+ *     strain ε gives τ_xx = (λ + 2μ)ε and τ_yy = λε to 1e-6, c_d² ρ0 is
+ *     the P-wave modulus, ρ0 = η0 ρ_true; bad parameters name the field.
  * Exit status 0 if all hold. */
 #include <math.h>
 #include <stdio.h>
@@ -38,6 +41,31 @@ int main(void) {
     int32_t st[2];
     check("reference", granbed_hex_reference(1, xref, ref, st) == GRANBED_OK && st[0] == GRANBED_OK);
     check("volume", fabs(ref[0] - 1e-9) < 1e-24);
+
+    /* 4. The derived constants against the element's small-strain response. */
+    {
+        GranbedMaterialDerived d;
+        GranbedParamError e;
+        check("derived", granbed_material_derived(&p, &d, &e) == GRANBED_OK);
+        const double eps = 1e-7, Fs[9] = {1 + eps, 0, 0, 0, 1, 0, 0, 0, 1};
+        double xs[24], cps[6], fs[24], taus[6];
+        apply(Fs, xref, xs);
+        granbed_state_init(1, cps);
+        check("small strain", granbed_hex_forces(&p, 1, GRANBED_DEFAULT_HOURGLASS_KAPPA, 1, ref, xs, cps, fs, taus,
+                                                 NULL, st) == GRANBED_OK);
+        check("tau_xx = (lambda + 2 mu) eps", fabs(taus[0] / (eps * d.p_wave_pa) - 1) < 1e-6);
+        check("tau_yy = lambda eps", fabs(taus[1] / (eps * d.lambda_pa) - 1) < 1e-6);
+        check("p-wave = lambda + 2 mu", fabs(d.p_wave_pa - d.lambda_pa - 2 * d.mu_pa) <= 1e-12 * d.p_wave_pa);
+        check("bulk = lambda + 2 mu / 3", fabs(d.bulk_pa - d.lambda_pa - 2 * d.mu_pa / 3) <= 1e-12 * d.bulk_pa);
+        check("rho0 = eta0 rho_true", fabs(d.density0_kg_m3 - p.eta0 * p.true_density_kg_m3) <= 1e-12 * d.density0_kg_m3);
+        check("c_d^2 rho0 = p-wave",
+              fabs(d.wave_speed_m_s * d.wave_speed_m_s * d.density0_kg_m3 / d.p_wave_pa - 1) < 1e-12);
+        GranbedMaterialParams bad = p;
+        bad.poisson_ratio = 0.5;
+        check("derived of bad parameters", granbed_material_derived(&bad, &d, &e) == GRANBED_ERR_INVALID_PARAMETER &&
+                                               strcmp(e.field, "poisson_ratio") == 0);
+        check("derived, NULL out", granbed_material_derived(&p, NULL, NULL) == GRANBED_ERR_NULL_POINTER);
+    }
 
     /* 1. Homogeneous compression with shear (plastic for B2). */
     const double F[9] = {1.01, 0.02, 0, 0, 0.99, 0.01, 0, 0, 0.9};
