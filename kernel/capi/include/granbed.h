@@ -182,6 +182,10 @@ typedef struct GranbedPointInfo {
   double eta;
   // Plastic dissipation of the step per unit reference volume, J/m³.
   double dissipation_density;
+  // Hourglass energy (k/2) Σ|q|² stored in the element, J
+  // (`granbed_hex_forces`; 0 for a material point): with the internal
+  // and plastic work it closes a host's energy balance.
+  double hourglass_energy;
   // 1 if the step was plastic, else 0.
   int32_t plastic;
   // Return-map iterations (0 for elastic steps and the radial return).

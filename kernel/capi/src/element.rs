@@ -212,6 +212,7 @@ pub unsafe extern "C" fn granbed_hex_forces(
                             j: out.j,
                             eta: out.info.eta,
                             dissipation_density: out.plastic_dissipation / r[0],
+                            hourglass_energy: out.hourglass_energy,
                             plastic: i32::from(out.info.plastic),
                             iterations: i32::try_from(out.info.iterations).unwrap_or(i32::MAX),
                         };

@@ -25,6 +25,10 @@ pub struct GranbedPointInfo {
     pub eta: f64,
     /// Plastic dissipation of the step per unit reference volume, J/m³.
     pub dissipation_density: f64,
+    /// Hourglass energy (k/2) Σ|q|² stored in the element, J
+    /// (`granbed_hex_forces`; 0 for a material point): with the internal
+    /// and plastic work it closes a host's energy balance.
+    pub hourglass_energy: f64,
     /// 1 if the step was plastic, else 0.
     pub plastic: i32,
     /// Return-map iterations (0 for elastic steps and the radial return).
@@ -55,6 +59,7 @@ pub(crate) fn point_info(up: &PointUpdate, j: f64) -> GranbedPointInfo {
         j,
         eta: up.info.eta,
         dissipation_density: up.dissipation_density(),
+        hourglass_energy: 0.0,
         plastic: i32::from(up.info.plastic),
         iterations: i32::try_from(up.info.iterations).unwrap_or(i32::MAX),
     }

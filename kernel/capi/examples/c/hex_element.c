@@ -9,7 +9,10 @@
  *     the good one still computed;
  *  4. the derived constants (granbed_material_derived): a small uniaxial
  *     strain ε gives τ_xx = (λ + 2μ)ε and τ_yy = λε to 1e-6, c_d² ρ0 is
- *     the P-wave modulus, ρ0 = η0 ρ_true; bad parameters name the field.
+ *     the P-wave modulus, ρ0 = η0 ρ_true; bad parameters name the field;
+ *  5. the hourglass energy: none in a homogeneous field; for a pure
+ *     hourglass mode (u_x ∝ ξηζ, F̄ = 1, so τ = 0) the forces are the
+ *     hourglass spring's and its energy is ½ Σ f·u.
  * Exit status 0 if all hold. */
 #include <math.h>
 #include <stdio.h>
@@ -84,6 +87,8 @@ int main(void) {
     printf("hex_element: tau_zz element %.12g Pa, point %.12g Pa, plastic %d/%d\n", tau[2], tau_point[2],
            info.plastic, info_point.plastic);
     check("element stress = point stress", dtau <= 1e-9 * tau_scale && info.plastic == 1);
+    check("no hourglass energy in a homogeneous field", fabs(info.hourglass_energy) <= 1e-30);
+    check("a point has no hourglass energy", info_point.hourglass_energy == 0);
     double sum[3] = {0, 0, 0}, fmax_abs = 0;
     for (int i = 0; i < 8; i++)
         for (int a = 0; a < 3; a++) { sum[a] += f[3 * i + a]; fmax_abs = fmax(fmax_abs, fabs(f[3 * i + a])); }
@@ -123,6 +128,24 @@ int main(void) {
     check("batch", granbed_hex_forces(&p, 1, 0.05, 2, refs, xs, cps, fs, NULL, NULL, st) == GRANBED_ERR_POINT_FAILED);
     check("batch codes", st[0] == GRANBED_OK && st[1] == GRANBED_ERR_INVERTED);
     check("good element computed", memcmp(fs, f, sizeof f) == 0);
+
+    /* 5. A pure hourglass mode: u_x = a ξηζ at the corners (a = 1 nm). */
+    {
+        const double a = 1e-9;
+        double xh[24], cph[6], fh[24], work = 0;
+        memcpy(xh, xref, sizeof xh);
+        for (int i = 0; i < 8; i++) {
+            const double xi = CUBE[i][0] > 0 ? 1 : -1, eta = CUBE[i][1] > 0 ? 1 : -1, zeta = CUBE[i][2] > 0 ? 1 : -1;
+            xh[3 * i] += a * xi * eta * zeta;
+        }
+        granbed_state_init(1, cph);
+        GranbedPointInfo ih;
+        check("hourglass mode", granbed_hex_forces(&p, 1, GRANBED_DEFAULT_HOURGLASS_KAPPA, 1, ref, xh, cph, fh, NULL, &ih,
+                                                   st) == GRANBED_OK);
+        for (int i = 0; i < 24; i++) work += 0.5 * fh[i] * (xh[i] - xref[i]);
+        printf("hex_element: hourglass energy %.6e J, 1/2 f.u %.6e J\n", ih.hourglass_energy, work);
+        check("hourglass energy = 1/2 f.u", ih.hourglass_energy > 0 && fabs(ih.hourglass_energy / work - 1) < 1e-9);
+    }
     printf("hex_element: %s\n", failures ? "FAILED" : "all checks hold");
     return failures ? 1 : 0;
 }
