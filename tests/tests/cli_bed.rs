@@ -134,6 +134,8 @@ fn a_small_bed_runs_end_to_end_and_is_thread_independent() {
     // The published scene's selective mass scaling at 50 mm/s:
     // quasi-static by the certificate.
     assert_eq!(s["quasi_static"]["passed"], true, "{}", s["quasi_static"]);
+    let warned = |w: &serde_json::Value| w.as_str().unwrap().contains("NOT quasi-static");
+    assert!(!s["warnings"].as_array().unwrap().iter().any(warned), "{s}");
 }
 
 #[test]
@@ -351,6 +353,7 @@ fn heavy_mass_scaling_fails_the_quasi_static_certificate() {
     let dir = out_dir("mass100");
     let mut argv = vec![
         "bed",
+        "--quiet",
         "-j",
         "2",
         "--out",
@@ -366,7 +369,17 @@ fn heavy_mass_scaling_fails_the_quasi_static_certificate() {
     let s = summary(&dir);
     assert_eq!(s["scene"]["mass_scaling"], 100.0);
     assert_eq!(s["quasi_static"]["passed"], false, "{}", s["quasi_static"]);
-    assert!(run.stderr.contains("NOT quasi-static"), "{}", run.stderr);
+    // A warning, in the summary and on stderr even with --quiet, with the
+    // strains judged and the failing figure against its limit.
+    let warning = s["warnings"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter_map(|w| w.as_str())
+        .find(|w| w.starts_with("NOT quasi-static over C = "))
+        .unwrap_or_else(|| panic!("no certificate warning: {s}"));
+    assert!(warning.contains("[limit 0.01]"), "{warning}");
+    assert!(run.stderr.contains(warning), "{}", run.stderr);
     let run = cli(&["bed", "--print-scene", "--mass-scaling", "0.5"]);
     assert_eq!(run.code, 2);
     assert!(run.stderr.contains("mass_scaling"), "{}", run.stderr);

@@ -75,6 +75,15 @@ fn three_types_from_one_pour_are_ordered_by_yield_stress() {
     {
         assert_eq!(v, s["kawakita"]["points"].as_f64().unwrap(), "{t}");
     }
+    // The certificate's verdict, 1 or 0, is the summary's.
+    for ((t, s), v) in TYPES
+        .iter()
+        .zip(&summaries)
+        .zip(table.num("quasi_static_passed"))
+    {
+        let passed = s["quasi_static"]["passed"].as_bool().unwrap();
+        assert_eq!(v, if passed { 1.0 } else { 0.0 }, "{t}");
+    }
     assert_eq!(table.num("yield_stress_pa"), [10e3, 30e3, 100e3]);
     assert_eq!(table.num("eta0"), [0.8; 3]);
 

@@ -28,7 +28,7 @@ pub const DENSITY_SVG: &str = "comparison_density.svg";
 
 /// Columns of [`COMPARISON_CSV`], in order (`NaN` where the summary has
 /// `null`, e.g. no Kawakita fit below C = 0.25).
-pub const COMPARISON_COLUMNS: [&str; 13] = [
+pub const COMPARISON_COLUMNS: [&str; 14] = [
     "type",
     "yield_stress_pa",
     "eta0",
@@ -41,6 +41,7 @@ pub const COMPARISON_COLUMNS: [&str; 13] = [
     "final_pressure_pa",
     "final_relative_density",
     "final_coordination",
+    "quasi_static_passed",
     "wall_time_s",
 ];
 
@@ -72,6 +73,10 @@ pub struct ComparisonRow {
     pub final_relative_density: Real,
     /// Coordination number Z at the end.
     pub final_coordination: Real,
+    /// The run's quasi-static certificate passed (1 in the CSV; a row
+    /// that failed it describes a bed with inertia in it: its summary's
+    /// warning says which figure failed).
+    pub quasi_static_passed: bool,
     /// Wall time of the compression, s.
     pub wall_time_s: f64,
     /// The error that stopped the run early, if any.
@@ -94,6 +99,7 @@ impl ComparisonRow {
             final_pressure_pa: s.final_pressure_pa,
             final_relative_density: s.final_relative_density,
             final_coordination: s.final_coordination,
+            quasi_static_passed: s.quasi_static.passed,
             wall_time_s: s.wall_time_s,
             error: s.error.clone(),
         }
@@ -114,6 +120,7 @@ impl ComparisonRow {
             self.final_pressure_pa.into(),
             self.final_relative_density.into(),
             self.final_coordination.into(),
+            Field::Int(u64::from(self.quasi_static_passed)),
             self.wall_time_s.into(),
         ]
     }

@@ -606,7 +606,13 @@ impl BedArgs {
             .iter()
             .filter(|w| !notes.contains(w))
         {
-            writeln!(streams.stderr, "warning: {w}")?;
+            // Several runs in one command (`--types`, the rate check's
+            // twin) say whose warning it is.
+            if label == "bed" {
+                writeln!(streams.stderr, "warning: {w}")?;
+            } else {
+                writeln!(streams.stderr, "warning: {label}: {w}")?;
+            }
         }
         Ok(result)
     }
