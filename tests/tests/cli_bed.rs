@@ -293,6 +293,33 @@ fn a_stopped_run_resumes_to_the_same_bits() {
         *partial.last().unwrap() < 0.02,
         "the first part ran to {partial:?}"
     );
+    // A fresh run into the stopped run's directory would lose its
+    // checkpoint: refused, naming --resume and --overwrite, nothing
+    // touched.
+    let ck = std::fs::read(parts.join("checkpoint.bin")).unwrap();
+    let mut argv = vec!["bed", "--out", parts_s];
+    argv.extend_from_slice(&args);
+    let refused = cli(&argv);
+    assert_eq!(refused.code, 2, "{}", refused.stderr);
+    assert!(
+        refused.stderr.contains("unfinished run")
+            && refused.stderr.contains(&format!("--resume {parts_s}"))
+            && refused.stderr.contains("--overwrite"),
+        "{}",
+        refused.stderr
+    );
+    assert_eq!(std::fs::read(parts.join("checkpoint.bin")).unwrap(), ck);
+    // With --overwrite (on a copy of it) the fresh run goes ahead.
+    let over = out_dir("overwrite");
+    std::fs::create_dir_all(&over).unwrap();
+    std::fs::write(over.join("checkpoint.bin"), &ck).unwrap();
+    run(&[&["--out", over.to_str().unwrap(), "--overwrite"][..], &args].concat());
+    assert_eq!(
+        std::fs::read(over.join("compression.csv")).unwrap(),
+        std::fs::read(whole.join("compression.csv")).unwrap()
+    );
+    // A finished run is replaced without a word (the whole run again).
+    run(&[&["--out", whole_s][..], &args].concat());
     // A second segment (0.01 → 0.06): the summary's wall time
     // counts the first segment too, so it exceeds what the checkpoint
     // recorded for the first (a second segment alone is far shorter).

@@ -322,6 +322,13 @@ pub struct BedArgs {
     /// printed).
     #[arg(short, long)]
     pub quiet: bool,
+
+    /// Start afresh even where --out (or, with --types, DIR/<TYPE>) holds
+    /// an unfinished run, whose checkpoint is then lost. Without it such a
+    /// directory is refused (`--resume DIR` continues the run); a finished
+    /// run is replaced either way.
+    #[arg(long, conflicts_with = "resume")]
+    pub overwrite: bool,
 }
 
 /// The scene field a `bed` override flag sets (`--die-diameter-mm` sets
@@ -497,7 +504,13 @@ impl BedArgs {
             .num_threads(self.threads)
             .build()?;
         if let Some(types) = &self.types {
+            for t in &types.0 {
+                self.keep_unfinished(&self.out.join(t.name()))?;
+            }
             return self.run_types(&scene, &types.0, &notes, &pool, streams);
+        }
+        if resume.is_none() {
+            self.keep_unfinished(&out)?;
         }
         if let Some(c) = &resume {
             let reached = c.progress.die.strain_at(c.state.time);
@@ -815,6 +828,37 @@ fn interrupted(result: &run::BedRun, dir: &std::path::Path, what: &str) -> anyho
         dir.display(),
         dir.display()
     )))
+}
+
+impl BedArgs {
+    /// Refuses a fresh run into `dir` when it holds an unfinished run
+    /// (readable `checkpoint.bin` short of its final strain), unless
+    /// `--overwrite`: its checkpoint would be lost. A finished run, a
+    /// directory without a checkpoint and an unreadable checkpoint (which
+    /// no resume could use) are no reason to stop.
+    fn keep_unfinished(&self, dir: &std::path::Path) -> anyhow::Result<()> {
+        if self.overwrite || !dir.join(checkpoint::FILE_NAME).is_file() {
+            return Ok(());
+        }
+        let Ok(c) = checkpoint::Checkpoint::read(dir) else {
+            return Ok(());
+        };
+        let Ok(scene) = Scene::from_toml(&c.progress.scene_toml) else {
+            return Ok(());
+        };
+        if c.state.time >= c.progress.die.time_of_strain(scene.final_strain) {
+            return Ok(());
+        }
+        Err(crate::error::input_error(format!(
+            "`{}` holds an unfinished run (checkpoint at C = {:.4} of {}): `granbed-cli bed \
+             --resume {}` continues it; choose another --out, or pass --overwrite to start \
+             afresh there and lose it",
+            dir.display(),
+            c.progress.die.strain_at(c.state.time),
+            scene.final_strain,
+            dir.display()
+        )))
+    }
 }
 
 /// What the command does with the run as it goes.
