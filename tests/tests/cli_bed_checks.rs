@@ -71,6 +71,31 @@ fn scene_fields_out_of_range_or_contradicting_are_named() {
         let path = scene_file("print", text);
         bed(&["--print-scene", "--scene", path.to_str().unwrap()])
     };
+    // Snapshot strains past the file's final strain: refused, naming the
+    // file; a --strain that reaches them makes the file good (the test
+    // comes after the overrides), and the printed scene keeps them.
+    let late = DEFAULT_SCENE.replace(
+        "snapshot_strains = [0.0, 0.1, 0.2, 0.3]",
+        "snapshot_strains = [0.0, 0.3, 0.5]",
+    );
+    rejected(
+        &print(&late),
+        &["scene `", "`snapshot_strains` = 0.5", "final_strain = 0.3"],
+    );
+    let path = scene_file("late", &late);
+    let r = bed(&[
+        "--print-scene",
+        "--scene",
+        path.to_str().unwrap(),
+        "--strain",
+        "0.5",
+    ]);
+    assert_eq!(r.code, 0, "{}", r.stderr);
+    assert!(
+        r.stdout.contains("snapshot_strains = [0.0, 0.3, 0.5]"),
+        "{}",
+        r.stdout
+    );
     // The punch speed is bounded as granule's platen speed is.
     let fast = DEFAULT_SCENE.replace("punch_speed_m_s = 0.05", "punch_speed_m_s = 1e9");
     rejected(&print(&fast), &["`punch_speed_m_s`", "1e-4 <= v <= 10 m/s"]);

@@ -21,7 +21,9 @@ fn out_dir(name: &str) -> PathBuf {
 }
 
 const GRANULES: usize = 20;
-const SNAPSHOTS: [f64; 3] = [0.0, 0.05, 0.1];
+/// The scene's snapshot strains in order, then the final state's (the
+/// tiny bed's `--strain 0.12`, which the list does not reach).
+const SNAPSHOTS: [f64; 4] = [0.0, 0.05, 0.1, 0.12];
 const CELL_ARRAYS: [&str; 4] = ["granule", "relative_density", "heywood_dv", "heywood_d"];
 
 /// Runs the tiny bed into `dir` with `extra` flags; the scene file (the
@@ -215,9 +217,10 @@ fn snapshots_plots_and_report() {
     let quads = mesh.quads.len();
     assert_eq!(quads, 96);
 
-    // The collection lists the three snapshots in strain order.
+    // The collection lists the three snapshots in strain order, then the
+    // final state.
     let pvd = read_pvd(&dir.join("vtk/bed.pvd"));
-    let files: Vec<String> = (0..3).map(|k| format!("bed_{k}.vtu")).collect();
+    let files: Vec<String> = (0..4).map(|k| format!("bed_{k}.vtu")).collect();
     assert_eq!(
         pvd,
         SNAPSHOTS
@@ -253,11 +256,12 @@ fn snapshots_plots_and_report() {
     // Undeformed granules hold η0 = 0.8; pressed, they densify.
     assert!((mean_density[0] - 0.8).abs() < 1e-9, "{mean_density:?}");
     assert!(mean_density[2] > mean_density[0], "{mean_density:?}");
+    assert!(mean_density[3] > mean_density[2], "{mean_density:?}");
 
     // meshio reads the same cells and arrays.
     let paths: Vec<PathBuf> = files.iter().map(|f| dir.join("vtk").join(f)).collect();
     if let Some(lines) = meshio_summary(&paths) {
-        assert_eq!(lines.len(), 3);
+        assert_eq!(lines.len(), 4);
         for line in &lines {
             assert!(
                 line.starts_with(&format!("cells quad {}", GRANULES * quads)),
@@ -334,10 +338,13 @@ fn full_mesh_snapshots_hold_every_hex() {
     let dir = out_dir("hexes");
     tiny_bed(&dir, "0.01", &["--vtk-full-mesh"]);
     let mesh = mesh();
-    // Only the snapshot at C = 0 is reached.
+    // Only the snapshot at C = 0 is reached, then the final state.
     assert_eq!(
         read_pvd(&dir.join("vtk/bed.pvd")),
-        [(0.0, "bed_0.vtu".to_string())]
+        [
+            (0.0, "bed_0.vtu".to_string()),
+            (0.01, "bed_1.vtu".to_string())
+        ]
     );
     let s = read_vtu(&dir.join("vtk/bed_0.vtu"));
     assert_eq!(s.cells, GRANULES * mesh.hexes.len());

@@ -458,6 +458,15 @@ impl BedArgs {
         set!(face_list_skin, "--face-list-skin");
         set!(sweep_tolerance, "--sweep-tolerance");
         scene.validate().map_err(|e| flag_error(e, &given))?;
+        if resume.is_none() {
+            scene
+                .check_snapshots()
+                .map_err(|e| flag_error(e, &given))
+                .map_err(|e| match &self.scene {
+                    Some(path) => e.context(format!("scene `{}`", path.display())),
+                    None => e,
+                })?;
+        }
         Ok((scene, notes))
     }
 

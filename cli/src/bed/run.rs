@@ -284,8 +284,9 @@ pub trait BedObserver {
     /// A new output row.
     fn sample(&mut self, sample: &BedSample, elapsed_s: f64);
     /// The state when the strain first reaches `strain`, one of the
-    /// scene's `snapshot_strains` (and at t = 0 for a strain of 0). An
-    /// error stops the run.
+    /// scene's `snapshot_strains` (and at t = 0 for a strain of 0), and at
+    /// the end of a run that reached its final strain, at that strain,
+    /// if the list has none that high. An error stops the run.
     fn snapshot(
         &mut self,
         strain: Real,
@@ -683,6 +684,17 @@ pub fn run_bed(
             interrupted = true;
             break;
         }
+    }
+    // A run that reached its final strain ends with a snapshot of its
+    // final state, listed in `snapshot_strains` or not (a run past the
+    // published list's 0.3 had no picture of its end).
+    if error.is_none()
+        && !stopped
+        && !interrupted
+        && asm.time() >= end
+        && !snapshots.iter().any(|&c| c >= scene.final_strain - 1e-12)
+    {
+        observer.snapshot(scene.final_strain, &asm, &mesh)?;
     }
     // A run that reached its final strain ends with a checkpoint of its
     // last step, so that `--resume --strain` can take it further.

@@ -758,18 +758,25 @@ impl Scene {
     /// within its final strain (a snapshot beyond it would never be
     /// written).
     pub fn read(path: &std::path::Path) -> anyhow::Result<Self> {
-        Ok(Self::read_with_notes(path)?.0)
+        let scene = Self::read_with_notes(path)?.0;
+        scene
+            .check_snapshots()
+            .with_context(|| format!("scene `{}`", path.display()))?;
+        Ok(scene)
     }
 
-    /// [`Scene::read`], with the warnings about the file: the fields it
+    /// [`Scene::read`] without the test of its snapshot strains against its
+    /// final strain (`bed` makes it after its overrides), with the
+    /// warnings about the file: the fields it
     /// omits whose value then differs from the published scene's
     /// ([`Scene::omitted_fields`]).
     pub fn read_with_notes(path: &std::path::Path) -> anyhow::Result<(Self, Vec<String>)> {
         let text = std::fs::read_to_string(path)
             .with_context(|| format!("cannot read scene `{}`", path.display()))?;
-        let scene = Self::from_toml(&text)
-            .and_then(|s| s.check_snapshots().map(|()| s))
-            .with_context(|| format!("scene `{}`", path.display()))?;
+        // Its snapshot strains are checked against the final strain after
+        // the command's overrides (`--strain` may move the end past them).
+        let scene =
+            Self::from_toml(&text).with_context(|| format!("scene `{}`", path.display()))?;
         let omitted = scene.omitted_fields(&text);
         let notes = if omitted.is_empty() {
             Vec::new()
