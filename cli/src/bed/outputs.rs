@@ -533,6 +533,25 @@ fn warnings(
             _ => {}
         }
     }
+    if let Some(first) = run
+        .samples
+        .iter()
+        .find(|s| bed_solid_fraction(run, s.strain) >= 1.0)
+    {
+        let last = run.samples.last().map_or(first.strain, |s| s.strain);
+        w.push(format!(
+            "the bed's solid fraction D (the granules' solid volume over the die cavity) reaches \
+             1 at C = {:.3} ({:.3} at the end): the cavity is then smaller than the granules' \
+             solid at rest, which the model's elastic solid (E = {} MPa) allows by compressing \
+             it. ln(1/(1 - D)) (Heckel) is undefined from there, and the rows past it describe a \
+             compressed solid, not a porous compact",
+            first.strain,
+            bed_solid_fraction(run, last),
+            scene
+                .material_params()
+                .map_or(Real::NAN, |m| m.youngs_modulus_pa * 1e-6)
+        ));
+    }
     if let Some((from, min)) =
         first_fold(run.samples.iter().map(|s| (s.strain, s.min_gauss_jacobian)))
     {
@@ -842,5 +861,37 @@ mod tests {
         assert_eq!(geometry(&none.warnings), None);
         let json = serde_json::to_value(&none).unwrap();
         assert!(json["final_hidden_overlap"].is_null());
+    }
+
+    /// A bed whose solid fraction D reaches 1 is warned about from the
+    /// first row that reaches it (the unit die and bed of `of_samples`:
+    /// D = 1/(π(1 − C)), 1 from C = 1 − 1/π ≈ 0.682); one that stays
+    /// below is not.
+    #[test]
+    fn a_solid_fraction_of_one_is_warned_about() {
+        use crate::bed::run::{BedRun, BedSample};
+        let run = |strains: &[Real]| {
+            BedRun::of_samples(
+                strains
+                    .iter()
+                    .map(|&strain| BedSample {
+                        strain,
+                        min_jacobian: 0.9,
+                        min_gauss_jacobian: 0.9,
+                        ..BedSample::default()
+                    })
+                    .collect(),
+            )
+        };
+        let scene = Scene::published();
+        let solid = |w: &[String]| w.iter().find(|w| w.contains("solid fraction D")).cloned();
+        let w = summary(&scene, &run(&[0.0, 0.5, 0.7, 0.75])).warnings;
+        let warning = solid(&w).unwrap_or_else(|| panic!("{w:?}"));
+        assert!(
+            warning.contains("reaches 1 at C = 0.700 (1.273 at the end)"),
+            "{warning}"
+        );
+        let w = summary(&scene, &run(&[0.0, 0.5, 0.68])).warnings;
+        assert_eq!(solid(&w), None, "{w:?}");
     }
 }
