@@ -331,6 +331,21 @@ fn snapshots_plots_and_report() {
         assert!(html.contains(line), "report lacks the scene line {line}");
     }
     assert!(html.contains("snapshot_strains = ["), "no snapshot strains");
+    // Every warning of the summary is listed above the table, escaped,
+    // and not again as a raw JSON list in it.
+    let warnings = s["warnings"].as_array().unwrap();
+    assert!(
+        !warnings.is_empty(),
+        "the tiny bed has warnings (its Kawakita fit, its certificate)"
+    );
+    let (head, table) = html.split_at(html.find("<h2>Summary</h2>").unwrap());
+    assert!(head.contains("<h2>Warnings</h2>"));
+    for w in warnings {
+        let escaped = granbed_cli::bed::report::html_escape(w.as_str().unwrap());
+        assert!(head.contains(&format!("<li>{escaped}</li>")), "{escaped}");
+    }
+    assert!(!table.contains("<td>warnings</td>"));
+    assert!(table.contains("<td>quasi_static.passed</td>"));
 }
 
 #[test]

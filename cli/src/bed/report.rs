@@ -18,7 +18,7 @@ pub const REPORT_FILE: &str = "report.html";
 /// The fields of `summary.json` shown first, in this order, with their
 /// meaning; any other field follows (the nested `kawakita` object is
 /// flattened to `kawakita.<field>`, the scene is shown as TOML instead).
-const FIELDS: [(&str, &str); 38] = [
+const FIELDS: [(&str, &str); 53] = [
     ("kawakita_a", "Kawakita a (limiting strain)"),
     ("kawakita_inv_b_pa", "Kawakita 1/b, Pa"),
     (
@@ -34,7 +34,30 @@ const FIELDS: [(&str, &str); 38] = [
         "final_relative_density",
         "mean granule relative density at the end",
     ),
-    ("final_coordination", "coordination number Z at the end"),
+    (
+        "final_coordination",
+        "coordination number Z at the end (granule contacts only)",
+    ),
+    (
+        "quasi_static.passed",
+        "quasi-static certificate passed (every figure below its limit)",
+    ),
+    (
+        "quasi_static.max_kinetic_to_internal",
+        "largest kinetic energy / internal work over the judged rows (limit 0.01)",
+    ),
+    (
+        "quasi_static.force_imbalance_rel",
+        "mean |upper − lower − wall friction| / upper punch force (limit 0.05)",
+    ),
+    (
+        "quasi_static.rate_change_rel",
+        "change of P(C) at half the punch speed (--rate-check; limit 0.05)",
+    ),
+    (
+        "quasi_static.max_relative_kinetic_to_internal",
+        "the kinetic ratio without the punches' imposed motion (not judged)",
+    ),
     ("max_pressure_pa", "largest upper-punch pressure, Pa"),
     ("initial_bed_height_m", "initial bed height H0, m"),
     ("granules", "granules"),
@@ -71,6 +94,36 @@ const FIELDS: [(&str, &str); 38] = [
     ("threads", "threads"),
     ("min_jacobian", "smallest element Jacobian ratio"),
     (
+        "min_gauss_jacobian",
+        "smallest Gauss-point Jacobian ratio at the output rows (≤ 0: folded)",
+    ),
+    (
+        "max_penetration_m",
+        "deepest granule overlap read by the contact detection, m",
+    ),
+    (
+        "max_penetration_rel_element",
+        "that overlap / the element size (accepted below 0.01)",
+    ),
+    (
+        "final_hidden_overlap.depth_m",
+        "deepest overlap measured by geometry at the end, m",
+    ),
+    (
+        "final_hidden_overlap.rel_element",
+        "that overlap / the element size (accepted below 0.01)",
+    ),
+    (
+        "hourglass_to_internal",
+        "hourglass energy / internal work (one-point element's spurious modes)",
+    ),
+    ("max_node_speed_ratio", "largest node speed / punch speed"),
+    (
+        "cost_figures_from_step",
+        "first step the cost figures cover (0: the whole run)",
+    ),
+    ("interrupted", "stopped by SIGINT/SIGTERM (resumable)"),
+    (
         "energy_residual_rel",
         "|energy ledger residual| / punch work",
     ),
@@ -94,9 +147,10 @@ const FIELDS: [(&str, &str); 38] = [
     ),
     ("error", "error that stopped the run early"),
     ("version", "granbed version"),
-    // Shown in the fields above already.
+    // Shown in the fields above already, or above the table.
     ("kawakita.a", ""),
     ("kawakita.inv_b_pa", ""),
+    ("warnings", ""),
 ];
 
 /// `text` with the HTML special characters escaped (for element content
@@ -181,6 +235,17 @@ pub fn report_html(
             "<p><strong>The run stopped early:</strong> {}</p>",
             html_escape(e)
         )?;
+    }
+    if !summary.warnings.is_empty() {
+        writeln!(
+            h,
+            "<h2>Warnings</h2>\n<p>What the figures below hide (also in summary.json and on \
+             stderr):</p>\n<ul>"
+        )?;
+        for w in &summary.warnings {
+            writeln!(h, "<li>{}</li>", html_escape(w))?;
+        }
+        writeln!(h, "</ul>")?;
     }
     writeln!(
         h,
