@@ -50,16 +50,21 @@ Output, in --out DIR (created if missing):
                    final strain, max pressure, initial bed height, counts, wall
                    time, ns per element-step, cost figures (over the whole run,
                    resumed segments included), threads, min Jacobian, max nodal
-                   speed / punch speed, deepest overlap (m and / element size),
-                   hourglass / internal work, energy residual, peak memory,
+                   speed / punch speed, deepest overlap (m and / element size)
+                   read by the contact detection and measured by geometry at
+                   the end (final_hidden_overlap), hourglass / internal work,
+                   energy residual, peak memory, the quasi-static certificate,
                    interrupted, warnings (also on stderr, with --quiet too: a
                    final strain past the target by more than an output
                    interval, overlap above 1 % of the element, an element
                    folded at a Gauss point (J <= 0), a Kawakita fit
-                   with a outside (0, 1], 1/b <= 0 or R^2 < 0.9, scene fields left out
-                   whose old values are not the published ones), version
-  vtk/bed_<k>.vtu  VTU snapshots at the scene's snapshot_strains (a fresh run
-                   first removes those an earlier run left): every granule's
+                   with a outside (0, 1], 1/b <= 0 or R^2 < 0.9, a failed
+                   quasi-static certificate, a bed solid fraction D >= 1,
+                   scene fields left out whose old values are not the
+                   published ones), version
+  vtk/bed_<k>.vtu  VTU snapshots at the scene's snapshot_strains and of the
+                   final state (a fresh run first removes those an earlier
+                   run left): every granule's
                    surface quads (all hexes with --vtk-full-mesh), cell data
                    granule id, relative density eta0 V0/V, Heywood d_V S/V and d S/V
   vtk/bed.pvd      ParaView collection of the snapshots (timestep = strain)
@@ -75,7 +80,8 @@ alone with --resume DIR/<TYPE>), and DIR holds the comparison:
   comparison.csv   one row per type, in the order given: type, yield stress,
                    eta0, Kawakita a, 1/b (Pa), R^2, points, max pressure,
                    final strain, final pressure, final mean relative density,
-                   final coordination number, wall time
+                   final coordination number, quasi_static_passed (1/0),
+                   wall time
   comparison.json  the same rows, the errors, and the type of the pour
   comparison_pressure.svg, comparison_density.svg
                    upper-punch pressure and mean relative density against
@@ -86,11 +92,15 @@ it is listed, else of the first listed type; types with another eta0 (digit)
 reuse that packing.
 
 Without --scene the embedded published scene runs (print it with
---print-scene); the flags below override the scene's fields.
+--print-scene): 1000 B2 granules of 1 mm on the 8x2 mesh in an 11.3 mm die,
+pressed to C = 0.3, about 17 minutes on 2 cores. The options marked
+Override above change the scene's fields. A fresh run into a directory that
+holds an unfinished run is refused (--resume continues it; --overwrite).
 
 SIGINT (Ctrl-C) or SIGTERM: the run finishes its step, writes a checkpoint and
 the outputs so far (summary.json \"interrupted\": true), prints how to resume and
-exits with status 130; a second signal quits at once.
+exits with status 130 (during the pour, which has nothing to keep, it stops at
+the pour's next rest check); a second signal quits at once.
 
 Exit status: 0 success, 1 runtime failure (the run stopped early: the outputs
 so far are written), 2 usage or validation error, 130 interrupted (resumable).";
@@ -520,6 +530,18 @@ impl BedArgs {
         }
         if resume.is_none() {
             self.keep_unfinished(&out)?;
+            if !self.quiet {
+                writeln!(
+                    streams.stderr,
+                    "bed: {} x {} granules ({} mesh) in a {} mm die to C = {}, into `{}`",
+                    scene.granules,
+                    scene.granule_type,
+                    scene.mesh,
+                    scene.die_diameter_mm,
+                    scene.final_strain,
+                    out.display()
+                )?;
+            }
         }
         if let Some(c) = &resume {
             let reached = c.progress.die.strain_at(c.state.time);
