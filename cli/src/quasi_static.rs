@@ -29,6 +29,29 @@ pub struct QuasiStatic {
     pub passed: bool,
 }
 
+impl QuasiStatic {
+    /// Its figures against their limits, for the warning of a run that
+    /// failed it: "kinetic/internal work up to … [limit …], force
+    /// imbalance … [limit …], change at half speed … [limit …]" (n/a where
+    /// not measured).
+    pub fn figures(&self) -> String {
+        use granbed_kernel::analysis::quasi_static::{
+            FORCE_IMBALANCE_LIMIT, KINETIC_TO_INTERNAL_LIMIT, RATE_CHANGE_LIMIT,
+        };
+        let fmt = |x: Option<Real>| x.map_or_else(|| "n/a".to_owned(), |v| format!("{v:.3e}"));
+        format!(
+            "kinetic/internal work up to {} [limit {}], force imbalance {} [limit {}], change at \
+             half speed {} [limit {}]",
+            fmt(self.max_kinetic_to_internal),
+            KINETIC_TO_INTERNAL_LIMIT,
+            fmt(self.force_imbalance_rel),
+            FORCE_IMBALANCE_LIMIT,
+            fmt(self.rate_change_rel),
+            RATE_CHANGE_LIMIT,
+        )
+    }
+}
+
 impl From<Certificate> for QuasiStatic {
     fn from(c: Certificate) -> Self {
         Self {

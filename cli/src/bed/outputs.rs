@@ -399,29 +399,18 @@ pub fn summary<'a>(scene: &'a Scene, run: &BedRun) -> Summary<'a> {
 /// failed over which strains, and what slows the bed down. With its
 /// figures, so that `--quiet` (which prints warnings) keeps them too.
 fn not_quasi_static(scene: &Scene, run: &BedRun, q: &QuasiStatic) -> Option<String> {
-    use granbed_kernel::analysis::quasi_static::{
-        FORCE_IMBALANCE_LIMIT, KINETIC_TO_INTERNAL_LIMIT, RATE_CHANGE_LIMIT, judged,
-    };
     if q.passed || run.error.is_some() {
         return None;
     }
-    let judged = judged(&run.samples);
+    let judged = granbed_kernel::analysis::quasi_static::judged(&run.samples);
     let from = judged.first().map_or(Real::NAN, |s| s.strain);
     let to = judged.last().map_or(Real::NAN, |s| s.strain);
-    let fmt = |x: Option<Real>| x.map_or_else(|| "n/a".to_owned(), |v| format!("{v:.3}"));
     Some(format!(
         "NOT quasi-static over C = {from:.3} to {to:.3} (the second half of the output rows, \
-         which the certificate judges): kinetic/internal work up to {} [limit {}], force \
-         imbalance {} [limit {}], change at half speed {} [limit {}]. Inertia is in these \
-         figures: a slower punch (scene field punch_speed_m_s, now {} m/s) or lighter masses \
-         (--mass-scaling, now {}) reduce it; a bed of few granules rearranges by jumps whatever \
-         the speed",
-        fmt(q.max_kinetic_to_internal),
-        KINETIC_TO_INTERNAL_LIMIT,
-        fmt(q.force_imbalance_rel),
-        FORCE_IMBALANCE_LIMIT,
-        fmt(q.rate_change_rel),
-        RATE_CHANGE_LIMIT,
+         which the certificate judges): {}. Inertia is in these figures: a slower punch (scene \
+         field punch_speed_m_s, now {} m/s) or lighter masses (--mass-scaling, now {}) reduce \
+         it; a bed of few granules rearranges by jumps whatever the speed",
+        q.figures(),
         scene.punch_speed_m_s,
         scene.mass_scaling,
     ))

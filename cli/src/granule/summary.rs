@@ -5,9 +5,6 @@
 use crate::output::finite_ratio as ratio;
 use granbed_kernel::Real;
 use granbed_kernel::analysis::granule::{initial_effective_yield_stress, yield_stress_estimate};
-use granbed_kernel::analysis::quasi_static::{
-    FORCE_IMBALANCE_LIMIT, KINETIC_TO_INTERNAL_LIMIT, RATE_CHANGE_LIMIT,
-};
 use granbed_kernel::granule::forces::ElementKind;
 use granbed_kernel::granule::timestep::TimeStepMethod;
 use granbed_kernel::scene::platens::{PlatenParams, PlatenSample, SceneError, Symmetry};
@@ -281,19 +278,11 @@ impl Summary {
     /// The stderr warning of a run that failed the quasi-static
     /// certificate, with its figures.
     pub fn not_quasi_static(&self) -> String {
-        let q = &self.quasi_static;
-        let fmt = |x: Option<Real>| x.map_or_else(|| "n/a".to_owned(), |v| format!("{v:.3e}"));
         format!(
-            "granule {}: NOT quasi-static with mass scaling {} (kinetic/internal work up to {} \
-             [limit {}], force imbalance {} [limit {}], change at half speed {} [limit {}])",
+            "granule {}: NOT quasi-static with mass scaling {} ({})",
             self.granule_type,
             self.mass_scaling,
-            fmt(q.max_kinetic_to_internal),
-            KINETIC_TO_INTERNAL_LIMIT,
-            fmt(q.force_imbalance_rel),
-            FORCE_IMBALANCE_LIMIT,
-            fmt(q.rate_change_rel),
-            RATE_CHANGE_LIMIT,
+            self.quasi_static.figures()
         )
     }
 
