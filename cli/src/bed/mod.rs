@@ -333,7 +333,7 @@ pub struct BedArgs {
     #[arg(short, long)]
     pub quiet: bool,
 
-    /// Start afresh even where --out (or, with --types, DIR/<TYPE>) holds
+    /// Start afresh even where --out (or, with --types, `DIR/<TYPE>`) holds
     /// an unfinished run, whose checkpoint is then lost. Without it such a
     /// directory is refused (`--resume DIR` continues the run); a finished
     /// run is replaced either way.

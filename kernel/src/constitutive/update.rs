@@ -325,11 +325,11 @@ pub fn input_is_valid(f_finite: bool, j: Real, det_cp_inv: Real, eta: Real) -> b
 ///
 /// [`update_point`] and [`update_point_rows`] (hence the F-bar element's
 /// points) check their state with it. The one-point element's paths test
-/// only the determinant per element ([`check_input`]): the kernel's own returns leave C_p⁻¹ = F⁻¹ b^e F⁻ᵀ
-/// positive definite, and the full test cost the element loop about 1 %
-/// of its instructions (BENCHMARKS.md, session 45), so a host that loads
-/// states from elsewhere checks them once with this (the C ABI does, per
-/// element). A state with a positive determinant but two negative
+/// only the determinant per element ([`check_input`]): the kernel's own
+/// returns leave C_p⁻¹ = F⁻¹ b^e F⁻ᵀ positive definite, and the full test
+/// cost the element loop about 1 % of its instructions (BENCHMARKS.md,
+/// session 45), so a host that loads states from elsewhere checks them
+/// once with this (the C ABI does, per element). A state with a positive determinant but two negative
 /// eigenvalues had passed the determinant's test (an embedding audit).
 pub fn check_state(cp_inv: &Voigt) -> Result<(), UpdateError> {
     let det = tensor::det(cp_inv);
