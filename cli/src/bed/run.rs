@@ -685,17 +685,6 @@ pub fn run_bed(
             break;
         }
     }
-    // A run that reached its final strain ends with a snapshot of its
-    // final state, listed in `snapshot_strains` or not (a run past the
-    // published list's 0.3 had no picture of its end).
-    if error.is_none()
-        && !stopped
-        && !interrupted
-        && asm.time() >= end
-        && !snapshots.iter().any(|&c| c >= scene.final_strain - 1e-12)
-    {
-        observer.snapshot(scene.final_strain, &asm, &mesh)?;
-    }
     // A run that reached its final strain ends with a checkpoint of its
     // last step, so that `--resume --strain` can take it further.
     if let Some(dir) = dir
@@ -714,6 +703,18 @@ pub fn run_bed(
             good.write(dir)?;
             checkpoint_strain = Some(die.strain_at(good.state.time));
         }
+    }
+    // A run that reached its final strain ends with a snapshot of its
+    // final state, listed in `snapshot_strains` or not (a run past the
+    // published list's 0.3 had no picture of its end); after its last
+    // checkpoint, which a failure to write the snapshot must not cost.
+    if error.is_none()
+        && !stopped
+        && !interrupted
+        && asm.time() >= end
+        && !snapshots.iter().any(|&c| c >= scene.final_strain - 1e-12)
+    {
+        observer.snapshot(scene.final_strain, &asm, &mesh)?;
     }
     let wall_time_s = wall();
     let hidden_overlap =
