@@ -135,7 +135,7 @@ pub struct BedArgs {
 
     /// Override: number of granules (1 ≤ N ≤ 100000).
     #[arg(long, value_name = "N", allow_negative_numbers = true,
-          value_parser = crate::numbers::whole::<usize>(1, 100_000))]
+          value_parser = crate::numbers::whole::<usize>(1, crate::bed::scene::MAX_GRANULES as u64))]
     pub granules: Option<usize>,
 
     /// Override: mesh level NxM (8x2 = 1280 hexes, 4x1 = 160).

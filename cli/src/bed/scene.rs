@@ -34,6 +34,13 @@ pub const MIN_PUNCH_SPEED_M_S: f64 = 1.0e-4;
 /// and ran the pour out of memory).
 pub const MAX_DIE_DIAMETERS: f64 = 1000.0;
 
+/// The most granules a bed (and `pack`, and the studies' beds) takes; the
+/// pour's insertion lattice must also stand at most
+/// [`crate::pack::MAX_INSERTION_HEIGHT_M`] tall in its die.
+pub const MAX_GRANULES: usize = 100_000;
+// Spelled out in the scene's `granules` range.
+const _: () = assert!(MAX_GRANULES == 100_000);
+
 /// The smallest output and checkpoint strain interval: the run steps its
 /// next output strain forward by the interval, and an interval below the
 /// round-off of the strain never got past it.
@@ -571,7 +578,7 @@ impl Scene {
                 ">= 1e-6",
             ),
             (
-                (1..=100_000).contains(&self.granules),
+                (1..=MAX_GRANULES).contains(&self.granules),
                 "granules",
                 self.granules as f64,
                 "1..=100000",

@@ -206,7 +206,7 @@ pub struct PackArgs {
         value_name = "N",
         default_value_t = 1000,
         allow_negative_numbers = true,
-        value_parser = crate::numbers::whole::<usize>(1, 100_000)
+        value_parser = crate::numbers::whole::<usize>(1, crate::bed::scene::MAX_GRANULES as u64)
     )]
     pub granules: usize,
 

@@ -98,7 +98,7 @@ pub struct WorkPrecisionArgs {
     /// bed-small: granules per bed (1..=100000; default 125; 15 with
     /// --quick).
     #[arg(long, value_name = "N", allow_negative_numbers = true,
-          value_parser = crate::numbers::whole::<usize>(1, 100_000))]
+          value_parser = crate::numbers::whole::<usize>(1, crate::bed::scene::MAX_GRANULES as u64))]
     pub granules: Option<usize>,
 
     /// bed-small: die diameter, mm (more than 4 and at most 1000 granule
@@ -163,7 +163,7 @@ pub struct StabilityArgs {
 
     /// Granules per bed (1 ≤ N ≤ 100000).
     #[arg(long, value_name = "N", default_value_t = 30, allow_negative_numbers = true,
-          value_parser = crate::numbers::whole::<usize>(1, 100_000))]
+          value_parser = crate::numbers::whole::<usize>(1, crate::bed::scene::MAX_GRANULES as u64))]
     pub granules: usize,
 
     /// Mesh level of the bed granules.
