@@ -383,7 +383,7 @@ struct Report<'a> {
 }
 
 /// The largest platen strain of a single granule (the kernel's).
-pub const MAX_GRANULE_STRAIN: Real = 0.9;
+pub const MAX_GRANULE_STRAIN: Real = granbed_kernel::scene::platens::MAX_FINAL_STRAIN;
 
 impl StabilityArgs {
     /// The flags that set the beds' scene fields, with their values (for

@@ -90,6 +90,11 @@ pub struct PlatenParams {
 /// (kinetic energy ~10⁻⁵ of the internal work) does not see it.
 pub const STANDARD_MASS_SCALING: Real = 1.0;
 
+/// The largest final platen strain x/d a scene accepts (0 < strain ≤ this).
+pub const MAX_FINAL_STRAIN: Real = 0.9;
+// Spelled out in the range of `PlatenParams::validate`.
+const _: () = assert!(MAX_FINAL_STRAIN == 0.9);
+
 impl PlatenParams {
     /// The standard experiment for `material`: ξ = 0.5, 5 mm/s, the
     /// material's friction, to 40 % strain, C = 0.9 on the global estimate
@@ -161,7 +166,7 @@ impl PlatenParams {
                 "0 <= mu <= 10",
             ),
             (
-                self.final_strain > 0.0 && self.final_strain <= 0.9,
+                self.final_strain > 0.0 && self.final_strain <= MAX_FINAL_STRAIN,
                 "final_strain",
                 self.final_strain,
                 "0 < strain <= 0.9",
