@@ -46,6 +46,19 @@ pub fn ln(x: Real) -> Real {
     libm::log(x)
 }
 
+/// ln(1 + x), accurate for small x (the Heckel ordinate ln(1/(1 − D)) is
+/// −ln_1p(−D)).
+#[inline]
+pub fn ln_1p(x: Real) -> Real {
+    libm::log1p(x)
+}
+
+/// e^x − 1, accurate for small x.
+#[inline]
+pub fn exp_m1(x: Real) -> Real {
+    libm::expm1(x)
+}
+
 /// Absolute value.
 #[inline]
 pub fn abs(x: Real) -> Real {

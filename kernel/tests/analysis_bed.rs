@@ -7,8 +7,9 @@ use granbed_kernel::Real;
 use granbed_kernel::analysis::bed::{
     BedError, GranuleShape, HEYWOOD_FIXED_DIAMETER, KAWAKITA_MIN_STRAIN, applied_pressure,
     axial_strain, bed_density, coordination_number, coordination_number_with_walls, granule_shape,
-    heywood_coefficient, kawakita_fit, kawakita_fit_slices, mean_relative_density,
-    relative_density, solid_over_volume, surface_geometry, volume_equivalent_diameter,
+    heckel_fit, heckel_fit_slices, heywood_coefficient, kawakita_fit, kawakita_fit_slices,
+    mean_relative_density, relative_density, solid_over_volume, surface_geometry,
+    volume_equivalent_diameter,
 };
 use granbed_kernel::mesh::sphere::SphereMeshParams;
 use granbed_kernel::mesh::surface::area_and_volume;
@@ -112,6 +113,86 @@ fn kawakita_degenerate_inputs_give_none() {
     let data = [(0.0, 0.0), (1e5, 0.3), (2e5, 0.35)];
     assert_eq!(kawakita_fit(data.iter().copied(), 0.0).unwrap().points, 2);
     assert!(kawakita_fit(data.iter().copied(), Real::NAN).is_none());
+}
+
+/// Samples (P, D) on the Heckel law ln(1/(1 − D)) = K·P + A, i.e.
+/// D = 1 − exp(−(K·P + A)), for P evenly spaced from `p_lo` to `p_hi` Pa.
+fn heckel_law(k: Real, a: Real, p_lo: Real, p_hi: Real, n: usize) -> Vec<(Real, Real)> {
+    (0..n)
+        .map(|i| {
+            let p = p_lo + (p_hi - p_lo) * i as Real / (n - 1) as Real;
+            (p, 1.0 - (-(k * p + a)).exp())
+        })
+        .collect()
+}
+
+/// The Heckel law is recovered: P_y = 1/K, A and D_A = 1 − e^(−A) to 1e-12
+/// on two laws (a bed's kPa and a tablet press's MPa), R² = 1.
+#[test]
+fn heckel_recovers_the_law() {
+    for (py, a, p_hi) in [(120e3, 0.6, 60e3), (85e6, 0.35, 250e6)] {
+        let data = heckel_law(1.0 / py, a, 0.0, p_hi, 40);
+        let fit = heckel_fit(data.iter().copied()).unwrap();
+        println!(
+            "Heckel: P_y = {:.12} Pa (err {:.2e}), A = {:.15}, D_A = {:.15}, R² = {:.15}",
+            fit.yield_pressure_pa,
+            (fit.yield_pressure_pa - py).abs() / py,
+            fit.a,
+            fit.d_a,
+            fit.r_squared
+        );
+        assert_eq!(fit.points, data.len());
+        assert_close("P_y", fit.yield_pressure_pa, py, 1e-12, 0.0);
+        assert_close("K", fit.k_per_pa, 1.0 / py, 1e-12, 0.0);
+        assert_close("A", fit.a, a, 1e-12, 0.0);
+        assert_close("D_A", fit.d_a, 1.0 - (-a).exp(), 1e-12, 0.0);
+        assert_close("R²", fit.r_squared, 1.0, 1e-12, 0.0);
+    }
+}
+
+/// Rows where the law is undefined (D ≥ 1, D ≤ 0, not finite) are left
+/// out; the slices give the same bits; degenerate data give no fit.
+#[test]
+fn heckel_skips_undefined_rows_and_refuses_degenerate_data() {
+    let data = heckel_law(1.0 / 50e3, 0.7, 10e3, 40e3, 12);
+    let clean = heckel_fit(data.iter().copied()).unwrap();
+    let garbage = [
+        (5e4, 1.0),
+        (6e4, 1.2),
+        (1e3, 0.0),
+        (1e3, -0.1),
+        (Real::NAN, 0.5),
+        (2e4, Real::NAN),
+        (Real::INFINITY, 0.6),
+    ];
+    let mut dirty = Vec::new();
+    for (i, &d) in data.iter().enumerate() {
+        dirty.push(garbage[i % garbage.len()]);
+        dirty.push(d);
+    }
+    assert_eq!(heckel_fit(dirty.iter().copied()), Some(clean));
+    let (p, d): (Vec<Real>, Vec<Real>) = dirty.iter().copied().unzip();
+    assert_eq!(heckel_fit_slices(&p, &d), Ok(Some(clean)));
+    assert!(matches!(
+        heckel_fit_slices(&p[1..], &d),
+        Err(BedError::BufferLength {
+            buffer: "solid_fractions",
+            ..
+        })
+    ));
+
+    let none = |d: &[(Real, Real)]| heckel_fit(d.iter().copied());
+    assert!(none(&[]).is_none());
+    assert!(none(&[(1e4, 0.6)]).is_none(), "one point");
+    assert!(none(&[(1e4, 0.6), (1e4, 0.7)]).is_none(), "equal pressures");
+    assert!(
+        none(&[(1e4, 0.6), (2e4, 0.6)]).is_none(),
+        "no densification"
+    );
+    assert!(
+        none(&[(1e4, 0.7), (2e4, 0.6)]).is_none(),
+        "density falling with pressure"
+    );
 }
 
 /// §7 items 1–2: P = F/(πR_d²), C = (H0 − H)/H0.

@@ -1,5 +1,6 @@
 //! Measures of a compressed granule bed (physics.md §7 items 1–6): applied
-//! pressure and strain, the Kawakita fit, per-granule geometry (envelope
+//! pressure and strain, the Kawakita fit (and the Heckel fit, which §7 does
+//! not name), per-granule geometry (envelope
 //! volume, surface area, relative density, Heywood coefficient) and the bed
 //! aggregates (coordination number, mean relative density).
 //!
@@ -183,6 +184,82 @@ pub fn kawakita_fit_slices(
     Ok(kawakita_fit(
         pressures_pa.iter().copied().zip(strains.iter().copied()),
         min_strain,
+    ))
+}
+
+// ---------------------------------------------------------------------------
+// Heckel (not in physics.md §7: the pharmaceutical scientist's other law)
+
+/// Heckel parameters of a compaction curve, ln(1/(1 − D)) = K·P + A, D the
+/// compact's solid fraction (relative density) at punch pressure P.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct HeckelFit {
+    /// K = slope, 1/Pa.
+    pub k_per_pa: Real,
+    /// A = intercept, dimensionless.
+    pub a: Real,
+    /// The mean yield pressure P_y = 1/K, Pa.
+    pub yield_pressure_pa: Real,
+    /// D_A = 1 − exp(−A): the solid fraction the line gives at P = 0.
+    pub d_a: Real,
+    /// Coefficient of determination R² of the line.
+    pub r_squared: Real,
+    /// Points used.
+    pub points: usize,
+}
+
+/// Heckel fit: ordinary least squares of y = ln(1/(1 − D)) against x = P
+/// (Pa) over the samples `(P [Pa], D)` with P finite and 0 < D < 1 (beyond
+/// D = 1 the law is undefined); then P_y = 1/K and D_A = 1 − e^(−A). Which
+/// rows form the law's linear stretch is the caller's choice (the CLI takes
+/// those past a strain, as for [`kawakita_fit`]). The line is
+/// [`linear_fit`]; the iterator is cloned for its two passes.
+///
+/// `None` with fewer than two usable points, when all usable P are equal, or
+/// when K is not positive (the compact did not densify with pressure) or
+/// P_y would not be finite.
+pub fn heckel_fit<I>(samples: I) -> Option<HeckelFit>
+where
+    I: Iterator<Item = (Real, Real)> + Clone,
+{
+    let line = linear_fit(
+        samples
+            .filter(|&(p, d)| p.is_finite() && d > 0.0 && d < 1.0)
+            .map(|(p, d)| (p, -crate::math::ln_1p(-d))),
+    )?;
+    let yield_pressure_pa = 1.0 / line.slope;
+    if !(line.slope > 0.0 && yield_pressure_pa.is_finite()) {
+        return None;
+    }
+    Some(HeckelFit {
+        k_per_pa: line.slope,
+        a: line.intercept,
+        yield_pressure_pa,
+        d_a: -crate::math::exp_m1(-line.intercept),
+        r_squared: line.r_squared,
+        points: line.points,
+    })
+}
+
+/// [`heckel_fit`] over two parallel slices: pressures (Pa) and solid
+/// fractions. `Err` if the lengths differ, `Ok(None)` if the data allow no
+/// fit.
+pub fn heckel_fit_slices(
+    pressures_pa: &[Real],
+    solid_fractions: &[Real],
+) -> Result<Option<HeckelFit>, BedError> {
+    if solid_fractions.len() != pressures_pa.len() {
+        return Err(BedError::BufferLength {
+            buffer: "solid_fractions",
+            expected: pressures_pa.len(),
+            got: solid_fractions.len(),
+        });
+    }
+    Ok(heckel_fit(
+        pressures_pa
+            .iter()
+            .copied()
+            .zip(solid_fractions.iter().copied()),
     ))
 }
 
