@@ -101,6 +101,37 @@ fn a_small_bed_runs_end_to_end_and_is_thread_independent() {
         fit.points
     );
     assert!(fit.points >= 10);
+    // The Heckel fit: a least-squares line of y = ln(1/(1 − D)) against P
+    // over the rows with C ≥ 0.25 (and D < 1) of the table, checked by its
+    // normal equations (the residuals sum to zero and are orthogonal to P)
+    // rather than by the kernel's fit again; D0 is the table's first D.
+    let solid = table.num("bed_solid_fraction");
+    assert_eq!(number(&s, "initial_solid_fraction"), solid[0]);
+    let heckel = &s["heckel"];
+    assert_eq!(number(heckel, "min_strain"), 0.25);
+    let (k, a) = (number(heckel, "k_per_pa"), number(heckel, "a"));
+    assert_eq!(number(&s, "heckel_yield_pressure_pa"), 1.0 / k);
+    assert_eq!(number(heckel, "d_a"), -(-a).exp_m1());
+    let rows: Vec<(f64, f64)> = (0..n)
+        .filter(|&i| strain[i] >= 0.25 && solid[i] < 1.0)
+        .map(|i| (pressure[i], -(-solid[i]).ln_1p()))
+        .collect();
+    assert_eq!(number(heckel, "points") as usize, rows.len());
+    assert!(rows.len() >= 10);
+    let (mut sum_r, mut sum_rp, mut scale_r, mut scale_rp) = (0.0, 0.0, 0.0, 0.0);
+    for &(p, y) in &rows {
+        let r = y - (k * p + a);
+        sum_r += r;
+        sum_rp += r * p;
+        scale_r += y.abs();
+        scale_rp += (y * p).abs();
+    }
+    assert!(
+        sum_r.abs() <= 1e-12 * scale_r && sum_rp.abs() <= 1e-12 * scale_rp,
+        "Heckel normal equations: Σr = {sum_r:e}, Σr·P = {sum_rp:e}"
+    );
+    // The densifying bed: the compact's solid fraction rises with P.
+    assert!(k > 0.0 && solid[n - 1] > solid[0], "K = {k}, D {solid:?}");
     assert!(number(&s, "energy_residual_rel") < 0.01);
     assert!(number(&s, "min_jacobian") > 0.0);
     // Issue #9's contact criterion: granules overlap by less than 1 % of
@@ -136,6 +167,35 @@ fn a_small_bed_runs_end_to_end_and_is_thread_independent() {
     assert_eq!(s["quasi_static"]["passed"], true, "{}", s["quasi_static"]);
     let warned = |w: &serde_json::Value| w.as_str().unwrap().contains("NOT quasi-static");
     assert!(!s["warnings"].as_array().unwrap().iter().any(warned), "{s}");
+
+    // A finished run refitted over other strain windows by --resume: no
+    // step, the same table, the fits over the new windows.
+    let refit = cli(&[
+        "bed",
+        "--quiet",
+        "--resume",
+        two.to_str().unwrap(),
+        "--kawakita-min-strain",
+        "0.1",
+        "--heckel-min-strain",
+        "0.15",
+    ]);
+    assert_eq!(refit.code, 0, "refit failed:\n{}", refit.stderr);
+    assert_eq!(std::fs::read(two.join("compression.csv")).unwrap(), csv);
+    let r = summary(&two);
+    assert_eq!(r["steps"], s["steps"]);
+    assert_eq!(r["scene"]["kawakita_min_strain"], 0.1);
+    let wider = granbed_kernel::analysis::bed::kawakita_fit(
+        pressure.iter().copied().zip(strain.iter().copied()),
+        0.1,
+    )
+    .unwrap();
+    assert_eq!(number(&r, "kawakita_a"), wider.a);
+    assert_eq!(number(&r["kawakita"], "min_strain"), 0.1);
+    let from = |c: f64| (0..n).filter(|&i| strain[i] >= c && solid[i] < 1.0).count();
+    assert_eq!(number(&r["heckel"], "points") as usize, from(0.15));
+    assert!(from(0.15) > from(0.25));
+    assert!(two.join("plots/heckel.svg").is_file());
 }
 
 #[test]

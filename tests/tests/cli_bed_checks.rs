@@ -197,7 +197,7 @@ fn scene_fields_out_of_range_or_contradicting_are_named() {
 
 #[test]
 fn every_numeric_flag_takes_a_minus_and_names_its_range() {
-    let cases: [(&str, &[&str]); 17] = [
+    let cases: [(&str, &[&str]); 19] = [
         ("--granules", &["'--granules <N>'", "1..=100000"]),
         ("--seed", &["'--seed <SEED>'", "0..=18446744073709551615"]),
         ("--strain", &["`--strain -1`", "0 < C <= 0.9"]),
@@ -228,6 +228,14 @@ fn every_numeric_flag_takes_a_minus_and_names_its_range() {
         (
             "--exact-contact-from-strain",
             &["`--exact-contact-from-strain -1`", "0 <= C <= 1 (1: never)"],
+        ),
+        (
+            "--kawakita-min-strain",
+            &["`--kawakita-min-strain -1`", "0 <= C <= 0.9"],
+        ),
+        (
+            "--heckel-min-strain",
+            &["`--heckel-min-strain -1`", "0 <= C <= 0.9"],
         ),
         ("--stop-at-strain", &["`--stop-at-strain -1`", "0 < C <="]),
         ("--mass-scaling", &["`--mass-scaling -1`", "1 <= F <= 1e6"]),

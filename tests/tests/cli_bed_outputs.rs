@@ -285,6 +285,7 @@ fn snapshots_plots_and_report() {
     for name in [
         "pressure_strain.svg",
         "kawakita.svg",
+        "heckel.svg",
         "coordination_strain.svg",
         "relative_density_strain.svg",
         "heywood_strain.svg",
@@ -300,7 +301,7 @@ fn snapshots_plots_and_report() {
     let html = std::fs::read_to_string(dir.join("report.html")).unwrap();
     assert!(html.starts_with("<!DOCTYPE html>"));
     assert!(html.trim_end().ends_with("</html>"));
-    assert_eq!(html.matches("<svg").count(), 5);
+    assert_eq!(html.matches("<svg").count(), 6);
     let s = summary(&dir);
     for key in [
         "final_strain",

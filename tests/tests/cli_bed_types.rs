@@ -20,7 +20,8 @@ fn out_dir(name: &str) -> PathBuf {
 const TYPES: [&str; 3] = ["A2", "B2", "C2"];
 
 /// `comparison.csv` column → `summary.json` field.
-const SAME_AS_SUMMARY: [(&str, &str); 7] = [
+const SAME_AS_SUMMARY: [(&str, &str); 8] = [
+    ("initial_solid_fraction", "initial_solid_fraction"),
     ("max_pressure_pa", "max_pressure_pa"),
     ("final_strain", "final_strain"),
     ("final_pressure_pa", "final_pressure_pa"),

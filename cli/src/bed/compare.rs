@@ -27,8 +27,8 @@ pub const PRESSURE_SVG: &str = "comparison_pressure.svg";
 pub const DENSITY_SVG: &str = "comparison_density.svg";
 
 /// Columns of [`COMPARISON_CSV`], in order (`NaN` where the summary has
-/// `null`, e.g. no Kawakita fit below C = 0.25).
-pub const COMPARISON_COLUMNS: [&str; 14] = [
+/// `null`, e.g. no Kawakita fit for a run that ended before its window).
+pub const COMPARISON_COLUMNS: [&str; 17] = [
     "type",
     "yield_stress_pa",
     "eta0",
@@ -36,6 +36,9 @@ pub const COMPARISON_COLUMNS: [&str; 14] = [
     "kawakita_inv_b_pa",
     "kawakita_r_squared",
     "kawakita_points",
+    "heckel_yield_pressure_pa",
+    "heckel_r_squared",
+    "initial_solid_fraction",
     "max_pressure_pa",
     "final_strain",
     "final_pressure_pa",
@@ -61,8 +64,14 @@ pub struct ComparisonRow {
     pub kawakita_inv_b_pa: Option<Real>,
     /// R² of the Kawakita fit.
     pub kawakita_r_squared: Option<Real>,
-    /// Samples in the fit (C ≥ 0.25).
+    /// Output rows in the fit (C ≥ the scene's `kawakita_min_strain`).
     pub kawakita_points: usize,
+    /// Heckel mean yield pressure, Pa.
+    pub heckel_yield_pressure_pa: Option<Real>,
+    /// R² of the Heckel fit.
+    pub heckel_r_squared: Option<Real>,
+    /// The poured bed's solid fraction D0.
+    pub initial_solid_fraction: Real,
     /// Largest upper-punch pressure, Pa.
     pub max_pressure_pa: Real,
     /// Strain reached.
@@ -94,6 +103,9 @@ impl ComparisonRow {
             kawakita_inv_b_pa: s.kawakita.inv_b_pa,
             kawakita_r_squared: s.kawakita.r_squared,
             kawakita_points: s.kawakita.points,
+            heckel_yield_pressure_pa: s.heckel.yield_pressure_pa,
+            heckel_r_squared: s.heckel.r_squared,
+            initial_solid_fraction: s.initial_solid_fraction,
             max_pressure_pa: s.max_pressure_pa,
             final_strain: s.final_strain,
             final_pressure_pa: s.final_pressure_pa,
@@ -115,6 +127,9 @@ impl ComparisonRow {
             opt(self.kawakita_inv_b_pa),
             opt(self.kawakita_r_squared),
             Field::Int(self.kawakita_points as u64),
+            opt(self.heckel_yield_pressure_pa),
+            opt(self.heckel_r_squared),
+            self.initial_solid_fraction.into(),
             self.max_pressure_pa.into(),
             self.final_strain.into(),
             self.final_pressure_pa.into(),

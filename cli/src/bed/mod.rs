@@ -46,8 +46,11 @@ Output, in --out DIR (created if missing):
                    (granule solid volume / (die area x H0 (1 - C)); Heckel:
                    ln(1/(1 - D)) against the pressure), mean Heywood coefficient
                    (d_V and nominal d), min Jacobian, steps, energies
-  summary.json     the scene, Kawakita fit (a, 1/b, R^2, points with C >= 0.25),
-                   final strain, max pressure, initial bed height, counts, wall
+  summary.json     the scene, Kawakita fit (a, 1/b, R^2, points; over the rows
+                   with C >= kawakita_min_strain, 0.25), Heckel fit of
+                   ln(1/(1 - D)) = K P + A (yield pressure P_y = 1/K, A,
+                   D_A = 1 - exp(-A), R^2, points; C >= heckel_min_strain,
+                   0.25), the poured bed's solid fraction D0, final strain, max pressure, initial bed height, counts, wall
                    time, ns per element-step, cost figures (over the whole run,
                    resumed segments included), threads, min Jacobian, max nodal
                    speed / punch speed, deepest overlap (m and / element size)
@@ -58,7 +61,8 @@ Output, in --out DIR (created if missing):
                    final strain past the target by more than an output
                    interval, overlap above 1 % of the element, an element
                    folded at a Gauss point (J <= 0), a Kawakita fit
-                   with a outside (0, 1], 1/b <= 0 or R^2 < 0.9, a failed
+                   with a outside (0, 1], 1/b <= 0 or R^2 < 0.9, a Heckel
+                   fit with R^2 < 0.9, a failed
                    quasi-static certificate, a bed solid fraction D >= 1,
                    scene fields left out whose old values are not the
                    published ones), version
@@ -69,8 +73,12 @@ Output, in --out DIR (created if missing):
                    granule id, relative density eta0 V0/V, Heywood d_V S/V and d S/V
   vtk/bed.pvd      ParaView collection of the snapshots (timestep = strain)
   plots/*.svg      pressure, coordination number, relative density and Heywood
-                   coefficient against strain; Kawakita plot P/C vs P with the fit
+                   coefficient against strain; Kawakita plot P/C vs P and
+                   Heckel plot ln(1/(1 - D)) vs P, each with its fit
   report.html      one page: the summary table, the plots and the scene
+
+`--resume DIR` on a finished run takes no step and writes its outputs again:
+with --kawakita-min-strain or --heckel-min-strain it refits the run.
   checkpoint.bin   the state to continue from with --resume (every
                    checkpoint_interval_minutes and checkpoint_strain_interval,
                    and at the end)
@@ -78,7 +86,8 @@ Output, in --out DIR (created if missing):
 With --types, the files above go to DIR/<TYPE>/ per type (each resumable
 alone with --resume DIR/<TYPE>), and DIR holds the comparison:
   comparison.csv   one row per type, in the order given: type, yield stress,
-                   eta0, Kawakita a, 1/b (Pa), R^2, points, max pressure,
+                   eta0, Kawakita a, 1/b (Pa), R^2, points, Heckel P_y (Pa),
+                   R^2, D0, max pressure,
                    final strain, final pressure, final mean relative density,
                    final coordination number, quasi_static_passed (1/0),
                    wall time
@@ -248,6 +257,18 @@ pub struct BedArgs {
     #[arg(long, value_name = "C", allow_negative_numbers = true)]
     pub exact_contact_from_strain: Option<f64>,
 
+    /// Override: the Kawakita fit of summary.json takes the output rows
+    /// with C ≥ this (0 ≤ C ≤ 0.9; published 0.25, physics.md). Allowed
+    /// with --resume: on a finished run it refits without a step.
+    #[arg(long, value_name = "C", allow_negative_numbers = true)]
+    pub kawakita_min_strain: Option<f64>,
+
+    /// Override: the Heckel fit of summary.json (ln(1/(1 - D)) against P)
+    /// takes the output rows with C ≥ this (0 ≤ C ≤ 0.9; published 0.25).
+    /// Allowed with --resume: on a finished run it refits without a step.
+    #[arg(long, value_name = "C", allow_negative_numbers = true)]
+    pub heckel_min_strain: Option<f64>,
+
     /// Continue the run whose checkpoint is in DIR (its `checkpoint.bin`);
     /// the outputs go to DIR. Only --strain, --stop-at-strain,
     /// --time-step-safety, --mass-scaling, --sweep-tolerance,
@@ -255,8 +276,8 @@ pub struct BedArgs {
     /// --held-reprojection, --nearest-penetrated-face,
     /// --exact-sweep-tolerance,
     /// --exact-contact-from-strain, --face-list-skin,
-    /// --time-step-floor, --max-mass-factor, -j and --quiet may be given
-    /// with it.
+    /// --time-step-floor, --max-mass-factor, --kawakita-min-strain,
+    /// --heckel-min-strain, -j and --quiet may be given with it.
     #[arg(long, value_name = "DIR", conflicts_with_all = ["scene", "out", "granule_type", "granules", "mesh", "seed", "die_diameter_mm", "element", "hourglass_kappa", "rigid_until_touched", "local_sweeps", "selective_mass_scaling", "selective_mass_ratio"])]
     pub resume: Option<PathBuf>,
 
@@ -467,6 +488,8 @@ impl BedArgs {
         set!(max_mass_factor, "--max-mass-factor");
         set!(face_list_skin, "--face-list-skin");
         set!(sweep_tolerance, "--sweep-tolerance");
+        set!(kawakita_min_strain, "--kawakita-min-strain");
+        set!(heckel_min_strain, "--heckel-min-strain");
         scene.validate().map_err(|e| flag_error(e, &given))?;
         if resume.is_none() {
             scene

@@ -103,8 +103,31 @@ pub struct KawakitaSummary {
     pub inv_b_pa: Option<Real>,
     /// R² of the fit.
     pub r_squared: Option<Real>,
-    /// Points with C ≥ 0.25 used.
+    /// Points used: the output rows with C ≥ `min_strain`.
     pub points: usize,
+    /// The fit's strain window starts here (scene `kawakita_min_strain`).
+    pub min_strain: Real,
+}
+
+/// The Heckel fit of `summary.json`: ln(1/(1 − D)) = K·P + A over the
+/// output rows with C ≥ `min_strain`, D the bed's solid fraction
+/// ([`bed_solid_fraction`]) and P the upper-punch pressure.
+#[derive(Clone, Copy, Debug, Serialize)]
+pub struct HeckelSummary {
+    /// Mean yield pressure P_y = 1/K, Pa.
+    pub yield_pressure_pa: Option<Real>,
+    /// K, 1/Pa.
+    pub k_per_pa: Option<Real>,
+    /// A (dimensionless).
+    pub a: Option<Real>,
+    /// D_A = 1 − e^(−A).
+    pub d_a: Option<Real>,
+    /// R² of the fit.
+    pub r_squared: Option<Real>,
+    /// Points used: the output rows with C ≥ `min_strain` and 0 < D < 1.
+    pub points: usize,
+    /// The fit's strain window starts here (scene `heckel_min_strain`).
+    pub min_strain: Real,
 }
 
 /// The quasi-static certificate of a bed run: the upper punch drives, the
@@ -137,6 +160,13 @@ pub struct Summary<'a> {
     pub kawakita_inv_b_pa: Option<Real>,
     /// The fit in full.
     pub kawakita: KawakitaSummary,
+    /// The Heckel fit's mean yield pressure P_y, Pa.
+    pub heckel_yield_pressure_pa: Option<Real>,
+    /// The Heckel fit in full.
+    pub heckel: HeckelSummary,
+    /// The bed's solid fraction D0 at C = 0 (the poured bed: the granules'
+    /// solid volume over the die volume below H0).
+    pub initial_solid_fraction: Real,
     /// Yield stress of the granules as run (the type's, or the scene's
     /// override), Pa.
     pub yield_stress_pa: Real,
@@ -240,22 +270,50 @@ pub fn peak_memory_bytes() -> Option<u64> {
     Some(kb * 1024)
 }
 
-/// The Kawakita fit of the samples (C ≥ 0.25).
-pub fn kawakita(samples: &[BedSample]) -> KawakitaSummary {
+/// The Kawakita fit of the samples with C ≥ `min_strain`.
+pub fn kawakita(samples: &[BedSample], min_strain: Real) -> KawakitaSummary {
     let points = samples.iter().map(|s| (s.upper_pressure_pa, s.strain));
-    match granbed_kernel::analysis::bed::kawakita_fit(points, 0.25) {
-        Some(f) => KawakitaSummary {
-            a: Some(f.a),
-            inv_b_pa: Some(f.inv_b_pa),
-            r_squared: Some(f.r_squared),
-            points: f.points,
-        },
-        None => KawakitaSummary {
-            a: None,
-            inv_b_pa: None,
-            r_squared: None,
-            points: samples.iter().filter(|s| s.strain >= 0.25).count(),
-        },
+    let fit = granbed_kernel::analysis::bed::kawakita_fit(points, min_strain);
+    KawakitaSummary {
+        a: fit.map(|f| f.a),
+        inv_b_pa: fit.map(|f| f.inv_b_pa),
+        r_squared: fit.map(|f| f.r_squared),
+        points: fit.map_or_else(
+            || samples.iter().filter(|s| s.strain >= min_strain).count(),
+            |f| f.points,
+        ),
+        min_strain,
+    }
+}
+
+/// The rows of the Heckel plot: (P in Pa, D, C) of every output row.
+pub fn heckel_rows(run: &BedRun) -> impl Iterator<Item = (Real, Real, Real)> + Clone + '_ {
+    run.samples.iter().map(|s| {
+        (
+            s.upper_pressure_pa,
+            bed_solid_fraction(run, s.strain),
+            s.strain,
+        )
+    })
+}
+
+/// The Heckel fit of the run's output rows with C ≥ `min_strain`.
+pub fn heckel(run: &BedRun, min_strain: Real) -> HeckelSummary {
+    let window = heckel_rows(run)
+        .filter(move |&(_, _, c)| c >= min_strain)
+        .map(|(p, d, _)| (p, d));
+    let fit = granbed_kernel::analysis::bed::heckel_fit(window.clone());
+    HeckelSummary {
+        yield_pressure_pa: fit.map(|f| f.yield_pressure_pa),
+        k_per_pa: fit.map(|f| f.k_per_pa),
+        a: fit.map(|f| f.a),
+        d_a: fit.map(|f| f.d_a),
+        r_squared: fit.map(|f| f.r_squared),
+        points: fit.map_or_else(
+            || window.filter(|&(_, d)| d > 0.0 && d < 1.0).count(),
+            |f| f.points,
+        ),
+        min_strain,
     }
 }
 
@@ -294,7 +352,8 @@ impl HiddenOverlapSummary {
 /// The summary of `run`.
 pub fn summary<'a>(scene: &'a Scene, run: &BedRun) -> Summary<'a> {
     let last = run.samples.last().copied().unwrap_or_default();
-    let k = kawakita(&run.samples);
+    let k = kawakita(&run.samples, scene.kawakita_min_strain);
+    let heckel = heckel(run, scene.heckel_min_strain);
     let min_jacobian = run
         .samples
         .iter()
@@ -319,7 +378,7 @@ pub fn summary<'a>(scene: &'a Scene, run: &BedRun) -> Summary<'a> {
     let mut warnings = warnings(
         scene,
         run,
-        &k,
+        (&k, &heckel),
         max_penetration_m,
         max_penetration_rel_element,
     );
@@ -332,6 +391,9 @@ pub fn summary<'a>(scene: &'a Scene, run: &BedRun) -> Summary<'a> {
         kawakita_a: k.a,
         kawakita_inv_b_pa: k.inv_b_pa,
         kawakita: k,
+        heckel_yield_pressure_pa: heckel.yield_pressure_pa,
+        heckel,
+        initial_solid_fraction: bed_solid_fraction(run, 0.0),
         yield_stress_pa: material.map_or(Real::NAN, |m| m.yield_stress_pa),
         eta0: material.map_or(Real::NAN, |m| m.eta0),
         final_strain: last.strain,
@@ -422,7 +484,7 @@ pub const OVERLAP_WARNING_REL: Real = crate::study::stability::MAX_PENETRATION_R
 
 /// Why the Kawakita fit `k` does not describe a bed, if it does not: a
 /// outside (0, 1] (a limiting strain; NaN included), 1/b ≤ 0, R² below
-/// [`KAWAKITA_MIN_R_SQUARED`]. Empty for a fit inside the law's regime.
+/// [`FIT_MIN_R_SQUARED`]. Empty for a fit inside the law's regime.
 fn kawakita_doubts(k: &KawakitaSummary) -> Vec<String> {
     let mut why = Vec::new();
     if let Some(a) = k.a.filter(|&a| !(a > 0.0 && a <= 1.0)) {
@@ -433,8 +495,8 @@ fn kawakita_doubts(k: &KawakitaSummary) -> Vec<String> {
     if let Some(inv_b) = k.inv_b_pa.filter(|&x| x <= 0.0) {
         why.push(format!("1/b = {inv_b:.3e} Pa <= 0"));
     }
-    if let Some(r2) = k.r_squared.filter(|&r| r < KAWAKITA_MIN_R_SQUARED) {
-        why.push(format!("R^2 = {r2:.3} < {KAWAKITA_MIN_R_SQUARED}"));
+    if let Some(r2) = k.r_squared.filter(|&r| r < FIT_MIN_R_SQUARED) {
+        why.push(format!("R^2 = {r2:.3} < {FIT_MIN_R_SQUARED}"));
     }
     why
 }
@@ -444,7 +506,7 @@ fn kawakita_doubts(k: &KawakitaSummary) -> Vec<String> {
 fn warnings(
     scene: &Scene,
     run: &BedRun,
-    kawakita: &KawakitaSummary,
+    (kawakita, heckel): (&KawakitaSummary, &HeckelSummary),
     max_penetration_m: Real,
     max_penetration_rel: Option<Real>,
 ) -> Vec<String> {
@@ -555,11 +617,20 @@ fn warnings(
     let why = kawakita_doubts(kawakita);
     if !why.is_empty() {
         w.push(format!(
-            "the Kawakita fit over C >= 0.25 ({} points) does not describe this bed: {}; its a \
+            "the Kawakita fit over C >= {} ({} points) does not describe this bed: {}; its a \
              and 1/b are not material figures (a bed too small or a strain too short for the \
-             law's regime)",
+             law's regime; `--kawakita-min-strain` sets the window)",
+            kawakita.min_strain,
             kawakita.points,
             why.join(", ")
+        ));
+    }
+    if let Some(r2) = heckel.r_squared.filter(|&r| r < FIT_MIN_R_SQUARED) {
+        w.push(format!(
+            "the Heckel fit over C >= {} ({} points) has R^2 = {r2:.3} < {FIT_MIN_R_SQUARED}: \
+             ln(1/(1 - D)) is not linear in P there, and its yield pressure is not a material \
+             figure (`--heckel-min-strain` sets the window)",
+            heckel.min_strain, heckel.points
         ));
     }
     if run.counters_from_step > 0 {
@@ -608,8 +679,8 @@ fn first_fold(rows: impl Iterator<Item = (Real, Real)>) -> Option<(Real, Real)> 
     fold
 }
 
-/// The R² below which the Kawakita fit is warned about.
-pub const KAWAKITA_MIN_R_SQUARED: Real = 0.9;
+/// The R² below which the Kawakita and Heckel fits are warned about.
+pub const FIT_MIN_R_SQUARED: Real = 0.9;
 
 /// Writes `compression.csv`, `summary.json`, the plots and `report.html`
 /// into `dir` (created).
@@ -626,7 +697,7 @@ pub fn write_all(dir: &Path, scene: &Scene, run: &BedRun) -> anyhow::Result<()> 
     finish_file(csv.into_inner(), &path)?;
     let summary = summary(scene, run);
     write_json(&dir.join("summary.json"), &summary)?;
-    let svgs = super::plots::write_plots(dir, &run.samples, &summary.kawakita)?;
+    let svgs = super::plots::write_plots(dir, run, &summary)?;
     super::report::write_report(dir, scene, &summary, &svgs)
 }
 
@@ -725,6 +796,7 @@ mod tests {
             inv_b_pa: Some(inv_b),
             r_squared: Some(r2),
             points: 11,
+            min_strain: 0.25,
         };
         for a in [1.0, 0.4] {
             assert!(kawakita_doubts(&fit(a, 2e5, 0.99)).is_empty(), "a = {a}");
@@ -745,6 +817,7 @@ mod tests {
             inv_b_pa: None,
             r_squared: None,
             points: 2,
+            min_strain: 0.25,
         };
         assert!(kawakita_doubts(&none).is_empty());
     }

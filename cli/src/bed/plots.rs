@@ -4,8 +4,9 @@
 //!
 //! * `pressure_strain.svg`: upper- and lower-punch pressure against the
 //!   axial strain C;
-//! * `kawakita.svg`: P/C against P with the Kawakita fit line (points with
-//!   C ≥ 0.25 are the fitted ones);
+//! * `kawakita.svg`: P/C against P with the Kawakita fit line (points in
+//!   the fit's strain window filled);
+//! * `heckel.svg`: ln(1/(1 − D)) against P with the Heckel fit line;
 //! * `coordination_strain.svg`: coordination number Z, without and with
 //!   the walls;
 //! * `relative_density_strain.svg`: mean granule relative density and
@@ -15,22 +16,21 @@
 
 use std::path::Path;
 
-use anyhow::Context as _;
-use granbed_kernel::Real;
-use granbed_kernel::analysis::bed::KAWAKITA_MIN_STRAIN;
-
-use super::outputs::KawakitaSummary;
-use super::run::BedSample;
+use super::outputs::{HeckelSummary, KawakitaSummary, Summary, heckel_rows};
+use super::run::{BedRun, BedSample};
 use crate::output::write_text;
 use crate::plot::{Mark, Series, xy_svg};
+use anyhow::Context as _;
+use granbed_kernel::Real;
 
 /// Sub-directory of the output directory holding the plots.
 pub const PLOTS_DIR: &str = "plots";
 
 /// The plot files, in the order [`write_plots`] writes them.
-pub const PLOT_FILES: [&str; 5] = [
+pub const PLOT_FILES: [&str; 6] = [
     "pressure_strain.svg",
     "kawakita.svg",
+    "heckel.svg",
     "coordination_strain.svg",
     "relative_density_strain.svg",
     "heywood_strain.svg",
@@ -69,31 +69,31 @@ fn against_strain(samples: &[BedSample], curves: [(&str, Quantity); 2]) -> [Seri
         .map(|(label, y)| Series::new(label, Mark::Line, samples.iter().map(|s| (s.strain, y(s)))))
 }
 
-/// The Kawakita plot: P/C against P (kPa) of the samples with C > 0, the
-/// fitted ones (C ≥ 0.25) filled, and the line P/C = P/a + (1/b)/a over the
-/// fitted pressures.
-pub fn kawakita_svg(samples: &[BedSample], fit: &KawakitaSummary) -> anyhow::Result<String> {
-    let point = |s: &BedSample| {
-        (
-            s.upper_pressure_pa * 1e-3,
-            s.upper_pressure_pa / s.strain * 1e-3,
-        )
-    };
-    let used = |s: &&BedSample| s.strain >= KAWAKITA_MIN_STRAIN;
-    let early = |s: &&BedSample| s.strain > 0.0 && s.strain < KAWAKITA_MIN_STRAIN;
+/// A fit's plot: `rows` (x, y, C) before the strain window `min_strain`
+/// as rings, those in it as dots, and the fitted `line` (its legend and
+/// y(x)), if any, over the window's x range.
+fn fit_svg(
+    title: &str,
+    (x_desc, y_desc): (&str, &str),
+    rows: impl Iterator<Item = (f64, f64, f64)> + Clone,
+    min_strain: f64,
+    line: Option<(String, &dyn Fn(f64) -> f64)>,
+) -> anyhow::Result<String> {
+    let before = rows.clone().filter(|&(_, _, c)| c < min_strain);
+    let within = rows.filter(|&(_, _, c)| c >= min_strain);
     let mut series = vec![
         Series::new(
-            format!("C < {KAWAKITA_MIN_STRAIN}"),
+            format!("C < {min_strain}"),
             Mark::Rings,
-            samples.iter().filter(early).map(point),
+            before.map(|(x, y, _)| (x, y)),
         ),
         Series::new(
-            format!("C ≥ {KAWAKITA_MIN_STRAIN} (fitted)"),
+            format!("C ≥ {min_strain} (fitted)"),
             Mark::Dots,
-            samples.iter().filter(used).map(point),
+            within.map(|(x, y, _)| (x, y)),
         ),
     ];
-    if let (Some(a), Some(inv_b)) = (fit.a, fit.inv_b_pa) {
+    if let Some((label, y)) = line {
         let (lo, hi) = series[1]
             .points()
             .iter()
@@ -101,30 +101,94 @@ pub fn kawakita_svg(samples: &[BedSample], fit: &KawakitaSummary) -> anyhow::Res
                 (lo.min(p.0), hi.max(p.0))
             });
         if lo <= hi {
-            // In kPa: P/C = P/a + (1/b)/a.
-            let line = |p: f64| (p, p / a + inv_b * 1e-3 / a);
-            let r2 = fit.r_squared.map_or("n/a".into(), |r| format!("{r:.4}"));
             series.push(Series::new(
-                format!("fit: a = {a:.4}, 1/b = {:.4} kPa, R² = {r2}", inv_b * 1e-3),
+                label,
                 Mark::Dashed,
-                [line(lo), line(hi)].into_iter(),
+                [(lo, y(lo)), (hi, y(hi))].into_iter(),
             ));
         }
     }
-    xy_svg(
+    xy_svg(title, x_desc, y_desc, &series, true)
+}
+
+/// The R² of a fit for a legend.
+fn r2_text(r_squared: Option<Real>) -> String {
+    r_squared.map_or("n/a".into(), |r| format!("{r:.4}"))
+}
+
+/// The Kawakita plot: P/C against P (kPa) of the samples with C > 0, the
+/// fitted ones (C ≥ the fit's window) filled, and the line
+/// P/C = P/a + (1/b)/a over the fitted pressures.
+pub fn kawakita_svg(samples: &[BedSample], fit: &KawakitaSummary) -> anyhow::Result<String> {
+    let rows = samples.iter().filter(|s| s.strain > 0.0).map(|s| {
+        (
+            s.upper_pressure_pa * 1e-3,
+            s.upper_pressure_pa / s.strain * 1e-3,
+            s.strain,
+        )
+    });
+    // In kPa: P/C = P/a + (1/b)/a.
+    let line = fit
+        .a
+        .zip(fit.inv_b_pa)
+        .map(|(a, inv_b)| (a, inv_b, move |p: f64| p / a + inv_b * 1e-3 / a));
+    let line = line.as_ref().map(|(a, inv_b, y)| {
+        let label = format!(
+            "fit: a = {a:.4}, 1/b = {:.4} kPa, R² = {}",
+            inv_b * 1e-3,
+            r2_text(fit.r_squared)
+        );
+        (label, y as &dyn Fn(f64) -> f64)
+    });
+    fit_svg(
         "Kawakita plot",
-        "upper-punch pressure P, kPa",
-        "P/C, kPa",
-        &series,
-        true,
+        ("upper-punch pressure P, kPa", "P/C, kPa"),
+        rows,
+        fit.min_strain,
+        line,
     )
 }
 
-/// The SVG text of every plot, named as in [`PLOT_FILES`].
-pub fn plots(
-    samples: &[BedSample],
-    fit: &KawakitaSummary,
-) -> anyhow::Result<[(&'static str, String); 5]> {
+/// The Heckel plot: ln(1/(1 − D)) against P (kPa) of the rows `(P [Pa], D,
+/// C)` with 0 < D < 1, the fitted ones (C ≥ the fit's window) filled, and
+/// the line K·P + A over the fitted pressures.
+pub fn heckel_svg(
+    rows: impl Iterator<Item = (Real, Real, Real)> + Clone,
+    fit: &HeckelSummary,
+) -> anyhow::Result<String> {
+    let rows = rows
+        .filter(|&(_, d, _)| d > 0.0 && d < 1.0)
+        .map(|(p, d, c)| (p * 1e-3, -(-d).ln_1p(), c));
+    // In kPa: K·P + A with K per kPa.
+    let line = fit
+        .k_per_pa
+        .zip(fit.a)
+        .map(|(k, a)| move |p: f64| k * 1e3 * p + a);
+    let line = line.as_ref().map(|y| {
+        let label = format!(
+            "fit: P_y = {:.4} kPa, A = {:.4}, R² = {}",
+            fit.yield_pressure_pa.unwrap_or(f64::NAN) * 1e-3,
+            fit.a.unwrap_or(f64::NAN),
+            r2_text(fit.r_squared)
+        );
+        (label, y as &dyn Fn(f64) -> f64)
+    });
+    fit_svg(
+        "Heckel plot",
+        (
+            "upper-punch pressure P, kPa",
+            "ln(1/(1 - D)), D the bed's solid fraction",
+        ),
+        rows,
+        fit.min_strain,
+        line,
+    )
+}
+
+/// The SVG text of every plot of `run`, named as in [`PLOT_FILES`], with
+/// the fits of its `summary`.
+pub fn plots(run: &BedRun, summary: &Summary) -> anyhow::Result<[(&'static str, String); 6]> {
+    let samples = &run.samples[..];
     const C: &str = "axial strain C = (H0 - H)/H0";
     let pressure = against_strain(
         samples,
@@ -154,19 +218,27 @@ pub fn plots(
             ("d S/V (nominal d)", |s| s.heywood_d),
         ],
     );
-    let [f0, f1, f2, f3, f4] = PLOT_FILES;
+    let [
+        pressure_f,
+        kawakita_f,
+        heckel_f,
+        coordination_f,
+        density_f,
+        heywood_f,
+    ] = PLOT_FILES;
     Ok([
         (
-            f0,
+            pressure_f,
             xy_svg("Punch pressure", C, "pressure P, kPa", &pressure, true)?,
         ),
-        (f1, kawakita_svg(samples, fit)?),
+        (kawakita_f, kawakita_svg(samples, &summary.kawakita)?),
+        (heckel_f, heckel_svg(heckel_rows(run), &summary.heckel)?),
         (
-            f2,
+            coordination_f,
             xy_svg("Coordination number", C, "Z", &coordination, true)?,
         ),
         (
-            f3,
+            density_f,
             xy_svg(
                 "Granule relative density",
                 C,
@@ -176,7 +248,7 @@ pub fn plots(
             )?,
         ),
         (
-            f4,
+            heywood_f,
             xy_svg(
                 "Heywood coefficient (mean over granules)",
                 C,
@@ -188,17 +260,17 @@ pub fn plots(
     ])
 }
 
-/// Writes the plots of `samples` into `dir`/[`PLOTS_DIR`] (created) and
+/// Writes the plots of `run` into `dir`/[`PLOTS_DIR`] (created) and
 /// returns them (file name, SVG text) for the report.
 pub fn write_plots(
     dir: &Path,
-    samples: &[BedSample],
-    fit: &KawakitaSummary,
-) -> anyhow::Result<[(&'static str, String); 5]> {
+    run: &BedRun,
+    summary: &Summary,
+) -> anyhow::Result<[(&'static str, String); 6]> {
     let dir = dir.join(PLOTS_DIR);
     std::fs::create_dir_all(&dir)
         .with_context(|| format!("cannot create directory `{}`", dir.display()))?;
-    let svgs = plots(samples, fit)?;
+    let svgs = plots(run, summary)?;
     for (name, svg) in &svgs {
         write_text(&dir.join(name), svg)?;
     }
@@ -229,10 +301,38 @@ mod tests {
             inv_b_pa: Some(fit.inv_b_pa),
             r_squared: Some(fit.r_squared),
             points: fit.points,
+            min_strain: 0.25,
         };
         let svg = kawakita_svg(&samples, &summary).unwrap();
         assert!(svg.starts_with("<svg"), "{}", &svg[..100]);
         assert!(svg.contains("fit: a = 0.5000, 1/b = 100.0000 kPa"), "{svg}");
         assert!(svg.contains("C &lt; 0.25"));
+    }
+
+    #[test]
+    fn the_heckel_plot_has_the_fit_line_and_leaves_out_d_of_1() {
+        // ln(1/(1 − D)) = P/(80 kPa) + 0.5, and one row past D = 1.
+        let mut rows: Vec<(Real, Real, Real)> = (0..30)
+            .map(|i| {
+                let p = 4e3 * f64::from(i);
+                (p, 1.0 - (-(p / 80e3 + 0.5)).exp(), 0.01 * f64::from(i))
+            })
+            .collect();
+        rows.push((2e5, 1.05, 0.3));
+        let window = rows.iter().filter(|r| r.2 >= 0.2).map(|r| (r.0, r.1));
+        let fit = granbed_kernel::analysis::bed::heckel_fit(window).unwrap();
+        let summary = HeckelSummary {
+            yield_pressure_pa: Some(fit.yield_pressure_pa),
+            k_per_pa: Some(fit.k_per_pa),
+            a: Some(fit.a),
+            d_a: Some(fit.d_a),
+            r_squared: Some(fit.r_squared),
+            points: fit.points,
+            min_strain: 0.2,
+        };
+        let svg = heckel_svg(rows.iter().copied(), &summary).unwrap();
+        assert!(svg.contains("fit: P_y = 80.0000 kPa, A = 0.5000"), "{svg}");
+        assert!(svg.contains("C &lt; 0.2") && svg.contains("(fitted)"));
+        assert!(!svg.contains("NaN"), "the row past D = 1 is plotted");
     }
 }

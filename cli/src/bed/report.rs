@@ -16,16 +16,41 @@ use crate::output::write_text;
 pub const REPORT_FILE: &str = "report.html";
 
 /// The fields of `summary.json` shown first, in this order, with their
-/// meaning; any other field follows (the nested `kawakita` object is
-/// flattened to `kawakita.<field>`, the scene is shown as TOML instead).
-const FIELDS: [(&str, &str); 53] = [
+/// meaning; any other field follows (nested objects such as `kawakita` and
+/// `heckel` are flattened to `kawakita.<field>`; the scene is shown as TOML
+/// instead).
+const FIELDS: [(&str, &str); 63] = [
     ("kawakita_a", "Kawakita a (limiting strain)"),
     ("kawakita_inv_b_pa", "Kawakita 1/b, Pa"),
     (
         "kawakita.r_squared",
         "R² of the Kawakita line P/C against P",
     ),
-    ("kawakita.points", "samples with C ≥ 0.25 in the fit"),
+    ("kawakita.points", "output rows in the Kawakita fit"),
+    (
+        "kawakita.min_strain",
+        "the Kawakita fit takes the rows with C ≥ this",
+    ),
+    (
+        "heckel_yield_pressure_pa",
+        "Heckel mean yield pressure P_y = 1/K, Pa",
+    ),
+    ("heckel.a", "Heckel intercept A of ln(1/(1 − D)) = K·P + A"),
+    ("heckel.k_per_pa", "Heckel slope K, 1/Pa"),
+    ("heckel.d_a", "D_A = 1 − exp(−A)"),
+    (
+        "heckel.r_squared",
+        "R² of the Heckel line ln(1/(1 − D)) against P",
+    ),
+    ("heckel.points", "output rows in the Heckel fit"),
+    (
+        "heckel.min_strain",
+        "the Heckel fit takes the rows with C ≥ this",
+    ),
+    (
+        "initial_solid_fraction",
+        "the poured bed's solid fraction D0 (solid volume / die volume below H0)",
+    ),
     ("yield_stress_pa", "granule yield stress, Pa"),
     ("eta0", "granule initial relative density η0"),
     ("final_strain", "axial strain reached"),
@@ -150,6 +175,7 @@ const FIELDS: [(&str, &str); 53] = [
     // Shown in the fields above already, or above the table.
     ("kawakita.a", ""),
     ("kawakita.inv_b_pa", ""),
+    ("heckel.yield_pressure_pa", ""),
     ("warnings", ""),
 ];
 

@@ -41,6 +41,18 @@ pub const MAX_GRANULES: usize = 100_000;
 // Spelled out in the scene's `granules` range.
 const _: () = assert!(MAX_GRANULES == 100_000);
 
+/// The largest final strain of a bed, also the bound of the fits' strain
+/// windows.
+pub const MAX_FINAL_STRAIN: f64 = 0.9;
+// Spelled out in the checks' allowed ranges.
+const _: () = assert!(MAX_FINAL_STRAIN == 0.9);
+
+/// The Heckel fit's default strain window starts where the Kawakita fit's
+/// does (physics.md §7 item 3's C ≥ 0.25): past the rearrangement, in the
+/// dense stage where both laws are meant to hold. physics.md names no Heckel
+/// window; the scene field `heckel_min_strain` sets another.
+pub const HECKEL_MIN_STRAIN: f64 = granbed_kernel::analysis::bed::KAWAKITA_MIN_STRAIN;
+
 /// The smallest output and checkpoint strain interval: the run steps its
 /// next output strain forward by the interval, and an interval below the
 /// round-off of the strain never got past it.
@@ -195,6 +207,13 @@ exact_sweep_tolerance = 0.005
 # far (0: try every face near the overlap every sweep). The results are the
 # same bits either way; only the speed depends on it.
 face_list_skin = 0.05
+# The fits of summary.json over the output rows with C >= these strains
+# (0 <= C <= 0.9): Kawakita (physics.md: C >= 0.25, the dense stage) and
+# Heckel (ln(1/(1 - D)) against P, D the bed's solid fraction). Past the end
+# of a run, `granbed-cli bed --resume DIR --kawakita-min-strain C` refits a
+# finished run without a step.
+kawakita_min_strain = 0.25
+heckel_min_strain = 0.25
 # Watchdogs: stop (with a checkpoint from before) when the kinetic energy
 # exceeds this multiple of all the energy put in (punch or contact work,
 # gravity, initial motion), or when a node moves faster than this multiple of
@@ -368,6 +387,14 @@ pub struct Scene {
     /// bits for any value.
     #[serde(default = "default_face_list_skin")]
     pub face_list_skin: f64,
+    /// The Kawakita fit uses the output rows with C ≥ this, 0 ≤ C ≤
+    /// [`MAX_FINAL_STRAIN`] (absent: physics.md's 0.25).
+    #[serde(default = "default_kawakita_min_strain")]
+    pub kawakita_min_strain: f64,
+    /// The Heckel fit uses the output rows with C ≥ this, 0 ≤ C ≤
+    /// [`MAX_FINAL_STRAIN`] (absent: [`HECKEL_MIN_STRAIN`]).
+    #[serde(default = "default_heckel_min_strain")]
+    pub heckel_min_strain: f64,
     /// Watchdog limit on the kinetic energy as a multiple of the energy
     /// put in, 1 ≤ r ≤ 1e9 (absent: 2).
     #[serde(default = "default_watchdog_energy_ratio")]
@@ -379,6 +406,14 @@ pub struct Scene {
     /// Material overrides.
     #[serde(default)]
     pub material: MaterialOverrides,
+}
+
+fn default_kawakita_min_strain() -> f64 {
+    granbed_kernel::analysis::bed::KAWAKITA_MIN_STRAIN
+}
+
+fn default_heckel_min_strain() -> f64 {
+    HECKEL_MIN_STRAIN
 }
 
 fn never_strain() -> f64 {
@@ -498,7 +533,7 @@ impl Scene {
             (MAX_DIE_DIAMETERS * d).shown(),
             d.shown()
         );
-        let checks: [(bool, &str, f64, &str); 26] = [
+        let checks: [(bool, &str, f64, &str); 28] = [
             (
                 self.sweep_tolerance > 0.0 && self.sweep_tolerance <= 0.1,
                 "sweep_tolerance",
@@ -603,10 +638,22 @@ impl Scene {
                 "1e-4 <= v <= 10 m/s (10: the platen speed limit of `granbed-cli granule`)",
             ),
             (
-                self.final_strain > 0.0 && self.final_strain <= 0.9,
+                self.final_strain > 0.0 && self.final_strain <= MAX_FINAL_STRAIN,
                 "final_strain",
                 self.final_strain,
                 "0 < C <= 0.9",
+            ),
+            (
+                (0.0..=MAX_FINAL_STRAIN).contains(&self.kawakita_min_strain),
+                "kawakita_min_strain",
+                self.kawakita_min_strain,
+                "0 <= C <= 0.9",
+            ),
+            (
+                (0.0..=MAX_FINAL_STRAIN).contains(&self.heckel_min_strain),
+                "heckel_min_strain",
+                self.heckel_min_strain,
+                "0 <= C <= 0.9",
             ),
             (
                 self.output_strain_interval >= MIN_STRAIN_INTERVAL
@@ -665,7 +712,7 @@ impl Scene {
         if let Some(c) = self
             .snapshot_strains
             .iter()
-            .find(|c| !(0.0..=0.9).contains(*c))
+            .find(|c| !(0.0..=MAX_FINAL_STRAIN).contains(*c))
         {
             bail!(invalid("snapshot_strains", c, "each 0 <= C <= 0.9"));
         }

@@ -194,7 +194,7 @@ fn run_setting(
             setting.name
         );
     }
-    let k = kawakita(&run.samples);
+    let k = kawakita(&run.samples, scene.kawakita_min_strain);
     Ok(Measured {
         setting: *setting,
         seed,
