@@ -26,7 +26,7 @@ fn checkpoint_granules(dir: &Path) -> Vec<granbed_cli::assembly::GranuleState> {
 /// The CI bed of these tests: 30 coarse granules to 30 %.
 const SMALL: [&str; 8] = common::small_bed("30", "0.3");
 
-fn bed(dir: &Path, threads: &str) -> common::Run {
+fn bed(dir: &Path, threads: &str, extra: &[&str]) -> common::Run {
     let mut argv = vec![
         "bed",
         "--quiet",
@@ -36,6 +36,7 @@ fn bed(dir: &Path, threads: &str) -> common::Run {
         dir.to_str().unwrap(),
     ];
     argv.extend_from_slice(&SMALL);
+    argv.extend_from_slice(extra);
     let run = cli(&argv);
     assert_eq!(run.code, 0, "bed failed:\n{}", run.stderr);
     run
@@ -44,8 +45,10 @@ fn bed(dir: &Path, threads: &str) -> common::Run {
 #[test]
 fn a_small_bed_runs_end_to_end_and_is_thread_independent() {
     let (one, two) = (out_dir("j1"), out_dir("j2"));
-    bed(&one, "1");
-    bed(&two, "2");
+    bed(&one, "1", &[]);
+    // Snapshots of every hex for the stress check below (the run is the
+    // same: the compression table is compared bit for bit).
+    bed(&two, "2", &["--vtk-full-mesh"]);
     let csv = std::fs::read(one.join("compression.csv")).unwrap();
     assert_eq!(
         csv,
@@ -167,6 +170,49 @@ fn a_small_bed_runs_end_to_end_and_is_thread_independent() {
     assert_eq!(s["quasi_static"]["passed"], true, "{}", s["quasi_static"]);
     let warned = |w: &serde_json::Value| w.as_str().unwrap().contains("NOT quasi-static");
     assert!(!s["warnings"].as_array().unwrap().iter().any(warned), "{s}");
+
+    // The average-stress theorem: in equilibrium the element stresses'
+    // axial virial Σ_e (−σ_zz)_e v_e equals Σ z f_z of the external forces,
+    // H F_top less the die-wall friction's Σ z f (0 ≤ z ≤ H): between
+    // H F_bottom and H F_top. Checked within the certificate's 5 % force
+    // imbalance of their mean at the snapshots of 20 and 30 %
+    // (instantaneous, against the rows' averages at those strains); v_e
+    // from the element's relative density, v = J V0 = (η0/η_e) V0.
+    let mesh = granbed_cli::model::OwnedReference::sphere(
+        0.5e-3,
+        "4x1".parse::<granbed_cli::model::MeshLevel>().unwrap(),
+        false,
+    )
+    .unwrap();
+    let h0 = number(&s, "initial_bed_height_m");
+    for (file, c) in [("bed_2.vtu", 0.2), ("bed_3.vtu", 0.3)] {
+        let vtu = common::read_vtu(
+            &two.join("vtk").join(file),
+            &["axial_stress_pa", "element_relative_density"],
+        );
+        let (axial, rho) = (
+            &vtu.cell_data["axial_stress_pa"],
+            &vtu.cell_data["element_relative_density"],
+        );
+        assert_eq!(axial.len(), 30 * mesh.elements.len());
+        let virial: f64 = axial
+            .iter()
+            .zip(rho)
+            .enumerate()
+            .map(|(i, (sz, r))| sz * (0.8 / r) * mesh.elements[i % mesh.elements.len()].volume)
+            .sum();
+        let row = (0..n)
+            .min_by(|&a, &b| (strain[a] - c).abs().total_cmp(&(strain[b] - c).abs()))
+            .unwrap();
+        let force = virial / (h0 * (1.0 - strain[row]));
+        let mean = 0.5 * (up[row] + low[row]);
+        assert!(
+            (force - mean).abs() <= 0.05 * mean,
+            "C = {c}: Σ(−σ_zz)v/H = {force:e} N against the punches' {} / {} N",
+            up[row],
+            low[row]
+        );
+    }
 
     // A finished run refitted over other strain windows by --resume: no
     // step, the same table, the fits over the new windows.

@@ -8,11 +8,10 @@
 
 mod common;
 
-use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
-use common::{Element, cli, parse_xml, summary};
+use common::{cli, parse_xml, read_vtu, summary};
 use granbed_cli::bed::DEFAULT_SCENE;
 use granbed_cli::model::{MeshLevel, OwnedReference};
 
@@ -24,7 +23,27 @@ const GRANULES: usize = 20;
 /// The scene's snapshot strains in order, then the final state's (the
 /// tiny bed's `--strain 0.12`, which the list does not reach).
 const SNAPSHOTS: [f64; 4] = [0.0, 0.05, 0.1, 0.12];
-const CELL_ARRAYS: [&str; 4] = ["granule", "relative_density", "heywood_dv", "heywood_d"];
+/// The cell data holding one value per granule.
+const GRANULE_ARRAYS: [&str; 4] = ["granule", "relative_density", "heywood_dv", "heywood_d"];
+/// The cell data holding the value of each cell's element (a quad's: the
+/// hex under it).
+const ELEMENT_ARRAYS: [&str; 4] = [
+    "pressure_pa",
+    "von_mises_pa",
+    "axial_stress_pa",
+    "element_relative_density",
+];
+/// Every cell data array of a snapshot.
+const CELL_ARRAYS: [&str; 8] = [
+    GRANULE_ARRAYS[0],
+    GRANULE_ARRAYS[1],
+    GRANULE_ARRAYS[2],
+    GRANULE_ARRAYS[3],
+    ELEMENT_ARRAYS[0],
+    ELEMENT_ARRAYS[1],
+    ELEMENT_ARRAYS[2],
+    ELEMENT_ARRAYS[3],
+];
 
 /// Runs the tiny bed into `dir` with `extra` flags; the scene file (the
 /// published scene with three snapshot strains) is written beside `dir`.
@@ -55,90 +74,6 @@ fn tiny_bed(dir: &Path, strain: &str, extra: &[&str]) {
 /// The coarse granule mesh of the tiny bed.
 fn mesh() -> OwnedReference {
     OwnedReference::sphere(0.5e-3, "4x1".parse::<MeshLevel>().unwrap(), false).unwrap()
-}
-
-/// Standard base64 (with padding), for the binary VTK data arrays.
-fn base64_decode(text: &str) -> Vec<u8> {
-    let value = |c: u8| -> u32 {
-        match c {
-            b'A'..=b'Z' => u32::from(c - b'A'),
-            b'a'..=b'z' => u32::from(c - b'a') + 26,
-            b'0'..=b'9' => u32::from(c - b'0') + 52,
-            b'+' => 62,
-            b'/' => 63,
-            _ => panic!("bad base64 character {c:?}"),
-        }
-    };
-    let bytes: Vec<u8> = text.bytes().filter(|c| !c.is_ascii_whitespace()).collect();
-    assert_eq!(bytes.len() % 4, 0, "base64 length");
-    let mut out = Vec::new();
-    for chunk in bytes.chunks(4) {
-        let pad = chunk.iter().filter(|&&c| c == b'=').count();
-        let n = chunk
-            .iter()
-            .map(|&c| if c == b'=' { 0 } else { value(c) })
-            .fold(0u32, |n, v| (n << 6) | v);
-        out.extend_from_slice(&n.to_be_bytes()[1..4 - pad]);
-    }
-    out
-}
-
-/// The values of a binary (inline base64, UInt64 header) little-endian
-/// `DataArray` of 8-byte numbers, as `f64` (Float64) or `i64` (Int64).
-fn binary_values(e: &Element) -> Vec<f64> {
-    assert_eq!(e.attrs["format"], "binary", "{}", e.attrs["Name"]);
-    let bytes = base64_decode(&e.text);
-    let (header, data) = bytes.split_at(8);
-    let len = u64::from_le_bytes(header.try_into().unwrap()) as usize;
-    assert_eq!(len, data.len(), "header of {}", e.attrs["Name"]);
-    data.chunks(8)
-        .map(|b| {
-            let b: [u8; 8] = b.try_into().unwrap();
-            match e.attrs["type"].as_str() {
-                "Float64" => f64::from_le_bytes(b),
-                "Int64" => i64::from_le_bytes(b) as f64,
-                t => panic!("unexpected type {t}"),
-            }
-        })
-        .collect()
-}
-
-/// What a snapshot file holds, as this test reads it.
-struct Snapshot {
-    points: usize,
-    cells: usize,
-    cell_data: HashMap<String, Vec<f64>>,
-    types: Vec<u8>,
-}
-
-fn read_vtu(path: &Path) -> Snapshot {
-    let xml = std::fs::read_to_string(path)
-        .unwrap_or_else(|e| panic!("cannot read {}: {e}", path.display()));
-    let elements = parse_xml(&xml);
-    let root = elements.last().unwrap();
-    assert_eq!(root.name, "VTKFile");
-    assert_eq!(root.attrs["type"], "UnstructuredGrid");
-    let piece = elements.iter().find(|e| e.name == "Piece").unwrap();
-    let count = |k: &str| piece.attrs[k].parse::<usize>().unwrap();
-    let array = |name: &str| {
-        elements
-            .iter()
-            .find(|e| {
-                e.name == "DataArray" && e.attrs.get("Name").map(String::as_str) == Some(name)
-            })
-            .unwrap_or_else(|| panic!("no DataArray {name} in {}", path.display()))
-    };
-    let types = base64_decode(&array("types").text)[8..].to_vec();
-    let cell_data = CELL_ARRAYS
-        .iter()
-        .map(|&n| (n.to_string(), binary_values(array(n))))
-        .collect();
-    Snapshot {
-        points: count("NumberOfPoints"),
-        cells: count("NumberOfCells"),
-        cell_data,
-        types,
-    }
 }
 
 /// The `(timestep, file)` entries of a `.pvd` collection.
@@ -231,8 +166,9 @@ fn snapshots_plots_and_report() {
     );
 
     let mut mean_density = Vec::new();
+    let mut max_axial = Vec::new();
     for file in &files {
-        let s = read_vtu(&dir.join("vtk").join(file));
+        let s = read_vtu(&dir.join("vtk").join(file), &CELL_ARRAYS);
         assert_eq!(s.cells, GRANULES * quads, "{file}");
         assert_eq!(s.points, GRANULES * mesh.surface_nodes, "{file}");
         assert!(s.types.len() == s.cells && s.types.iter().all(|&t| t == 9));
@@ -245,8 +181,24 @@ fn snapshots_plots_and_report() {
             let v = &s.cell_data[name];
             assert_eq!(v.len(), s.cells, "{file}: {name}");
             assert!(v.iter().all(|x| x.is_finite()), "{file}: {name}");
+        }
+        for name in GRANULE_ARRAYS {
             // One value per granule.
+            let v = &s.cell_data[name];
             assert!(v.chunks(quads).all(|c| c.iter().all(|x| *x == c[0])));
+        }
+        let axial = &s.cell_data["axial_stress_pa"];
+        max_axial.push(axial.iter().copied().fold(f64::NEG_INFINITY, f64::max));
+        // The von Mises stress is a norm; at the start (every granule a
+        // rigid body, untouched) there is no stress and no densification.
+        assert!(s.cell_data["von_mises_pa"].iter().all(|&q| q >= 0.0));
+        if file == &files[0] {
+            for name in ["pressure_pa", "von_mises_pa", "axial_stress_pa"] {
+                let v = &s.cell_data[name];
+                assert!(v.iter().all(|x| x.abs() < 1e-3), "{file}: {name}");
+            }
+            let rho = &s.cell_data["element_relative_density"];
+            assert!(rho.iter().all(|x| (x - 0.8).abs() < 1e-9), "{file}");
         }
         let rho = &s.cell_data["relative_density"];
         mean_density.push(rho.iter().sum::<f64>() / rho.len() as f64);
@@ -257,6 +209,8 @@ fn snapshots_plots_and_report() {
     assert!((mean_density[0] - 0.8).abs() < 1e-9, "{mean_density:?}");
     assert!(mean_density[2] > mean_density[0], "{mean_density:?}");
     assert!(mean_density[3] > mean_density[2], "{mean_density:?}");
+    // Pressed, some element carries an axial compression of kPa.
+    assert!(max_axial[3] > 1e3, "largest axial stress {max_axial:?}");
 
     // meshio reads the same cells and arrays.
     let paths: Vec<PathBuf> = files.iter().map(|f| dir.join("vtk").join(f)).collect();
@@ -362,7 +316,7 @@ fn full_mesh_snapshots_hold_every_hex() {
             (0.01, "bed_1.vtu".to_string())
         ]
     );
-    let s = read_vtu(&dir.join("vtk/bed_0.vtu"));
+    let s = read_vtu(&dir.join("vtk/bed_0.vtu"), &CELL_ARRAYS);
     assert_eq!(s.cells, GRANULES * mesh.hexes.len());
     assert_eq!(s.points, GRANULES * mesh.positions.len());
     assert!(s.types.iter().all(|&t| t == 12));
@@ -374,6 +328,47 @@ fn full_mesh_snapshots_hold_every_hex() {
             lines[0].starts_with(&format!("cells hexahedron {}", GRANULES * mesh.hexes.len())),
             "{}",
             lines[0]
+        );
+    }
+}
+
+/// A surface quad shows the element values of the hex under it: the
+/// final snapshot of the tiny bed written as surfaces and as hexes (the
+/// same run, deterministic) agree quad by quad with the hex holding the
+/// quad's four nodes.
+#[test]
+fn a_surface_quad_shows_the_element_under_it() {
+    let (surfaces, hexes) = (out_dir("quads"), out_dir("quads-hexes"));
+    tiny_bed(&surfaces, "0.12", &[]);
+    tiny_bed(&hexes, "0.12", &["--vtk-full-mesh"]);
+    let mesh = mesh();
+    let last = |dir: &Path| read_vtu(&dir.join("vtk/bed_3.vtu"), &ELEMENT_ARRAYS);
+    let (s, h) = (last(&surfaces), last(&hexes));
+    let (quads, elements) = (mesh.quads.len(), mesh.hexes.len());
+    let hex_of: Vec<usize> = mesh
+        .quads
+        .iter()
+        .map(|q| {
+            let holding: Vec<usize> = (0..elements)
+                .filter(|&e| q.iter().all(|n| mesh.hexes[e].contains(n)))
+                .collect();
+            assert_eq!(holding.len(), 1, "quad {q:?} on hexes {holding:?}");
+            holding[0]
+        })
+        .collect();
+    for name in ELEMENT_ARRAYS {
+        let (sv, hv) = (&s.cell_data[name], &h.cell_data[name]);
+        let mut compressed = 0;
+        for g in 0..GRANULES {
+            for (q, &e) in hex_of.iter().enumerate() {
+                let (a, b) = (sv[g * quads + q], hv[g * elements + e]);
+                assert_eq!(a.to_bits(), b.to_bits(), "{name}: granule {g} quad {q}");
+                compressed += usize::from(name == "pressure_pa" && a > 0.0);
+            }
+        }
+        assert!(
+            name != "pressure_pa" || compressed > 0,
+            "no compressed quad"
         );
     }
 }

@@ -71,6 +71,10 @@ Output, in --out DIR (created if missing):
                    run left): every granule's
                    surface quads (all hexes with --vtk-full-mesh), cell data
                    granule id, relative density eta0 V0/V, Heywood d_V S/V and d S/V
+                   per granule; per element (a quad: the hex under it) the
+                   Cauchy stress's pressure_pa (-tr/3), von_mises_pa and
+                   axial_stress_pa (-sigma_zz), and element_relative_density
+                   eta0/J
   vtk/bed.pvd      ParaView collection of the snapshots (timestep = strain)
   plots/*.svg      pressure, coordination number, relative density and Heywood
                    coefficient against strain; Kawakita plot P/C vs P and

@@ -3,7 +3,9 @@
 //! quads (or, on request, all its hexes) in the current configuration,
 //! with cell data per granule: `granule` (id), `relative_density`
 //! (η_g = η0 V0/V), `heywood_dv` (α_SV with d_V) and `heywood_d` (α_SV with
-//! the nominal diameter). `bed.pvd` lists the snapshots with the strain as
+//! the nominal diameter); and per element (a surface quad shows the hex
+//! under it): `pressure_pa` (−tr σ/3), `von_mises_pa`, `axial_stress_pa`
+//! (−σ_zz, along the punches' axis) and `element_relative_density` (η0/J). `bed.pvd` lists the snapshots with the strain as
 //! the timestep and is rewritten after each one, so a run that stops
 //! early leaves a valid collection. k is the index of the strain among the
 //! scene's sorted snapshot strains, and the collection lists every
@@ -72,6 +74,103 @@ pub fn granule_fields(asm: &Assembly<'_>, mesh: &OwnedReference, d_fixed_m: Real
     f
 }
 
+/// The per-element cell data of a snapshot, `[granule][hex]` flattened:
+/// each element's stress and volume at the snapshot's positions
+/// ([`granbed_kernel::granule::forces::element_stresses`]: what the next
+/// step's element pass computes, the stored states unchanged).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct ElementFields {
+    /// Pressure −tr σ/3, Pa, positive in compression.
+    pub pressure_pa: Vec<Real>,
+    /// Von Mises stress √(3/2)‖dev σ‖, Pa.
+    pub von_mises_pa: Vec<Real>,
+    /// Axial stress −σ_zz along the punches' axis, Pa, positive in
+    /// compression.
+    pub axial_stress_pa: Vec<Real>,
+    /// The element's relative density η0/J (J its current / reference
+    /// volume).
+    pub relative_density: Vec<Real>,
+}
+
+/// The pressure −tr σ/3 and von Mises stress √(3/2)‖dev σ‖ of a Cauchy
+/// stress σ (Voigt `[xx, yy, zz, yz, xz, xy]`), Pa.
+pub fn pressure_and_von_mises(sigma: &[Real; 6]) -> (Real, Real) {
+    let mean = (sigma[0] + sigma[1] + sigma[2]) / 3.0;
+    let dev2 = (0..3).map(|k| (sigma[k] - mean).powi(2)).sum::<Real>()
+        + 2.0 * (3..6).map(|k| sigma[k] * sigma[k]).sum::<Real>();
+    (-mean, (1.5 * dev2).sqrt())
+}
+
+/// The element fields of every granule of `asm` (meshes `mesh`), granules
+/// in parallel (each on its own; the values do not depend on the threads).
+/// A granule whose element update fails (an inverted element) gets NaN
+/// throughout: the picture shows it, the run's own step reports it.
+pub fn element_fields(asm: &Assembly<'_>, mesh: &OwnedReference) -> ElementFields {
+    use granbed_kernel::granule::forces::{ElementStress, element_stresses};
+    use rayon::prelude::*;
+    let params = asm.params();
+    let eta0 = params.material.params.eta0;
+    let hexes = mesh.hexes.len();
+    let per_granule: Vec<Vec<ElementStress>> = asm
+        .granules()
+        .par_iter()
+        .map(|g| {
+            let mut out = vec![ElementStress::default(); hexes];
+            let ok = element_stresses(
+                &mesh.view(),
+                &params.material,
+                &params.elements,
+                &g.x,
+                &g.cp_inv,
+                &mut out,
+            );
+            if ok.is_err() {
+                out.fill(ElementStress {
+                    sigma: [Real::NAN; 6],
+                    j: Real::NAN,
+                });
+            }
+            out
+        })
+        .collect();
+    let mut f = ElementFields::default();
+    for o in per_granule.iter().flatten() {
+        let (p, q) = pressure_and_von_mises(&o.sigma);
+        f.pressure_pa.push(p);
+        f.von_mises_pa.push(q);
+        f.axial_stress_pa.push(-o.sigma[2]);
+        f.relative_density.push(eta0 / o.j);
+    }
+    f
+}
+
+/// The hex of each surface quad of `mesh` (the hex holding its four
+/// nodes), in quad order.
+pub fn quad_hexes(mesh: &OwnedReference) -> anyhow::Result<Vec<usize>> {
+    let mut hexes_of_node: Vec<Vec<usize>> = vec![Vec::new(); mesh.positions.len()];
+    for (h, hex) in mesh.hexes.iter().enumerate() {
+        for &n in hex {
+            if let Some(list) = hexes_of_node.get_mut(n as usize) {
+                list.push(h);
+            }
+        }
+    }
+    mesh.quads
+        .iter()
+        .enumerate()
+        .map(|(q, quad)| {
+            hexes_of_node
+                .get(quad[0] as usize)
+                .and_then(|list| {
+                    list.iter()
+                        .copied()
+                        .find(|&h| quad.iter().all(|n| mesh.hexes[h].contains(n)))
+                })
+                .with_context(|| format!("surface quad {q} is the face of no hex"))
+        })
+        .collect()
+}
+
 /// The snapshot of `asm` as a VTK unstructured grid: the granules one
 /// after the other (points, then cells, in granule order).
 pub fn snapshot_vtk(
@@ -127,6 +226,17 @@ pub fn snapshot_vtk(
     let ids: Vec<i64> = (0..granules.len() as i64)
         .flat_map(|g| core::iter::repeat_n(g, cells_per_granule))
         .collect();
+    // Each cell's element: the hex itself, or the hex under the quad.
+    let cell_hex: Vec<usize> = match content {
+        SnapshotContent::Surfaces => quad_hexes(mesh)?,
+        SnapshotContent::Hexes => (0..mesh.hexes.len()).collect(),
+    };
+    let elements = element_fields(asm, mesh);
+    let per_element = |v: &[Real]| -> Vec<Real> {
+        v.chunks(mesh.hexes.len().max(1))
+            .flat_map(|granule| cell_hex.iter().map(|&h| granule[h]))
+            .collect()
+    };
     let cell_data = vec![
         Attribute::generic("granule", 1).with_data(ids),
         // The active scalars: what a viewer colours by at first.
@@ -134,6 +244,11 @@ pub fn snapshot_vtk(
             .with_data(per_cell_values(&fields.relative_density)),
         Attribute::generic("heywood_dv", 1).with_data(per_cell_values(&fields.heywood_dv)),
         Attribute::generic("heywood_d", 1).with_data(per_cell_values(&fields.heywood_d)),
+        Attribute::generic("pressure_pa", 1).with_data(per_element(&elements.pressure_pa)),
+        Attribute::generic("von_mises_pa", 1).with_data(per_element(&elements.von_mises_pa)),
+        Attribute::generic("axial_stress_pa", 1).with_data(per_element(&elements.axial_stress_pa)),
+        Attribute::generic("element_relative_density", 1)
+            .with_data(per_element(&elements.relative_density)),
     ];
     Ok(Vtk {
         version: Version::new_xml(1, 0),

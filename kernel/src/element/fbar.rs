@@ -174,6 +174,34 @@ pub fn fbar_forces(
     Ok(out)
 }
 
+/// Cauchy stress of one F-bar element at current positions `x` (m), Pa,
+/// Voigt `[xx, yy, zz, yz, xz, xy]`, positive in tension, and its volume
+/// ratio J̄ = v/V0: each Gauss point's τ_g updated from a copy of its C_p⁻¹
+/// (`cp_inv` is read, not changed), σ_g = τ_g/J̄ (det F̄_g = J̄), averaged
+/// over the element's current volume, σ = Σ_g w_g σ_g / Σ_g w_g with
+/// w_g = det J_g^ref · J_g.
+pub fn fbar_stress(
+    mat: &Material,
+    opts: &UpdateOptions,
+    x_ref: &HexCoords,
+    x: &HexCoords,
+    cp_inv: &[Voigt; 8],
+) -> Result<(Voigt, Real), UpdateError> {
+    let k = kinematics(x_ref, x)?;
+    let mut sum = [0.0; 6];
+    let mut volume = 0.0;
+    for (g, state) in cp_inv.iter().enumerate() {
+        let fbar = k.f[g] * crate::math::cbrt(k.j_bar / k.j[g]);
+        let up = update_point(mat, opts, &fbar, &mut state.clone())?;
+        let w = k.det_ref[g] * k.j[g];
+        for (s, t) in sum.iter_mut().zip(&up.tau) {
+            *s += w * t;
+        }
+        volume += w;
+    }
+    Ok((sum.map(|s| s / (volume * k.j_bar)), k.j_bar))
+}
+
 /// Stored elastic energy Σ_g det J_g ψ(F̄_g, C_p⁻¹_g) of one F-bar element, J
 /// (0 if the element is inverted).
 pub fn fbar_elastic_energy(

@@ -7,8 +7,9 @@ use core::fmt;
 use crate::Real;
 use crate::constitutive::{UpdateError, UpdateInfo, UpdateOptions};
 use crate::element::batch::{BATCH, BatchOutput, ElementPath, Sink, one_point_elements};
-use crate::element::fbar::{fbar_elastic_energy, fbar_forces};
+use crate::element::fbar::{fbar_elastic_energy, fbar_forces, fbar_stress};
 use crate::element::force::HexForces;
+use crate::element::hex8::HexCoords;
 use crate::material::Material;
 use crate::mesh::reference::ReferenceMesh;
 use crate::tensor::Voigt;
@@ -366,6 +367,74 @@ impl Sink for Assemble<'_> {
             );
         }
     }
+}
+
+/// An element's stress and volume change ([`element_stresses`]).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct ElementStress {
+    /// Cauchy stress σ, Pa, Voigt `[xx, yy, zz, yz, xz, xy]`, positive in
+    /// tension.
+    pub sigma: Voigt,
+    /// The element's volume ratio J = det F̄ (current / reference volume;
+    /// the element's local relative density is η0/J).
+    pub j: Real,
+}
+
+/// The Cauchy stress and volume ratio of every element of a granule at
+/// positions `x`: what the next element pass would compute from the stored
+/// states `cp_inv`, which are read, not changed (each update runs on a
+/// copy, so a trial state beyond the yield surface is returned onto it).
+/// `out[e]` is element e's: σ = τ/J at the one-point element's point, the
+/// current-volume average of the Gauss points' for F-bar
+/// ([`crate::element::fbar::fbar_stress`]). For pictures and
+/// post-processing (the bed's snapshots); `x` and `cp_inv` as in
+/// [`internal_forces`], checked the same way, `out` one entry per hex. An
+/// element whose update fails stops the pass with its index.
+pub fn element_stresses(
+    mesh: &ReferenceMesh<'_>,
+    mat: &Material,
+    settings: &ElementSettings,
+    x: &[[Real; 3]],
+    cp_inv: &[Voigt],
+    out: &mut [ElementStress],
+) -> Result<(), ForcesError> {
+    settings.check()?;
+    check_element_buffers(
+        mesh,
+        settings.points_per_element(),
+        x.len(),
+        cp_inv.len(),
+        None,
+    )?;
+    let hexes = mesh.mesh.hexes;
+    if out.len() != hexes.len() {
+        return Err(ForcesError::BufferLength {
+            buffer: "out",
+            expected: hexes.len(),
+            got: out.len(),
+        });
+    }
+    let opts = &settings.update;
+    for (element, (hex, o)) in hexes.iter().zip(out.iter_mut()).enumerate() {
+        let xe: HexCoords = core::array::from_fn(|i| x[hex[i] as usize]);
+        let stress = match settings.kind {
+            ElementKind::OnePoint => {
+                let f =
+                    crate::element::force::mean_deformation_gradient(&mesh.elements[element], &xe);
+                let j = crate::tensor::det_mat(&f);
+                crate::constitutive::update_point(mat, opts, &f, &mut cp_inv[element].clone())
+                    .map(|up| (up.tau.map(|t| t / j), j))
+            }
+            ElementKind::FBar => {
+                let xr = core::array::from_fn(|i| mesh.mesh.positions[hex[i] as usize]);
+                let (states, _) = cp_inv.as_chunks::<8>();
+                fbar_stress(mat, opts, &xr, &xe, &states[element])
+            }
+        };
+        let (sigma, j) = stress.map_err(|error| ElementFailure { element, error })?;
+        *o = ElementStress { sigma, j };
+    }
+    Ok(())
 }
 
 /// Stored elastic energy Σ ∫ψ(b^e, J^e) dV0 of a granule, J, with

@@ -123,6 +123,23 @@ pub struct ElementData {
     pub node_volume: Vec<Real>,
 }
 
+impl ElementData {
+    /// The reference mesh of `mesh` (whose data this is) as the element
+    /// passes read it.
+    pub fn reference<'a>(
+        &'a self,
+        mesh: &'a OwnedMesh,
+    ) -> granbed_kernel::mesh::reference::ReferenceMesh<'a> {
+        granbed_kernel::mesh::reference::ReferenceMesh {
+            mesh: mesh.view(),
+            node_quads: &mesh.node_quads,
+            elements: &self.elements,
+            batches: &self.batches,
+            node_volume: &self.node_volume,
+        }
+    }
+}
+
 impl OwnedMesh {
     pub fn hex_coords(&self, e: usize) -> [[Real; 3]; 8] {
         core::array::from_fn(|i| self.positions[self.hexes[e][i] as usize])

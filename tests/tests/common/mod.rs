@@ -243,3 +243,93 @@ pub fn parse_xml(xml: &str) -> Vec<Element> {
     assert!(open.is_empty(), "unclosed <{}>", open[0].name);
     done
 }
+
+/// Standard base64 (with padding), for the binary VTK data arrays.
+pub fn base64_decode(text: &str) -> Vec<u8> {
+    let value = |c: u8| -> u32 {
+        match c {
+            b'A'..=b'Z' => u32::from(c - b'A'),
+            b'a'..=b'z' => u32::from(c - b'a') + 26,
+            b'0'..=b'9' => u32::from(c - b'0') + 52,
+            b'+' => 62,
+            b'/' => 63,
+            _ => panic!("bad base64 character {c:?}"),
+        }
+    };
+    let bytes: Vec<u8> = text.bytes().filter(|c| !c.is_ascii_whitespace()).collect();
+    assert_eq!(bytes.len() % 4, 0, "base64 length");
+    let mut out = Vec::new();
+    for chunk in bytes.chunks(4) {
+        let pad = chunk.iter().filter(|&&c| c == b'=').count();
+        let n = chunk
+            .iter()
+            .map(|&c| if c == b'=' { 0 } else { value(c) })
+            .fold(0u32, |n, v| (n << 6) | v);
+        out.extend_from_slice(&n.to_be_bytes()[1..4 - pad]);
+    }
+    out
+}
+
+/// The values of a binary (inline base64, UInt64 header) little-endian
+/// `DataArray` of 8-byte numbers, as `f64` (Float64) or `i64` (Int64).
+pub fn binary_values(e: &Element) -> Vec<f64> {
+    assert_eq!(e.attrs["format"], "binary", "{}", e.attrs["Name"]);
+    let bytes = base64_decode(&e.text);
+    let (header, data) = bytes.split_at(8);
+    let len = u64::from_le_bytes(header.try_into().unwrap()) as usize;
+    assert_eq!(len, data.len(), "header of {}", e.attrs["Name"]);
+    data.chunks(8)
+        .map(|b| {
+            let b: [u8; 8] = b.try_into().unwrap();
+            match e.attrs["type"].as_str() {
+                "Float64" => f64::from_le_bytes(b),
+                "Int64" => i64::from_le_bytes(b) as f64,
+                t => panic!("unexpected type {t}"),
+            }
+        })
+        .collect()
+}
+
+/// What a VTU snapshot holds, as the tests read it.
+pub struct Snapshot {
+    /// NumberOfPoints.
+    pub points: usize,
+    /// NumberOfCells.
+    pub cells: usize,
+    /// The cell data arrays asked for, by name.
+    pub cell_data: HashMap<String, Vec<f64>>,
+    /// The cell types.
+    pub types: Vec<u8>,
+}
+
+/// Reads a binary VTU file of `granbed-cli bed` with its cell data arrays
+/// `arrays` (each must be there).
+pub fn read_vtu(path: &Path, arrays: &[&str]) -> Snapshot {
+    let xml = std::fs::read_to_string(path)
+        .unwrap_or_else(|e| panic!("cannot read {}: {e}", path.display()));
+    let elements = parse_xml(&xml);
+    let root = elements.last().unwrap();
+    assert_eq!(root.name, "VTKFile");
+    assert_eq!(root.attrs["type"], "UnstructuredGrid");
+    let piece = elements.iter().find(|e| e.name == "Piece").unwrap();
+    let count = |k: &str| piece.attrs[k].parse::<usize>().unwrap();
+    let array = |name: &str| {
+        elements
+            .iter()
+            .find(|e| {
+                e.name == "DataArray" && e.attrs.get("Name").map(String::as_str) == Some(name)
+            })
+            .unwrap_or_else(|| panic!("no DataArray {name} in {}", path.display()))
+    };
+    let types = base64_decode(&array("types").text)[8..].to_vec();
+    let cell_data = arrays
+        .iter()
+        .map(|&n| (n.to_string(), binary_values(array(n))))
+        .collect();
+    Snapshot {
+        points: count("NumberOfPoints"),
+        cells: count("NumberOfCells"),
+        cell_data,
+        types,
+    }
+}
