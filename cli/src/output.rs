@@ -73,6 +73,21 @@ impl Write for Output<'_> {
     }
 }
 
+/// Creates the output directory `dir` (and its parents) if missing. A
+/// path that names an existing file is a usage error (exit status 2)
+/// saying so, before any work is done; other failures (permissions, a full
+/// disk) are runtime errors naming the directory.
+pub fn create_out_dir(dir: &Path) -> anyhow::Result<()> {
+    if dir.exists() && !dir.is_dir() {
+        return Err(crate::error::input_error(format!(
+            "the output directory `{}` is a file: --out names a directory (created if missing)",
+            dir.display()
+        )));
+    }
+    std::fs::create_dir_all(dir)
+        .with_context(|| format!("cannot create output directory `{}`", dir.display()))
+}
+
 /// Creates (or truncates) the output file `path` for buffered writing.
 pub fn create_file(path: &Path) -> anyhow::Result<BufWriter<File>> {
     let file = File::create(path)

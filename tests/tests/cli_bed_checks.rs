@@ -5,7 +5,8 @@
 //! a run whose figures are not what they seem says so on stderr and in
 //! `summary.json`'s `warnings` (a final strain past the target, overlaps
 //! above 1 % of the element, a Kawakita fit outside the law's regime); and
-//! `compression.csv` carries the bed's solid fraction for a Heckel plot.
+//! `compression.csv` carries the bed's solid fraction for a Heckel plot. An
+//! output path that is a file is refused by every command.
 
 mod common;
 
@@ -431,4 +432,31 @@ fn the_kawakita_fit_outside_its_regime_is_flagged_and_the_solid_fraction_written
     // denser as the punch descends.
     assert!(d[0] > 0.3 && d[0] < 0.55, "{}", d[0]);
     assert!(d.windows(2).all(|w| w[1] > w[0]));
+}
+
+/// `--out` naming an existing file is a usage error (exit status 2) that
+/// says so, for every command writing an output directory, before any
+/// work (it was a runtime error, exit status 1, "File exists").
+#[test]
+fn an_output_path_that_is_a_file_is_a_usage_error() {
+    let file = out_dir("a-file").with_extension("txt");
+    std::fs::create_dir_all(file.parent().unwrap()).unwrap();
+    std::fs::write(&file, "not a directory").unwrap();
+    let out = file.to_str().unwrap();
+    for argv in [
+        &["granule", "--quiet", "--out", out][..],
+        &["pack", "--quiet", "--out", out],
+        &["bed", "--quiet", "--out", out],
+        &["study", "stability", "--quiet", "--out", out],
+        &["study", "work-precision", "--quiet", "--out", out],
+    ] {
+        let run = cli(argv);
+        assert_eq!(run.code, 2, "{argv:?}: {}", run.stderr);
+        assert!(
+            run.stderr.contains("is a file: --out names a directory"),
+            "{argv:?}: {}",
+            run.stderr
+        );
+    }
+    assert_eq!(std::fs::read_to_string(&file).unwrap(), "not a directory");
 }

@@ -659,8 +659,7 @@ impl BedArgs {
                 1e-3 * scene.diameter_mm,
             ),
         };
-        std::fs::create_dir_all(out)
-            .with_context(|| format!("cannot create output directory `{}`", out.display()))?;
+        crate::output::create_out_dir(out)?;
         let result = pool.install(|| run::run_bed(scene, &control, &mut observer));
         observer.pour.finish();
         observer.progress.finish();
@@ -787,8 +786,7 @@ impl BedArgs {
             .position(|t| t.name() == base.granule_type)
             .unwrap_or(0);
         let pour_type = types[pour_index];
-        std::fs::create_dir_all(&self.out)
-            .with_context(|| format!("cannot create output directory `{}`", self.out.display()))?;
+        crate::output::create_out_dir(&self.out)?;
         let mut spinner = PourSpinner::new(self.quiet, &scenes[pour_index])?;
         let packing = pool.install(|| {
             run::pour(

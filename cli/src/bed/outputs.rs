@@ -685,8 +685,7 @@ pub const FIT_MIN_R_SQUARED: Real = 0.9;
 /// Writes `compression.csv`, `summary.json`, the plots and `report.html`
 /// into `dir` (created).
 pub fn write_all(dir: &Path, scene: &Scene, run: &BedRun) -> anyhow::Result<()> {
-    std::fs::create_dir_all(dir)
-        .with_context(|| format!("cannot create output directory `{}`", dir.display()))?;
+    crate::output::create_out_dir(dir)?;
     let path = dir.join("compression.csv");
     let mut csv = CsvWriter::new(create_file(&path)?, &COMPRESSION_COLUMNS)
         .with_context(|| format!("cannot write to `{}`", path.display()))?;

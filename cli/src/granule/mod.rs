@@ -488,8 +488,7 @@ impl GranuleArgs {
         let mesh = OwnedReference::sphere(radius, self.mesh, octant)?;
         let jobs = self.jobs(&mesh)?;
         for dir in core::iter::once(&self.out).chain(jobs.iter().map(|j| &j.dir)) {
-            std::fs::create_dir_all(dir)
-                .with_context(|| format!("cannot create output directory `{}`", dir.display()))?;
+            crate::output::create_out_dir(dir)?;
         }
         let bars = progress::bars(self.quiet);
         let outcomes: Vec<anyhow::Result<Outcome>> = if jobs.len() == 1 {

@@ -14,7 +14,6 @@ use core::fmt;
 use core::str::FromStr;
 use std::path::PathBuf;
 
-use anyhow::Context as _;
 use clap::Args;
 use granbed_kernel::dem::pour::{PourError, PourParams};
 use granbed_kernel::material::{GranuleType, Material};
@@ -447,8 +446,7 @@ impl PackArgs {
         let material = self.material.material()?;
         let params = self.params(&material);
         self.check(&params)?;
-        std::fs::create_dir_all(&self.out)
-            .with_context(|| format!("cannot create output directory `{}`", self.out.display()))?;
+        crate::output::create_out_dir(&self.out)?;
         let bar = progress::Progress::new(self.quiet, params.granules, params.max_time);
         // No stop: `pack` keeps the default SIGINT handling (it has no
         // finished work to save before its outputs).

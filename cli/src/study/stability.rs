@@ -438,8 +438,7 @@ impl StabilityArgs {
         let pool = rayon::ThreadPoolBuilder::new()
             .num_threads(self.threads)
             .build()?;
-        std::fs::create_dir_all(&self.out)
-            .with_context(|| format!("cannot create output directory `{}`", self.out.display()))?;
+        crate::output::create_out_dir(&self.out)?;
         let types = self.types.0.clone();
         let mut records = Vec::new();
         let say = |r: &Record, streams: &mut Streams<'_>| -> anyhow::Result<()> {

@@ -688,8 +688,7 @@ impl WorkPrecisionArgs {
                 .material()
             })
             .collect::<anyhow::Result<Vec<_>>>()?;
-        std::fs::create_dir_all(&self.out)
-            .with_context(|| format!("cannot create output directory `{}`", self.out.display()))?;
+        crate::output::create_out_dir(&self.out)?;
         let study = match self.scene {
             StudyScene::Granule => self.granule_study(&types, &materials, streams)?,
             StudyScene::BedSmall => super::bed_small::study(self, streams)?,
