@@ -479,54 +479,64 @@ fn the_input_checks_accept_exactly_the_valid_inputs_and_name_the_first_failure()
     ];
     let positive = |v: Real| v.partial_cmp(&0.0) == Some(Greater);
     let mut counts = [0; 4];
+    // φ^tr: finite or −∞ (an infinite yield stress), and not (NaN, +∞ of
+    // an overflowing trial stress).
+    let phis = [-3.0e8, f64::NEG_INFINITY, f64::NAN, f64::INFINITY];
     for f_finite in [true, false] {
         for &j in &specials {
             for &det_c in &specials {
                 for &eta in &specials {
-                    // A trial state built from the identity, its J,
-                    // det C_p⁻¹ and η then set to the values under test.
-                    let f = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
-                    let mut t = trial(&mat, &f, &VOIGT_IDENTITY);
-                    (t.j, t.det_cp_inv, t.eta) = (j, det_c, eta);
-                    let expected = if !f_finite {
-                        Some(UpdateError::NonFinite)
-                    } else if !positive(j) {
-                        Some(UpdateError::InvertedDeformation { j })
-                    } else if !positive(det_c) || det_c.is_infinite() {
-                        Some(UpdateError::InvalidState { det: det_c })
-                    } else if eta.is_nan() || eta.is_infinite() {
-                        Some(UpdateError::InvertedDeformation { j })
-                    } else {
-                        None
-                    };
-                    let what =
-                        format!("F finite {f_finite}, J {j:e}, det C_p⁻¹ {det_c:e}, η {eta:e}");
-                    let got = check_input(f_finite, &t);
-                    match expected {
-                        None => assert_eq!(got, Ok(()), "{what}"),
-                        // Compared as text: the errors carry a NaN J or det.
-                        Some(e) => assert_eq!(
-                            format!("{got:?}"),
-                            format!("{:?}", Err::<(), _>(e)),
+                    for &phi in &phis {
+                        // A trial state built from the identity, its J,
+                        // det C_p⁻¹ and η then set to the values under test,
+                        // with φ^tr given.
+                        let f = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
+                        let mut t = trial(&mat, &f, &VOIGT_IDENTITY);
+                        (t.j, t.det_cp_inv, t.eta) = (j, det_c, eta);
+                        let expected = if !f_finite {
+                            Some(UpdateError::NonFinite)
+                        } else if !positive(j) {
+                            Some(UpdateError::InvertedDeformation { j })
+                        } else if !positive(det_c) || det_c.is_infinite() {
+                            Some(UpdateError::InvalidState { det: det_c })
+                        } else if eta.is_nan() || eta.is_infinite() {
+                            Some(UpdateError::InvertedDeformation { j })
+                        } else if phi.is_nan() || phi == f64::INFINITY {
+                            Some(UpdateError::NonFinite)
+                        } else {
+                            None
+                        };
+                        let what = format!(
+                            "F finite {f_finite}, J {j:e}, det C_p⁻¹ {det_c:e}, η {eta:e}, \
+                         φ {phi:e}"
+                        );
+                        let got = check_input(f_finite, &t, phi);
+                        match expected {
+                            None => assert_eq!(got, Ok(()), "{what}"),
+                            // Compared as text: the errors carry a NaN J or det.
+                            Some(e) => assert_eq!(
+                                format!("{got:?}"),
+                                format!("{:?}", Err::<(), _>(e)),
+                                "{what}"
+                            ),
+                        }
+                        assert_eq!(
+                            input_is_valid(f_finite, j, det_c, eta, phi),
+                            expected.is_none(),
                             "{what}"
-                        ),
+                        );
+                        counts[match expected {
+                            None => 0,
+                            Some(UpdateError::NonFinite) => 1,
+                            Some(UpdateError::InvalidState { .. }) => 2,
+                            Some(_) => 3,
+                        }] += 1;
                     }
-                    assert_eq!(
-                        input_is_valid(f_finite, j, det_c, eta),
-                        expected.is_none(),
-                        "{what}"
-                    );
-                    counts[match expected {
-                        None => 0,
-                        Some(UpdateError::NonFinite) => 1,
-                        Some(UpdateError::InvalidState { .. }) => 2,
-                        Some(_) => 3,
-                    }] += 1;
                 }
             }
         }
     }
-    // Every outcome occurs: 2 × 11³ cases.
+    // Every outcome occurs: 2 × 11³ × 4 cases.
     assert!(counts.iter().all(|&c| c > 0), "{counts:?}");
-    assert_eq!(counts.iter().sum::<usize>(), 2 * 11 * 11 * 11);
+    assert_eq!(counts.iter().sum::<usize>(), 2 * 11 * 11 * 11 * 4);
 }

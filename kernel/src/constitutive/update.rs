@@ -123,7 +123,9 @@ impl UpdateInfo {
 /// Why an update could not be done. The state is left unchanged.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum UpdateError {
-    /// A component of F is NaN or infinite.
+    /// A component of F is NaN or infinite, or F is so large that the
+    /// trial stress it gives overflows (b = F C_p⁻¹ Fᵀ beyond the largest
+    /// float).
     NonFinite,
     /// J = det F ≤ 0, or so small that η0/J overflows: the element is
     /// inverted or crushed flat.
@@ -149,7 +151,9 @@ pub enum UpdateError {
 impl fmt::Display for UpdateError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
-            Self::NonFinite => f.write_str("deformation gradient is not finite"),
+            Self::NonFinite => f.write_str(
+                "deformation gradient is not finite, or so large that its trial stress overflows",
+            ),
             Self::InvertedDeformation { j } => write!(f, "inverted element: det F = {j:e}"),
             Self::InvalidState { det } => write!(
                 f,
@@ -264,8 +268,9 @@ pub struct TrialCheck {
     pub plastic_scale: Option<Real>,
 }
 
-/// Checks the input of an update: a finite `f`, J > 0, a valid stored state
-/// and a finite η; then evaluates the yield function at the trial state.
+/// Checks the input of an update: a finite `f`, J > 0, a valid stored state,
+/// a finite η and a trial stress that does not overflow ([`check_input`]);
+/// returns the yield function at the trial state with the diagnostics.
 #[inline(always)]
 pub fn check_trial(
     mat: &Material,
@@ -273,11 +278,11 @@ pub fn check_trial(
     f: &Rows<Real>,
     t: &Trial<Real>,
 ) -> Result<TrialCheck, UpdateError> {
-    check_input(f.iter().flatten().all(|x| x.is_finite()), t)?;
     let coefficients = yield_surface::coefficients(&mat.params, t.eta);
     let sy = mat.params.yield_stress_pa;
     let scale = yield_surface::yield_scale(&coefficients, sy);
     let phi_tr = yield_surface::yield_function(&coefficients, sy, t.beta, t.alpha);
+    check_input(f.iter().flatten().all(|x| x.is_finite()), t, phi_tr)?;
     Ok(TrialCheck {
         info: UpdateInfo::elastic(t.eta, t.je, coefficients, phi_tr / scale),
         plastic_scale: yields(opts, phi_tr, scale).then_some(scale),
@@ -288,11 +293,14 @@ pub fn check_trial(
 /// the first test that failed, in this order: F not finite
 /// ([`UpdateError::NonFinite`]), J not > 0 (inverted), det C_p⁻¹ not in
 /// (0, ∞) (invalid state), η not finite (inverted: J > 0 but so small —
-/// subnormal — that η = η0/J overflows, crushed flat; found by fuzzing).
+/// subnormal — that η = η0/J overflows, crushed flat; found by fuzzing),
+/// the trial yield function `phi_tr` +∞ or NaN (non-finite: a finite F so
+/// large that F C_p⁻¹ Fᵀ or the stress's square overflows, which had read
+/// as "no convergence" of a return map that could not start).
 #[inline(always)]
-pub fn check_input(f_finite: bool, t: &Trial<Real>) -> Result<(), UpdateError> {
+pub fn check_input(f_finite: bool, t: &Trial<Real>, phi_tr: Real) -> Result<(), UpdateError> {
     let det_c = t.det_cp_inv;
-    if input_is_valid(f_finite, t.j, det_c, t.eta) {
+    if input_is_valid(f_finite, t.j, det_c, t.eta, phi_tr) {
         return Ok(());
     }
     Err(if !f_finite {
@@ -301,20 +309,30 @@ pub fn check_input(f_finite: bool, t: &Trial<Real>) -> Result<(), UpdateError> {
         UpdateError::InvertedDeformation { j: t.j }
     } else if det_c.is_nan() || det_c <= 0.0 || det_c.is_infinite() {
         UpdateError::InvalidState { det: det_c }
-    } else {
+    } else if !t.eta.is_finite() {
         UpdateError::InvertedDeformation { j: t.j }
+    } else {
+        UpdateError::NonFinite
     })
 }
 
 /// Whether an update's input is admissible: F finite (`f_finite`), J > 0,
-/// 0 < det C_p⁻¹ < ∞ and η finite (a NaN fails every test) — the rule of
-/// [`check_input`], without naming what failed. The tests are combined
-/// without branches, so an element batch takes one verdict for all its
-/// lanes (a batch that fails is redone element by element, which names
-/// the error).
+/// 0 < det C_p⁻¹ < ∞, η finite and the trial state's yield function
+/// `phi_tr` below +∞ (every entry of b^tr enters it, squared, so an
+/// overflowing trial stress makes it +∞ or NaN; −∞ is the elastic limit of
+/// an infinite yield stress; a NaN fails every test) — the rule of
+/// [`check_input`], without naming what failed.
+/// The tests are combined without branches, so an element batch takes one
+/// verdict for all its lanes (a batch that fails is redone element by
+/// element, which names the error).
 #[inline(always)]
-pub fn input_is_valid(f_finite: bool, j: Real, det_cp_inv: Real, eta: Real) -> bool {
-    f_finite & (j > 0.0) & (det_cp_inv > 0.0) & (det_cp_inv < Real::INFINITY) & eta.is_finite()
+pub fn input_is_valid(f_finite: bool, j: Real, det_cp_inv: Real, eta: Real, phi_tr: Real) -> bool {
+    f_finite
+        & (j > 0.0)
+        & (det_cp_inv > 0.0)
+        & (det_cp_inv < Real::INFINITY)
+        & eta.is_finite()
+        & (phi_tr < Real::INFINITY)
 }
 
 /// Checks a stored state C_p⁻¹ supplied from outside the kernel: it must
@@ -615,6 +633,36 @@ mod tests {
     /// leaves it untouched; the identity and a sheared positive definite
     /// state pass. The element's own test is the determinant alone
     /// ([`check_input`]), which the first two pass.
+    /// A finite F so large that the trial state overflows is refused as
+    /// non-finite, the state untouched: b = F C_p⁻¹ Fᵀ itself (F11 = 1e160,
+    /// b11 = 1e320; J = 1e160 and η are finite), or the stress's norm and
+    /// the yield function, which square it (F11 = 1e100, b finite). Both had
+    /// gone on to the return map and read as "no convergence". (A finite
+    /// trial state far outside any physical step, F11 = 1e20, still gives
+    /// "no convergence"; a 100 % stretch in one step, F11 = 2, is returned.)
+    #[test]
+    fn a_trial_state_that_overflows_is_non_finite() {
+        let mat = GranuleType::B2.params().validate().unwrap();
+        let opts = UpdateOptions::default();
+        let stretch = |s: Real| [[s, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
+        let t = trial(&mat, &stretch(1e160), &VOIGT_IDENTITY);
+        assert!(t.j.is_finite() && t.eta.is_finite() && !t.alpha.is_finite());
+        let t = trial(&mat, &stretch(1e100), &VOIGT_IDENTITY);
+        assert!(t.b.iter().all(|v| v.is_finite()) && !t.beta.is_finite());
+        for s in [1e160, 1e100] {
+            let mut c = VOIGT_IDENTITY;
+            assert_eq!(
+                update_point_rows(&mat, &opts, &stretch(s), &mut c),
+                Err(UpdateError::NonFinite),
+                "F11 = {s:e}"
+            );
+            assert_eq!(c, VOIGT_IDENTITY);
+        }
+        let mut c = VOIGT_IDENTITY;
+        let r = update_point_rows(&mat, &opts, &stretch(2.0), &mut c);
+        assert!(r.is_ok_and(|up| up.info.plastic), "{r:?}");
+    }
+
     #[test]
     fn a_state_that_is_not_positive_definite_is_refused() {
         let mat = GranuleType::B2.params().validate().unwrap();
@@ -644,7 +692,7 @@ mod tests {
         ] {
             let t = trial(&mat, &f, &bad);
             assert!(
-                t.det_cp_inv > 0.0 && check_input(true, &t).is_ok(),
+                t.det_cp_inv > 0.0 && check_input(true, &t, 0.0).is_ok(),
                 "{bad:?}"
             );
         }
