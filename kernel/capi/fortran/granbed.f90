@@ -22,7 +22,8 @@ module granbed
        c_null_char, c_f_pointer
   implicit none
   private
-  public :: granbed_vumat_block, granbed_preset_props, granbed_check_props, granbed_message
+  public :: granbed_vumat_block, granbed_preset_props, granbed_check_props, granbed_derived_props, &
+       granbed_message
 
   integer(c_int32_t), parameter, public :: GRANBED_OK = 0
   integer(c_int32_t), parameter, public :: GRANBED_ERR_INVALID_PARAMETER = 2
@@ -34,6 +35,12 @@ module granbed
      real(c_double) :: youngs_modulus_pa, poisson_ratio, yield_stress_pa, eta0, cp, eta_c, &
           true_density_kg_m3, friction
   end type granbed_material_params
+
+  !> struct GranbedMaterialDerived: lambda, mu, K, lambda + 2 mu [Pa], rho0
+  !> [kg/m^3], c_d [m/s].
+  type, bind(c), public :: granbed_material_derived
+     real(c_double) :: lambda_pa, mu_pa, bulk_pa, p_wave_pa, density0_kg_m3, wave_speed_m_s
+  end type granbed_material_derived
 
   type, bind(c), public :: granbed_param_error
      character(kind=c_char) :: field(40)
@@ -64,6 +71,14 @@ module granbed
        character(kind=c_char), intent(in) :: name(*)
        type(granbed_material_params), intent(out) :: params
      end function c_granbed_material_preset
+
+     integer(c_int32_t) function c_granbed_material_derived(params, out, error) &
+          bind(c, name='granbed_material_derived')
+       import :: c_int32_t, granbed_material_params, granbed_material_derived, granbed_param_error
+       type(granbed_material_params), intent(in) :: params
+       type(granbed_material_derived), intent(out) :: out
+       type(granbed_param_error), intent(out) :: error
+     end function c_granbed_material_derived
 
      type(c_ptr) function c_granbed_status_message(code) bind(c, name='granbed_status_message')
        import :: c_ptr, c_int32_t
@@ -114,6 +129,26 @@ contains
             ' = ', e%value, ': allowed range is ', trim(c_string(e%allowed))
     end if
   end subroutine granbed_check_props
+
+  !> The constants derived from props(1:8), for a host's stable time step
+  !> (dt <= h / c_d for an element of size h) and hourglass stiffness:
+  !> derived = [lambda, mu, K, lambda + 2 mu (Pa), rho0 (kg/m^3), c_d (m/s)].
+  !> ierr is GRANBED_ERR_INVALID_PARAMETER for props that granbed_check_props
+  !> rejects (then derived is zero).
+  subroutine granbed_derived_props(props, derived, ierr)
+    real(c_double), intent(in) :: props(GRANBED_VUMAT_NPROPS)
+    real(c_double), intent(out) :: derived(6)
+    integer(c_int32_t), intent(out) :: ierr
+    type(granbed_material_params) :: p
+    type(granbed_material_derived) :: d
+    type(granbed_param_error) :: e
+    p = granbed_material_params(props(1), props(2), props(3), props(4), props(5), props(6), &
+         props(7), props(8))
+    ierr = c_granbed_material_derived(p, d, e)
+    derived = 0
+    if (ierr == GRANBED_OK) derived = [d%lambda_pa, d%mu_pa, d%bulk_pa, d%p_wave_pa, &
+         d%density0_kg_m3, d%wave_speed_m_s]
+  end subroutine granbed_derived_props
 
   !> The message of status code code.
   function granbed_message(code) result(message)

@@ -1,7 +1,8 @@
 !> Drives a block of material points through granbed_vumat_block along the
 !> paths of `granbed-cli point` CSV files (point k follows file k) and checks
 !> that the Cauchy stress and the relative density equal the CLI's bit for
-!> bit; then checks that a bad Poisson ratio is named.
+!> bit; then checks the derived constants against their formulas and that a
+!> bad Poisson ratio is named.
 !>
 !> usage: material_paths_f TYPE FILE.csv [FILE.csv ...]   (TYPE: A1 ... C3)
 program material_paths_f
@@ -14,7 +15,7 @@ program material_paths_f
   integer, parameter :: nstatev = GRANBED_VUMAT_NSTATEV
   real(c_double), allocatable :: rows(:, :, :), defgrad(:, :), state_old(:, :), state_new(:, :), stress(:, :)
   integer(c_int32_t), allocatable :: status(:)
-  real(c_double) :: props(GRANBED_VUMAT_NPROPS), expect(6)
+  real(c_double) :: props(GRANBED_VUMAT_NPROPS), expect(6), derived(6), expect_derived(6), mu, lambda
   integer(c_int32_t) :: ierr
   integer :: nblock, nrows, k, r, u, ios, mismatches, plastic
   character(len=512) :: arg, message
@@ -81,7 +82,24 @@ program material_paths_f
   print '(a,i0,a,i0,a,i0,a,i0,a)', 'material_paths_f: ', nblock, ' points x ', nrows, ' rows (', &
        plastic, ' plastic updates): ', mismatches, ' mismatches'
 
+  ! The derived constants, against their formulas written out here.
+  call granbed_derived_props(props, derived, ierr)
+  mu = props(1) / (2 * (1 + props(2)))
+  lambda = props(1) * props(2) / ((1 + props(2)) * (1 - 2 * props(2)))
+  expect_derived = [lambda, mu, lambda + 2 * mu / 3, lambda + 2 * mu, props(4) * props(7), &
+       sqrt((lambda + 2 * mu) / (props(4) * props(7)))]
+  if (ierr /= GRANBED_OK .or. any(abs(derived - expect_derived) > 1e-13_c_double * abs(expect_derived))) then
+     print '(a,6es25.17)', 'FAIL: derived constants ', derived
+     stop 1
+  end if
+  print '(a,f0.3,a)', 'material_paths_f: derived constants agree, c_d = ', derived(6), ' m/s'
+
   props(2) = 0.6_c_double
+  call granbed_derived_props(props, derived, ierr)
+  if (ierr /= GRANBED_ERR_INVALID_PARAMETER .or. any(derived /= 0)) then
+     print '(a)', 'FAIL: nu = 0.6 gave derived constants'
+     stop 1
+  end if
   call granbed_check_props(props, ierr, message)
   print '(2a)', 'material_paths_f: ', trim(message)
   if (ierr /= GRANBED_ERR_INVALID_PARAMETER .or. index(message, 'poisson_ratio') == 0) then
