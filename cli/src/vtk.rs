@@ -2,11 +2,13 @@
 //! other VTK readers: points, cells of any VTK type, and named point and
 //! cell data arrays.
 //!
-//! Hand-rolled rather than taken from crates.io: the maintained Rust VTK
-//! crate, `vtkio`, centres on the legacy format, its newest release is a
-//! release candidate (0.7.0-rc2; 0.6.3 before it), and its default features
-//! pull in C compression libraries (lz4, xz2). What is needed here (ASCII
-//! data arrays in a fixed XML skeleton) is a page of code.
+//! Used by `pack` for its `packing.vtu` (a few thousand points, written as
+//! text so that a test or a reader can compare the centres digit for digit
+//! with `packing.csv`). The bed's snapshots, a million cells and more, are
+//! written in binary by the `vtkio` crate instead (`bed::snapshots`, XML
+//! feature only: its default features pull in C compression libraries, and
+//! its current line is a release candidate, 0.7.0-rc2). This writer came
+//! first; moving `pack` onto `vtkio` would leave one writer.
 //!
 //! Floats are written round-trip exact ([`crate::csv::write_real`]); the
 //! file uses `header_type="UInt64"` and 64-bit connectivity and offsets.
