@@ -28,8 +28,9 @@ pub const DENSITY_SVG: &str = "comparison_density.svg";
 
 /// Columns of [`COMPARISON_CSV`], in order (`NaN` where the summary has
 /// `null`, e.g. no Kawakita fit for a run that ended before its window).
-pub const COMPARISON_COLUMNS: [&str; 17] = [
+pub const COMPARISON_COLUMNS: [&str; 18] = [
     "type",
+    "seed",
     "yield_stress_pa",
     "eta0",
     "kawakita_a",
@@ -54,6 +55,8 @@ pub struct ComparisonRow {
     /// Granule type.
     #[serde(rename = "type")]
     pub granule_type: &'static str,
+    /// Seed of the run's pour and mesh rotations.
+    pub seed: u64,
     /// Yield stress, Pa.
     pub yield_stress_pa: Real,
     /// Initial relative density η0.
@@ -97,6 +100,7 @@ impl ComparisonRow {
     pub fn new(t: GranuleType, s: &Summary<'_>) -> Self {
         Self {
             granule_type: t.name(),
+            seed: s.scene.seed,
             yield_stress_pa: s.yield_stress_pa,
             eta0: s.eta0,
             kawakita_a: s.kawakita.a,
@@ -121,6 +125,7 @@ impl ComparisonRow {
         let opt = |x: Option<Real>| Field::Real(x.unwrap_or(Real::NAN));
         [
             Field::Text(self.granule_type),
+            Field::Int(self.seed),
             self.yield_stress_pa.into(),
             self.eta0.into(),
             opt(self.kawakita_a),
@@ -162,41 +167,56 @@ pub fn write_comparison(
     comparison: &Comparison<'_>,
     samples: &[&[BedSample]],
 ) -> anyhow::Result<()> {
-    let path = dir.join(COMPARISON_CSV);
+    write_rows(&dir.join(COMPARISON_CSV), comparison.types)?;
+    write_json(&dir.join(COMPARISON_JSON), comparison)?;
+    let labels: Vec<&str> = comparison.types.iter().map(|r| r.granule_type).collect();
+    let suffix = format!(
+        "by granule type (one pour, sphere density of {})",
+        comparison.pour_granule_type
+    );
+    write_overlays(dir, [PRESSURE_SVG, DENSITY_SVG], &labels, samples, &suffix)
+}
+
+/// Writes `rows` as a table of [`COMPARISON_COLUMNS`] to `path`.
+pub fn write_rows(path: &Path, rows: &[ComparisonRow]) -> anyhow::Result<()> {
     let ctx = || format!("cannot write to `{}`", path.display());
-    let mut csv = CsvWriter::new(create_file(&path)?, &COMPARISON_COLUMNS).with_context(ctx)?;
-    for row in comparison.types {
+    let mut csv = CsvWriter::new(create_file(path)?, &COMPARISON_COLUMNS).with_context(ctx)?;
+    for row in rows {
         csv.write_row(&row.fields()).with_context(ctx)?;
     }
-    finish_file(csv.into_inner(), &path)?;
-    write_json(&dir.join(COMPARISON_JSON), comparison)?;
-    let curves: Vec<(&str, &[BedSample])> = comparison
-        .types
+    finish_file(csv.into_inner(), path)
+}
+
+/// Writes the overlaid plots `[pressure, density]` (file names in `dir`)
+/// of the runs' `samples`, one curve per run named by `labels`, the titles
+/// ending with `suffix`.
+pub fn write_overlays(
+    dir: &Path,
+    [pressure_file, density_file]: [&str; 2],
+    labels: &[&str],
+    samples: &[&[BedSample]],
+    suffix: &str,
+) -> anyhow::Result<()> {
+    let curves: Vec<(&str, &[BedSample])> = labels
         .iter()
-        .zip(samples)
-        .map(|(row, s)| (row.granule_type, *s))
+        .copied()
+        .zip(samples.iter().copied())
         .collect();
-    let title = |what: &str| {
-        format!(
-            "{what} by granule type (one pour, sphere density of {})",
-            comparison.pour_granule_type
-        )
-    };
     let pressure = overlay_svg(
-        &title("Upper-punch pressure"),
+        &format!("Upper-punch pressure {suffix}"),
         "pressure P, kPa",
         &curves,
         |s| s.upper_pressure_pa * 1e-3,
         true,
     )?;
     let density = overlay_svg(
-        &title("Granule relative density"),
+        &format!("Granule relative density {suffix}"),
         "mean relative density η0 V0/V",
         &curves,
         |s| s.relative_density_mean,
         false,
     )?;
-    for (name, svg) in [(PRESSURE_SVG, pressure), (DENSITY_SVG, density)] {
+    for (name, svg) in [(pressure_file, pressure), (density_file, density)] {
         write_text(&dir.join(name), &svg)?;
     }
     Ok(())

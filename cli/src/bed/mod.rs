@@ -31,6 +31,7 @@ pub mod plots;
 pub mod report;
 pub mod run;
 pub mod scene;
+pub mod seeds;
 pub mod snapshots;
 
 pub use scene::{DEFAULT_SCENE, Scene};
@@ -89,7 +90,7 @@ with --kawakita-min-strain or --heckel-min-strain it refits the run.
 
 With --types, the files above go to DIR/<TYPE>/ per type (each resumable
 alone with --resume DIR/<TYPE>), and DIR holds the comparison:
-  comparison.csv   one row per type, in the order given: type, yield stress,
+  comparison.csv   one row per type, in the order given: type, seed, yield stress,
                    eta0, Kawakita a, 1/b (Pa), R^2, points, Heckel P_y (Pa),
                    R^2, D0, max pressure,
                    final strain, final pressure, final mean relative density,
@@ -99,6 +100,17 @@ alone with --resume DIR/<TYPE>), and DIR holds the comparison:
   comparison_pressure.svg, comparison_density.svg
                    upper-punch pressure and mean relative density against
                    strain, one curve per type
+With --seeds S1,S2,..., the scene is poured and compressed once per seed into
+`DIR/seed_<S>/` (each resumable alone with --resume), and DIR holds the
+run-to-run spread:
+  seeds.csv        one row per seed, the columns of comparison.csv
+  seeds_spread.csv per figure (Kawakita a and 1/b, Heckel P_y, D0, max and final
+                   pressure, final relative density and Z): runs, mean, sample
+                   standard deviation, min, max, spread = max - min
+  seeds.json       both tables
+  seeds_pressure.svg, seeds_density.svg
+                   one curve per seed
+
 All types start from ONE pour (as the published study compares the nine
 types on one bed): the pour uses the sphere density of the scene's type if
 it is listed, else of the first listed type; types with another eta0 (digit)
@@ -145,6 +157,15 @@ pub struct BedArgs {
     /// plus `DIR/comparison.csv`, `.json` and the `comparison_*.svg` plots.
     #[arg(long, value_name = "LIST", conflicts_with_all = ["granule_type", "resume", "stop_at_strain"])]
     pub types: Option<TypeList>,
+
+    /// Pour and compress the scene once per seed, one after the other
+    /// (each on all the -j threads), for the run-to-run spread: a comma list
+    /// such as `1,2,3`. Writes `DIR/seed_<S>/` per seed (each resumable
+    /// alone with --resume) plus `DIR/seeds.csv`, `seeds_spread.csv` (mean,
+    /// standard deviation, min, max of the Kawakita, Heckel and final
+    /// figures), `seeds.json` and the `seeds_*.svg` plots.
+    #[arg(long, value_name = "LIST", conflicts_with_all = ["types", "seed", "resume", "stop_at_strain", "rate_check"])]
+    pub seeds: Option<seeds::SeedList>,
 
     /// Override: number of granules (1 ≤ N ≤ 100000).
     #[arg(long, value_name = "N", allow_negative_numbers = true,
@@ -549,6 +570,9 @@ impl BedArgs {
         let pool = rayon::ThreadPoolBuilder::new()
             .num_threads(self.threads)
             .build()?;
+        if let Some(seeds) = &self.seeds {
+            return self.run_seeds(&scene, &seeds.0, &notes, &pool, streams);
+        }
         if let Some(types) = &self.types {
             for t in &types.0 {
                 self.keep_unfinished(&self.out.join(t.name()))?;
