@@ -836,37 +836,18 @@ impl BedArgs {
                 types.len()
             )?;
         }
-        let mut runs = Vec::with_capacity(types.len());
-        for (t, scene) in types.iter().zip(&scenes) {
-            let dir = self.out.join(t.name());
-            let control = run::RunControl {
-                resume: None,
+        let series: Vec<SeriesRun> = types
+            .iter()
+            .zip(&scenes)
+            .map(|(t, scene)| SeriesRun {
+                name: format!("granule type {t}"),
+                label: format!("bed {t}"),
+                dir: self.out.join(t.name()),
+                scene,
                 packing: Some(packing.clone()),
-                checkpoint_dir: Some(dir.clone()),
-                stop_at_strain: None,
-                interrupt: Some(&crate::signal::INTERRUPT),
-                check_final_overlap: true,
-            };
-            let label = format!("bed {t}");
-            let result = self
-                .compress(pool, scene, control, &dir, &label, notes, streams)
-                .with_context(|| format!("granule type {t}"))?;
-            if result.interrupted {
-                let done = runs.len();
-                let rest: Vec<&str> = types[done + 1..].iter().map(|t| t.name()).collect();
-                let rest = if rest.is_empty() {
-                    String::new()
-                } else {
-                    format!("; not run: {}", rest.join(", "))
-                };
-                return Err(interrupted(
-                    &result,
-                    &dir,
-                    &format!(" (type {t}; no comparison written{rest})"),
-                ));
-            }
-            runs.push(result);
-        }
+            })
+            .collect();
+        let runs = self.compress_series(pool, &series, "comparison", notes, streams)?;
         let rows: Vec<compare::ComparisonRow> = types
             .iter()
             .zip(&scenes)
@@ -881,20 +862,91 @@ impl BedArgs {
             types: &rows,
         };
         compare::write_comparison(&self.out, &comparison, &samples)?;
-        // Runs the kernel stopped: the others ran on; report them all.
-        let failed = types.iter().zip(runs).filter_map(|(t, r)| {
-            let strain = r.samples.last().map_or(0.0, |s| s.strain);
-            let dir = self.out.join(t.name());
-            r.error.map(|e| {
-                anyhow::Error::new(e).context(format!(
-                    "granule type {t}: the bed compression stopped early after C = {strain:.4} \
-                     (outputs so far and the last checkpoint in `{}`)",
-                    dir.display()
-                ))
-            })
-        });
-        crate::output::all_failures(failed, "stopped early")
+        series_failures(&series, runs)
     }
+}
+
+/// One run of a series (`--types`, `--seeds`): what it is called in
+/// messages, its progress label, output directory, scene and, for runs
+/// that share one pour, the packing.
+struct SeriesRun<'a> {
+    name: String,
+    label: String,
+    dir: std::path::PathBuf,
+    scene: &'a Scene,
+    packing: Option<run::Packing>,
+}
+
+impl BedArgs {
+    /// Compresses the runs of `series` one after the other (each fresh, on
+    /// all of `pool`'s threads, with its checkpoints and outputs in its
+    /// directory). A run the kernel stopped does not stop the others (see
+    /// [`series_failures`]); an interrupt stops the series with an error
+    /// naming the runs not made and the `what` (the series' own output)
+    /// left unwritten.
+    fn compress_series(
+        &self,
+        pool: &rayon::ThreadPool,
+        series: &[SeriesRun<'_>],
+        what: &str,
+        notes: &[String],
+        streams: &mut Streams<'_>,
+    ) -> anyhow::Result<Vec<run::BedRun>> {
+        let mut runs = Vec::with_capacity(series.len());
+        for (k, item) in series.iter().enumerate() {
+            let control = run::RunControl {
+                resume: None,
+                packing: item.packing.clone(),
+                checkpoint_dir: Some(item.dir.clone()),
+                stop_at_strain: None,
+                interrupt: Some(&crate::signal::INTERRUPT),
+                check_final_overlap: true,
+            };
+            let result = self
+                .compress(
+                    pool,
+                    item.scene,
+                    control,
+                    &item.dir,
+                    &item.label,
+                    notes,
+                    streams,
+                )
+                .with_context(|| item.name.clone())?;
+            if result.interrupted {
+                let rest: Vec<&str> = series[k + 1..].iter().map(|r| r.name.as_str()).collect();
+                let rest = if rest.is_empty() {
+                    String::new()
+                } else {
+                    format!("; not run: {}", rest.join(", "))
+                };
+                return Err(interrupted(
+                    &result,
+                    &item.dir,
+                    &format!(" ({}; no {what} written{rest})", item.name),
+                ));
+            }
+            runs.push(result);
+        }
+        Ok(runs)
+    }
+}
+
+/// The runs of a series the kernel stopped, each named with its strain and
+/// directory (the others ran on): all reported, or `Ok`.
+fn series_failures(series: &[SeriesRun<'_>], runs: Vec<run::BedRun>) -> anyhow::Result<()> {
+    let failed = series.iter().zip(runs).filter_map(|(item, r)| {
+        let strain = r.samples.last().map_or(0.0, |s| s.strain);
+        r.error.map(|e| {
+            anyhow::Error::new(e).context(format!(
+                "{}: the bed compression stopped early after C = {strain:.4} (outputs so far and \
+                 the last checkpoint in `{}`)",
+                item.name,
+                item.dir.display()
+            ))
+        })
+    });
+    crate::output::all_failures(failed, "stopped early")
 }
 
 /// The error of a run stopped by SIGINT/SIGTERM, its outputs and

@@ -19,7 +19,7 @@ use granbed_kernel::Real;
 use serde::Serialize;
 
 use super::compare::{ComparisonRow, write_overlays, write_rows};
-use super::{BedArgs, Scene, outputs, run};
+use super::{BedArgs, Scene, SeriesRun, outputs, run, series_failures};
 use crate::csv::{CsvWriter, Field};
 use crate::output::{Streams, create_file, finish_file, write_json};
 
@@ -234,36 +234,18 @@ impl BedArgs {
                 self.out.display()
             )?;
         }
-        let mut runs = Vec::with_capacity(seeds.len());
-        for (k, (&seed, scene)) in seeds.iter().zip(&scenes).enumerate() {
-            let dir = self.out.join(seed_dir(seed));
-            let control = run::RunControl {
-                resume: None,
+        let series: Vec<SeriesRun> = seeds
+            .iter()
+            .zip(&scenes)
+            .map(|(seed, scene)| SeriesRun {
+                name: format!("seed {seed}"),
+                label: format!("bed seed {seed}"),
+                dir: self.out.join(seed_dir(*seed)),
+                scene,
                 packing: None,
-                checkpoint_dir: Some(dir.clone()),
-                stop_at_strain: None,
-                interrupt: Some(&crate::signal::INTERRUPT),
-                check_final_overlap: true,
-            };
-            let label = format!("bed seed {seed}");
-            let result = self
-                .compress(pool, scene, control, &dir, &label, notes, streams)
-                .with_context(|| format!("seed {seed}"))?;
-            if result.interrupted {
-                let rest = SeedList(seeds[k + 1..].to_vec());
-                let rest = if rest.0.is_empty() {
-                    String::new()
-                } else {
-                    format!("; not run: seeds {rest}")
-                };
-                return Err(super::interrupted(
-                    &result,
-                    &dir,
-                    &format!(" (seed {seed}; no spread written{rest})"),
-                ));
-            }
-            runs.push(result);
-        }
+            })
+            .collect();
+        let runs = self.compress_series(pool, &series, "spread", notes, streams)?;
         let rows: Vec<ComparisonRow> = scenes
             .iter()
             .zip(&runs)
@@ -274,18 +256,7 @@ impl BedArgs {
             .collect::<anyhow::Result<_>>()?;
         let samples: Vec<&[run::BedSample]> = runs.iter().map(|r| r.samples.as_slice()).collect();
         write_seeds(&self.out, &rows, &samples)?;
-        let failed = seeds.iter().zip(runs).filter_map(|(&seed, r)| {
-            let strain = r.samples.last().map_or(0.0, |s| s.strain);
-            let dir = self.out.join(seed_dir(seed));
-            r.error.map(|e| {
-                anyhow::Error::new(e).context(format!(
-                    "seed {seed}: the bed compression stopped early after C = {strain:.4} \
-                     (outputs so far and the last checkpoint in `{}`)",
-                    dir.display()
-                ))
-            })
-        });
-        crate::output::all_failures(failed, "stopped early")
+        series_failures(&series, runs)
     }
 }
 
