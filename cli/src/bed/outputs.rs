@@ -124,7 +124,8 @@ pub struct HeckelSummary {
     pub d_a: Option<Real>,
     /// R² of the fit.
     pub r_squared: Option<Real>,
-    /// Points used: the output rows with C ≥ `min_strain` and 0 < D < 1.
+    /// Points used: the output rows with C ≥ `min_strain`, P finite and
+    /// 0 < D < 1.
     pub points: usize,
     /// The fit's strain window starts here (scene `heckel_min_strain`).
     pub min_strain: Real,
@@ -310,7 +311,11 @@ pub fn heckel(run: &BedRun, min_strain: Real) -> HeckelSummary {
         d_a: fit.map(|f| f.d_a),
         r_squared: fit.map(|f| f.r_squared),
         points: fit.map_or_else(
-            || window.filter(|&(_, d)| d > 0.0 && d < 1.0).count(),
+            || {
+                window
+                    .filter(|&(p, d)| p.is_finite() && d > 0.0 && d < 1.0)
+                    .count()
+            },
             |f| f.points,
         ),
         min_strain,
