@@ -282,6 +282,32 @@ fn a_failing_element_is_reported_alike_and_leaves_the_same_states() {
     });
 }
 
+/// A stored state that is valid (positive definite, det C_p⁻¹ = 1) but so
+/// stretched that the trial stress b = F C_p⁻¹ Fᵀ overflows fails its
+/// element as non-finite on every path, the states untouched: the batch
+/// has no test of φ^tr of its own, its corrector cannot return the lane,
+/// and the redo element by element names it (it had read as "no
+/// convergence").
+#[test]
+fn an_overflowing_trial_state_is_non_finite_on_every_path() {
+    let mesh = sphere_mesh(&SphereMeshParams::standard());
+    let count = 4 * BATCH + 1;
+    let hexes = &mesh.hexes[..count];
+    let refs: Vec<HexReference> = (0..count)
+        .map(|e| hex_reference(&mesh.hex_coords(e)).unwrap())
+        .collect();
+    let bad = 6;
+    let stretched: Voigt = [1e300, 1e-300, 1.0, 0.0, 0.0, 0.0];
+    for path in PATHS {
+        let mut cp = vec![VOIGT_IDENTITY; count];
+        cp[bad] = stretched;
+        let pass = run(path, hexes, &refs, &mesh.positions, &mut cp);
+        assert_eq!(pass.result, Err((bad, UpdateError::NonFinite)), "{path:?}");
+        assert!(cp[..bad].iter().all(|c| *c == VOIGT_IDENTITY), "{path:?}");
+        assert_eq!(cp[bad], stretched, "{path:?}");
+    }
+}
+
 /// The kernel's own `cpuid`/`xgetbv` detection agrees with the standard
 /// library's.
 #[test]
@@ -521,7 +547,7 @@ fn the_input_checks_accept_exactly_the_valid_inputs_and_name_the_first_failure()
                             ),
                         }
                         assert_eq!(
-                            input_is_valid(f_finite, j, det_c, eta, phi),
+                            input_is_valid(f_finite, j, det_c, eta) && phi < f64::INFINITY,
                             expected.is_none(),
                             "{what}"
                         );

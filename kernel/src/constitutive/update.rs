@@ -289,8 +289,10 @@ pub fn check_trial(
     })
 }
 
-/// The input checks of [`check_trial`]: [`input_is_valid`], and if not,
-/// the first test that failed, in this order: F not finite
+/// The input checks of [`check_trial`]: [`input_is_valid`] and a trial
+/// yield function `phi_tr` below +∞ (−∞ is the elastic limit of an
+/// infinite yield stress), and if not, the first test that failed, in this
+/// order: F not finite
 /// ([`UpdateError::NonFinite`]), J not > 0 (inverted), det C_p⁻¹ not in
 /// (0, ∞) (invalid state), η not finite (inverted: J > 0 but so small —
 /// subnormal — that η = η0/J overflows, crushed flat; found by fuzzing),
@@ -300,7 +302,7 @@ pub fn check_trial(
 #[inline(always)]
 pub fn check_input(f_finite: bool, t: &Trial<Real>, phi_tr: Real) -> Result<(), UpdateError> {
     let det_c = t.det_cp_inv;
-    if input_is_valid(f_finite, t.j, det_c, t.eta, phi_tr) {
+    if input_is_valid(f_finite, t.j, det_c, t.eta) & (phi_tr < Real::INFINITY) {
         return Ok(());
     }
     Err(if !f_finite {
@@ -317,22 +319,17 @@ pub fn check_input(f_finite: bool, t: &Trial<Real>, phi_tr: Real) -> Result<(), 
 }
 
 /// Whether an update's input is admissible: F finite (`f_finite`), J > 0,
-/// 0 < det C_p⁻¹ < ∞, η finite and the trial state's yield function
-/// `phi_tr` below +∞ (every entry of b^tr enters it, squared, so an
-/// overflowing trial stress makes it +∞ or NaN; −∞ is the elastic limit of
-/// an infinite yield stress; a NaN fails every test) — the rule of
-/// [`check_input`], without naming what failed.
-/// The tests are combined without branches, so an element batch takes one
-/// verdict for all its lanes (a batch that fails is redone element by
-/// element, which names the error).
+/// 0 < det C_p⁻¹ < ∞ and η finite (a NaN fails every test) — the rule of
+/// [`check_input`] without naming what failed, and without its test of
+/// the trial yield function. The tests are combined without branches, so
+/// an element batch takes one verdict for all its lanes (a batch that
+/// fails is redone element by element, which names the error). The batch
+/// needs no test of φ^tr: a φ^tr that is +∞ or NaN yields ([`yields`]),
+/// the corrector cannot return it (or its state is not finite), and the
+/// batch is redone element by element, where [`check_input`] names it.
 #[inline(always)]
-pub fn input_is_valid(f_finite: bool, j: Real, det_cp_inv: Real, eta: Real, phi_tr: Real) -> bool {
-    f_finite
-        & (j > 0.0)
-        & (det_cp_inv > 0.0)
-        & (det_cp_inv < Real::INFINITY)
-        & eta.is_finite()
-        & (phi_tr < Real::INFINITY)
+pub fn input_is_valid(f_finite: bool, j: Real, det_cp_inv: Real, eta: Real) -> bool {
+    f_finite & (j > 0.0) & (det_cp_inv > 0.0) & (det_cp_inv < Real::INFINITY) & eta.is_finite()
 }
 
 /// Checks a stored state C_p⁻¹ supplied from outside the kernel: it must

@@ -384,7 +384,7 @@ const UNSET: UpdateInfo = UpdateInfo::elastic(
 /// finite entries leave it +0 ([`non_finite_probe`]).
 #[allow(non_snake_case)]
 #[inline(always)]
-fn inputs_valid<const W: usize>(F: &Rows<Lanes<W>>, t: &Trial<Lanes<W>>, phi: Lanes<W>) -> bool {
+fn inputs_valid<const W: usize>(F: &Rows<Lanes<W>>, t: &Trial<Lanes<W>>) -> bool {
     let probe = non_finite_probe(F.as_flattened());
     let mut valid = true;
     for l in 0..W {
@@ -393,7 +393,6 @@ fn inputs_valid<const W: usize>(F: &Rows<Lanes<W>>, t: &Trial<Lanes<W>>, phi: La
             t.j.0[l],
             t.det_cp_inv.0[l],
             t.eta.0[l],
-            phi.0[l],
         );
     }
     valid
@@ -586,7 +585,7 @@ impl Job<'_> {
         let mut info = [UNSET; W];
         let mut solutions: [Option<ReturnSolution>; W] = [None; W];
         let mut dissipation = [0.0; W];
-        if !inputs_valid(&F, &t, phi) {
+        if !inputs_valid(&F, &t) {
             return false;
         }
         let system = corrector(self.mat, &t, a1, scale);
@@ -761,8 +760,7 @@ mod tests {
         };
         let c: [Lanes<BATCH>; 6] = VOIGT_IDENTITY.map(Lanes::splat);
         let valid = lanes_of(None);
-        let zero = Lanes::splat(0.0);
-        assert!(inputs_valid(&valid, &trial(&mat, &valid, &c), zero));
+        assert!(inputs_valid(&valid, &trial(&mat, &valid, &c)));
         let infinite = lanes_of(Some(Real::INFINITY));
         let t = trial(&mat, &infinite, &c);
         assert_eq!(t.j.0[2], Real::INFINITY);
@@ -771,12 +769,11 @@ mod tests {
             true,
             t.j.0[2],
             t.det_cp_inv.0[2],
-            t.eta.0[2],
-            0.0
+            t.eta.0[2]
         ));
-        assert!(!inputs_valid(&infinite, &t, zero));
+        assert!(!inputs_valid(&infinite, &t));
         let nan = lanes_of(Some(Real::NAN));
-        assert!(!inputs_valid(&nan, &trial(&mat, &nan, &c), zero));
+        assert!(!inputs_valid(&nan, &trial(&mat, &nan, &c)));
     }
 
     /// A new C_p⁻¹ that is not finite fails the batch only in a yielding
