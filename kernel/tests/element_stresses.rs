@@ -3,7 +3,9 @@
 //! element of either formulation carries the material point's stress —
 //! the neo-Hookean closed form while elastic (physics.md §1.7 C1), a stress
 //! on the yield surface when the trial state lies beyond it (C4), and the
-//! volume ratio det F — and the stored states are only read.
+//! volume ratio det F — and the stored states are only read. Deformed
+//! unevenly, each element's σ v is the virial Σ_I x_I ⊗ f_I of its internal
+//! forces (the average-stress theorem the bed's axial check relies on).
 
 mod common;
 
@@ -162,4 +164,67 @@ fn the_stress_buffer_is_checked() {
             got: h - 1
         }
     );
+}
+
+/// In an uneven (non-affine), plastic deformation of the mesh, each
+/// element's σ v equals the virial Σ_I x_I ⊗ f_I of the forces its pass
+/// computes from the same states (v = J V0): the one-point element without
+/// hourglass forces (κ = 0), and F-bar, whose Gauss points differ, so that
+/// a stress averaged with other weights than their volumes misses it.
+#[test]
+fn each_element_stress_is_the_virial_of_its_forces() {
+    use granbed_kernel::element::fbar::fbar_forces;
+    use granbed_kernel::element::force::hex_forces;
+    let mesh = sphere_mesh(&SphereMeshParams::new(0.5e-3, 4, 1));
+    let data = mesh.element_data();
+    let mat = material(GranuleType::B2);
+    let mut rng = common::Rng::new(7);
+    // 8 % axial compression with node jitter of 3 % of the radius.
+    let x: Vec<[Real; 3]> = mesh
+        .positions
+        .iter()
+        .map(|p| {
+            let j: [Real; 3] = core::array::from_fn(|_| rng.uniform(-15e-6, 15e-6));
+            [p[0] + j[0], p[1] + j[1], 0.92 * p[2] + j[2]]
+        })
+        .collect();
+    for kind in KINDS {
+        let mut s = settings(kind);
+        s.hourglass_kappa = 0.0;
+        let points = s.points_per_element();
+        let cp_inv = vec![VOIGT_IDENTITY; mesh.hexes.len() * points];
+        let mut out = vec![ElementStress::default(); mesh.hexes.len()];
+        element_stresses(&data.reference(&mesh), &mat, &s, &x, &cp_inv, &mut out).unwrap();
+        let mut plastic = 0;
+        for (e, (hex, o)) in mesh.hexes.iter().zip(&out).enumerate() {
+            let xe: [[Real; 3]; 8] = core::array::from_fn(|i| x[hex[i] as usize]);
+            let (f, v) = match kind {
+                ElementKind::OnePoint => {
+                    let r = &data.elements[e];
+                    let mut c = VOIGT_IDENTITY;
+                    let h = hex_forces(&mat, &s.update, 0.0, r, &xe, &mut c).unwrap();
+                    plastic += usize::from(h.info.plastic);
+                    (h.f, h.j * r.volume)
+                }
+                ElementKind::FBar => {
+                    let xr = mesh.hex_coords(e);
+                    let mut c = [VOIGT_IDENTITY; 8];
+                    let h = fbar_forces(&mat, &s.update, &xr, &xe, &mut c).unwrap();
+                    plastic += usize::from(h.plastic_points > 0);
+                    let v0: Real = data.elements[e].volume;
+                    (h.f, o.j * v0)
+                }
+            };
+            let scale = o.sigma.iter().fold(0.0, |m: Real, t| m.max(t.abs())) * v;
+            for (k, &(a, b)) in PAIRS.iter().enumerate() {
+                let virial: Real = (0..8).map(|i| xe[i][a] * f[i][b]).sum();
+                assert!(
+                    (virial - o.sigma[k] * v).abs() <= 1e-10 * scale,
+                    "{kind:?} element {e} ({a}{b}): virial {virial:e} against σv {:e}",
+                    o.sigma[k] * v
+                );
+            }
+        }
+        assert!(plastic > 0, "{kind:?}: no element yielded");
+    }
 }

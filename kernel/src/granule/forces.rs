@@ -385,8 +385,10 @@ pub struct ElementStress {
 /// states `cp_inv`, which are read, not changed (each update runs on a
 /// copy, so a trial state beyond the yield surface is returned onto it).
 /// `out[e]` is element e's: σ = τ/J at the one-point element's point, the
-/// current-volume average of the Gauss points' for F-bar
-/// ([`crate::element::fbar::fbar_stress`]). For pictures and
+/// volume average of the Gauss points' for F-bar
+/// ([`crate::element::fbar::fbar_stress`]); either way σ v is the element's
+/// virial Σ_I x_I ⊗ f_I of its internal forces (without the one-point
+/// element's hourglass forces). For pictures and
 /// post-processing (the bed's snapshots); `x` and `cp_inv` as in
 /// [`internal_forces`], checked the same way, `out` one entry per hex. An
 /// element whose update fails stops the pass with its index.
