@@ -242,6 +242,14 @@ fn a_small_bed_runs_end_to_end_and_is_thread_independent() {
     assert_eq!(number(&r["heckel"], "points") as usize, from(0.15));
     assert!(from(0.15) > from(0.25));
     assert!(two.join("plots/heckel.svg").is_file());
+    // The refit's windows are the run's from now on: a plain --resume keeps
+    // them (its checkpoint was written again with the scene).
+    let again = cli(&["bed", "--quiet", "--resume", two.to_str().unwrap()]);
+    assert_eq!(again.code, 0, "{}", again.stderr);
+    let a = summary(&two);
+    assert_eq!(number(&a["kawakita"], "min_strain"), 0.1);
+    assert_eq!(number(&a["heckel"], "min_strain"), 0.15);
+    assert_eq!(a["steps"], s["steps"]);
 }
 
 #[test]

@@ -434,6 +434,43 @@ fn the_kawakita_fit_outside_its_regime_is_flagged_and_the_solid_fraction_written
     assert!(d.windows(2).all(|w| w[1] > w[0]));
 }
 
+/// A Heckel fit the rows cannot give (K <= 0: on 20 coarse granules to 30 %
+/// the pressure falls over C >= 0.25 while the bed densifies) is warned
+/// about with its window and points, not left as a silent null; so is a
+/// fit window that starts past the strain a finished run reached.
+#[test]
+fn a_heckel_fit_that_cannot_be_made_and_a_window_past_the_run_are_flagged() {
+    let dir = out_dir("heckel");
+    let mut argv = vec!["--out", dir.to_str().unwrap()];
+    argv.extend_from_slice(&common::small_bed("20", "0.3"));
+    let r = bed(&argv);
+    assert_eq!(r.code, 0, "{}", r.stderr);
+    let s = summary(&dir);
+    let points = number(&s["heckel"], "points");
+    assert!(
+        s["heckel"]["yield_pressure_pa"].is_null() && points >= 2.0,
+        "the bed no longer shows the case: {}",
+        s["heckel"]
+    );
+    let w = warnings(&dir);
+    let needle = format!("no Heckel fit over C >= 0.25 ({points} points)");
+    assert!(w.iter().any(|w| w.contains(&needle)), "{needle}: {w:?}");
+    assert!(!w.iter().any(|w| w.contains("window starts")), "{w:?}");
+    let r = bed(&[
+        "--resume",
+        dir.to_str().unwrap(),
+        "--kawakita-min-strain",
+        "0.5",
+    ]);
+    assert_eq!(r.code, 0, "{}", r.stderr);
+    let w = warnings(&dir);
+    assert!(
+        w.iter()
+            .any(|w| w.contains("Kawakita fit's window starts at C = 0.5")),
+        "{w:?}"
+    );
+}
+
 /// `--out` naming an existing file is a usage error (exit status 2) that
 /// says so, for every command writing an output directory, before any
 /// work (it was a runtime error, exit status 1, "File exists").

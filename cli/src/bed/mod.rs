@@ -51,8 +51,9 @@ Output, in --out DIR (created if missing):
                    with C >= kawakita_min_strain, 0.25), Heckel fit of
                    ln(1/(1 - D)) = K P + A (yield pressure P_y = 1/K, A,
                    D_A = 1 - exp(-A), R^2, points; C >= heckel_min_strain,
-                   0.25), the poured bed's solid fraction D0, final strain, max pressure, initial bed height, counts, wall
-                   time, ns per element-step, cost figures (over the whole run,
+                   0.25), the poured bed's solid fraction D0, final strain,
+                   max pressure, initial bed height, counts, wall time, ns per
+                   element-step, cost figures (over the whole run,
                    resumed segments included), threads, min Jacobian, max nodal
                    speed / punch speed, deepest overlap (m and / element size)
                    read by the contact detection and measured by geometry at
@@ -81,17 +82,19 @@ Output, in --out DIR (created if missing):
                    coefficient against strain; Kawakita plot P/C vs P and
                    Heckel plot ln(1/(1 - D)) vs P, each with its fit
   report.html      one page: the summary table, the plots and the scene
-
-`--resume DIR` on a finished run takes no step and writes its outputs again:
-with --kawakita-min-strain or --heckel-min-strain it refits the run.
   checkpoint.bin   the state to continue from with --resume (every
                    checkpoint_interval_minutes and checkpoint_strain_interval,
                    and at the end)
 
+`--resume DIR` on a finished run takes no step and writes its outputs again:
+with --kawakita-min-strain or --heckel-min-strain it refits the run, and its
+checkpoint keeps the new windows. (A run of --types or --seeds refitted so
+leaves DIR's comparison tables as they were.)
+
 With --types, the files above go to DIR/<TYPE>/ per type (each resumable
 alone with --resume DIR/<TYPE>), and DIR holds the comparison:
-  comparison.csv   one row per type, in the order given: type, seed, yield stress,
-                   eta0, Kawakita a, 1/b (Pa), R^2, points, Heckel P_y (Pa),
+  comparison.csv   one row per type, in the order given: type, seed, yield
+                   stress, eta0, Kawakita a, 1/b (Pa), R^2, points, Heckel P_y (Pa),
                    R^2, D0, max pressure,
                    final strain, final pressure, final mean relative density,
                    final coordination number, quasi_static_passed (1/0),

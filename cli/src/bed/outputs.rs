@@ -280,7 +280,14 @@ pub fn kawakita(samples: &[BedSample], min_strain: Real) -> KawakitaSummary {
         inv_b_pa: fit.map(|f| f.inv_b_pa),
         r_squared: fit.map(|f| f.r_squared),
         points: fit.map_or_else(
-            || samples.iter().filter(|s| s.strain >= min_strain).count(),
+            || {
+                samples
+                    .iter()
+                    .filter(|s| {
+                        s.strain >= min_strain && s.strain > 0.0 && s.upper_pressure_pa.is_finite()
+                    })
+                    .count()
+            },
             |f| f.points,
         ),
         min_strain,
@@ -628,6 +635,28 @@ fn warnings(
             kawakita.min_strain,
             kawakita.points,
             why.join(", ")
+        ));
+    }
+    for (law, min_strain, flag) in [
+        ("Kawakita", kawakita.min_strain, "--kawakita-min-strain"),
+        ("Heckel", heckel.min_strain, "--heckel-min-strain"),
+    ] {
+        // A run stopped or interrupted on purpose goes on later: no warning.
+        let reached = run.samples.last().map_or(0.0, |s| s.strain);
+        if min_strain > reached && !run.stopped && !run.interrupted {
+            w.push(format!(
+                "the {law} fit's window starts at C = {min_strain}, past the strain the run \
+                 reached ({reached:.4}): no fit (`{flag}` sets the window)"
+            ));
+        }
+    }
+    if heckel.yield_pressure_pa.is_none() && heckel.points >= 2 {
+        w.push(format!(
+            "no Heckel fit over C >= {} ({} points): ln(1/(1 - D)) does not rise with the \
+             pressure there (K <= 0: the pressure fell while the bed densified, as in a bed \
+             that still rearranges; or the pressures are all equal), so there is no yield \
+             pressure (`--heckel-min-strain` sets the window)",
+            heckel.min_strain, heckel.points
         ));
     }
     if let Some(r2) = heckel.r_squared.filter(|&r| r < FIT_MIN_R_SQUARED) {

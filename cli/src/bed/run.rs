@@ -696,6 +696,19 @@ pub fn run_bed(
         make(&asm, &samples, &window, next, snapshots_done).write(dir)?;
         on_disk = Some((asm.steps(), die.strain_at(asm.time())));
     }
+    // A resumed run that took no step but changed its scene (a finished
+    // run refitted with --kawakita-min-strain, say) keeps the change: its
+    // checkpoint is written again with the scene, else the next --resume
+    // would go back to the old one.
+    if let (Some(dir), Some(c)) = (dir, &control.resume)
+        && error.is_none()
+        && asm.steps() == first_step
+        && on_disk.is_none()
+        && c.progress.scene_toml != scene.to_toml()
+    {
+        make(&asm, &samples, &window, next, snapshots_done).write(dir)?;
+        on_disk = Some((asm.steps(), die.strain_at(asm.time())));
+    }
     let mut checkpoint_strain = on_disk.map(|(_, c)| c);
     if let (Some(_), Some(dir), Some(good)) = (&error, dir, &last_good) {
         let newer = on_disk.is_none_or(|(steps, _)| good.state.steps > steps);

@@ -216,8 +216,9 @@ pub struct HeckelFit {
 /// [`linear_fit`]; the iterator is cloned for its two passes.
 ///
 /// `None` with fewer than two usable points, when all usable P are equal, or
-/// when K is not positive (the compact did not densify with pressure) or
-/// P_y would not be finite.
+/// when K is not positive (ln(1/(1 − D)) does not rise with P over the rows:
+/// the pressure fell while the bed densified, say, as in a rearranging bed
+/// of few granules) or P_y would not be finite.
 pub fn heckel_fit<I>(samples: I) -> Option<HeckelFit>
 where
     I: Iterator<Item = (Real, Real)> + Clone,
