@@ -6,6 +6,7 @@ use std::path::Path;
 
 use anyhow::Context as _;
 use granbed_kernel::Real;
+use granbed_kernel::analysis::bed::{heckel_fit, heckel_usable};
 use granbed_kernel::analysis::quasi_static::LoadSample;
 use indicatif::ProgressBar;
 use serde::Serialize;
@@ -310,7 +311,7 @@ pub fn heckel(run: &BedRun, min_strain: Real) -> HeckelSummary {
     let window = heckel_rows(run)
         .filter(move |&(_, _, c)| c >= min_strain)
         .map(|(p, d, _)| (p, d));
-    let fit = granbed_kernel::analysis::bed::heckel_fit(window.clone());
+    let fit = heckel_fit(window.clone());
     HeckelSummary {
         yield_pressure_pa: fit.map(|f| f.yield_pressure_pa),
         k_per_pa: fit.map(|f| f.k_per_pa),
@@ -318,11 +319,7 @@ pub fn heckel(run: &BedRun, min_strain: Real) -> HeckelSummary {
         d_a: fit.map(|f| f.d_a),
         r_squared: fit.map(|f| f.r_squared),
         points: fit.map_or_else(
-            || {
-                window
-                    .filter(|&(p, d)| p.is_finite() && d > 0.0 && d < 1.0)
-                    .count()
-            },
+            || window.filter(|&(p, d)| heckel_usable(p, d)).count(),
             |f| f.points,
         ),
         min_strain,
@@ -497,7 +494,7 @@ pub const OVERLAP_WARNING_REL: Real = crate::study::stability::MAX_PENETRATION_R
 /// Why the Kawakita fit `k` does not describe a bed, if it does not: a
 /// outside (0, 1] (a limiting strain; NaN included), 1/b ≤ 0, R² below
 /// [`FIT_MIN_R_SQUARED`]. Empty for a fit inside the law's regime.
-fn kawakita_doubts(k: &KawakitaSummary) -> Vec<String> {
+pub fn kawakita_doubts(k: &KawakitaSummary) -> Vec<String> {
     let mut why = Vec::new();
     if let Some(a) = k.a.filter(|&a| !(a > 0.0 && a <= 1.0)) {
         why.push(format!(

@@ -150,14 +150,14 @@ pub fn kawakita_svg(samples: &[BedSample], fit: &KawakitaSummary) -> anyhow::Res
 }
 
 /// The Heckel plot: ln(1/(1 − D)) against P (kPa) of the rows `(P [Pa], D,
-/// C)` with 0 < D < 1, the fitted ones (C ≥ the fit's window) filled, and
+/// C)` the fit can use (P finite, 0 < D < 1), the fitted ones (C ≥ the fit's window) filled, and
 /// the line K·P + A over the fitted pressures.
 pub fn heckel_svg(
     rows: impl Iterator<Item = (Real, Real, Real)> + Clone,
     fit: &HeckelSummary,
 ) -> anyhow::Result<String> {
     let rows = rows
-        .filter(|&(_, d, _)| d > 0.0 && d < 1.0)
+        .filter(|&(p, d, _)| granbed_kernel::analysis::bed::heckel_usable(p, d))
         .map(|(p, d, c)| (p * 1e-3, -(-d).ln_1p(), c));
     // In kPa: K·P + A with K per kPa.
     let line = fit
@@ -310,7 +310,7 @@ mod tests {
     }
 
     #[test]
-    fn the_heckel_plot_has_the_fit_line_and_leaves_out_d_of_1() {
+    fn the_heckel_plot_has_the_fit_line_and_only_the_rows_of_the_law() {
         // ln(1/(1 − D)) = P/(80 kPa) + 0.5, and one row past D = 1.
         let mut rows: Vec<(Real, Real, Real)> = (0..30)
             .map(|i| {
@@ -333,6 +333,14 @@ mod tests {
         let svg = heckel_svg(rows.iter().copied(), &summary).unwrap();
         assert!(svg.contains("fit: P_y = 80.0000 kPa, A = 0.5000"), "{svg}");
         assert!(svg.contains("C &lt; 0.2") && svg.contains("(fitted)"));
-        assert!(!svg.contains("NaN"), "the row past D = 1 is plotted");
+        // Rows the law does not cover are not drawn: D = 0 would plot at
+        // ln 1 = 0, D < 0 below it (D > 1 gives NaN, which no plot draws).
+        let mut more = rows.clone();
+        more.extend([(1.5e5, 0.0, 0.3), (1.6e5, -0.1, 0.3)]);
+        let svg_more = heckel_svg(more.iter().copied(), &summary).unwrap();
+        assert_eq!(
+            svg_more.matches("<circle").count(),
+            svg.matches("<circle").count()
+        );
     }
 }

@@ -6,8 +6,9 @@
 //! * `seeds.csv`: one row per seed, the columns of `--types`'
 //!   `comparison.csv` ([`super::compare::COMPARISON_COLUMNS`]);
 //! * `seeds_spread.csv`: per figure ([`SPREAD_FIGURES`]) the runs that have
-//!   it, its mean, sample standard deviation, smallest and largest value
-//!   and their difference;
+//!   it (a fit the run's summary warns about left out) and those left out,
+//!   its mean, sample standard deviation, smallest and largest value and
+//!   their difference;
 //! * `seeds.json`: both tables;
 //! * `seeds_pressure.svg`, `seeds_density.svg`: one curve per seed.
 
@@ -19,6 +20,7 @@ use granbed_kernel::Real;
 use serde::Serialize;
 
 use super::compare::{ComparisonRow, write_overlays, write_rows};
+use super::outputs::{FIT_MIN_R_SQUARED, KawakitaSummary, kawakita_doubts};
 use super::{BedArgs, Scene, SeriesRun, outputs, run, series_failures};
 use crate::csv::{CsvWriter, Field};
 use crate::output::{Streams, create_file, finish_file, write_json};
@@ -78,11 +80,34 @@ impl fmt::Display for SeedList {
 /// A figure of a run's row whose spread over the seeds is reported.
 pub type Figure = fn(&ComparisonRow) -> Option<Real>;
 
-/// The figures of [`SPREAD_CSV`], by their `seeds.csv` column names.
+/// Whether a row's Kawakita fit describes its bed: none of the summary's
+/// doubts (a in (0, 1], 1/b > 0, R² at least [`FIT_MIN_R_SQUARED`]).
+fn kawakita_described(r: &ComparisonRow) -> bool {
+    kawakita_doubts(&KawakitaSummary {
+        a: r.kawakita_a,
+        inv_b_pa: r.kawakita_inv_b_pa,
+        r_squared: r.kawakita_r_squared,
+        points: r.kawakita_points,
+        min_strain: Real::NAN,
+    })
+    .is_empty()
+}
+
+/// The figures of [`SPREAD_CSV`], by their `seeds.csv` column names. A fit
+/// the run's summary warns about (Kawakita outside the law's regime, Heckel
+/// with R² below [`FIT_MIN_R_SQUARED`]) is left out: its figures are not
+/// material figures, and one such run (a 1/b ≤ 0, say) would move the mean.
 pub const SPREAD_FIGURES: [(&str, Figure); 8] = [
-    ("kawakita_a", |r| r.kawakita_a),
-    ("kawakita_inv_b_pa", |r| r.kawakita_inv_b_pa),
-    ("heckel_yield_pressure_pa", |r| r.heckel_yield_pressure_pa),
+    ("kawakita_a", |r| {
+        r.kawakita_a.filter(|_| kawakita_described(r))
+    }),
+    ("kawakita_inv_b_pa", |r| {
+        r.kawakita_inv_b_pa.filter(|_| kawakita_described(r))
+    }),
+    ("heckel_yield_pressure_pa", |r| {
+        r.heckel_yield_pressure_pa
+            .filter(|_| r.heckel_r_squared.is_some_and(|r2| r2 >= FIT_MIN_R_SQUARED))
+    }),
     ("initial_solid_fraction", |r| Some(r.initial_solid_fraction)),
     ("max_pressure_pa", |r| Some(r.max_pressure_pa)),
     ("final_pressure_pa", |r| Some(r.final_pressure_pa)),
@@ -91,16 +116,20 @@ pub const SPREAD_FIGURES: [(&str, Figure); 8] = [
 ];
 
 /// Columns of [`SPREAD_CSV`], in order.
-pub const SPREAD_COLUMNS: [&str; 7] = ["figure", "runs", "mean", "std", "min", "max", "spread"];
+pub const SPREAD_COLUMNS: [&str; 8] = [
+    "figure", "runs", "left_out", "mean", "std", "min", "max", "spread",
+];
 
-/// One figure's spread over the runs (the runs without it left out: a
-/// Kawakita fit the run's strain does not reach, a NaN).
+/// One figure's spread over the runs (the runs without it left out: a fit
+/// the run's strain does not reach or its summary warns about, a NaN).
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct Spread {
     /// The `seeds.csv` column.
     pub figure: &'static str,
     /// Runs with a finite value.
     pub runs: usize,
+    /// Runs left out.
+    pub left_out: usize,
     /// Their mean (none without runs).
     pub mean: Option<Real>,
     /// Their sample standard deviation, with n − 1 (none below 2 runs).
@@ -130,6 +159,7 @@ pub fn spread(name: &'static str, figure: Figure, rows: &[ComparisonRow]) -> Spr
     Spread {
         figure: name,
         runs: n,
+        left_out: rows.len() - n,
         mean,
         std,
         min,
@@ -169,6 +199,7 @@ pub fn write_seeds(
         csv.write_row(&[
             Field::Text(s.figure),
             Field::Int(s.runs as u64),
+            Field::Int(s.left_out as u64),
             opt(s.mean),
             opt(s.std),
             opt(s.min),
@@ -295,8 +326,8 @@ mod tests {
             yield_stress_pa: 30e3,
             eta0: 0.8,
             kawakita_a: a,
-            kawakita_inv_b_pa: None,
-            kawakita_r_squared: None,
+            kawakita_inv_b_pa: Some(8e3),
+            kawakita_r_squared: Some(0.99),
             kawakita_points: 0,
             heckel_yield_pressure_pa: None,
             heckel_r_squared: None,
@@ -328,5 +359,34 @@ mod tests {
         assert_eq!((one.runs, one.std, one.spread), (1, None, Some(0.0)));
         let none = spread("kawakita_a", a, &rows[1..2]);
         assert_eq!((none.runs, none.mean, none.min), (0, None, None));
+        assert_eq!((s.left_out, none.left_out), (2, 1));
+
+        // The reported figures leave out the fits the summary warns about:
+        // a Kawakita a outside (0, 1] or with 1/b <= 0 (both its figures),
+        // a Heckel fit with R^2 < 0.9.
+        let mut odd = row(Some(3.5));
+        let mut negative = row(Some(0.45));
+        negative.kawakita_inv_b_pa = Some(-2.0);
+        odd.heckel_yield_pressure_pa = Some(1e4);
+        odd.heckel_r_squared = Some(0.5);
+        let mut good = row(Some(0.4));
+        good.heckel_yield_pressure_pa = Some(3e4);
+        good.heckel_r_squared = Some(0.99);
+        let rows = [odd, negative, good];
+        let figure = |name: &str| {
+            let (n, f) = SPREAD_FIGURES.iter().find(|(n, _)| *n == name).unwrap();
+            spread(n, *f, &rows)
+        };
+        for name in [
+            "kawakita_a",
+            "kawakita_inv_b_pa",
+            "heckel_yield_pressure_pa",
+        ] {
+            let s = figure(name);
+            assert_eq!((s.runs, s.left_out), (1, 2), "{name}");
+        }
+        assert_eq!(figure("kawakita_a").mean, Some(0.4));
+        assert_eq!(figure("heckel_yield_pressure_pa").mean, Some(3e4));
+        assert_eq!(figure("final_relative_density").runs, 3);
     }
 }

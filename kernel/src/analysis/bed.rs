@@ -225,7 +225,7 @@ where
 {
     let line = linear_fit(
         samples
-            .filter(|&(p, d)| p.is_finite() && d > 0.0 && d < 1.0)
+            .filter(|&(p, d)| heckel_usable(p, d))
             .map(|(p, d)| (p, -crate::math::ln_1p(-d))),
     )?;
     let yield_pressure_pa = 1.0 / line.slope;
@@ -240,6 +240,12 @@ where
         r_squared: line.r_squared,
         points: line.points,
     })
+}
+
+/// Whether a row (P [Pa], D) enters the Heckel fit: P finite and
+/// 0 < D < 1, where ln(1/(1 − D)) is defined.
+pub fn heckel_usable(p: Real, d: Real) -> bool {
+    p.is_finite() && d > 0.0 && d < 1.0
 }
 
 /// [`heckel_fit`] over two parallel slices: pressures (Pa) and solid
