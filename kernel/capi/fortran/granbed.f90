@@ -118,11 +118,8 @@ contains
     real(c_double), intent(in) :: props(GRANBED_VUMAT_NPROPS)
     integer(c_int32_t), intent(out) :: ierr
     character(len=*), intent(out) :: message
-    type(granbed_material_params) :: p
     type(granbed_param_error) :: e
-    p = granbed_material_params(props(1), props(2), props(3), props(4), props(5), props(6), &
-         props(7), props(8))
-    ierr = c_granbed_material_check(p, e)
+    ierr = c_granbed_material_check(params_of(props), e)
     message = ''
     if (ierr == GRANBED_ERR_INVALID_PARAMETER) then
        write (message, '(3a,g0,2a)') 'invalid material parameter ', trim(c_string(e%field)), &
@@ -139,16 +136,21 @@ contains
     real(c_double), intent(in) :: props(GRANBED_VUMAT_NPROPS)
     real(c_double), intent(out) :: derived(6)
     integer(c_int32_t), intent(out) :: ierr
-    type(granbed_material_params) :: p
     type(granbed_material_derived) :: d
     type(granbed_param_error) :: e
-    p = granbed_material_params(props(1), props(2), props(3), props(4), props(5), props(6), &
-         props(7), props(8))
-    ierr = c_granbed_material_derived(p, d, e)
+    ierr = c_granbed_material_derived(params_of(props), d, e)
     derived = 0
     if (ierr == GRANBED_OK) derived = [d%lambda_pa, d%mu_pa, d%bulk_pa, d%p_wave_pa, &
          d%density0_kg_m3, d%wave_speed_m_s]
   end subroutine granbed_derived_props
+
+  !> props(1:8) as the C struct GranbedMaterialParams.
+  pure function params_of(props) result(p)
+    real(c_double), intent(in) :: props(GRANBED_VUMAT_NPROPS)
+    type(granbed_material_params) :: p
+    p = granbed_material_params(props(1), props(2), props(3), props(4), props(5), props(6), &
+         props(7), props(8))
+  end function params_of
 
   !> The message of status code code.
   function granbed_message(code) result(message)
