@@ -5,9 +5,10 @@
 //! (η_g = η0 V0/V), `heywood_dv` (α_SV with d_V) and `heywood_d` (α_SV with
 //! the nominal diameter); and per element (a surface quad shows the hex
 //! under it): `pressure_pa` (−tr σ/3), `von_mises_pa`, `axial_stress_pa`
-//! (−σ_zz, along the punches' axis) and `element_relative_density` (η0/J). `bed.pvd` lists the snapshots with the strain as
-//! the timestep and is rewritten after each one, so a run that stops
-//! early leaves a valid collection. k is the index of the strain among the
+//! (−σ_zz, along the punches' axis) and `element_relative_density` (η0/J).
+//! `bed.pvd` lists the snapshots with the strain as the timestep and is
+//! rewritten after each one, so a run that stops early leaves a valid
+//! collection. k is the index of the strain among the
 //! scene's sorted snapshot strains, and the collection lists every
 //! snapshot up to the current one whose file is there, so a resumed run
 //! continues the collection of the run it resumes.
