@@ -242,7 +242,7 @@ where
     })
 }
 
-/// Whether a row (P [Pa], D) enters the Heckel fit: P finite and
+/// Whether a row (P in Pa, D) enters the Heckel fit: P finite and
 /// 0 < D < 1, where ln(1/(1 − D)) is defined.
 pub fn heckel_usable(p: Real, d: Real) -> bool {
     p.is_finite() && d > 0.0 && d < 1.0
