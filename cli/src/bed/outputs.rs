@@ -647,6 +647,14 @@ fn warnings(
             ));
         }
     }
+    if kawakita.a.is_none() && kawakita.points >= 2 {
+        w.push(format!(
+            "no Kawakita fit over C >= {} ({} points): the line P/C against P has no finite, \
+             non-zero slope there (the pressures all equal, or P/C constant), so there is no a \
+             or 1/b (`--kawakita-min-strain` sets the window)",
+            kawakita.min_strain, kawakita.points
+        ));
+    }
     if heckel.yield_pressure_pa.is_none() && heckel.points >= 2 {
         w.push(format!(
             "no Heckel fit over C >= {} ({} points): ln(1/(1 - D)) does not rise with the \
@@ -985,5 +993,48 @@ mod tests {
         );
         let w = summary(&scene, &run(&[0.0, 0.5, 0.68])).warnings;
         assert_eq!(solid(&w), None, "{w:?}");
+    }
+
+    /// Rows in a fit's window from which no fit can be made are warned
+    /// about, for either law, with the window and the points: equal
+    /// pressures (no line); rows that make a fit are not.
+    #[test]
+    fn a_fit_that_cannot_be_made_is_warned_about() {
+        use crate::bed::run::{BedRun, BedSample};
+        let run = |pressures: &[Real]| {
+            BedRun::of_samples(
+                pressures
+                    .iter()
+                    .enumerate()
+                    .map(|(i, &upper_pressure_pa)| BedSample {
+                        strain: 0.25 + 0.01 * i as Real,
+                        upper_pressure_pa,
+                        min_jacobian: 0.9,
+                        min_gauss_jacobian: 0.9,
+                        ..BedSample::default()
+                    })
+                    .collect(),
+            )
+        };
+        let scene = Scene::published();
+        let refused = |w: &[String], law: &str| {
+            w.iter()
+                .find(|w| w.starts_with(&format!("no {law} fit over C >= 0.25 (3 points)")))
+                .cloned()
+        };
+        let flat = summary(&scene, &run(&[5e3, 5e3, 5e3]));
+        assert!(flat.kawakita.a.is_none() && flat.heckel.yield_pressure_pa.is_none());
+        for law in ["Kawakita", "Heckel"] {
+            assert!(
+                refused(&flat.warnings, law).is_some(),
+                "{law}: {:?}",
+                flat.warnings
+            );
+        }
+        let rising = summary(&scene, &run(&[5e3, 6e3, 7e3]));
+        assert!(rising.heckel.yield_pressure_pa.is_some());
+        for law in ["Kawakita", "Heckel"] {
+            assert_eq!(refused(&rising.warnings, law), None, "{law}");
+        }
     }
 }
