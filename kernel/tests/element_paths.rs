@@ -236,14 +236,22 @@ fn fails_alike(
     reference.unwrap()
 }
 
-#[test]
-fn a_failing_element_is_reported_alike_and_leaves_the_same_states() {
+/// The standard mesh and the reference data of its first four batches
+/// and one element more (the scalar tail): the elements the failure tests
+/// run.
+fn first_elements() -> (common::OwnedMesh, Vec<HexReference>) {
     let mesh = sphere_mesh(&SphereMeshParams::standard());
-    let count = 4 * BATCH + 1;
-    let hexes = &mesh.hexes[..count];
-    let refs: Vec<HexReference> = (0..count)
+    let refs = (0..4 * BATCH + 1)
         .map(|e| hex_reference(&mesh.hex_coords(e)).unwrap())
         .collect();
+    (mesh, refs)
+}
+
+#[test]
+fn a_failing_element_is_reported_alike_and_leaves_the_same_states() {
+    let (mesh, refs) = first_elements();
+    let count = refs.len();
+    let hexes = &mesh.hexes[..count];
     // Compress 25 % (plastic), then flip element 6 (inside the second
     // batch) through its centre: J < 0 there.
     let mut x: Vec<[Real; 3]> = mesh
@@ -290,12 +298,9 @@ fn a_failing_element_is_reported_alike_and_leaves_the_same_states() {
 /// convergence").
 #[test]
 fn an_overflowing_trial_state_is_non_finite_on_every_path() {
-    let mesh = sphere_mesh(&SphereMeshParams::standard());
-    let count = 4 * BATCH + 1;
+    let (mesh, refs) = first_elements();
+    let count = refs.len();
     let hexes = &mesh.hexes[..count];
-    let refs: Vec<HexReference> = (0..count)
-        .map(|e| hex_reference(&mesh.hex_coords(e)).unwrap())
-        .collect();
     let bad = 6;
     let stretched: Voigt = [1e300, 1e-300, 1.0, 0.0, 0.0, 0.0];
     for path in PATHS {

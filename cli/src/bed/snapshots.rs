@@ -96,10 +96,11 @@ pub struct ElementFields {
 /// The pressure −tr σ/3 and von Mises stress √(3/2)‖dev σ‖ of a Cauchy
 /// stress σ (Voigt `[xx, yy, zz, yz, xz, xy]`), Pa.
 pub fn pressure_and_von_mises(sigma: &[Real; 6]) -> (Real, Real) {
-    let mean = (sigma[0] + sigma[1] + sigma[2]) / 3.0;
-    let dev2 = (0..3).map(|k| (sigma[k] - mean).powi(2)).sum::<Real>()
-        + 2.0 * (3..6).map(|k| sigma[k] * sigma[k]).sum::<Real>();
-    (-mean, (1.5 * dev2).sqrt())
+    use granbed_kernel::tensor::{deviator, norm, trace};
+    (
+        -trace(sigma) / 3.0,
+        granbed_kernel::math::sqrt(1.5) * norm(&deviator(sigma)),
+    )
 }
 
 /// The element fields of every granule of `asm` (meshes `mesh`), granules
@@ -396,6 +397,19 @@ impl SnapshotWriter {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Uniaxial compression σ_zz = −s: p = s/3, von Mises s; pure shear
+    /// σ_xy = t: p = 0, von Mises √3 t; a hydrostatic stress has none.
+    #[test]
+    fn pressure_and_von_mises_of_known_stresses() {
+        let close = |a: Real, b: Real| (a - b).abs() <= 1e-12 * b.abs().max(1.0);
+        let (p, q) = pressure_and_von_mises(&[0.0, 0.0, -3e4, 0.0, 0.0, 0.0]);
+        assert!(close(p, 1e4) && close(q, 3e4), "{p} {q}");
+        let (p, q) = pressure_and_von_mises(&[0.0, 0.0, 0.0, 0.0, 0.0, 2e3]);
+        assert!(close(p, 0.0) && close(q, 3.0_f64.sqrt() * 2e3), "{p} {q}");
+        let (p, q) = pressure_and_von_mises(&[-5.0, -5.0, -5.0, 0.0, 0.0, 0.0]);
+        assert!(close(p, 5.0) && q == 0.0, "{p} {q}");
+    }
 
     #[test]
     fn the_collection_escapes_and_keeps_the_strains() {
