@@ -1,6 +1,7 @@
 //! Whole-number flags (`--granules`, `--seed`, `-j`, …): a value parser
 //! whose rejection says what is allowed, where the standard integer
-//! parsers say "invalid digit found in string" for `-3`, `1.5` or `1e3`.
+//! parsers say "invalid digit found in string" for `-3`, `1.5` or `1e3`;
+//! and the comma lists of distinct values of `--types` and `--seeds`.
 
 /// A clap value parser of whole numbers `lo..=hi` written in digits; a
 /// rejection (clap prefixes the flag and the value) gives the range.
@@ -24,9 +25,42 @@ where
     }
 }
 
+/// The comma list `text` parsed item by item (items trimmed) with
+/// `parse`, each item at most once. A rejection names the item: "`x`:
+/// what `parse` said", "`x` is listed twice".
+pub fn distinct_list<T: PartialEq>(
+    text: &str,
+    parse: impl Fn(&str) -> Result<T, String>,
+) -> Result<Vec<T>, String> {
+    let mut items = Vec::new();
+    for item in text.split(',').map(str::trim) {
+        let value = parse(item).map_err(|e| format!("`{item}`: {e}"))?;
+        if items.contains(&value) {
+            return Err(format!("`{item}` is listed twice"));
+        }
+        items.push(value);
+    }
+    Ok(items)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn distinct_list_names_the_item_it_refuses() {
+        let parse = |t: &str| t.parse::<u8>().map_err(|_| "not a byte".to_owned());
+        assert_eq!(distinct_list(" 1, 2,3", parse), Ok(vec![1, 2, 3]));
+        assert_eq!(
+            distinct_list("1,x", parse),
+            Err("`x`: not a byte".to_owned())
+        );
+        assert_eq!(
+            distinct_list("1, 2, 01", parse),
+            Err("`01` is listed twice".to_owned())
+        );
+        assert_eq!(distinct_list("", parse), Err("``: not a byte".to_owned()));
+    }
 
     #[test]
     fn rejections_give_the_range() {

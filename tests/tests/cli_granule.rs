@@ -338,7 +338,7 @@ fn bad_input_names_the_flag() {
             "`--rate-check` needs `--strain` above 0.02",
         ),
         (&["--types", "A1,X9"], "--types"),
-        (&["--types", "all,A1"], "`all` stands alone"),
+        (&["--types", "all,A1"], "`all`: write `all` alone"),
         (&["--type", "A1", "--types", "B2"], "--types"),
     ];
     for (args, flag) in cases {

@@ -51,15 +51,7 @@ impl FromStr for SeedList {
     type Err = String;
 
     fn from_str(s: &str) -> Result<Self, Self::Err> {
-        let parse = crate::numbers::whole::<u64>(0, u64::MAX);
-        let mut seeds = Vec::new();
-        for text in s.split(',').map(str::trim) {
-            let seed = parse(text).map_err(|e| format!("`{text}`: {e}"))?;
-            if seeds.contains(&seed) {
-                return Err(format!("seed {seed} is listed twice"));
-            }
-            seeds.push(seed);
-        }
+        let seeds = crate::numbers::distinct_list(s, crate::numbers::whole::<u64>(0, u64::MAX))?;
         if seeds.len() > MAX_SEEDS {
             return Err(format!(
                 "{} seeds: at most {MAX_SEEDS} (each is a whole run)",

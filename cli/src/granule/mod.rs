@@ -163,20 +163,14 @@ impl FromStr for TypeList {
         if s.trim().eq_ignore_ascii_case("all") {
             return Ok(Self(GranuleType::ALL.to_vec()));
         }
-        let mut types = Vec::new();
-        for name in s.split(',').map(str::trim) {
+        crate::numbers::distinct_list(s, |name| {
             if name.eq_ignore_ascii_case("all") {
-                return Err("`all` stands alone, not in a list".to_owned());
+                return Err("write `all` alone, not in a list".to_owned());
             }
-            let t: GranuleType = name
-                .parse()
-                .map_err(|e| format!("`{name}`: {e}, or `all` alone"))?;
-            if types.contains(&t) {
-                return Err(format!("{t} is listed twice"));
-            }
-            types.push(t);
-        }
-        Ok(Self(types))
+            name.parse::<GranuleType>()
+                .map_err(|e| format!("{e}, or `all` alone"))
+        })
+        .map(Self)
     }
 }
 
