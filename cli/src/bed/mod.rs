@@ -32,6 +32,7 @@ pub mod report;
 pub mod run;
 pub mod scene;
 pub mod seeds;
+pub mod series;
 pub mod snapshots;
 
 pub use scene::{DEFAULT_SCENE, Scene};
@@ -88,8 +89,14 @@ Output, in --out DIR (created if missing):
 
 `--resume DIR` on a finished run takes no step and writes its outputs again:
 with --kawakita-min-strain or --heckel-min-strain it refits the run, and its
-checkpoint keeps the new windows. (A run of --types or --seeds refitted so
-leaves DIR's comparison tables as they were.)
+checkpoint keeps the new windows.
+
+A series (--types, --seeds) keeps DIR/series.json (its members, scene and,
+for --types, its pour, exactly): `--resume DIR` on the series directory
+continues every run from its checkpoint, starts the runs never started,
+refits the finished ones (with the windows given) and writes DIR's tables
+again; --resume DIR/<member> continues that run alone and leaves DIR's tables
+as they were.
 
 With --types, the files above go to DIR/<TYPE>/ per type (each resumable
 alone with --resume DIR/<TYPE>), and DIR holds the comparison:
@@ -103,6 +110,7 @@ alone with --resume DIR/<TYPE>), and DIR holds the comparison:
   comparison_pressure.svg, comparison_density.svg
                    upper-punch pressure and mean relative density against
                    strain, one curve per type
+  series.json      the series (types, scene, the pour) for --resume DIR
 With --seeds S1,S2,..., the scene is poured and compressed once per seed into
 `DIR/seed_<S>/` (each resumable alone with --resume), and DIR holds the
 run-to-run spread:
@@ -114,6 +122,7 @@ run-to-run spread:
   seeds.json       both tables
   seeds_pressure.svg, seeds_density.svg
                    one curve per seed
+  series.json      the series (seeds, scene) for --resume DIR
 
 All types start from ONE pour (as the published study compares the nine
 types on one bed): the pour uses the sphere density of the scene's type if
@@ -298,8 +307,10 @@ pub struct BedArgs {
     #[arg(long, value_name = "C", allow_negative_numbers = true)]
     pub heckel_min_strain: Option<f64>,
 
-    /// Continue the run whose checkpoint is in DIR (its `checkpoint.bin`);
-    /// the outputs go to DIR. Only --strain, --stop-at-strain,
+    /// Continue the run whose checkpoint is in DIR (its `checkpoint.bin`),
+    /// or the series of --types or --seeds in DIR (its `series.json`: every
+    /// run continued or started, the tables written again); the outputs go
+    /// to DIR. Only --strain, --stop-at-strain,
     /// --time-step-safety, --mass-scaling, --sweep-tolerance,
     /// --hold-constraints, --contact-search-interval, --contact-capture,
     /// --held-reprojection, --nearest-penetrated-face,
@@ -455,7 +466,7 @@ impl BedArgs {
         &self,
         resume: Option<&checkpoint::Checkpoint>,
     ) -> anyhow::Result<(Scene, Vec<String>)> {
-        let (mut scene, notes) = match (&self.scene, resume) {
+        let (scene, notes) = match (&self.scene, resume) {
             (_, Some(c)) => (
                 Scene::from_toml(&c.progress.scene_toml).context("the checkpoint's scene")?,
                 Vec::new(),
@@ -463,6 +474,13 @@ impl BedArgs {
             (Some(path), None) => Scene::read_with_notes(path)?,
             (None, None) => (Scene::published(), Vec::new()),
         };
+        Ok((self.overridden(scene, resume.is_none())?, notes))
+    }
+
+    /// `scene` with the overrides given applied, validated; `fresh` for a
+    /// run that starts from a pour (not from a checkpoint): its snapshot
+    /// strains past the final strain are dropped and the rest checked.
+    fn overridden(&self, mut scene: Scene, fresh: bool) -> anyhow::Result<Scene> {
         // Each override given is applied and remembered as the flag and
         // its value, so that a field it set that fails the scene's checks
         // is reported by the flag.
@@ -487,7 +505,7 @@ impl BedArgs {
             // Snapshots past the end are never written: a fresh run's scene
             // (printed, or kept in its checkpoint) leaves them out, so that it
             // reads back as a scene file. A resumed run keeps its own list.
-            if resume.is_none() {
+            if fresh {
                 scene.snapshot_strains.retain(|&s| s <= c);
             }
         });
@@ -520,7 +538,7 @@ impl BedArgs {
         set!(kawakita_min_strain, "--kawakita-min-strain");
         set!(heckel_min_strain, "--heckel-min-strain");
         scene.validate().map_err(|e| flag_error(e, &given))?;
-        if resume.is_none() {
+        if fresh {
             scene
                 .check_snapshots()
                 .map_err(|e| flag_error(e, &given))
@@ -529,11 +547,23 @@ impl BedArgs {
                     None => e,
                 })?;
         }
-        Ok((scene, notes))
+        Ok(scene)
     }
 
     /// Runs the command.
     pub fn run(&self, streams: &mut Streams<'_>) -> anyhow::Result<()> {
+        if let Some(dir) = &self.resume
+            && !dir.join(checkpoint::FILE_NAME).is_file()
+            && series::SeriesFile::is_in(dir)
+        {
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(self.threads)
+                .build()?;
+            return self.resume_series(dir, &pool, streams);
+        }
+        if let Some(dir) = &self.resume {
+            series::refuse_runs_without_series(dir)?;
+        }
         let resume = match &self.resume {
             Some(dir) => Some(checkpoint::Checkpoint::read(dir)?),
             None => None,
@@ -622,7 +652,7 @@ impl BedArgs {
         };
         let mut result = self.compress(&pool, &scene, control, &out, "bed", &notes, streams)?;
         if result.interrupted {
-            return Err(interrupted(&result, &out, ""));
+            return Err(interrupted(&result, &out, &out, ""));
         }
         if self.rate_check && result.error.is_none() {
             self.rate_check(&pool, &scene, &out, &mut result, streams)?;
@@ -840,7 +870,15 @@ impl BedArgs {
                 types.len()
             )?;
         }
-        let series: Vec<SeriesRun> = types
+        series::SeriesFile {
+            format: series::FORMAT,
+            kind: series::SeriesKind::Types,
+            members: types.iter().map(|t| t.name().to_owned()).collect(),
+            scene_toml: base.to_toml(),
+            pour: Some(series::StoredPacking::new(pour_type, &packing)),
+        }
+        .write(&self.out)?;
+        let mut series: Vec<SeriesRun> = types
             .iter()
             .zip(&scenes)
             .map(|(t, scene)| SeriesRun {
@@ -849,25 +887,44 @@ impl BedArgs {
                 dir: self.out.join(t.name()),
                 scene,
                 packing: Some(packing.clone()),
+                resume: None,
             })
             .collect();
-        let runs = self.compress_series(pool, &series, "comparison", notes, streams)?;
-        let rows: Vec<compare::ComparisonRow> = types
-            .iter()
-            .zip(&scenes)
-            .zip(&runs)
-            .map(|((t, scene), r)| compare::ComparisonRow::new(*t, &outputs::summary(scene, r)))
-            .collect();
-        let samples: Vec<&[run::BedSample]> = runs.iter().map(|r| r.samples.as_slice()).collect();
-        let comparison = compare::Comparison {
-            version: env!("CARGO_PKG_VERSION"),
-            pour_granule_type: pour_type.name(),
-            pour_wall_time_s: packing.wall_time_s,
-            types: &rows,
-        };
-        compare::write_comparison(&self.out, &comparison, &samples)?;
+        let runs =
+            self.compress_series(pool, &mut series, &self.out, "comparison", notes, streams)?;
+        write_types_tables(&self.out, &scenes, &runs, pour_type, packing.wall_time_s)?;
         series_failures(&series, runs)
     }
+}
+
+/// The comparison of a `--types` series in `dir` ([`compare::write_comparison`]):
+/// `scenes` and `runs` per type, in order; the pour was of `pour_type`'s
+/// sphere density and took `pour_wall_time_s`.
+fn write_types_tables(
+    dir: &std::path::Path,
+    scenes: &[Scene],
+    runs: &[run::BedRun],
+    pour_type: GranuleType,
+    pour_wall_time_s: f64,
+) -> anyhow::Result<()> {
+    let rows: Vec<compare::ComparisonRow> = scenes
+        .iter()
+        .zip(runs)
+        .map(|(scene, r)| {
+            Ok(compare::ComparisonRow::new(
+                scene.granule_type()?,
+                &outputs::summary(scene, r),
+            ))
+        })
+        .collect::<anyhow::Result<_>>()?;
+    let samples: Vec<&[run::BedSample]> = runs.iter().map(|r| r.samples.as_slice()).collect();
+    let comparison = compare::Comparison {
+        version: env!("CARGO_PKG_VERSION"),
+        pour_granule_type: pour_type.name(),
+        pour_wall_time_s,
+        types: &rows,
+    };
+    compare::write_comparison(dir, &comparison, &samples)
 }
 
 /// One run of a series (`--types`, `--seeds`): what it is called in
@@ -879,27 +936,33 @@ struct SeriesRun<'a> {
     dir: std::path::PathBuf,
     scene: &'a Scene,
     packing: Option<run::Packing>,
+    /// The checkpoint to continue from (a resumed series), else a fresh run.
+    resume: Option<checkpoint::Checkpoint>,
 }
 
 impl BedArgs {
-    /// Compresses the runs of `series` one after the other (each fresh, on
-    /// all of `pool`'s threads, with its checkpoints and outputs in its
-    /// directory). A run the kernel stopped does not stop the others (see
+    /// Compresses the runs of `series` one after the other (each fresh or
+    /// from its checkpoint, which is taken out of it, on all of `pool`'s
+    /// threads, with its checkpoints and outputs in its directory). A run
+    /// the kernel stopped does not stop the others (see
     /// [`series_failures`]); an interrupt stops the series with an error
-    /// naming the runs not made and the `what` (the series' own output)
-    /// left unwritten.
+    /// naming the runs not made and the `what` (the series' own output in
+    /// `series_dir`) left unwritten, and how to resume the series.
     fn compress_series(
         &self,
         pool: &rayon::ThreadPool,
-        series: &[SeriesRun<'_>],
+        series: &mut [SeriesRun<'_>],
+        series_dir: &std::path::Path,
         what: &str,
         notes: &[String],
         streams: &mut Streams<'_>,
     ) -> anyhow::Result<Vec<run::BedRun>> {
         let mut runs = Vec::with_capacity(series.len());
-        for (k, item) in series.iter().enumerate() {
+        for k in 0..series.len() {
+            let resume = series[k].resume.take();
+            let item = &series[k];
             let control = run::RunControl {
-                resume: None,
+                resume,
                 packing: item.packing.clone(),
                 checkpoint_dir: Some(item.dir.clone()),
                 stop_at_strain: None,
@@ -927,6 +990,7 @@ impl BedArgs {
                 return Err(interrupted(
                     &result,
                     &item.dir,
+                    series_dir,
                     &format!(" ({}; no {what} written{rest})", item.name),
                 ));
             }
@@ -954,15 +1018,21 @@ fn series_failures(series: &[SeriesRun<'_>], runs: Vec<run::BedRun>) -> anyhow::
 }
 
 /// The error of a run stopped by SIGINT/SIGTERM, its outputs and
-/// checkpoint in `dir`; `what` adds to the message.
-fn interrupted(result: &run::BedRun, dir: &std::path::Path, what: &str) -> anyhow::Error {
+/// checkpoint in `dir`, continued by `--resume resume_dir` (`dir`, or the
+/// directory of the series it belongs to); `what` adds to the message.
+fn interrupted(
+    result: &run::BedRun,
+    dir: &std::path::Path,
+    resume_dir: &std::path::Path,
+    what: &str,
+) -> anyhow::Error {
     anyhow::Error::new(crate::signal::Interrupted(format!(
         "interrupted at C = {:.4}, step {}{what}: the checkpoint and the outputs so far are in \
          `{}`; continue with: granbed-cli bed --resume {}",
         result.strain_reached,
         result.steps,
         dir.display(),
-        dir.display()
+        resume_dir.display()
     )))
 }
 

@@ -21,7 +21,7 @@ use serde::Serialize;
 
 use super::compare::{ComparisonRow, write_overlays, write_rows};
 use super::outputs::{FIT_MIN_R_SQUARED, KawakitaSummary, kawakita_doubts};
-use super::{BedArgs, Scene, SeriesRun, outputs, run, series_failures};
+use super::{BedArgs, Scene, SeriesRun, outputs, run, series, series_failures};
 use crate::csv::{CsvWriter, Field};
 use crate::output::{Streams, create_file, finish_file, write_json};
 
@@ -257,7 +257,15 @@ impl BedArgs {
                 self.out.display()
             )?;
         }
-        let series: Vec<SeriesRun> = seeds
+        series::SeriesFile {
+            format: series::FORMAT,
+            kind: series::SeriesKind::Seeds,
+            members: seeds.iter().map(u64::to_string).collect(),
+            scene_toml: base.to_toml(),
+            pour: None,
+        }
+        .write(&self.out)?;
+        let mut series: Vec<SeriesRun> = seeds
             .iter()
             .zip(&scenes)
             .map(|(seed, scene)| SeriesRun {
@@ -266,21 +274,32 @@ impl BedArgs {
                 dir: self.out.join(seed_dir(*seed)),
                 scene,
                 packing: None,
+                resume: None,
             })
             .collect();
-        let runs = self.compress_series(pool, &series, "spread", notes, streams)?;
-        let rows: Vec<ComparisonRow> = scenes
-            .iter()
-            .zip(&runs)
-            .map(|(scene, r)| {
-                let t = scene.granule_type()?;
-                Ok(ComparisonRow::new(t, &outputs::summary(scene, r)))
-            })
-            .collect::<anyhow::Result<_>>()?;
-        let samples: Vec<&[run::BedSample]> = runs.iter().map(|r| r.samples.as_slice()).collect();
-        write_seeds(&self.out, &rows, &samples)?;
+        let runs = self.compress_series(pool, &mut series, &self.out, "spread", notes, streams)?;
+        write_seed_tables(&self.out, &scenes, &runs)?;
         series_failures(&series, runs)
     }
+}
+
+/// The spread of a `--seeds` series in `dir` ([`write_seeds`]): `scenes`
+/// and `runs` per seed, in order.
+pub(super) fn write_seed_tables(
+    dir: &std::path::Path,
+    scenes: &[Scene],
+    runs: &[run::BedRun],
+) -> anyhow::Result<()> {
+    let rows: Vec<ComparisonRow> = scenes
+        .iter()
+        .zip(runs)
+        .map(|(scene, r)| {
+            let t = scene.granule_type()?;
+            Ok(ComparisonRow::new(t, &outputs::summary(scene, r)))
+        })
+        .collect::<anyhow::Result<_>>()?;
+    let samples: Vec<&[run::BedSample]> = runs.iter().map(|r| r.samples.as_slice()).collect();
+    write_seeds(dir, &rows, &samples)
 }
 
 #[cfg(test)]

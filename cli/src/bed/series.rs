@@ -1,0 +1,312 @@
+//! A series of bed runs (`--types`, `--seeds`) kept resumable as a whole.
+//!
+//! A series writes `DIR/series.json` ([`SeriesFile`]) before its first
+//! run: what kind of series it is, its members in order, the scene they
+//! share and, for `--types`, the one pour they all compress (sphere
+//! centres as their bits, so a member started later gets the same bed).
+//! `granbed-cli bed --resume DIR` on such a directory then continues every
+//! member from its checkpoint, runs the members never started from the
+//! series' scene (and pour), refits the finished ones with the windows
+//! given, and writes `DIR`'s tables again — what an interrupted series
+//! had left unwritten, or a refit would otherwise leave stale.
+
+use std::io::Write as _;
+use std::path::{Path, PathBuf};
+
+use anyhow::Context as _;
+use granbed_kernel::material::GranuleType;
+use serde::{Deserialize, Serialize};
+
+use super::seeds::seed_dir;
+use super::{BedArgs, Scene, SeriesRun, checkpoint, run};
+use crate::error::input_error;
+use crate::output::Streams;
+
+/// File name of the series description in the series directory.
+pub const FILE_NAME: &str = "series.json";
+/// Format version written and read.
+pub const FORMAT: u32 = 1;
+
+/// What a series runs once per member.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum SeriesKind {
+    /// `--types`: one granule type per member, all from one pour.
+    Types,
+    /// `--seeds`: one seed per member, each with its own pour.
+    Seeds,
+}
+
+/// The pour a `--types` series shares, exactly: floats as their bits.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct StoredPacking {
+    /// The granule type whose sphere density the pour used.
+    pub granule_type: String,
+    /// Sphere centres, m, as `f64::to_bits`.
+    pub centres_bits: Vec<[u64; 3]>,
+    /// Sphere radius, m, as bits.
+    pub radius_m_bits: u64,
+    /// Die radius, m, as bits.
+    pub die_radius_m_bits: u64,
+    /// Wall time of the pour, s.
+    pub wall_time_s: f64,
+}
+
+impl StoredPacking {
+    /// `packing`, poured with the sphere density of `granule_type`.
+    pub fn new(granule_type: GranuleType, packing: &run::Packing) -> Self {
+        Self {
+            granule_type: granule_type.name().to_owned(),
+            centres_bits: packing
+                .centres
+                .iter()
+                .map(|c| c.map(f64::to_bits))
+                .collect(),
+            radius_m_bits: packing.radius_m.to_bits(),
+            die_radius_m_bits: packing.die_radius_m.to_bits(),
+            wall_time_s: packing.wall_time_s,
+        }
+    }
+
+    /// The packing, bit for bit as stored.
+    pub fn packing(&self) -> run::Packing {
+        run::Packing {
+            centres: self
+                .centres_bits
+                .iter()
+                .map(|c| c.map(f64::from_bits))
+                .collect(),
+            radius_m: f64::from_bits(self.radius_m_bits),
+            die_radius_m: f64::from_bits(self.die_radius_m_bits),
+            wall_time_s: self.wall_time_s,
+        }
+    }
+}
+
+/// `DIR/series.json`.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct SeriesFile {
+    /// [`FORMAT`].
+    pub format: u32,
+    /// The kind of series.
+    pub kind: SeriesKind,
+    /// The members in order: granule type names, or seeds in decimal.
+    pub members: Vec<String>,
+    /// The scene every member starts from (TOML), before its own type or
+    /// seed is set.
+    pub scene_toml: String,
+    /// The shared pour (`--types` only).
+    pub pour: Option<StoredPacking>,
+}
+
+/// One member of a series: its name in messages, its label on the
+/// progress bar, its directory and its scene when started afresh.
+struct Member {
+    name: String,
+    label: String,
+    dir: PathBuf,
+    scene: Scene,
+}
+
+impl SeriesFile {
+    /// Whether `dir` holds a series description.
+    pub fn is_in(dir: &Path) -> bool {
+        dir.join(FILE_NAME).is_file()
+    }
+
+    /// Writes the file into `dir` atomically (a temporary file, synced,
+    /// renamed over the old one).
+    pub fn write(&self, dir: &Path) -> anyhow::Result<()> {
+        let path = dir.join(FILE_NAME);
+        let tmp = dir.join(format!("{FILE_NAME}.tmp"));
+        let ctx = || format!("cannot write `{}`", tmp.display());
+        let mut text = serde_json::to_vec_pretty(self).with_context(ctx)?;
+        text.push(b'\n');
+        let mut file = std::fs::File::create(&tmp).with_context(ctx)?;
+        file.write_all(&text)
+            .and_then(|()| file.sync_all())
+            .with_context(ctx)?;
+        drop(file);
+        std::fs::rename(&tmp, &path)
+            .with_context(|| format!("cannot move the series file to `{}`", path.display()))
+    }
+
+    /// Reads `dir/series.json`; an error names the file and what is wrong
+    /// with it.
+    pub fn read(dir: &Path) -> anyhow::Result<Self> {
+        let path = dir.join(FILE_NAME);
+        let text = std::fs::read_to_string(&path)
+            .with_context(|| format!("cannot read `{}`", path.display()))?;
+        let bad = |what: String| input_error(format!("`{}`: {what}", path.display()));
+        let file: Self = serde_json::from_str(&text).map_err(|e| bad(e.to_string()))?;
+        if file.format != FORMAT {
+            return Err(bad(format!(
+                "format {} (this build reads format {FORMAT})",
+                file.format
+            )));
+        }
+        if file.members.is_empty() {
+            return Err(bad("no members".to_owned()));
+        }
+        if (file.kind == SeriesKind::Types) != file.pour.is_some() {
+            return Err(bad(
+                "a series of types holds its pour, a series of seeds none".to_owned(),
+            ));
+        }
+        Ok(file)
+    }
+
+    /// The members with their directories in `dir` and their fresh
+    /// scenes; an error names a member that is no type or seed.
+    fn members(&self, dir: &Path) -> anyhow::Result<Vec<Member>> {
+        let base = Scene::from_toml(&self.scene_toml).context("the series' scene")?;
+        self.members
+            .iter()
+            .map(|m| {
+                let bad =
+                    || input_error(format!("`{}`: member `{m}`", dir.join(FILE_NAME).display()));
+                Ok(match self.kind {
+                    SeriesKind::Types => {
+                        let t: GranuleType = m.parse().map_err(|_| bad())?;
+                        Member {
+                            name: format!("granule type {t}"),
+                            label: format!("bed {t}"),
+                            dir: dir.join(t.name()),
+                            scene: Scene {
+                                granule_type: t.name().to_owned(),
+                                ..base.clone()
+                            },
+                        }
+                    }
+                    SeriesKind::Seeds => {
+                        let seed: u64 = m.parse().map_err(|_| bad())?;
+                        Member {
+                            name: format!("seed {seed}"),
+                            label: format!("bed seed {seed}"),
+                            dir: dir.join(seed_dir(seed)),
+                            scene: Scene {
+                                seed,
+                                ..base.clone()
+                            },
+                        }
+                    }
+                })
+            })
+            .collect()
+    }
+}
+
+/// `Err` naming the runs in `dir`'s sub-directories when `dir` holds no
+/// checkpoint and no [`FILE_NAME`] but runs of its own (a series written
+/// before series files): each resumes alone. `Ok` otherwise.
+pub fn refuse_runs_without_series(dir: &Path) -> anyhow::Result<()> {
+    if dir.join(checkpoint::FILE_NAME).is_file() || SeriesFile::is_in(dir) {
+        return Ok(());
+    }
+    let Ok(entries) = std::fs::read_dir(dir) else {
+        return Ok(());
+    };
+    let mut runs: Vec<String> = entries
+        .filter_map(Result::ok)
+        .filter(|e| e.path().join(checkpoint::FILE_NAME).is_file())
+        .map(|e| e.file_name().to_string_lossy().into_owned())
+        .collect();
+    if runs.is_empty() {
+        return Ok(());
+    }
+    runs.sort();
+    Err(input_error(format!(
+        "`{}` holds no checkpoint and no {FILE_NAME}, but runs with checkpoints in {}: resume \
+         each alone with --resume {}/<run>",
+        dir.display(),
+        runs.join(", "),
+        dir.display()
+    )))
+}
+
+impl BedArgs {
+    /// `--resume DIR` on a series directory: every member continued from
+    /// its checkpoint (with the overrides allowed with `--resume`), or
+    /// started afresh from the series' scene and pour if it has none; then
+    /// the series' tables written again.
+    pub(super) fn resume_series(
+        &self,
+        dir: &Path,
+        pool: &rayon::ThreadPool,
+        streams: &mut Streams<'_>,
+    ) -> anyhow::Result<()> {
+        for (given, flag) in [
+            (self.stop_at_strain.is_some(), "--stop-at-strain"),
+            (self.rate_check, "--rate-check"),
+        ] {
+            if given {
+                return Err(input_error(format!(
+                    "`{flag}` is not taken when resuming the series in `{}`; resume one of its \
+                     runs alone with --resume on its directory",
+                    dir.display()
+                )));
+            }
+        }
+        let file = SeriesFile::read(dir)?;
+        let packing = file.pour.as_ref().map(StoredPacking::packing);
+        // Every member's scene is made and checked before anything runs.
+        let mut scenes = Vec::new();
+        let mut resumes = Vec::new();
+        let members = file.members(dir)?;
+        for m in &members {
+            let resume = if m.dir.join(checkpoint::FILE_NAME).is_file() {
+                Some(checkpoint::Checkpoint::read(&m.dir).with_context(|| m.name.clone())?)
+            } else {
+                None
+            };
+            let scene = match &resume {
+                Some(c) => self.scene(Some(c)),
+                None => self.overridden(m.scene.clone(), true),
+            }
+            .with_context(|| m.name.clone())?;
+            scenes.push(scene);
+            resumes.push(resume);
+        }
+        if !self.quiet {
+            let started = resumes.iter().filter(|r| r.is_some()).count();
+            writeln!(
+                streams.stderr,
+                "bed: resuming the series in `{}`: {} runs, {started} with a checkpoint",
+                dir.display(),
+                members.len()
+            )?;
+        }
+        let mut series: Vec<SeriesRun> = members
+            .iter()
+            .zip(&scenes)
+            .zip(resumes)
+            .map(|((m, scene), resume)| SeriesRun {
+                name: m.name.clone(),
+                label: m.label.clone(),
+                dir: m.dir.clone(),
+                scene,
+                packing: packing.clone(),
+                resume,
+            })
+            .collect();
+        let what = match file.kind {
+            SeriesKind::Types => "comparison",
+            SeriesKind::Seeds => "spread",
+        };
+        let runs = self.compress_series(pool, &mut series, dir, what, &[], streams)?;
+        match &file.pour {
+            Some(pour) => {
+                let pour_type: GranuleType = pour.granule_type.parse().map_err(|_| {
+                    input_error(format!(
+                        "`{}`: pour granule type `{}`",
+                        dir.join(FILE_NAME).display(),
+                        pour.granule_type
+                    ))
+                })?;
+                super::write_types_tables(dir, &scenes, &runs, pour_type, pour.wall_time_s)?;
+            }
+            None => super::seeds::write_seed_tables(dir, &scenes, &runs)?,
+        }
+        super::series_failures(&series, runs)
+    }
+}
