@@ -841,7 +841,7 @@ impl BedArgs {
         // η0 reuse that packing as it is.
         let pour_index = types
             .iter()
-            .position(|t| t.name() == base.granule_type)
+            .position(|t| base.granule_type().is_ok_and(|b| b == *t))
             .unwrap_or(0);
         let pour_type = types[pour_index];
         crate::output::create_out_dir(&self.out)?;

@@ -501,11 +501,14 @@ impl Scene {
 
     /// Parses and validates a scene file's text.
     pub fn from_toml(text: &str) -> anyhow::Result<Self> {
-        let scene: Scene = toml::from_str(text).map_err(|e| {
+        let mut scene: Scene = toml::from_str(text).map_err(|e| {
             anyhow::Error::new(InputError(format!("invalid scene: {}", e.message())))
                 .context(e.to_string())
         })?;
         scene.validate()?;
+        // The type as it is spelt everywhere else (`b2` → `B2`): the
+        // outputs name it so, and `--types` finds the scene's type by it.
+        scene.granule_type = scene.granule_type()?.name().to_owned();
         Ok(scene)
     }
 
@@ -936,6 +939,19 @@ mod tests {
         };
         assert!(s.to_toml().contains("selective_mass_ratio = inf"));
         assert_eq!(Scene::from_toml(&s.to_toml()).unwrap(), s);
+    }
+
+    /// A type spelt in lower case is read as the type and named as the
+    /// outputs name it.
+    #[test]
+    fn a_lower_case_type_reads_as_the_type() {
+        let text = Scene::published()
+            .to_toml()
+            .replace("granule_type = \"B2\"", "granule_type = \"c1\"");
+        assert!(text.contains("\"c1\""));
+        let s = Scene::from_toml(&text).unwrap();
+        assert_eq!(s.granule_type, "C1");
+        assert_eq!(s.granule_type().unwrap(), GranuleType::C1);
     }
 
     #[test]
