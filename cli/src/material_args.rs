@@ -135,9 +135,103 @@ pub fn flag_for_field(field: &str) -> String {
     format!("--{}", field.replace('_', "-"))
 }
 
+/// What material overrides do to a comparison of `types` (`--types`): the
+/// types differ in their yield stress (the letter) and η0 (the digit), and
+/// an override given for one of them replaces it in every type.
+/// `overrides` are the yield stress, Pa, and η0 given, each with how the
+/// user spelt it (a flag or a scene field). Two listed types left with the
+/// same yield stress and η0 would be one material under two names: `Err`,
+/// a usage error. An override of a parameter in which the listed types
+/// differ, the types still distinct: a warning to show. Otherwise `None`.
+pub fn check_type_overrides(
+    types: &[GranuleType],
+    [(yield_stress, yield_name), (eta0, eta0_name)]: [(Option<f64>, &str); 2],
+) -> anyhow::Result<Option<String>> {
+    let own = |t: &GranuleType| (t.yield_stress_pa(), t.eta0());
+    let effective = |t: &GranuleType| {
+        let (y, e) = own(t);
+        (yield_stress.unwrap_or(y), eta0.unwrap_or(e))
+    };
+    for (i, a) in types.iter().enumerate() {
+        if let Some(b) = types[i + 1..].iter().find(|b| effective(b) == effective(a)) {
+            let (y, e) = effective(a);
+            let given: Vec<&str> = [(yield_stress, yield_name), (eta0, eta0_name)]
+                .iter()
+                .filter(|(v, _)| v.is_some())
+                .map(|&(_, name)| name)
+                .collect();
+            return Err(InputError(format!(
+                "{} applies to every listed type: {a} and {b} would run the same material (yield \
+                 stress {y} Pa, eta0 {e}) under two names; leave it out to compare the types",
+                given.join(" and ")
+            ))
+            .into());
+        }
+    }
+    let differ = |f: fn(&(f64, f64)) -> f64| {
+        types
+            .windows(2)
+            .any(|w| f(&own(&w[0])).to_bits() != f(&own(&w[1])).to_bits())
+    };
+    let replaced: Vec<String> = [
+        (yield_stress, yield_name, "yield stresses", differ(|p| p.0)),
+        (eta0, eta0_name, "eta0", differ(|p| p.1)),
+    ]
+    .iter()
+    .filter_map(|&(v, name, what, differ)| {
+        v.filter(|_| differ)
+            .map(|v| format!("{name} = {v} replaces the listed types' own {what}"))
+    })
+    .collect();
+    Ok((!replaced.is_empty()).then(|| {
+        format!(
+            "{}: the types compared differ only in what is left",
+            replaced.join("; ")
+        )
+    }))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn overrides_that_merge_types_are_refused_and_those_that_replace_warned() {
+        use GranuleType::{A2, A3, C2};
+        let names = |y, e| [(y, "--yield-stress-pa"), (e, "--eta0")];
+        // Nothing given, or a parameter the types share: nothing to say.
+        assert!(
+            check_type_overrides(&[A2, C2], names(None, None))
+                .unwrap()
+                .is_none()
+        );
+        assert!(
+            check_type_overrides(&[A2, C2], names(None, Some(0.7)))
+                .unwrap()
+                .is_none()
+        );
+        // A2 and C2 differ in their yield stress only.
+        let e = check_type_overrides(&[A2, C2], names(Some(5e4), None)).unwrap_err();
+        let e = e.to_string();
+        assert!(
+            e.contains("--yield-stress-pa") && e.contains("A2 and C2"),
+            "{e}"
+        );
+        // A2, A3 and C2: η0 replaced, A2/A3 merge.
+        let e = check_type_overrides(&[A2, A3, C2], names(None, Some(0.7))).unwrap_err();
+        assert!(e.to_string().contains("A2 and A3"), "{e}");
+        // A3 and C2 differ in both: replacing one leaves them distinct.
+        let w = check_type_overrides(&[A3, C2], names(Some(5e4), None))
+            .unwrap()
+            .unwrap();
+        assert!(w.contains("--yield-stress-pa = 50000"), "{w}");
+        // A single type compares nothing.
+        assert!(
+            check_type_overrides(&[A2], names(Some(5e4), Some(0.7)))
+                .unwrap()
+                .is_none()
+        );
+    }
     use clap::Parser;
 
     #[derive(Parser)]

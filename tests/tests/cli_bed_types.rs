@@ -162,5 +162,34 @@ fn bad_type_lists_and_conflicts_are_usage_errors() {
             run.stderr
         );
     }
+    // A scene whose material override leaves two listed types one
+    // material: refused before the pour, naming the field.
+    let scenes = out_dir("scenes");
+    std::fs::create_dir_all(&scenes).unwrap();
+    let printed = cli(&["bed", "--print-scene"]);
+    assert_eq!(printed.code, 0);
+    let scene = scenes.join("yield.toml");
+    std::fs::write(
+        &scene,
+        printed
+            .stdout
+            .replace("[material]\n", "[material]\nyield_stress_pa = 50000.0\n"),
+    )
+    .unwrap();
+    let run = cli(&[
+        "bed",
+        "--out",
+        out,
+        "--scene",
+        scene.to_str().unwrap(),
+        "--types",
+        "A2,C2",
+    ]);
+    assert_eq!(run.code, 2, "{}", run.stderr);
+    assert!(
+        run.stderr.contains("material.yield_stress_pa") && run.stderr.contains("A2 and C2"),
+        "{}",
+        run.stderr
+    );
     assert!(!dir.exists(), "a usage error wrote {}", dir.display());
 }

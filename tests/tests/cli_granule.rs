@@ -319,7 +319,7 @@ fn platens_carry_equal_forces() {
 fn bad_input_names_the_flag() {
     let dir = out_dir("bad");
     let out = dir.to_str().unwrap();
-    let cases: [(&[&str], &str); 14] = [
+    let cases: [(&[&str], &str); 15] = [
         (&["--strain", "0"], "--strain"),
         (
             &["--diameter-mm", "0"],
@@ -339,6 +339,10 @@ fn bad_input_names_the_flag() {
         ),
         (&["--types", "A1,X9"], "--types"),
         (&["--types", "all,A1"], "`all`: write `all` alone"),
+        (
+            &["--types", "A2,C2", "--yield-stress-pa", "50000"],
+            "--yield-stress-pa applies to every listed type: A2 and C2",
+        ),
         (&["--type", "A1", "--types", "B2"], "--types"),
     ];
     for (args, flag) in cases {

@@ -168,6 +168,10 @@ pub struct BedArgs {
     /// `A2,B2,C2`. The pour uses the sphere density of the scene's type if
     /// listed, else of the first listed type. Writes `DIR/<TYPE>/` per type
     /// plus `DIR/comparison.csv`, `.json` and the `comparison_*.svg` plots.
+    /// The scene's `[material]` overrides apply to every type: one that
+    /// leaves two listed types the same material (the yield stress of
+    /// types of one letter, η0 of one digit) is refused, one that replaces
+    /// what they differ in is warned about.
     #[arg(long, value_name = "LIST", conflicts_with_all = ["granule_type", "resume", "stop_at_strain"])]
     pub types: Option<TypeList>,
 
@@ -834,6 +838,18 @@ impl BedArgs {
                 Ok(scene)
             })
             .collect::<anyhow::Result<_>>()?;
+        let mut notes = notes.to_vec();
+        let given = [
+            (
+                base.material.yield_stress_pa,
+                "the scene's material.yield_stress_pa",
+            ),
+            (base.material.eta0, "the scene's material.eta0"),
+        ];
+        if let Some(w) = crate::material_args::check_type_overrides(types, given)? {
+            writeln!(streams.stderr, "warning: {w}")?;
+            notes.push(w);
+        }
         // One pour for all types, as the published study compares the nine
         // types on one bed. The pour depends on the type only through the
         // sphere density (η0, the type's digit): it uses the scene's own
@@ -891,7 +907,7 @@ impl BedArgs {
             })
             .collect();
         let runs =
-            self.compress_series(pool, &mut series, &self.out, "comparison", notes, streams)?;
+            self.compress_series(pool, &mut series, &self.out, "comparison", &notes, streams)?;
         write_types_tables(&self.out, &scenes, &runs, pour_type, packing.wall_time_s)?;
         series_failures(&series, runs)
     }

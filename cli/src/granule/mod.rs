@@ -192,7 +192,9 @@ pub struct GranuleArgs {
 
     /// Run several granule types instead of --type: `all` (A1…C3) or a
     /// comma list such as `A1,B2,C3`. The material overrides apply to every
-    /// type. Writes `DIR/<TYPE>/…` per type plus `DIR/types.csv` and
+    /// type: --yield-stress-pa or --eta0 leaving two listed types the same
+    /// material is refused, replacing what they differ in is warned about.
+    /// Writes `DIR/<TYPE>/…` per type plus `DIR/types.csv` and
     /// `DIR/force_displacement_types.svg`.
     #[arg(long, value_name = "LIST", conflicts_with = "granule_type")]
     pub types: Option<TypeList>,
@@ -481,6 +483,15 @@ impl GranuleArgs {
         let radius = radius_of_diameter_mm(self.diameter_mm)?;
         let mesh = OwnedReference::sphere(radius, self.mesh, octant)?;
         let jobs = self.jobs(&mesh)?;
+        if let Some(types) = &self.types {
+            let given = [
+                (self.material.yield_stress_pa, "--yield-stress-pa"),
+                (self.material.eta0, "--eta0"),
+            ];
+            if let Some(w) = crate::material_args::check_type_overrides(&types.0, given)? {
+                writeln!(streams.stderr, "warning: {w}")?;
+            }
+        }
         for dir in core::iter::once(&self.out).chain(jobs.iter().map(|j| &j.dir)) {
             crate::output::create_out_dir(dir)?;
         }
