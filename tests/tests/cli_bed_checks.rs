@@ -194,12 +194,28 @@ fn scene_fields_out_of_range_or_contradicting_are_named() {
     let printed = scene_file("printed", &r.stdout);
     let scene = Scene::read(&printed).unwrap();
     assert_eq!(scene.snapshot_strains, [0.0, 0.1]);
+    // The punch speed and the granule size are flags too.
+    let r = bed(&[
+        "--print-scene",
+        "--punch-speed-m-s",
+        "0.02",
+        "--diameter-mm",
+        "0.8",
+    ]);
+    assert_eq!(r.code, 0, "{}", r.stderr);
+    let scene = Scene::read(&scene_file("speed", &r.stdout)).unwrap();
+    assert_eq!((scene.punch_speed_m_s, scene.diameter_mm), (0.02, 0.8));
 }
 
 #[test]
 fn every_numeric_flag_takes_a_minus_and_names_its_range() {
-    let cases: [(&str, &[&str]); 19] = [
+    let cases: [(&str, &[&str]); 21] = [
         ("--granules", &["'--granules <N>'", "1..=100000"]),
+        ("--diameter-mm", &["`--diameter-mm -1`", "0 < d < 2000"]),
+        (
+            "--punch-speed-m-s",
+            &["`--punch-speed-m-s -1`", "1e-4 <= v <= 10 m/s"],
+        ),
         ("--seed", &["'--seed <SEED>'", "0..=18446744073709551615"]),
         ("--strain", &["`--strain -1`", "0 < C <= 0.9"]),
         (

@@ -209,6 +209,17 @@ pub struct BedArgs {
     #[arg(long, value_name = "MM", allow_negative_numbers = true)]
     pub die_diameter_mm: Option<f64>,
 
+    /// Override: granule diameter, mm (0 < d < 2000; the die must stay
+    /// more than 4 granule diameters wide).
+    #[arg(long, value_name = "MM", allow_negative_numbers = true)]
+    pub diameter_mm: Option<f64>,
+
+    /// Override: upper-punch speed, m/s (1e-4 ≤ v ≤ 10; published 0.05). A
+    /// slower punch brings a run closer to quasi-static at the cost of
+    /// proportionally more steps.
+    #[arg(long, value_name = "M_S", allow_negative_numbers = true)]
+    pub punch_speed_m_s: Option<f64>,
+
     /// Override: element formulation (one-point, or fbar for verification:
     /// about 8× the element cost).
     #[arg(long, value_enum, value_name = "KIND")]
@@ -322,7 +333,7 @@ pub struct BedArgs {
     /// --exact-contact-from-strain, --face-list-skin,
     /// --time-step-floor, --max-mass-factor, --kawakita-min-strain,
     /// --heckel-min-strain, -j and --quiet may be given with it.
-    #[arg(long, value_name = "DIR", conflicts_with_all = ["scene", "out", "granule_type", "granules", "mesh", "seed", "die_diameter_mm", "element", "hourglass_kappa", "rigid_until_touched", "local_sweeps", "selective_mass_scaling", "selective_mass_ratio"])]
+    #[arg(long, value_name = "DIR", conflicts_with_all = ["scene", "out", "granule_type", "granules", "mesh", "seed", "die_diameter_mm", "diameter_mm", "punch_speed_m_s", "element", "hourglass_kappa", "rigid_until_touched", "local_sweeps", "selective_mass_scaling", "selective_mass_ratio"])]
     pub resume: Option<PathBuf>,
 
     /// Write a checkpoint and stop once the strain reaches C (continue
@@ -429,6 +440,7 @@ pub fn flag_error(e: anyhow::Error, given: &[(&'static str, String)]) -> anyhow:
     let related: &[&str] = match f.field {
         "output_strain_interval" | "snapshot_strains" => &["final_strain"],
         "contact_search_interval" => &["hold_constraints"],
+        "die_diameter_mm" => &["diameter_mm"],
         _ => &[],
     };
     let own = given
@@ -515,6 +527,8 @@ impl BedArgs {
         });
         set!(seed, "--seed");
         set!(die_diameter_mm, "--die-diameter-mm");
+        set!(diameter_mm, "--diameter-mm");
+        set!(punch_speed_m_s, "--punch-speed-m-s");
         // A value clap parsed from its list: no check can reject it.
         if let Some(e) = self.element {
             scene.element = scene::element_name(e.into()).to_owned();
