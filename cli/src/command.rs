@@ -48,7 +48,7 @@ pub enum Command {
     /// finite-element granule and press the upper punch to the final
     /// strain; write the compression profile and a summary with the
     /// Kawakita fit. Without arguments it runs the published scene.
-    /// (Boxed: its options are most of the enum's size.)
+    // Boxed: its options are most of the enum's size.
     Bed(Box<BedArgs>),
     /// Studies of the code itself: `work-precision` measures what each
     /// numerical setting costs and how far it moves the answer.
