@@ -140,8 +140,8 @@ pub struct PointArgs {
 
     /// Number of equal strain increments (1 to 10000000); the CSV has
     /// steps + 1 rows.
-    #[arg(long, default_value_t = 1000,
-          value_parser = clap::value_parser!(u32).range(1..=i64::from(MAX_STEPS)))]
+    #[arg(long, default_value_t = 1000, allow_negative_numbers = true,
+          value_parser = crate::numbers::whole::<u32>(1, MAX_STEPS as u64))]
     pub steps: u32,
 
     /// CSV output file; `-` or absent writes to stdout.

@@ -72,6 +72,11 @@ fn scene_fields_out_of_range_or_contradicting_are_named() {
         let path = scene_file("print", text);
         bed(&["--print-scene", "--scene", path.to_str().unwrap()])
     };
+    // A scene file that is not there: a usage error naming it.
+    rejected(
+        &bed(&["--print-scene", "--scene", "no/such/scene.toml"]),
+        &["cannot read scene `no/such/scene.toml`"],
+    );
     // Snapshot strains past the file's final strain: refused, naming the
     // file; a --strain that reaches them makes the file good (the test
     // comes after the overrides), and the printed scene keeps them.

@@ -97,7 +97,7 @@ fn hydrostatic_a1_plastic_rows_sit_on_the_pressure_cap() {
 /// what is allowed, and nothing is written to stdout.
 #[test]
 fn bad_input_names_the_flag_and_the_range() {
-    let cases: [(&[&str], &[&str]); 7] = [
+    let cases: [(&[&str], &[&str]); 8] = [
         (
             &["--path", "hydrostatic", "--eta0", "0.1"],
             &["--eta0", "eta_c < eta0 <= 1", "eta_c = 0.2"],
@@ -121,6 +121,10 @@ fn bad_input_names_the_flag_and_the_range() {
         (
             &["--path", "hydrostatic", "--steps", "0"],
             &["--steps", "1..=10000000"],
+        ),
+        (
+            &["--path", "hydrostatic", "--steps", "1e3"],
+            &["--steps", "not a whole number", "1..=10000000"],
         ),
         (
             // η0 from the preset becomes invalid through another flag.

@@ -828,8 +828,10 @@ impl Scene {
     /// omits whose value then differs from the published scene's
     /// ([`Scene::omitted_fields`]).
     pub fn read_with_notes(path: &std::path::Path) -> anyhow::Result<(Self, Vec<String>)> {
-        let text = std::fs::read_to_string(path)
-            .with_context(|| format!("cannot read scene `{}`", path.display()))?;
+        // A scene that cannot be read is the user's to fix: a usage error.
+        let text = std::fs::read_to_string(path).map_err(|e| {
+            crate::error::input_error(format!("cannot read scene `{}`: {e}", path.display()))
+        })?;
         // Its snapshot strains are checked against the final strain after
         // the command's overrides (`--strain` may move the end past them).
         let scene =
