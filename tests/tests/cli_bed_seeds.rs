@@ -104,6 +104,26 @@ fn each_seed_is_its_own_run_and_the_spread_is_of_their_figures() {
         "heckel_yield_pressure_pa" => hr[k] >= 0.9,
         _ => true,
     };
+    // The table says which fits are material figures, by the same rule.
+    for k in 0..2 {
+        let ok = |column: &str| table.num(column)[k] == 1.0;
+        assert_eq!(ok("kawakita_ok"), described("kawakita_a", k), "row {k}");
+        assert_eq!(
+            ok("heckel_ok"),
+            described("heckel_yield_pressure_pa", k),
+            "row {k}"
+        );
+        let warned = summaries[k]["warnings"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .any(|w| w.as_str().unwrap().contains("Kawakita fit"));
+        assert_eq!(
+            ok("kawakita_ok"),
+            !warned,
+            "row {k}: the summary's warnings"
+        );
+    }
     for (i, figure) in figures.iter().enumerate() {
         let v: Vec<f64> = (0..2)
             .map(|k| table.num(figure)[k])

@@ -11,7 +11,7 @@ use granbed_kernel::Real;
 use granbed_kernel::material::GranuleType;
 use serde::Serialize;
 
-use super::outputs::Summary;
+use super::outputs::{FIT_MIN_R_SQUARED, Summary, kawakita_doubts};
 use super::plots::overlay_svg;
 use super::run::BedSample;
 use crate::csv::{CsvWriter, Field};
@@ -28,7 +28,7 @@ pub const DENSITY_SVG: &str = "comparison_density.svg";
 
 /// Columns of [`COMPARISON_CSV`], in order (`NaN` where the summary has
 /// `null`, e.g. no Kawakita fit for a run that ended before its window).
-pub const COMPARISON_COLUMNS: [&str; 18] = [
+pub const COMPARISON_COLUMNS: [&str; 20] = [
     "type",
     "seed",
     "yield_stress_pa",
@@ -37,8 +37,10 @@ pub const COMPARISON_COLUMNS: [&str; 18] = [
     "kawakita_inv_b_pa",
     "kawakita_r_squared",
     "kawakita_points",
+    "kawakita_ok",
     "heckel_yield_pressure_pa",
     "heckel_r_squared",
+    "heckel_ok",
     "initial_solid_fraction",
     "max_pressure_pa",
     "final_strain",
@@ -69,10 +71,18 @@ pub struct ComparisonRow {
     pub kawakita_r_squared: Option<Real>,
     /// Output rows in the fit (C ≥ the scene's `kawakita_min_strain`).
     pub kawakita_points: usize,
+    /// The Kawakita fit exists and describes the bed (1 in the CSV): none
+    /// of the summary's doubts ([`kawakita_doubts`]: a in (0, 1], 1/b > 0,
+    /// R² at least [`FIT_MIN_R_SQUARED`]). A fit with 0 is no material
+    /// figure; the summary's warning says why.
+    pub kawakita_ok: bool,
     /// Heckel mean yield pressure, Pa.
     pub heckel_yield_pressure_pa: Option<Real>,
     /// R² of the Heckel fit.
     pub heckel_r_squared: Option<Real>,
+    /// The Heckel fit exists with R² at least [`FIT_MIN_R_SQUARED`] (1 in
+    /// the CSV; 0: no material figure, as the summary warns).
+    pub heckel_ok: bool,
     /// The poured bed's solid fraction D0.
     pub initial_solid_fraction: Real,
     /// Largest upper-punch pressure, Pa.
@@ -107,8 +117,11 @@ impl ComparisonRow {
             kawakita_inv_b_pa: s.kawakita.inv_b_pa,
             kawakita_r_squared: s.kawakita.r_squared,
             kawakita_points: s.kawakita.points,
+            kawakita_ok: s.kawakita.a.is_some() && kawakita_doubts(&s.kawakita).is_empty(),
             heckel_yield_pressure_pa: s.heckel.yield_pressure_pa,
             heckel_r_squared: s.heckel.r_squared,
+            heckel_ok: s.heckel.yield_pressure_pa.is_some()
+                && s.heckel.r_squared.is_some_and(|r2| r2 >= FIT_MIN_R_SQUARED),
             initial_solid_fraction: s.initial_solid_fraction,
             max_pressure_pa: s.max_pressure_pa,
             final_strain: s.final_strain,
@@ -132,8 +145,10 @@ impl ComparisonRow {
             opt(self.kawakita_inv_b_pa),
             opt(self.kawakita_r_squared),
             Field::Int(self.kawakita_points as u64),
+            Field::Int(u64::from(self.kawakita_ok)),
             opt(self.heckel_yield_pressure_pa),
             opt(self.heckel_r_squared),
+            Field::Int(u64::from(self.heckel_ok)),
             self.initial_solid_fraction.into(),
             self.max_pressure_pa.into(),
             self.final_strain.into(),

@@ -101,11 +101,13 @@ as they were.
 With --types, the files above go to DIR/<TYPE>/ per type (each resumable
 alone with --resume DIR/<TYPE>), and DIR holds the comparison:
   comparison.csv   one row per type, in the order given: type, seed, yield
-                   stress, eta0, Kawakita a, 1/b (Pa), R^2, points, Heckel P_y (Pa),
-                   R^2, D0, max pressure,
+                   stress, eta0, Kawakita a, 1/b (Pa), R^2, points, kawakita_ok,
+                   Heckel P_y (Pa), R^2, heckel_ok, D0, max pressure,
                    final strain, final pressure, final mean relative density,
                    final coordination number, quasi_static_passed (1/0),
-                   wall time
+                   wall time; kawakita_ok / heckel_ok: 1 if the fit is a
+                   material figure, 0 if absent or warned about (summary.json
+                   says why)
   comparison.json  the same rows, the errors, and the type of the pour
   comparison_pressure.svg, comparison_density.svg
                    upper-punch pressure and mean relative density against

@@ -20,7 +20,6 @@ use granbed_kernel::Real;
 use serde::Serialize;
 
 use super::compare::{ComparisonRow, write_overlays, write_rows};
-use super::outputs::{FIT_MIN_R_SQUARED, KawakitaSummary, kawakita_doubts};
 use super::{BedArgs, Scene, SeriesRun, outputs, run, series, series_failures};
 use crate::csv::{CsvWriter, Field};
 use crate::output::{Streams, create_file, finish_file, write_json};
@@ -72,33 +71,17 @@ impl fmt::Display for SeedList {
 /// A figure of a run's row whose spread over the seeds is reported.
 pub type Figure = fn(&ComparisonRow) -> Option<Real>;
 
-/// Whether a row's Kawakita fit describes its bed: none of the summary's
-/// doubts (a in (0, 1], 1/b > 0, R² at least [`FIT_MIN_R_SQUARED`]).
-fn kawakita_described(r: &ComparisonRow) -> bool {
-    kawakita_doubts(&KawakitaSummary {
-        a: r.kawakita_a,
-        inv_b_pa: r.kawakita_inv_b_pa,
-        r_squared: r.kawakita_r_squared,
-        points: r.kawakita_points,
-        min_strain: Real::NAN,
-    })
-    .is_empty()
-}
-
 /// The figures of [`SPREAD_CSV`], by their `seeds.csv` column names. A fit
 /// the run's summary warns about (Kawakita outside the law's regime, Heckel
 /// with R² below [`FIT_MIN_R_SQUARED`]) is left out: its figures are not
 /// material figures, and one such run (a 1/b ≤ 0, say) would move the mean.
 pub const SPREAD_FIGURES: [(&str, Figure); 8] = [
-    ("kawakita_a", |r| {
-        r.kawakita_a.filter(|_| kawakita_described(r))
-    }),
+    ("kawakita_a", |r| r.kawakita_a.filter(|_| r.kawakita_ok)),
     ("kawakita_inv_b_pa", |r| {
-        r.kawakita_inv_b_pa.filter(|_| kawakita_described(r))
+        r.kawakita_inv_b_pa.filter(|_| r.kawakita_ok)
     }),
     ("heckel_yield_pressure_pa", |r| {
-        r.heckel_yield_pressure_pa
-            .filter(|_| r.heckel_r_squared.is_some_and(|r2| r2 >= FIT_MIN_R_SQUARED))
+        r.heckel_yield_pressure_pa.filter(|_| r.heckel_ok)
     }),
     ("initial_solid_fraction", |r| Some(r.initial_solid_fraction)),
     ("max_pressure_pa", |r| Some(r.max_pressure_pa)),
