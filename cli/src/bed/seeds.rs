@@ -73,7 +73,7 @@ pub type Figure = fn(&ComparisonRow) -> Option<Real>;
 
 /// The figures of [`SPREAD_CSV`], by their `seeds.csv` column names. A fit
 /// the run's summary warns about (Kawakita outside the law's regime, Heckel
-/// with R² below [`FIT_MIN_R_SQUARED`]) is left out: its figures are not
+/// with R² below [`super::outputs::FIT_MIN_R_SQUARED`]) is left out: its figures are not
 /// material figures, and one such run (a 1/b ≤ 0, say) would move the mean.
 pub const SPREAD_FIGURES: [(&str, Figure); 8] = [
     ("kawakita_a", |r| r.kawakita_a.filter(|_| r.kawakita_ok)),
