@@ -1,6 +1,8 @@
 // The page in Debian's headless chromium: run B2, compare the shown σ_est
-// with granbed-cli's, download the CSV (the CLI's bytes), cancel a run, and
-// provoke a bad input (ν = 0.6). Screenshots go to out/.
+// with granbed-cli's, download the CSV (the CLI's bytes, named by the inputs
+// that ran), cancel a run (the inputs locked while it goes), provoke bad
+// inputs (ν = 0.6, a decimal comma), and lay the page out at a phone's
+// width. Screenshots go to out/.
 import { test, before, after } from 'node:test';
 import assert from 'node:assert/strict';
 import { mkdirSync, readFileSync } from 'node:fs';
@@ -61,7 +63,10 @@ test('B2: the shown sigma_est is the native one; the CSV is the CLI\'s', async (
       `wall ${wall.toFixed(2)} s in chromium, native ${ref.summary.wall_time_s.toFixed(2)} s, ratio ${(wall / ref.summary.wall_time_s).toFixed(2)}`,
   );
 
+  // The inputs that ran, as the worker built the granule from them.
+  assert.match(await page.textContent('#run-inputs'), /^B2, mesh 8x2: σy = 30000 Pa, η0 = 0\.8, .* d = 1 mm$/);
   const [download] = await Promise.all([page.waitForEvent('download'), page.click('#download')]);
+  assert.equal(download.suggestedFilename(), 'granule_B2_8x2_force_displacement.csv');
   const file = join(OUT, download.suggestedFilename());
   await download.saveAs(file);
   assert.equal(readFileSync(file, 'utf8'), ref.csv);
@@ -72,6 +77,8 @@ test('B2: the shown sigma_est is the native one; the CSV is the CLI\'s', async (
 test('Cancel stops a run and the page can run again', async () => {
   await page.click('#run');
   await page.waitForSelector('#cancel:not([disabled])');
+  // The inputs are locked while the run goes.
+  for (const id of ['#type', '#mesh', '#custom']) assert.equal(await page.isDisabled(id), true, id);
   await page.click('#cancel');
   await page.waitForSelector('#results[data-state="cancelled"]');
   await page.waitForSelector('#run:not([disabled])', { timeout: 60_000 });
@@ -92,4 +99,28 @@ test('nu = 0.6 gives a readable error naming the field and its range', async () 
   assert.equal(await page.isEnabled('#run'), true);
   await page.screenshot({ path: join(OUT, 'error.png') });
   assert.deepEqual(problems, []);
+});
+
+test('a decimal comma is refused with its fix, not read as another number', async () => {
+  await page.check('#custom');
+  await page.fill('#poisson_ratio', '0.3');
+  await page.fill('#friction', '0,3');
+  await page.click('#run');
+  await page.waitForSelector('#results[data-state="rejected"]');
+  assert.match(await page.textContent('#error'), /μ: “0,3” has a decimal comma: write 0\.3/);
+  assert.equal(await page.getAttribute('#friction', 'aria-invalid'), 'true');
+  assert.equal(await page.isEnabled('#run'), true);
+  await page.fill('#friction', '0.3');
+  await page.uncheck('#custom');
+  assert.deepEqual(problems, []);
+});
+
+test('the page fits a phone: nothing wider than its 375 px', async () => {
+  await page.setViewportSize({ width: 375, height: 800 });
+  const width = await page.evaluate(() => document.documentElement.scrollWidth);
+  assert.ok(width <= 375, `the page is ${width} px wide`);
+  const plot = await page.evaluate(() => document.getElementById('plot').getBoundingClientRect().width);
+  assert.ok(plot <= 375, `the plot is ${plot} px wide`);
+  await page.screenshot({ path: join(OUT, 'phone.png'), fullPage: true });
+  await page.setViewportSize({ width: 1000, height: 1100 });
 });

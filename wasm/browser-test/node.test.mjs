@@ -5,6 +5,7 @@ import assert from 'node:assert/strict';
 import { readFileSync } from 'node:fs';
 import { join } from 'node:path';
 import { WWW, native } from './common.js';
+import { parseDecimal, tick } from '../www/format.js';
 
 const pkg = await import(join(WWW, 'pkg', 'granbed_wasm.js'));
 pkg.initSync({ module: readFileSync(join(WWW, 'pkg', 'granbed_wasm_bg.wasm')) });
@@ -56,6 +57,8 @@ test('bad inputs throw an Error naming the field and its range', () => {
     [{ type: 'B2', poisson_ratio: 0.6 }, 'poisson_ratio', /-1 < nu < 0\.5/],
     [{ type: 'B2', eta0: 0.1 }, 'eta0', /eta_c < eta0 <= 1/],
     [{ type: 'B2', diameter_m: 0 }, 'diameter_m', /1e-6 <= d <= 1 m/],
+    [{ type: 'B2', diameter_mm: 0.0001 }, 'diameter_mm', /d \(mm\) = 0\.0001 .*0\.001 <= d <= 1000 mm/],
+    [{ type: 'B2', diameter_mm: 2000 }, 'diameter_mm', /0\.001 <= d <= 1000 mm/],
     [{ type: 'D4' }, 'type', /A1, A2/],
   ];
   for (const [inputs, field, allowed] of cases) {
@@ -69,6 +72,35 @@ test('bad inputs throw an Error naming the field and its range', () => {
   assert.throws(() => new pkg.Granule({ type: 'B2', cp: 'x' }), /must be a number/);
   assert.throws(() => new pkg.Granule({ type: 'B2', mesh: '3x1' }), /3x1/);
   assert.throws(() => new pkg.Granule(42), /must be an object/);
+  assert.throws(() => new pkg.Granule({ diameter_m: 1e-3, diameter_mm: 1 }), /not both/);
+});
+
+test('a diameter in mm is the same run as in m', () => {
+  const a = new pkg.Granule({ type: 'B2', mesh: '4x1', diameter_mm: 2 });
+  const b = new pkg.Granule({ type: 'B2', mesh: '4x1', diameter_m: 2e-3 });
+  assert.equal(a.diameter_m(), b.diameter_m());
+  a.free();
+  b.free();
+});
+
+test('typed numbers: a decimal point is read, a comma or junk refused', () => {
+  for (const [text, v] of [['0.3', 0.3], [' .5 ', 0.5], ['3e4', 3e4], ['-1E-2', -0.01], ['7', 7], ['2.', 2]]) {
+    assert.equal(parseDecimal(text, 'x', 'f'), v, text);
+  }
+  assert.throws(() => parseDecimal('0,3', 'μ', 'friction'), (e) => e.field === 'friction' && /decimal comma: write 0\.3/.test(e.message));
+  for (const bad of ['', '1.5.2', '0x10', 'Infinity', '1,000.5', 'abc', '1e']) {
+    assert.throws(() => parseDecimal(bad, 'x', 'f'), /“.*” (is empty|is not a number)/, bad);
+  }
+});
+
+test('tick labels fit the margin at any scale', () => {
+  assert.equal(tick(0), '0');
+  assert.equal(tick(0.25), '0.25');
+  assert.equal(tick(12000), '12000');
+  assert.equal(tick(1.5e6), '1.5e+6');
+  assert.equal(tick(2e7), '2e+7');
+  assert.equal(tick(2e-9), '2e-9');
+  for (const v of [3e-12, 4.5e-5, 0.001, 1, 99999, 1e5, 1.8e10]) assert.ok(tick(v).length <= 7, `${v}: ${tick(v)}`);
 });
 
 test('presets are the kernel types', () => {

@@ -30,6 +30,22 @@ pub const STANDARD_DIAMETER_M: Real = 1.0e-3;
 /// Allowed granule diameters, m.
 pub const DIAMETER_RANGE_M: [Real; 2] = [1.0e-6, 1.0];
 
+/// [`DIAMETER_RANGE_M`] as the page states it, in mm.
+pub const DIAMETER_RANGE_MM_TEXT: &str = "0.001 <= d <= 1000 mm";
+
+/// The granule diameter `d_mm`, given in mm (the page's unit), in m. Out of
+/// [`DIAMETER_RANGE_M`] (NaN included) the error names `diameter_mm` and
+/// the range in mm, so that a user who typed millimetres reads
+/// millimetres.
+pub fn diameter_m_of_mm(d_mm: Real) -> Result<Real, Error> {
+    let d = d_mm * 1.0e-3;
+    if (DIAMETER_RANGE_M[0]..=DIAMETER_RANGE_M[1]).contains(&d) {
+        Ok(d)
+    } else {
+        Err(Error::invalid("diameter_mm", d_mm, DIAMETER_RANGE_MM_TEXT))
+    }
+}
+
 /// The material fields a caller may override, in the names of
 /// [`MaterialParams`].
 pub const MATERIAL_FIELDS: [&str; 8] = [
@@ -55,6 +71,7 @@ pub fn field_label(field: &str) -> &'static str {
         "friction" => "friction coefficient μ",
         "true_density_kg_m3" => "true density (kg/m³)",
         "diameter_m" => "granule diameter d (m)",
+        "diameter_mm" => "granule diameter d (mm)",
         "mesh" => "mesh level",
         "type" => "granule type",
         _ => "parameter",

@@ -29,7 +29,7 @@ use wasm_bindgen::prelude::*;
 use experiment::{Error, Experiment, Inputs, MATERIAL_FIELDS};
 
 /// Inputs other than [`MATERIAL_FIELDS`] that [`Granule::new`] accepts.
-const OTHER_FIELDS: [&str; 3] = ["type", "diameter_m", "mesh"];
+const OTHER_FIELDS: [&str; 4] = ["type", "diameter_m", "diameter_mm", "mesh"];
 
 fn js_error(e: &Error) -> JsValue {
     let err = js_sys::Error::new(&e.message);
@@ -94,7 +94,7 @@ fn inputs_from_js(obj: &JsValue) -> Result<Inputs, JsValue> {
         let key = key.as_string().unwrap_or_default();
         if !MATERIAL_FIELDS.contains(&key.as_str()) && !OTHER_FIELDS.contains(&key.as_str()) {
             return Err(message(format!(
-                "unknown input `{key}`: the inputs are type, mesh, diameter_m, {}",
+                "unknown input `{key}`: the inputs are type, mesh, diameter_m or diameter_mm, {}",
                 MATERIAL_FIELDS.join(", ")
             )));
         }
@@ -115,8 +115,17 @@ fn inputs_from_js(obj: &JsValue) -> Result<Inputs, JsValue> {
             inputs.set(field, v);
         }
     }
-    if let Some(d) = number("diameter_m")? {
-        inputs.diameter_m = d;
+    match (number("diameter_m")?, number("diameter_mm")?) {
+        (Some(_), Some(_)) => {
+            return Err(message(
+                "give the granule diameter once: diameter_m or diameter_mm, not both".into(),
+            ));
+        }
+        (Some(d), None) => inputs.diameter_m = d,
+        (None, Some(d_mm)) => {
+            inputs.diameter_m = experiment::diameter_m_of_mm(d_mm).map_err(|e| js_error(&e))?;
+        }
+        (None, None) => {}
     }
     if let Some(v) = get("mesh") {
         let text = v.as_string().unwrap_or_default();
@@ -174,7 +183,8 @@ impl Granule {
     /// Sets up the experiment from `{ type: "B2", mesh: "8x2", diameter_m,
     /// yield_stress_pa, eta0, youngs_modulus_pa, poisson_ratio, cp, eta_c,
     /// friction, true_density_kg_m3 }`: the preset of `type` (default B2)
-    /// with every given field overriding it. Throws an `Error` naming the
+    /// with every given field overriding it. The diameter may be given in
+    /// mm instead (`diameter_mm`, its errors in mm), not both. Throws an `Error` naming the
     /// field and its allowed range (`field`, `value`, `allowed` set).
     #[wasm_bindgen(constructor)]
     pub fn new(inputs: &JsValue) -> Result<Granule, JsValue> {

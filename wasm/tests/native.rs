@@ -125,3 +125,22 @@ fn custom_diameter_scales_the_strain() {
     let last = run.samples().last().unwrap();
     assert_eq!(last.strain, last.approach_m / 2.0e-3);
 }
+
+/// A diameter typed in mm is refused in mm, at the bounds of the range in m.
+#[test]
+fn a_diameter_in_mm_is_refused_in_mm() {
+    use granbed_wasm::experiment::{DIAMETER_RANGE_M, diameter_m_of_mm};
+    assert_eq!(diameter_m_of_mm(1000.0).unwrap(), DIAMETER_RANGE_M[1]);
+    assert_eq!(diameter_m_of_mm(1.0).unwrap(), 1.0e-3);
+    assert!(diameter_m_of_mm(0.001).unwrap() >= DIAMETER_RANGE_M[0]);
+    for bad in [0.0001, 2000.0, -1.0, f64::NAN] {
+        let e = diameter_m_of_mm(bad).unwrap_err();
+        assert_eq!(e.field, Some("diameter_mm"));
+        assert!(
+            e.message.contains("granule diameter d (mm)")
+                && e.message.contains("0.001 <= d <= 1000 mm"),
+            "{}",
+            e.message
+        );
+    }
+}

@@ -1,5 +1,6 @@
-// Number formats of the results table, shared with the browser test so that
-// it compares the shown text with the native value printed the same way.
+// Number formats and the parsing of typed numbers: pure functions of the
+// page, shared with the tests (the browser test compares the shown text with
+// the native value printed the same way).
 
 /** A stress in Pa as kPa with six significant digits, e.g. "44.6423 kPa". */
 export function formatStress(pa) {
@@ -9,4 +10,29 @@ export function formatStress(pa) {
 /** A slope in N/m with six significant digits. */
 export function formatSlope(nPerM) {
   return nPerM === null || nPerM === undefined || !Number.isFinite(nPerM) ? 'n/a' : `${nPerM.toPrecision(6)} N/m`;
+}
+
+// A decimal number as typed: digits with a decimal point and an optional
+// exponent (0.3, .5, 3e4, -1E-2). Anything else is refused, a decimal comma
+// with its own message, never read as another number.
+const DECIMAL = /^[+-]?(\d+\.?\d*|\.\d+)([eE][+-]?\d+)?$/;
+
+export function parseDecimal(text, label, field) {
+  const t = text.trim();
+  if (DECIMAL.test(t)) return Number(t);
+  const why = t === ''
+    ? 'is empty'
+    : /^[+-]?\d*,\d+$/.test(t)
+      ? `has a decimal comma: write ${t.replace(',', '.')} (with a point)`
+      : 'is not a number such as 0.3 or 3e4';
+  throw Object.assign(new Error(`${label}: “${t}” ${why} (field \`${field}\`)`), { field });
+}
+
+// A tick label that fits the margin: plain digits for 0.001 ≤ |v| < 1e5,
+// else with an exponent (1.5e+6, 2e-9).
+export function tick(v) {
+  const a = Math.abs(v);
+  if (a === 0) return '0';
+  if (a >= 1e5 || a < 1e-3) return v.toExponential(1).replace('.0e', 'e');
+  return +v.toPrecision(4) + '';
 }

@@ -1,6 +1,6 @@
 // The page: the form, the worker that runs the simulation, the live plot,
 // the granule view, the results table and the CSV download.
-import { formatStress, formatSlope } from './format.js';
+import { formatStress, formatSlope, parseDecimal, tick } from './format.js';
 
 const $ = (id) => document.getElementById(id);
 const FIELDS = ['yield_stress_pa', 'eta0', 'youngs_modulus_pa', 'poisson_ratio', 'cp', 'eta_c', 'friction'];
@@ -13,6 +13,9 @@ let worker = null;
 let running = false;
 let view = null; // { quads, positions, diameter, x, f, fit }
 let csvUrl = null;
+// The run in progress or last run: its type (or "custom"), mesh, the
+// parameters it used (from the worker) and its start time.
+let current = null;
 
 function setStatus(text) { $('status').textContent = text; }
 
@@ -25,16 +28,27 @@ function showError(message, field) {
   if (id && $(id)) $(id).setAttribute('aria-invalid', 'true');
 }
 
+// Refused before or at the start of a run: nothing runs.
+function refuse(message, field) {
+  showError(message, field);
+  $('run-inputs').textContent = '–';
+  $('results').dataset.state = 'rejected';
+}
+
 function clearError() {
   $('error').hidden = true;
   $('error').textContent = '';
   for (const input of document.querySelectorAll('#params input')) input.removeAttribute('aria-invalid');
 }
 
+// While a run goes, its inputs are locked: the results, the picture and
+// the download's name stay those of the inputs that ran.
 function setRunning(on) {
   running = on;
   $('run').disabled = on;
   $('cancel').disabled = !on;
+  for (const id of ['type', 'mesh', 'custom']) $(id).disabled = on;
+  $('params').disabled = on || !$('custom').checked;
 }
 
 function startWorker() {
@@ -60,15 +74,17 @@ function onWorker(msg) {
     case 'error':
       setRunning(false);
       setStatus('stopped');
-      showError(msg.message, msg.field);
+      refuse(msg.message, msg.field);
       break;
     case 'start':
       view = { quads: msg.quads, positions: msg.positions, diameter: msg.diameter, x: [], f: [], fit: null };
+      current.params = msg.params;
+      $('run-inputs').textContent = describeRun(current);
       drawAll();
       break;
     case 'progress':
       $('progress').value = msg.progress;
-      setStatus(`strain ${(100 * msg.strain).toFixed(1)} %, ${msg.steps} steps`);
+      setStatus(`strain ${(100 * msg.strain).toFixed(1)} %, ${msg.steps} steps${timeLeft(msg.progress)}`);
       Object.assign(view, { positions: msg.positions, x: msg.x, f: msg.f });
       drawAll();
       break;
@@ -90,24 +106,36 @@ function requestPreset() {
 }
 
 // The inputs object of granbed-wasm's Granule: the type and mesh, and with
-// "custom" every parameter field.
+// "custom" every parameter field (the diameter in mm, as typed).
 function readInputs() {
   const inputs = { type: $('type').value, mesh: $('mesh').value };
   if (!$('custom').checked) return inputs;
-  for (const k of [...FIELDS, 'diameter_mm']) {
-    const text = $(k).value.trim();
-    const v = Number(text);
-    if (text === '' || !Number.isFinite(v)) {
-      const field = k === 'diameter_mm' ? 'diameter_m' : k;
-      throw Object.assign(new Error(`${LABELS[k]}: “${text}” is not a number (field \`${field}\`)`), { field });
-    }
-    if (k === 'diameter_mm') inputs.diameter_m = v * 1e-3; else inputs[k] = v;
-  }
+  for (const k of [...FIELDS, 'diameter_mm']) inputs[k] = parseDecimal($(k).value, LABELS[k], k);
   return inputs;
 }
 
+// "B2, mesh 8x2: σy = 30000 Pa, …" for the results table.
+function describeRun(run) {
+  const p = run.params;
+  const head = `${run.custom ? `custom (from ${run.type})` : run.type}, mesh ${run.mesh}`;
+  if (!p) return head;
+  return `${head}: σy = ${p.yield_stress_pa} Pa, η0 = ${p.eta0}, E = ${p.youngs_modulus_pa} Pa, ` +
+    `ν = ${p.poisson_ratio}, cp = ${p.cp}, ηc = ${p.eta_c}, μ = ${p.friction}, ` +
+    `d = ${+(p.diameter_m * 1e3).toPrecision(12)} mm`;
+}
+
+// ", about 3 min left" from the progress so far (after a few seconds).
+function timeLeft(progress) {
+  const elapsed = (performance.now() - current.t0) / 1e3;
+  if (!(progress > 0) || elapsed < 3) return '';
+  const left = (elapsed * (1 - progress)) / progress;
+  if (left < 60) return `, about ${Math.ceil(left)} s left`;
+  if (left < 5400) return `, about ${Math.round(left / 60)} min left`;
+  return `, about ${(left / 3600).toFixed(1)} h left`;
+}
+
 function resetResults() {
-  for (const id of ['sigma-est', 'sigma-eff0', 'slope', 'r2', 'steps', 'quasi-static', 'wall']) {
+  for (const id of ['sigma-est', 'sigma-eff0', 'slope', 'r2', 'steps', 'quasi-static', 'wall', 'run-inputs']) {
     $(id).textContent = '–';
     delete $(id).dataset.value;
   }
@@ -125,10 +153,14 @@ function run(ev) {
   try {
     inputs = readInputs();
   } catch (e) {
-    showError(e.message, e.field);
+    refuse(e.message, e.field);
     return;
   }
   resetResults();
+  current = {
+    type: inputs.type, mesh: inputs.mesh, custom: $('custom').checked, params: null, t0: performance.now(),
+  };
+  $('run-inputs').textContent = describeRun(current);
   setRunning(true);
   setStatus('starting…');
   $('results').dataset.state = 'running';
@@ -142,6 +174,10 @@ function finish(msg) {
     view.fit = { slope: msg.slope, intercept: msg.intercept, x0: 0.1 * msg.diameter, x1: Math.min(0.4, msg.strain) * msg.diameter };
   }
   drawAll();
+  const last = msg.f.length ? msg.f[msg.f.length - 1] : 0;
+  $('plot').setAttribute('aria-label',
+    `platen force against platen approach: ${msg.f.length} points, to x = ${(1e3 * (msg.x[msg.x.length - 1] ?? 0)).toPrecision(3)} mm ` +
+    `and F = ${last.toPrecision(3)} N; the values are in the CSV`);
   const set = (id, text, value) => {
     $(id).textContent = text;
     if (value !== undefined && value !== null) $(id).dataset.value = String(value);
@@ -160,7 +196,7 @@ function finish(msg) {
   csvUrl = URL.createObjectURL(new Blob([msg.csv], { type: 'text/csv' }));
   const a = $('download');
   a.href = csvUrl;
-  a.download = `granule_${$('type').value}${$('custom').checked ? '_custom' : ''}_force_displacement.csv`;
+  a.download = `granule_${current.custom ? 'custom' : current.type}_${current.mesh}_force_displacement.csv`;
   a.hidden = false;
   $('progress').value = msg.failure ? $('progress').value : 1;
   if (msg.failure) {
@@ -208,16 +244,16 @@ function drawPlot() {
   g.beginPath(); g.moveTo(L, T); g.lineTo(L, H - B); g.lineTo(W - R, H - B); g.stroke();
   g.textAlign = 'center'; g.textBaseline = 'top';
   const xs = niceStep(xMax, 6);
-  for (let v = 0; v <= xMax + 1e-12; v += xs) {
-    g.fillText(+v.toPrecision(6) + '', px(v), H - B + 6);
+  for (let v = 0; v <= xMax + 1e-12 * xMax; v += xs) {
+    g.fillText(tick(v), px(v), H - B + 6);
     g.beginPath(); g.moveTo(px(v), H - B); g.lineTo(px(v), H - B + 4); g.stroke();
   }
   g.fillText('platen approach x, mm', (L + W - R) / 2, H - 18);
   g.textAlign = 'right'; g.textBaseline = 'middle';
   if (f.length) {
     const fs = niceStep(fMax, 6);
-    for (let v = 0; v <= fMax + 1e-15; v += fs) {
-      g.fillText(+v.toPrecision(4) + '', L - 6, py(v));
+    for (let v = 0; v <= fMax + 1e-15 * fMax; v += fs) {
+      g.fillText(tick(v), L - 6, py(v));
       g.strokeStyle = '#eee'; g.beginPath(); g.moveTo(L + 1, py(v)); g.lineTo(W - R, py(v)); g.stroke();
     }
   }
@@ -312,7 +348,7 @@ $('custom').addEventListener('change', () => {
   $('params').disabled = !$('custom').checked;
   if (!$('custom').checked) requestPreset();
 });
-// Drag on the picture to turn the granule.
+// Drag on the picture (or use the arrow keys on it) to turn the granule.
 {
   const c = $('granule');
   let last = null;
@@ -323,6 +359,15 @@ $('custom').addEventListener('change', () => {
     viewAngles.phi += 0.01 * (e.clientX - last[0]);
     viewAngles.theta = Math.max(-1.5, Math.min(1.5, viewAngles.theta + 0.01 * (e.clientY - last[1])));
     last = [e.clientX, e.clientY];
+    drawGranule();
+  });
+  const KEYS = { ArrowLeft: [-0.15, 0], ArrowRight: [0.15, 0], ArrowUp: [0, -0.15], ArrowDown: [0, 0.15] };
+  c.addEventListener('keydown', (e) => {
+    const k = KEYS[e.key];
+    if (!k) return;
+    e.preventDefault();
+    viewAngles.phi += k[0];
+    viewAngles.theta = Math.max(-1.5, Math.min(1.5, viewAngles.theta + k[1]));
     drawGranule();
   });
 }

@@ -29,11 +29,17 @@ function run(inputs) {
     postMessage({ kind: 'error', ...errorMessage(e) });
     return;
   }
+  // The parameters this run uses: the type's preset with the inputs given
+  // over it (what the Granule was built from), for the page to show.
+  const params = preset(inputs.type ?? 'B2');
+  for (const k of Object.keys(params)) if (inputs[k] !== undefined) params[k] = inputs[k];
+  params.diameter_m = g.diameter_m();
   postMessage({
     kind: 'start',
     quads: g.surface_quads(),
     positions: g.positions(),
     diameter: g.diameter_m(),
+    params,
   });
   let failure = null;
   try {
