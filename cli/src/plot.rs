@@ -2,6 +2,8 @@
 //! fonts: text is written as SVG `<text>` and laid out by the viewer),
 //! shared by the granule, bed and study plots.
 
+use core::ops::Range;
+
 use plotters::prelude::*;
 
 /// Plot size, pixels.
@@ -89,6 +91,32 @@ fn range(values: impl Iterator<Item = f64>, from_zero: bool) -> core::ops::Range
     }
 }
 
+/// The tick labels of an axis over `r`: `None` (plotters' own, plain
+/// decimals) when its largest magnitude lies in [0.01, 10⁵); otherwise
+/// numbers with an exponent and at most four significant digits (`2.5e-5`,
+/// `1.8e7`), where plain decimals would be rows of zeros or eight digits
+/// wide. Round-off beside zero (below 10⁻⁹ of the span) prints as `0`.
+fn exponent_labels(r: &Range<f64>) -> Option<impl Fn(&f64) -> String + use<>> {
+    let largest = r.start.abs().max(r.end.abs());
+    if (1.0e-2..1.0e5).contains(&largest) || largest == 0.0 || !largest.is_finite() {
+        return None;
+    }
+    let zero = 1.0e-9 * (r.end - r.start).abs();
+    Some(move |v: &f64| {
+        if v.abs() <= zero {
+            return "0".to_owned();
+        }
+        let text = format!("{v:.3e}");
+        match text.split_once('e') {
+            Some((mantissa, exponent)) if mantissa.contains('.') => {
+                let mantissa = mantissa.trim_end_matches('0').trim_end_matches('.');
+                format!("{mantissa}e{exponent}")
+            }
+            _ => text,
+        }
+    })
+}
+
 /// The SVG text of `series` under `title`, with axis labels.
 pub fn xy_svg(
     title: &str,
@@ -109,12 +137,18 @@ pub fn xy_svg(
             .margin(20)
             .x_label_area_size(50)
             .y_label_area_size(80)
-            .build_cartesian_2d(x_range, y_range)?;
-        chart
-            .configure_mesh()
-            .x_desc(x_desc)
-            .y_desc(y_desc)
-            .draw()?;
+            .build_cartesian_2d(x_range.clone(), y_range.clone())?;
+        let x_labels = exponent_labels(&x_range);
+        let y_labels = exponent_labels(&y_range);
+        let mut mesh = chart.configure_mesh();
+        mesh.x_desc(x_desc).y_desc(y_desc);
+        if let Some(f) = &x_labels {
+            mesh.x_label_formatter(f);
+        }
+        if let Some(f) = &y_labels {
+            mesh.y_label_formatter(f);
+        }
+        mesh.draw()?;
         let mut colour = COLOURS.iter().cycle();
         for s in series {
             let pts = s.points.iter().copied();
@@ -162,6 +196,46 @@ pub fn xy_svg(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn tiny_and_huge_axes_get_exponents() {
+        assert!(exponent_labels(&(0.0..0.4)).is_none());
+        assert!(exponent_labels(&(-0.03..18.0)).is_none());
+        let tiny = exponent_labels(&(-3.0e-7..1.05e-5)).unwrap();
+        assert_eq!(tiny(&2.5e-6), "2.5e-6");
+        assert_eq!(tiny(&1.0e-5), "1e-5");
+        assert_eq!(tiny(&-1.0e-22), "0");
+        let huge = exponent_labels(&(0.0..1.8e7)).unwrap();
+        assert_eq!(huge(&1.8e7), "1.8e7");
+        assert_eq!(huge(&12_345_678.0), "1.235e7");
+        // In a plot: no row of zeros, no eight-digit labels.
+        let points = |k: f64| (0..=10).map(move |i| (0.04 * f64::from(i), k * f64::from(i)));
+        let small = xy_svg(
+            "t",
+            "x",
+            "y",
+            &[Series::new("s", Mark::Line, points(1e-6))],
+            true,
+        )
+        .unwrap();
+        let label = |svg: &str, text: &str| svg.lines().any(|l| l.trim() == text);
+        assert!(
+            label(&small, "1e-5") && !small.contains("0.00001"),
+            "{small}"
+        );
+        let large = xy_svg(
+            "t",
+            "x",
+            "y",
+            &[Series::new("s", Mark::Line, points(2e6))],
+            true,
+        )
+        .unwrap();
+        assert!(
+            label(&large, "2e7") && !large.contains("20000000"),
+            "{large}"
+        );
+    }
 
     #[test]
     fn ranges_pad_and_survive_degenerate_data() {

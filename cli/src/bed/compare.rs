@@ -11,7 +11,7 @@ use granbed_kernel::Real;
 use granbed_kernel::material::GranuleType;
 use serde::Serialize;
 
-use super::outputs::{FIT_MIN_R_SQUARED, Summary, kawakita_doubts};
+use super::outputs::{FIT_MIN_R_SQUARED, KawakitaSummary, Summary, kawakita_doubts};
 use super::plots::overlay_svg;
 use super::run::BedSample;
 use crate::csv::{CsvWriter, Field};
@@ -117,11 +117,10 @@ impl ComparisonRow {
             kawakita_inv_b_pa: s.kawakita.inv_b_pa,
             kawakita_r_squared: s.kawakita.r_squared,
             kawakita_points: s.kawakita.points,
-            kawakita_ok: s.kawakita.a.is_some() && kawakita_doubts(&s.kawakita).is_empty(),
+            kawakita_ok: false,
             heckel_yield_pressure_pa: s.heckel.yield_pressure_pa,
             heckel_r_squared: s.heckel.r_squared,
-            heckel_ok: s.heckel.yield_pressure_pa.is_some()
-                && s.heckel.r_squared.is_some_and(|r2| r2 >= FIT_MIN_R_SQUARED),
+            heckel_ok: false,
             initial_solid_fraction: s.initial_solid_fraction,
             max_pressure_pa: s.max_pressure_pa,
             final_strain: s.final_strain,
@@ -132,6 +131,26 @@ impl ComparisonRow {
             wall_time_s: s.wall_time_s,
             error: s.error.clone(),
         }
+        .with_fit_flags()
+    }
+
+    /// The row with `kawakita_ok` and `heckel_ok` set from its own fit
+    /// values by the summary's rules ([`kawakita_doubts`]; Heckel R² at
+    /// least [`FIT_MIN_R_SQUARED`]).
+    pub fn with_fit_flags(mut self) -> Self {
+        let kawakita = KawakitaSummary {
+            a: self.kawakita_a,
+            inv_b_pa: self.kawakita_inv_b_pa,
+            r_squared: self.kawakita_r_squared,
+            points: self.kawakita_points,
+            min_strain: Real::NAN,
+        };
+        self.kawakita_ok = self.kawakita_a.is_some() && kawakita_doubts(&kawakita).is_empty();
+        self.heckel_ok = self.heckel_yield_pressure_pa.is_some()
+            && self
+                .heckel_r_squared
+                .is_some_and(|r2| r2 >= FIT_MIN_R_SQUARED);
+        self
     }
 
     fn fields(&self) -> [Field; COMPARISON_COLUMNS.len()] {

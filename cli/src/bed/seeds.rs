@@ -314,26 +314,31 @@ mod tests {
     /// deviation for one.
     #[test]
     fn the_spread_leaves_out_the_runs_without_the_figure() {
-        let row = |a: Option<Real>| ComparisonRow {
-            granule_type: "B2",
-            seed: 1,
-            yield_stress_pa: 30e3,
-            eta0: 0.8,
-            kawakita_a: a,
-            kawakita_inv_b_pa: Some(8e3),
-            kawakita_r_squared: Some(0.99),
-            kawakita_points: 0,
-            heckel_yield_pressure_pa: None,
-            heckel_r_squared: None,
-            initial_solid_fraction: 0.5,
-            max_pressure_pa: 0.0,
-            final_strain: 0.3,
-            final_pressure_pa: 0.0,
-            final_relative_density: 0.8,
-            final_coordination: 0.0,
-            quasi_static_passed: true,
-            wall_time_s: 0.0,
-            error: None,
+        let row = |a: Option<Real>| {
+            ComparisonRow {
+                granule_type: "B2",
+                seed: 1,
+                yield_stress_pa: 30e3,
+                eta0: 0.8,
+                kawakita_a: a,
+                kawakita_inv_b_pa: Some(8e3),
+                kawakita_r_squared: Some(0.99),
+                kawakita_points: 0,
+                kawakita_ok: false,
+                heckel_yield_pressure_pa: None,
+                heckel_r_squared: None,
+                heckel_ok: false,
+                initial_solid_fraction: 0.5,
+                max_pressure_pa: 0.0,
+                final_strain: 0.3,
+                final_pressure_pa: 0.0,
+                final_relative_density: 0.8,
+                final_coordination: 0.0,
+                quasi_static_passed: true,
+                wall_time_s: 0.0,
+                error: None,
+            }
+            .with_fit_flags()
         };
         let a: Figure = |r| r.kawakita_a;
         let rows = [
@@ -366,7 +371,7 @@ mod tests {
         let mut good = row(Some(0.4));
         good.heckel_yield_pressure_pa = Some(3e4);
         good.heckel_r_squared = Some(0.99);
-        let rows = [odd, negative, good];
+        let rows = [odd, negative, good].map(ComparisonRow::with_fit_flags);
         let figure = |name: &str| {
             let (n, f) = SPREAD_FIGURES.iter().find(|(n, _)| *n == name).unwrap();
             spread(n, *f, &rows)
