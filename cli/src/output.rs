@@ -84,6 +84,14 @@ pub fn create_out_dir(dir: &Path) -> anyhow::Result<()> {
             dir.display()
         )));
     }
+    // A file where a parent directory would have to be: the same mistake.
+    if let Some(file) = dir.ancestors().skip(1).find(|a| a.is_file()) {
+        return Err(crate::error::input_error(format!(
+            "the output directory `{}` cannot be made: `{}` is a file",
+            dir.display(),
+            file.display()
+        )));
+    }
     std::fs::create_dir_all(dir)
         .with_context(|| format!("cannot create output directory `{}`", dir.display()))
 }

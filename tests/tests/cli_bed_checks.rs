@@ -492,9 +492,10 @@ fn a_heckel_fit_that_cannot_be_made_and_a_window_past_the_run_are_flagged() {
     );
 }
 
-/// `--out` naming an existing file is a usage error (exit status 2) that
-/// says so, for every command writing an output directory, before any
-/// work (it was a runtime error, exit status 1, "File exists").
+/// `--out` naming an existing file, or a path below one, is a usage error
+/// (exit status 2) that says so, for every command writing an output
+/// directory, before any work (it was a runtime error, exit status 1,
+/// "File exists").
 #[test]
 fn an_output_path_that_is_a_file_is_a_usage_error() {
     let file = out_dir("a-file").with_extension("txt");
@@ -512,6 +513,21 @@ fn an_output_path_that_is_a_file_is_a_usage_error() {
         assert_eq!(run.code, 2, "{argv:?}: {}", run.stderr);
         assert!(
             run.stderr.contains("is a file: --out names a directory"),
+            "{argv:?}: {}",
+            run.stderr
+        );
+    }
+    // A file where a parent directory would be: the same usage error.
+    let below = file.join("sub");
+    let below = below.to_str().unwrap();
+    for argv in [
+        &["granule", "--quiet", "--out", below][..],
+        &["bed", "--quiet", "--out", below],
+    ] {
+        let run = cli(argv);
+        assert_eq!(run.code, 2, "{argv:?}: {}", run.stderr);
+        assert!(
+            run.stderr.contains("cannot be made"),
             "{argv:?}: {}",
             run.stderr
         );
