@@ -188,3 +188,52 @@ fn a_series_resume_refuses_what_it_cannot_do() {
     assert_eq!(run.code, 2, "{}", run.stderr);
     assert!(run.stderr.contains("A1"), "{}", run.stderr);
 }
+
+/// A series and a single run do not share a directory: each refuses the
+/// other's files (which would mix, and `--resume DIR` would take the wrong
+/// one), and `--overwrite` removes them first.
+#[test]
+fn a_series_and_a_single_run_keep_out_of_each_other() {
+    let dir = out_dir("mixed");
+    let out = dir.to_str().unwrap();
+    let short = common::small_bed("8", "0.03");
+    let single = |extra: &[&str]| {
+        let mut argv = vec!["--out", out];
+        argv.extend_from_slice(&short);
+        argv.extend_from_slice(extra);
+        bed(&argv)
+    };
+    let series = |extra: &[&str]| {
+        let mut argv = vec!["--out", out, "--types", "B1,B2"];
+        argv.extend_from_slice(&short);
+        argv.extend_from_slice(extra);
+        bed(&argv)
+    };
+    assert_eq!(single(&[]).code, 0);
+    let run = series(&[]);
+    assert_eq!(run.code, 2, "{}", run.stderr);
+    assert!(run.stderr.contains("holds a single run"), "{}", run.stderr);
+    assert!(!dir.join("series.json").exists());
+    let run = series(&["--overwrite"]);
+    assert_eq!(run.code, 0, "{}", run.stderr);
+    for f in [
+        "checkpoint.bin",
+        "summary.json",
+        "compression.csv",
+        "report.html",
+    ] {
+        assert!(
+            !dir.join(f).exists(),
+            "{f} of the single run left beside the series"
+        );
+    }
+    assert!(dir.join("series.json").is_file() && dir.join("B1/summary.json").is_file());
+
+    let run = single(&[]);
+    assert_eq!(run.code, 2, "{}", run.stderr);
+    assert!(run.stderr.contains("holds a series"), "{}", run.stderr);
+    let run = single(&["--overwrite"]);
+    assert_eq!(run.code, 0, "{}", run.stderr);
+    assert!(!dir.join("series.json").exists() && !dir.join("comparison.csv").exists());
+    assert!(dir.join("checkpoint.bin").is_file() && dir.join("B1/summary.json").is_file());
+}

@@ -414,7 +414,10 @@ pub struct BedArgs {
     /// Start afresh even where --out (or, with --types, `DIR/<TYPE>`) holds
     /// an unfinished run, whose checkpoint is then lost. Without it such a
     /// directory is refused (`--resume DIR` continues the run); a finished
-    /// run is replaced either way.
+    /// run is replaced either way. A series (--types, --seeds) into a
+    /// directory holding a single run's files, or a single run into a
+    /// series' directory, is refused too; with --overwrite the other's
+    /// files there are removed first (a series' run directories are left).
     #[arg(long, conflicts_with = "resume")]
     pub overwrite: bool,
 }
@@ -625,9 +628,11 @@ impl BedArgs {
             .num_threads(self.threads)
             .build()?;
         if let Some(seeds) = &self.seeds {
+            series::clear_other_kind(&self.out, true, self.overwrite)?;
             return self.run_seeds(&scene, &seeds.0, &notes, &pool, streams);
         }
         if let Some(types) = &self.types {
+            series::clear_other_kind(&self.out, true, self.overwrite)?;
             for t in &types.0 {
                 self.keep_unfinished(&self.out.join(t.name()))?;
             }
@@ -635,6 +640,7 @@ impl BedArgs {
         }
         if resume.is_none() {
             self.keep_unfinished(&out)?;
+            series::clear_other_kind(&out, false, self.overwrite)?;
             if !self.quiet {
                 writeln!(
                     streams.stderr,

@@ -491,6 +491,11 @@ fn not_quasi_static(scene: &Scene, run: &BedRun, q: &QuasiStatic) -> Option<Stri
 /// the criterion of `granbed-cli study stability` (issue #9's).
 pub const OVERLAP_WARNING_REL: Real = crate::study::stability::MAX_PENETRATION_REL;
 
+/// File name of the compression profile.
+pub const COMPRESSION_CSV: &str = "compression.csv";
+/// File name of the summary.
+pub const SUMMARY_JSON: &str = "summary.json";
+
 /// Why the Kawakita fit `k` does not describe a bed, if it does not: a
 /// outside (0, 1] (a limiting strain; NaN included), 1/b ≤ 0, R² below
 /// [`FIT_MIN_R_SQUARED`]. Empty for a fit inside the law's regime.
@@ -725,7 +730,7 @@ pub const FIT_MIN_R_SQUARED: Real = 0.9;
 /// into `dir` (created).
 pub fn write_all(dir: &Path, scene: &Scene, run: &BedRun) -> anyhow::Result<()> {
     crate::output::create_out_dir(dir)?;
-    let path = dir.join("compression.csv");
+    let path = dir.join(COMPRESSION_CSV);
     let mut csv = CsvWriter::new(create_file(&path)?, &COMPRESSION_COLUMNS)
         .with_context(|| format!("cannot write to `{}`", path.display()))?;
     for s in &run.samples {
@@ -734,7 +739,7 @@ pub fn write_all(dir: &Path, scene: &Scene, run: &BedRun) -> anyhow::Result<()> 
     }
     finish_file(csv.into_inner(), &path)?;
     let summary = summary(scene, run);
-    write_json(&dir.join("summary.json"), &summary)?;
+    write_json(&dir.join(SUMMARY_JSON), &summary)?;
     let svgs = super::plots::write_plots(dir, run, &summary)?;
     super::report::write_report(dir, scene, &summary, &svgs)
 }

@@ -18,7 +18,9 @@ use granbed_kernel::material::GranuleType;
 use serde::{Deserialize, Serialize};
 
 use super::seeds::seed_dir;
-use super::{BedArgs, Scene, SeriesRun, checkpoint, run};
+use super::{
+    BedArgs, Scene, SeriesRun, checkpoint, compare, outputs, plots, report, run, seeds, snapshots,
+};
 use crate::error::input_error;
 use crate::output::Streams;
 
@@ -220,6 +222,91 @@ pub fn refuse_runs_without_series(dir: &Path) -> anyhow::Result<()> {
          each alone with --resume {}/<run>",
         dir.display(),
         runs.join(", "),
+        dir.display()
+    )))
+}
+
+/// The outputs a single run writes into its directory (besides its
+/// snapshots, [`snapshots::remove_old`]).
+fn single_run_files(dir: &Path) -> Vec<PathBuf> {
+    let mut files = vec![
+        dir.join(checkpoint::FILE_NAME),
+        dir.join(outputs::COMPRESSION_CSV),
+        dir.join(outputs::SUMMARY_JSON),
+        dir.join(report::REPORT_FILE),
+    ];
+    files.extend(
+        plots::PLOT_FILES
+            .iter()
+            .map(|f| dir.join(plots::PLOTS_DIR).join(f)),
+    );
+    files
+}
+
+/// The tables a series writes into its directory (both kinds), and the
+/// series file.
+fn series_files(dir: &Path) -> Vec<PathBuf> {
+    [
+        FILE_NAME,
+        compare::COMPARISON_CSV,
+        compare::COMPARISON_JSON,
+        compare::PRESSURE_SVG,
+        compare::DENSITY_SVG,
+        seeds::SEEDS_CSV,
+        seeds::SPREAD_CSV,
+        seeds::SEEDS_JSON,
+    ]
+    .iter()
+    .chain(&seeds::SEEDS_SVG)
+    .map(|f| dir.join(f))
+    .collect()
+}
+
+/// Removes the `files` that exist; an error names the file.
+fn remove_files(files: &[PathBuf]) -> anyhow::Result<()> {
+    for f in files.iter().filter(|f| f.is_file()) {
+        std::fs::remove_file(f).with_context(|| format!("cannot remove `{}`", f.display()))?;
+    }
+    Ok(())
+}
+
+/// Before a fresh run of `kind` into `dir` (a series, or a single run when
+/// `series` is false): outputs of the other kind there would mix with the
+/// new ones, and `--resume DIR` would take the wrong one (a run's
+/// checkpoint before a series file). Refused, naming what is there; with
+/// `overwrite` the other kind's files in `dir` are removed (a series'
+/// member directories are left).
+pub fn clear_other_kind(dir: &Path, series: bool, overwrite: bool) -> anyhow::Result<()> {
+    let (found, files) = if series {
+        (
+            dir.join(outputs::SUMMARY_JSON).is_file() || dir.join(checkpoint::FILE_NAME).is_file(),
+            single_run_files(dir),
+        )
+    } else {
+        (SeriesFile::is_in(dir), series_files(dir))
+    };
+    if !found {
+        return Ok(());
+    }
+    if overwrite {
+        remove_files(&files)?;
+        if series {
+            snapshots::remove_old(dir)?;
+        }
+        return Ok(());
+    }
+    let (there, new) = if series {
+        (
+            "a single run (its summary.json or checkpoint.bin)",
+            "a series",
+        )
+    } else {
+        ("a series (its series.json)", "a single run")
+    };
+    Err(input_error(format!(
+        "`{}` holds {there}: {new} there would mix its files with it; choose another --out, or \
+         pass --overwrite to remove that run's files from `{}` first",
+        dir.display(),
         dir.display()
     )))
 }
