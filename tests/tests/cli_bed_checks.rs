@@ -534,3 +534,19 @@ fn an_output_path_that_is_a_file_is_a_usage_error() {
     }
     assert_eq!(std::fs::read_to_string(&file).unwrap(), "not a directory");
 }
+
+/// summary.json keeps the scene as run exactly (`scene_toml`, read back by
+/// `--scene`), where its JSON object can only say `null` for ∞.
+#[test]
+fn the_summary_keeps_the_scene_exactly() {
+    let dir = out_dir("scene-toml");
+    let mut argv = vec!["--out", dir.to_str().unwrap(), "--held-reprojection", "inf"];
+    argv.extend_from_slice(&common::small_bed("8", "0.02"));
+    let r = bed(&argv);
+    assert_eq!(r.code, 0, "{}", r.stderr);
+    let s = summary(&dir);
+    assert!(s["scene"]["held_reprojection"].is_null());
+    let scene = Scene::from_toml(s["scene_toml"].as_str().unwrap()).unwrap();
+    assert_eq!(scene.held_reprojection, f64::INFINITY);
+    assert_eq!(scene.granules, 8);
+}

@@ -48,7 +48,7 @@ Output, in --out DIR (created if missing):
                    (granule solid volume / (die area x H0 (1 - C)); Heckel:
                    ln(1/(1 - D)) against the pressure), mean Heywood coefficient
                    (d_V and nominal d), min Jacobian, steps, energies
-  summary.json     the scene, Kawakita fit (a, 1/b, R^2, points; over the rows
+  summary.json     the scene (and scene_toml, exact: --scene reads it), Kawakita fit (a, 1/b, R^2, points; over the rows
                    with C >= kawakita_min_strain, 0.25), Heckel fit of
                    ln(1/(1 - D)) = K P + A (yield pressure P_y = 1/K, A,
                    D_A = 1 - exp(-A), R^2, points; C >= heckel_min_strain,

@@ -154,8 +154,12 @@ pub fn quasi_static(samples: &[BedSample], rate_change_rel: Option<Real>) -> Qua
 pub struct Summary<'a> {
     /// granbed version.
     pub version: &'static str,
-    /// The scene as run.
+    /// The scene as run. (JSON has no infinity: a field set to ∞ reads
+    /// `null` here; `scene_toml` keeps it.)
     pub scene: &'a Scene,
+    /// The scene as run, exactly, as a scene file's text (`--scene`
+    /// reads it back; ∞ is `inf`).
+    pub scene_toml: String,
     /// Kawakita a.
     pub kawakita_a: Option<Real>,
     /// Kawakita 1/b, Pa.
@@ -397,6 +401,7 @@ pub fn summary<'a>(scene: &'a Scene, run: &BedRun) -> Summary<'a> {
     Summary {
         version: env!("CARGO_PKG_VERSION"),
         scene,
+        scene_toml: scene.to_toml(),
         kawakita_a: k.a,
         kawakita_inv_b_pa: k.inv_b_pa,
         kawakita: k,
