@@ -243,6 +243,7 @@ fn snapshots_plots_and_report() {
         "coordination_strain.svg",
         "relative_density_strain.svg",
         "heywood_strain.svg",
+        "solid_fraction_pressure.svg",
     ] {
         let svg = std::fs::read_to_string(dir.join("plots").join(name))
             .unwrap_or_else(|e| panic!("{name}: {e}"));
@@ -255,7 +256,7 @@ fn snapshots_plots_and_report() {
     let html = std::fs::read_to_string(dir.join("report.html")).unwrap();
     assert!(html.starts_with("<!DOCTYPE html>"));
     assert!(html.trim_end().ends_with("</html>"));
-    assert_eq!(html.matches("<svg").count(), 6);
+    assert_eq!(html.matches("<svg").count(), 7);
     let s = summary(&dir);
     for key in [
         "final_strain",

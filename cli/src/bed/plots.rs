@@ -12,7 +12,10 @@
 //! * `relative_density_strain.svg`: mean granule relative density and
 //!   Σsolid/ΣV;
 //! * `heywood_strain.svg`: mean Heywood coefficient α_SV with d_V and with
-//!   the nominal diameter.
+//!   the nominal diameter;
+//! * `solid_fraction_pressure.svg`: the compaction profile as the bed's
+//!   solid fraction D (relative density of the bed) against the
+//!   upper-punch pressure P.
 
 use std::path::Path;
 
@@ -27,13 +30,14 @@ use granbed_kernel::Real;
 pub const PLOTS_DIR: &str = "plots";
 
 /// The plot files, in the order [`write_plots`] writes them.
-pub const PLOT_FILES: [&str; 6] = [
+pub const PLOT_FILES: [&str; 7] = [
     "pressure_strain.svg",
     "kawakita.svg",
     "heckel.svg",
     "coordination_strain.svg",
     "relative_density_strain.svg",
     "heywood_strain.svg",
+    "solid_fraction_pressure.svg",
 ];
 
 /// The value of a sample a curve shows.
@@ -187,7 +191,10 @@ pub fn heckel_svg(
 
 /// The SVG text of every plot of `run`, named as in [`PLOT_FILES`], with
 /// the fits of its `summary`.
-pub fn plots(run: &BedRun, summary: &Summary) -> anyhow::Result<[(&'static str, String); 6]> {
+pub fn plots(
+    run: &BedRun,
+    summary: &Summary,
+) -> anyhow::Result<[(&'static str, String); PLOT_FILES.len()]> {
     let samples = &run.samples[..];
     const C: &str = "axial strain C = (H0 - H)/H0";
     let pressure = against_strain(
@@ -225,7 +232,13 @@ pub fn plots(run: &BedRun, summary: &Summary) -> anyhow::Result<[(&'static str, 
         coordination_f,
         density_f,
         heywood_f,
+        profile_f,
     ] = PLOT_FILES;
+    let profile = [Series::new(
+        "D against the upper-punch P",
+        Mark::Line,
+        heckel_rows(run).map(|(p, d, _)| (p * 1e-3, d)),
+    )];
     Ok([
         (
             pressure_f,
@@ -257,6 +270,16 @@ pub fn plots(run: &BedRun, summary: &Summary) -> anyhow::Result<[(&'static str, 
                 false,
             )?,
         ),
+        (
+            profile_f,
+            xy_svg(
+                "Compaction profile: the bed's solid fraction",
+                "upper-punch pressure P, kPa",
+                "bed solid fraction D",
+                &profile,
+                false,
+            )?,
+        ),
     ])
 }
 
@@ -266,7 +289,7 @@ pub fn write_plots(
     dir: &Path,
     run: &BedRun,
     summary: &Summary,
-) -> anyhow::Result<[(&'static str, String); 6]> {
+) -> anyhow::Result<[(&'static str, String); PLOT_FILES.len()]> {
     let dir = dir.join(PLOTS_DIR);
     std::fs::create_dir_all(&dir)
         .with_context(|| format!("cannot create directory `{}`", dir.display()))?;
