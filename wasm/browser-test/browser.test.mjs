@@ -115,6 +115,17 @@ test('a decimal comma is refused with its fix, not read as another number', asyn
   assert.deepEqual(problems, []);
 });
 
+test('a run without the fit window says why sigma_est is missing', async () => {
+  // E = 1 mPa: the stable step is so long that one step passes 40 %.
+  await page.check('#custom');
+  await page.fill('#youngs_modulus_pa', '0.001');
+  await page.click('#run');
+  await page.waitForSelector('#results[data-state="done"], #results[data-state="failed"]', { timeout: 60_000 });
+  assert.match(await page.textContent('#sigma-est'), /^n\/a \(no two samples in the 10–40 % window: the run ended at strain \d/);
+  await page.uncheck('#custom');
+  assert.deepEqual(problems, []);
+});
+
 test('the page fits a phone: nothing wider than its 375 px', async () => {
   await page.setViewportSize({ width: 375, height: 800 });
   const width = await page.evaluate(() => document.documentElement.scrollWidth);

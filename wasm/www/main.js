@@ -182,13 +182,21 @@ function finish(msg) {
     $(id).textContent = text;
     if (value !== undefined && value !== null) $(id).dataset.value = String(value);
   };
-  set('sigma-est', formatStress(msg.sigmaEst), msg.sigmaEst);
+  // Why σ_est is missing or fitted over less than 10–40 % (as the CLI's
+  // summary notes say).
+  const reached = `${(100 * msg.strain).toFixed(1)} %`;
+  const sigmaNote = msg.sigmaEst === null
+    ? ` (no two samples in the 10–40 % window: the run ended at strain ${reached})`
+    : msg.strain < 0.4 ? ` (fitted over 10 % to ${reached} only: the run ended there)` : '';
+  set('sigma-est', formatStress(msg.sigmaEst) + sigmaNote, msg.sigmaEst);
   set('sigma-eff0', formatStress(msg.sigmaEff0), msg.sigmaEff0);
   set('slope', formatSlope(msg.slope), msg.slope);
   set('r2', msg.r2 === null ? 'n/a' : msg.r2.toFixed(5), msg.r2);
   set('steps', String(msg.steps), msg.steps);
   set('quasi-static',
-    msg.kineticToInternal === null
+    msg.failure
+      ? 'n/a: the run stopped early'
+      : msg.kineticToInternal === null
       ? 'n/a'
       : `${msg.quasiStatic ? 'yes' : 'NO'}: kinetic/internal work ≤ ${msg.kineticToInternal.toExponential(1)} (limit ${100 * msg.kineticLimit} %), masses ×${msg.massScaling}`,
     msg.quasiStatic);
