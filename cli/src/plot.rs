@@ -93,20 +93,31 @@ fn range(values: impl Iterator<Item = f64>, from_zero: bool) -> core::ops::Range
 
 /// The tick labels of an axis over `r`: `None` (plotters' own, plain
 /// decimals) when its largest magnitude lies in [0.01, 10⁵); otherwise
-/// numbers with an exponent and at most four significant digits (`2.5e-5`,
-/// `1.8e7`), where plain decimals would be rows of zeros or eight digits
-/// wide. Round-off beside zero (below 10⁻⁹ of the span) prints as `0`.
+/// numbers with an exponent (`2.5e-5`, `1.8e7`), where plain decimals
+/// would be rows of zeros or eight digits wide, with the significant
+/// digits the span needs (trailing zeros dropped). Round-off beside zero
+/// (below 10⁻⁹ of the span) prints as `0`.
 fn exponent_labels(r: &Range<f64>) -> Option<impl Fn(&f64) -> String + use<>> {
     let largest = r.start.abs().max(r.end.abs());
     if (1.0e-2..1.0e5).contains(&largest) || largest == 0.0 || !largest.is_finite() {
         return None;
     }
-    let zero = 1.0e-9 * (r.end - r.start).abs();
+    let span = (r.end - r.start).abs();
+    let zero = 1.0e-9 * span;
+    // One digit more than ticks a tenth of the span apart need to differ
+    // (ticks at 2.5 steps included), more on an axis narrow for its
+    // magnitude (100000 to 100010).
+    let digits = if span > 0.0 {
+        ((10.0 * largest / span).log10().ceil() as usize + 2).clamp(2, 15)
+    } else {
+        4
+    };
+    let precision = digits - 1;
     Some(move |v: &f64| {
         if v.abs() <= zero {
             return "0".to_owned();
         }
-        let text = format!("{v:.3e}");
+        let text = format!("{v:.precision$e}");
         match text.split_once('e') {
             Some((mantissa, exponent)) if mantissa.contains('.') => {
                 let mantissa = mantissa.trim_end_matches('0').trim_end_matches('.');
@@ -207,7 +218,11 @@ mod tests {
         assert_eq!(tiny(&-1.0e-22), "0");
         let huge = exponent_labels(&(0.0..1.8e7)).unwrap();
         assert_eq!(huge(&1.8e7), "1.8e7");
-        assert_eq!(huge(&12_345_678.0), "1.235e7");
+        assert_eq!(huge(&12_345_678.0), "1.23e7");
+        // A narrow axis at a large magnitude keeps its ticks apart.
+        let narrow = exponent_labels(&(100_000.0..100_010.0)).unwrap();
+        assert_eq!(narrow(&100_001.0), "1.00001e5");
+        assert_ne!(narrow(&100_002.0), narrow(&100_003.0));
         // In a plot: no row of zeros, no eight-digit labels.
         let points = |k: f64| (0..=10).map(move |i| (0.04 * f64::from(i), k * f64::from(i)));
         let small = xy_svg(

@@ -9,7 +9,7 @@
 #   PREFIX/share/granbed/fortran/granbed.f90   (module source: .mod files
 #       belong to one compiler, so the host compiles it with its own)
 # Idempotent: running it again replaces the files. Extra arguments go to
-# cargo build (e.g. --target-dir DIR).
+# cargo build (e.g. --target-dir DIR, --target TRIPLE). Needs readelf.
 set -euo pipefail
 [[ $# -ge 1 ]] || { echo "usage: kernel/capi/install.sh PREFIX [cargo build args]" >&2; exit 2; }
 prefix=$1
@@ -19,16 +19,28 @@ mkdir -p "$prefix"
 prefix=$(cd "$prefix" && pwd)
 
 version=$(sed -n 's/^version = "\(.*\)"/\1/p' "$capi/Cargo.toml" | head -n 1)
-IFS=. read -r major minor _ <<<"$version"
-if [[ $major == 0 ]]; then abi=0.$minor; else abi=$major; fi
 
-target_dir=$capi/target
+# Where cargo puts the library: its own target directory (CARGO_TARGET_DIR
+# and .cargo/config included), or --target-dir / --target given here.
+target_dir=$(cargo metadata --format-version 1 --no-deps --manifest-path "$capi/Cargo.toml" |
+    sed -n 's/.*"target_directory":"\([^"]*\)".*/\1/p')
+triple=
 args=("$@")
 for ((i = 0; i < ${#args[@]}; i++)); do
-    [[ ${args[i]} == --target-dir ]] && target_dir=${args[i + 1]}
+    case ${args[i]} in
+    --target-dir) target_dir=${args[i + 1]} ;;
+    --target-dir=*) target_dir=${args[i]#--target-dir=} ;;
+    --target) triple=${args[i + 1]} ;;
+    --target=*) triple=${args[i]#--target=} ;;
+    esac
 done
+[[ -n $target_dir ]] || { echo "install.sh: cannot find cargo's target directory" >&2; exit 1; }
 cargo build --release --locked --manifest-path "$capi/Cargo.toml" "$@"
-built=$target_dir/release
+built=$target_dir/${triple:+$triple/}release
+# The ABI number is the one build.rs gave the library (its SONAME).
+soname=$(readelf -d "$built/libgranbed.so" | sed -n 's/.*Library soname: \[\(.*\)\]/\1/p')
+[[ $soname == libgranbed.so.* ]] || { echo "install.sh: $built/libgranbed.so has no SONAME" >&2; exit 1; }
+abi=${soname#libgranbed.so.}
 
 install -d "$prefix/lib/pkgconfig" "$prefix/include" "$prefix/share/granbed/fortran"
 install -m 644 "$built/libgranbed.a" "$prefix/lib/libgranbed.a"

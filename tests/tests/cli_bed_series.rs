@@ -229,6 +229,29 @@ fn a_series_and_a_single_run_keep_out_of_each_other() {
     }
     assert!(dir.join("series.json").is_file() && dir.join("B1/summary.json").is_file());
 
+    // A series refused for its scene after --overwrite was given removes
+    // nothing: the checks come first.
+    assert_eq!(single(&["--overwrite"]).code, 0);
+    let printed = cli(&["bed", "--print-scene"]).stdout;
+    let scene = dir.with_extension("toml");
+    std::fs::write(
+        &scene,
+        printed.replace("[material]\n", "[material]\nyield_stress_pa = 50000.0\n"),
+    )
+    .unwrap();
+    let run = bed(&[
+        "--out",
+        out,
+        "--scene",
+        scene.to_str().unwrap(),
+        "--types",
+        "A2,C2",
+        "--overwrite",
+    ]);
+    assert_eq!(run.code, 2, "{}", run.stderr);
+    assert!(dir.join("summary.json").is_file() && dir.join("checkpoint.bin").is_file());
+    assert_eq!(series(&["--overwrite"]).code, 0);
+
     let run = single(&[]);
     assert_eq!(run.code, 2, "{}", run.stderr);
     assert!(run.stderr.contains("holds a series"), "{}", run.stderr);
@@ -236,4 +259,65 @@ fn a_series_and_a_single_run_keep_out_of_each_other() {
     assert_eq!(run.code, 0, "{}", run.stderr);
     assert!(!dir.join("series.json").exists() && !dir.join("comparison.csv").exists());
     assert!(dir.join("checkpoint.bin").is_file() && dir.join("B1/summary.json").is_file());
+}
+
+/// A checkpoint in a member's directory that is not a run of the member
+/// (another seed, say) is refused by name, not taken into the tables; the
+/// scene of a series prints without a step; and a series.json whose pour
+/// names no type is refused before anything runs.
+#[test]
+fn a_series_resume_takes_only_its_own_runs() {
+    let dir = out_dir("own");
+    let out = dir.to_str().unwrap();
+    let short = common::small_bed("8", "0.03");
+    let mut argv = vec!["--out", out, "--seeds", "1,2"];
+    argv.extend_from_slice(&short);
+    assert_eq!(bed(&argv).code, 0);
+    let tables = read(&dir.join("seeds.csv"));
+
+    // --print-scene: the series' scene, no run.
+    let r = cli(&["bed", "--resume", out, "--print-scene"]);
+    assert_eq!(r.code, 0, "{}", r.stderr);
+    let scene = granbed_cli::bed::Scene::from_toml(&r.stdout).unwrap();
+    assert_eq!(scene.granules, 8);
+    assert_eq!(read(&dir.join("seeds.csv")), tables);
+
+    // seed_2 replaced by a run of seed 5: refused, naming it.
+    let seed_2 = dir.join("seed_2");
+    let mut argv = vec!["--out", seed_2.to_str().unwrap(), "--seed", "5"];
+    argv.extend_from_slice(&short);
+    assert_eq!(bed(&argv).code, 0);
+    let r = bed(&["--resume", out]);
+    assert_eq!(r.code, 2, "{}", r.stderr);
+    assert!(
+        r.stderr.contains("seed 2") && r.stderr.contains("not a run of this series"),
+        "{}",
+        r.stderr
+    );
+    assert_eq!(read(&dir.join("seeds.csv")), tables);
+
+    // A new series into the directory clears the members' old checkpoints
+    // and the tables of the other kind.
+    std::fs::remove_dir_all(&seed_2).unwrap();
+    let mut argv = vec!["--out", out, "--types", "B1,B2"];
+    argv.extend_from_slice(&short);
+    assert_eq!(bed(&argv).code, 0);
+    assert!(!dir.join("seeds.csv").exists() && dir.join("comparison.csv").is_file());
+
+    // A pour that names no type.
+    let text = std::fs::read_to_string(dir.join("series.json")).unwrap();
+    std::fs::write(
+        dir.join("series.json"),
+        text.replace("\"granule_type\": \"B2\"", "\"granule_type\": \"Z9\""),
+    )
+    .unwrap();
+    let before = read(&dir.join("B1/compression.csv"));
+    let r = bed(&["--resume", out]);
+    assert_eq!(r.code, 2, "{}", r.stderr);
+    assert!(
+        r.stderr.contains("`Z9` is none of A1 ... C3"),
+        "{}",
+        r.stderr
+    );
+    assert_eq!(read(&dir.join("B1/compression.csv")), before);
 }

@@ -327,8 +327,8 @@ pub struct BedArgs {
 
     /// Continue the run whose checkpoint is in DIR (its `checkpoint.bin`),
     /// or the series of --types or --seeds in DIR (its `series.json`: every
-    /// run continued or started, the tables written again); the outputs go
-    /// to DIR. Only --strain, --stop-at-strain,
+    /// run continued or started, the tables written again; --stop-at-strain
+    /// and --rate-check are refused there); the outputs go to DIR. Only --strain, --stop-at-strain,
     /// --time-step-safety, --mass-scaling, --sweep-tolerance,
     /// --hold-constraints, --contact-search-interval, --contact-capture,
     /// --held-reprojection, --nearest-penetrated-face,
@@ -580,6 +580,9 @@ impl BedArgs {
             && !dir.join(checkpoint::FILE_NAME).is_file()
             && series::SeriesFile::is_in(dir)
         {
+            if self.print_scene {
+                return self.print_series_scene(dir, streams);
+            }
             let pool = rayon::ThreadPoolBuilder::new()
                 .num_threads(self.threads)
                 .build()?;
@@ -629,11 +632,9 @@ impl BedArgs {
             .num_threads(self.threads)
             .build()?;
         if let Some(seeds) = &self.seeds {
-            series::clear_other_kind(&self.out, true, self.overwrite)?;
             return self.run_seeds(&scene, &seeds.0, &notes, &pool, streams);
         }
         if let Some(types) = &self.types {
-            series::clear_other_kind(&self.out, true, self.overwrite)?;
             for t in &types.0 {
                 self.keep_unfinished(&self.out.join(t.name()))?;
             }
@@ -873,6 +874,9 @@ impl BedArgs {
             writeln!(streams.stderr, "warning: {w}")?;
             notes.push(w);
         }
+        let members: Vec<std::path::PathBuf> =
+            types.iter().map(|t| self.out.join(t.name())).collect();
+        series::prepare_fresh(&self.out, &members, self.overwrite)?;
         // One pour for all types, as the published study compares the nine
         // types on one bed. The pour depends on the type only through the
         // sphere density (η0, the type's digit): it uses the scene's own
@@ -1000,6 +1004,12 @@ impl BedArgs {
         for k in 0..series.len() {
             let resume = series[k].resume.take();
             let item = &series[k];
+            let rest: Vec<&str> = series[k + 1..].iter().map(|r| r.name.as_str()).collect();
+            let rest = if rest.is_empty() {
+                String::new()
+            } else {
+                format!("; not run: {}", rest.join(", "))
+            };
             let control = run::RunControl {
                 resume,
                 packing: item.packing.clone(),
@@ -1018,14 +1028,22 @@ impl BedArgs {
                     notes,
                     streams,
                 )
-                .with_context(|| item.name.clone())?;
+                .map_err(|e| {
+                    // Stopped in its pour: the runs before it are kept,
+                    // and the series goes on from them.
+                    if e.downcast_ref::<crate::signal::Interrupted>().is_some() {
+                        anyhow::Error::new(crate::signal::Interrupted(format!(
+                            "interrupted during the pour of {} (nothing of it compressed; no \
+                             {what} written{rest}); the runs before it are kept: continue the \
+                             series with: granbed-cli bed --resume {}",
+                            item.name,
+                            series_dir.display()
+                        )))
+                    } else {
+                        e.context(item.name.clone())
+                    }
+                })?;
             if result.interrupted {
-                let rest: Vec<&str> = series[k + 1..].iter().map(|r| r.name.as_str()).collect();
-                let rest = if rest.is_empty() {
-                    String::new()
-                } else {
-                    format!("; not run: {}", rest.join(", "))
-                };
                 return Err(interrupted(
                     &result,
                     &item.dir,

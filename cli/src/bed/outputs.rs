@@ -483,8 +483,8 @@ fn not_quasi_static(scene: &Scene, run: &BedRun, q: &QuasiStatic) -> Option<Stri
     let to = judged.last().map_or(Real::NAN, |s| s.strain);
     Some(format!(
         "NOT quasi-static over C = {from:.3} to {to:.3} (the second half of the output rows, \
-         which the certificate judges): {}. Inertia is in these figures: a slower punch (scene \
-         field punch_speed_m_s, now {} m/s) or lighter masses (--mass-scaling, now {}) reduce \
+         which the certificate judges): {}. Inertia is in these figures: a slower punch \
+         (--punch-speed-m-s, now {} m/s) or lighter masses (--mass-scaling, now {}) reduce \
          it; a bed of few granules rearranges by jumps whatever the speed",
         q.figures(),
         scene.punch_speed_m_s,

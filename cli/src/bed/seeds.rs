@@ -224,6 +224,9 @@ impl BedArgs {
         for &seed in seeds {
             self.keep_unfinished(&self.out.join(seed_dir(seed)))?;
         }
+        let members: Vec<std::path::PathBuf> =
+            seeds.iter().map(|&s| self.out.join(seed_dir(s))).collect();
+        series::prepare_fresh(&self.out, &members, self.overwrite)?;
         crate::output::create_out_dir(&self.out)?;
         if !self.quiet {
             writeln!(

@@ -110,6 +110,36 @@ struct Member {
     scene: Scene,
 }
 
+impl Member {
+    /// `Err` unless the checkpoint `c` in the member's directory is a run
+    /// of the member: the same granule type, seed, bed and material as its
+    /// fresh scene (the fields `--resume` may change aside).
+    fn check_checkpoint(&self, c: &checkpoint::Checkpoint) -> anyhow::Result<()> {
+        let ran = Scene::from_toml(&c.progress.scene_toml)
+            .with_context(|| format!("{}: the checkpoint's scene", self.name))?;
+        let fresh = &self.scene;
+        let same = ran.granule_type == fresh.granule_type
+            && ran.seed == fresh.seed
+            && ran.granules == fresh.granules
+            && ran.mesh == fresh.mesh
+            && ran.diameter_mm.to_bits() == fresh.diameter_mm.to_bits()
+            && ran.die_diameter_mm.to_bits() == fresh.die_diameter_mm.to_bits()
+            && ran.punch_speed_m_s.to_bits() == fresh.punch_speed_m_s.to_bits()
+            && ran.material == fresh.material;
+        if same {
+            return Ok(());
+        }
+        Err(input_error(format!(
+            "{}: the checkpoint in `{}` is not a run of this series (another granule type, seed, \
+             bed or material than its series.json): remove that directory to run the member \
+             afresh, or resume it alone with --resume {}",
+            self.name,
+            self.dir.display(),
+            self.dir.display()
+        )))
+    }
+}
+
 impl SeriesFile {
     /// Whether `dir` holds a series description.
     pub fn is_in(dir: &Path) -> bool {
@@ -154,6 +184,14 @@ impl SeriesFile {
             return Err(bad(
                 "a series of types holds its pour, a series of seeds none".to_owned(),
             ));
+        }
+        if let Some(pour) = &file.pour {
+            pour.granule_type.parse::<GranuleType>().map_err(|_| {
+                bad(format!(
+                    "the pour's granule type `{}` is none of A1 ... C3",
+                    pour.granule_type
+                ))
+            })?;
         }
         Ok(file)
     }
@@ -311,7 +349,42 @@ pub fn clear_other_kind(dir: &Path, series: bool, overwrite: bool) -> anyhow::Re
     )))
 }
 
+/// Before a fresh series into `dir` with its `members`' directories, once
+/// everything is validated: a single run's files in `dir` refused (or, with
+/// `overwrite`, removed: [`clear_other_kind`]); an earlier series' tables
+/// (either kind) removed, as a finished run is replaced; and each member's
+/// old checkpoint removed (finished — an unfinished one was refused
+/// without `overwrite`), so that a resume of the new series never takes an
+/// earlier run for one of its members.
+pub fn prepare_fresh(dir: &Path, members: &[PathBuf], overwrite: bool) -> anyhow::Result<()> {
+    clear_other_kind(dir, true, overwrite)?;
+    remove_files(&series_files(dir))?;
+    let checkpoints: Vec<PathBuf> = members
+        .iter()
+        .map(|m| m.join(checkpoint::FILE_NAME))
+        .collect();
+    remove_files(&checkpoints)
+}
+
 impl BedArgs {
+    /// `--print-scene --resume DIR` on a series directory: the series'
+    /// scene with the overrides given (each member sets its own type or
+    /// seed).
+    pub(super) fn print_series_scene(
+        &self,
+        dir: &Path,
+        streams: &mut Streams<'_>,
+    ) -> anyhow::Result<()> {
+        let file = SeriesFile::read(dir)?;
+        let base = Scene::from_toml(&file.scene_toml).context("the series' scene")?;
+        write!(
+            streams.stdout,
+            "{}",
+            self.overridden(base, false)?.to_toml()
+        )?;
+        Ok(())
+    }
+
     /// `--resume DIR` on a series directory: every member continued from
     /// its checkpoint (with the overrides allowed with `--resume`), or
     /// started afresh from the series' scene and pour if it has none; then
@@ -342,7 +415,9 @@ impl BedArgs {
         let members = file.members(dir)?;
         for m in &members {
             let resume = if m.dir.join(checkpoint::FILE_NAME).is_file() {
-                Some(checkpoint::Checkpoint::read(&m.dir).with_context(|| m.name.clone())?)
+                let c = checkpoint::Checkpoint::read(&m.dir).with_context(|| m.name.clone())?;
+                m.check_checkpoint(&c)?;
+                Some(c)
             } else {
                 None
             };
@@ -380,20 +455,72 @@ impl BedArgs {
             SeriesKind::Types => "comparison",
             SeriesKind::Seeds => "spread",
         };
-        let runs = self.compress_series(pool, &mut series, dir, what, &[], streams)?;
+        // The warning a fresh --types gave about the scene's material
+        // overrides, again in the summaries written anew.
+        let mut notes = Vec::new();
+        if file.kind == SeriesKind::Types {
+            let types: Vec<GranuleType> = scenes
+                .iter()
+                .map(Scene::granule_type)
+                .collect::<anyhow::Result<_>>()?;
+            let base = &members[0].scene.material;
+            let given = [
+                (base.yield_stress_pa, "the scene's material.yield_stress_pa"),
+                (base.eta0, "the scene's material.eta0"),
+            ];
+            if let Some(w) = crate::material_args::check_type_overrides(&types, given)? {
+                notes.push(w);
+            }
+        }
+        let runs = self.compress_series(pool, &mut series, dir, what, &notes, streams)?;
         match &file.pour {
             Some(pour) => {
-                let pour_type: GranuleType = pour.granule_type.parse().map_err(|_| {
-                    input_error(format!(
-                        "`{}`: pour granule type `{}`",
-                        dir.join(FILE_NAME).display(),
-                        pour.granule_type
-                    ))
-                })?;
+                let pour_type: GranuleType = pour.granule_type.parse()?;
                 super::write_types_tables(dir, &scenes, &runs, pour_type, pour.wall_time_s)?;
             }
             None => super::seeds::write_seed_tables(dir, &scenes, &runs)?,
         }
         super::series_failures(&series, runs)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A fresh series clears its members' old checkpoints and an earlier
+    /// series' tables, refuses a single run's files without `overwrite`
+    /// (removing nothing) and removes them with it.
+    #[test]
+    fn a_fresh_series_clears_what_a_resume_could_mistake() {
+        let dir = std::env::temp_dir().join(format!("granbed-series-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&dir);
+        let member = dir.join("A1");
+        std::fs::create_dir_all(&member).unwrap();
+        let members = [member.clone()];
+        let touch = |p: &Path| std::fs::write(p, b"x").unwrap();
+        touch(&member.join(checkpoint::FILE_NAME));
+        touch(&member.join(outputs::SUMMARY_JSON));
+        touch(&dir.join(seeds::SEEDS_CSV));
+        touch(&dir.join(FILE_NAME));
+        prepare_fresh(&dir, &members, false).unwrap();
+        assert!(!member.join(checkpoint::FILE_NAME).exists());
+        assert!(
+            member.join(outputs::SUMMARY_JSON).exists(),
+            "a member's outputs are its own"
+        );
+        assert!(!dir.join(seeds::SEEDS_CSV).exists() && !SeriesFile::is_in(&dir));
+
+        touch(&dir.join(outputs::SUMMARY_JSON));
+        touch(&member.join(checkpoint::FILE_NAME));
+        let e = prepare_fresh(&dir, &members, false).unwrap_err();
+        assert!(e.to_string().contains("holds a single run"), "{e}");
+        assert!(
+            member.join(checkpoint::FILE_NAME).exists(),
+            "a refusal removed a file"
+        );
+        prepare_fresh(&dir, &members, true).unwrap();
+        assert!(!dir.join(outputs::SUMMARY_JSON).exists());
+        std::fs::remove_dir_all(&dir).unwrap();
     }
 }
