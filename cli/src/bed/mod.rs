@@ -419,6 +419,8 @@ pub struct BedArgs {
     /// directory holding a single run's files, or a single run into a
     /// series' directory, is refused too; with --overwrite the other's
     /// files there are removed first (a series' run directories are left).
+    /// A series replaces an earlier series' tables and its members' old
+    /// checkpoints either way.
     #[arg(long, conflicts_with = "resume")]
     pub overwrite: bool,
 }
