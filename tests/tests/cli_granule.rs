@@ -511,8 +511,8 @@ fn types_are_tabulated_and_independent_of_threads() {
     let t = Table::read(&dir.join("types.csv"));
     assert_eq!(
         t.header,
-        "type,sigma_y_pa,eta0,sigma_eff0_pa,sigma_est_pa,slope_n_per_m,steps,wall_time_s,\
-         energy_residual_rel,return_map_gap_rel"
+        "type,sigma_y_pa,eta0,sigma_eff0_pa,sigma_est_pa,slope_n_per_m,fit_r_squared,\
+         quasi_static_passed,steps,wall_time_s,energy_residual_rel,return_map_gap_rel"
     );
     assert_eq!(t.text("type"), ["A1", "C3"]);
     let sigma = t.num("sigma_est_pa");
@@ -531,6 +531,9 @@ fn types_are_tabulated_and_independent_of_threads() {
             sigma[i],
             "types.csv row of {ty}"
         );
+        assert_eq!(number(&s, "fit_r_squared"), t.num("fit_r_squared")[i]);
+        let passed = s["quasi_static"]["passed"].as_bool().unwrap();
+        assert_eq!(t.num("quasi_static_passed")[i], f64::from(u8::from(passed)));
     }
     let svg = std::fs::read_to_string(dir.join("force_displacement_types.svg")).unwrap();
     assert!(svg.starts_with("<svg"));

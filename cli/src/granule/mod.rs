@@ -89,8 +89,10 @@ Output, in --out DIR (created if missing; with --types in DIR/<TYPE>/ per type):
                           speed), cost, and \"error\" if the kernel stopped the
                           run
   force_displacement.svg  force against approach, with the sigma_est fit line
-With --types, also in DIR: types.csv (one row per type) and
-force_displacement_types.svg (all types overlaid).
+With --types, also in DIR: types.csv (one row per type: sigma_y, eta0,
+sigma_eff0, sigma_est, the fit's slope and R^2, quasi_static_passed 1/0, steps,
+wall time, energy residual, return-map gap) and force_displacement_types.svg
+(all types overlaid).
 Floats are written round-trip exact. Progress bars go to stderr when it is a
 terminal, then one summary line per type. If the kernel fails, the rows so far,
 the summary (with its \"error\") and the plot are still written, and the error

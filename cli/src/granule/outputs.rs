@@ -24,13 +24,15 @@ pub const TYPES_CSV: &str = "types.csv";
 pub const TYPES_SVG: &str = "force_displacement_types.svg";
 
 /// Header of [`TYPES_CSV`].
-pub const TYPES_COLUMNS: [&str; 10] = [
+pub const TYPES_COLUMNS: [&str; 12] = [
     "type",
     "sigma_y_pa",
     "eta0",
     "sigma_eff0_pa",
     "sigma_est_pa",
     "slope_n_per_m",
+    "fit_r_squared",
+    "quasi_static_passed",
     "steps",
     "wall_time_s",
     "energy_residual_rel",
@@ -74,6 +76,8 @@ fn types_row(t: GranuleType, s: &Summary) -> [Field; TYPES_COLUMNS.len()] {
         r(s.sigma_eff0_pa),
         opt(s.sigma_est_pa),
         opt(s.slope_n_per_m),
+        opt(s.fit_r_squared),
+        Field::Int(u64::from(s.quasi_static.passed)),
         Field::Int(s.steps),
         r(s.wall_time_s),
         opt(s.energy_residual_rel),
