@@ -645,6 +645,8 @@ impl BedArgs {
         if resume.is_none() {
             self.keep_unfinished(&out)?;
             series::clear_other_kind(&out, false, self.overwrite)?;
+            // A bad --out is reported before the banner that names it.
+            crate::output::create_out_dir(&out)?;
             if !self.quiet {
                 writeln!(
                     streams.stderr,
