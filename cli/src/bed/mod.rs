@@ -48,7 +48,8 @@ Output, in --out DIR (created if missing):
                    (granule solid volume / (die area x H0 (1 - C)); Heckel:
                    ln(1/(1 - D)) against the pressure), mean Heywood coefficient
                    (d_V and nominal d), min Jacobian, steps, energies
-  summary.json     the scene (and scene_toml, exact: --scene reads it), Kawakita fit (a, 1/b, R^2, points; over the rows
+  summary.json     the scene (and scene_toml, exact: --scene reads it),
+                   Kawakita fit (a, 1/b, R^2, points; over the rows
                    with C >= kawakita_min_strain, 0.25), Heckel fit of
                    ln(1/(1 - D)) = K P + A (yield pressure P_y = 1/K, A,
                    D_A = 1 - exp(-A), R^2, points; C >= heckel_min_strain,
@@ -328,8 +329,8 @@ pub struct BedArgs {
     /// Continue the run whose checkpoint is in DIR (its `checkpoint.bin`),
     /// or the series of --types or --seeds in DIR (its `series.json`: every
     /// run continued or started, the tables written again; --stop-at-strain
-    /// and --rate-check are refused there); the outputs go to DIR. Only --strain, --stop-at-strain,
-    /// --time-step-safety, --mass-scaling, --sweep-tolerance,
+    /// and --rate-check are refused there); the outputs go to DIR. Only
+    /// --strain, --stop-at-strain, --time-step-safety, --mass-scaling, --sweep-tolerance,
     /// --hold-constraints, --contact-search-interval, --contact-capture,
     /// --held-reprojection, --nearest-penetrated-face,
     /// --exact-sweep-tolerance,
