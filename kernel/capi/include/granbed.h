@@ -16,6 +16,17 @@
 #include <stddef.h>
 #include <stdint.h>
 
+// The major version of the header (with GRANBED_VERSION_MINOR and
+// GRANBED_VERSION_PATCH the crate's version): a host can compare it with
+// granbed_version() of the library it loaded.
+#define GRANBED_VERSION_MAJOR 0
+
+// The minor version of the header.
+#define GRANBED_VERSION_MINOR 1
+
+// The patch version of the header.
+#define GRANBED_VERSION_PATCH 0
+
 // Tolerance on |ξ|, |η| of the inside-the-face test (physics.md: 1e-6).
 #define GRANBED_INSIDE_TOLERANCE 1e-6
 
@@ -224,7 +235,8 @@ typedef struct GranbedMaterialDerived {
 extern "C" {
 #endif // __cplusplus
 
-// The library version, NUL-terminated (static storage).
+// The library version, NUL-terminated (static storage): the header's
+// `GRANBED_VERSION_MAJOR.MINOR.PATCH` for a library built with it.
 const char *granbed_version(void);
 
 // Projects the point `p` (3 doubles, m) on the bilinear quad `quad`

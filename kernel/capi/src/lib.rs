@@ -42,7 +42,17 @@ pub use status::*;
 pub use update::*;
 pub use vumat::*;
 
-/// The library version, NUL-terminated (static storage).
+/// The major version of the header (with GRANBED_VERSION_MINOR and
+/// GRANBED_VERSION_PATCH the crate's version): a host can compare it with
+/// granbed_version() of the library it loaded.
+pub const GRANBED_VERSION_MAJOR: u32 = 0;
+/// The minor version of the header.
+pub const GRANBED_VERSION_MINOR: u32 = 1;
+/// The patch version of the header.
+pub const GRANBED_VERSION_PATCH: u32 = 0;
+
+/// The library version, NUL-terminated (static storage): the header's
+/// `GRANBED_VERSION_MAJOR.MINOR.PATCH` for a library built with it.
 #[unsafe(no_mangle)]
 pub extern "C" fn granbed_version() -> *const core::ffi::c_char {
     const VERSION: &core::ffi::CStr = match core::ffi::CStr::from_bytes_with_nul(
@@ -89,6 +99,19 @@ pub unsafe extern "C" fn granbed_panic_probe(p: *const f64, n: usize, i: usize) 
 
 #[cfg(test)]
 mod tests {
+    /// The header's version constants are the crate's version, which
+    /// granbed_version() returns.
+    #[test]
+    fn the_version_constants_are_the_crate_version() {
+        let text = format!(
+            "{}.{}.{}",
+            super::GRANBED_VERSION_MAJOR,
+            super::GRANBED_VERSION_MINOR,
+            super::GRANBED_VERSION_PATCH
+        );
+        assert_eq!(text, env!("CARGO_PKG_VERSION"));
+    }
+
     /// The header's comments are plain text: no rustdoc link brackets.
     #[test]
     fn the_header_has_no_rustdoc_links() {
