@@ -232,13 +232,8 @@ fn a_series_and_a_single_run_keep_out_of_each_other() {
     // A series refused for its scene after --overwrite was given removes
     // nothing: the checks come first.
     assert_eq!(single(&["--overwrite"]).code, 0);
-    let printed = cli(&["bed", "--print-scene"]).stdout;
     let scene = dir.with_extension("toml");
-    std::fs::write(
-        &scene,
-        printed.replace("[material]\n", "[material]\nyield_stress_pa = 50000.0\n"),
-    )
-    .unwrap();
+    common::write_scene_with_material(&scene, "yield_stress_pa = 50000.0");
     let run = bed(&[
         "--out",
         out,

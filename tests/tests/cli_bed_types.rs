@@ -164,18 +164,8 @@ fn bad_type_lists_and_conflicts_are_usage_errors() {
     }
     // A scene whose material override leaves two listed types one
     // material: refused before the pour, naming the field.
-    let scenes = out_dir("scenes");
-    std::fs::create_dir_all(&scenes).unwrap();
-    let printed = cli(&["bed", "--print-scene"]);
-    assert_eq!(printed.code, 0);
-    let scene = scenes.join("yield.toml");
-    std::fs::write(
-        &scene,
-        printed
-            .stdout
-            .replace("[material]\n", "[material]\nyield_stress_pa = 50000.0\n"),
-    )
-    .unwrap();
+    let scene = out_dir("scenes").join("yield.toml");
+    common::write_scene_with_material(&scene, "yield_stress_pa = 50000.0");
     let run = cli(&[
         "bed",
         "--out",

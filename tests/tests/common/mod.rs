@@ -42,6 +42,19 @@ pub fn cli(args: &[&str]) -> Run {
     }
 }
 
+/// Writes to `path` the published scene (`bed --print-scene`) with
+/// `line` added to its `[material]` table, e.g. a yield stress that every
+/// type of a `--types` run would share.
+pub fn write_scene_with_material(path: &Path, line: &str) {
+    let printed = cli(&["bed", "--print-scene"]);
+    assert_eq!(printed.code, 0, "{}", printed.stderr);
+    let text = printed
+        .stdout
+        .replace("[material]\n", &format!("[material]\n{line}\n"));
+    std::fs::create_dir_all(path.parent().unwrap()).unwrap();
+    std::fs::write(path, text).unwrap();
+}
+
 /// A parsed CSV table (numbers or text cells).
 pub struct Table {
     columns: HashMap<String, usize>,
