@@ -16,6 +16,12 @@
 !>                              one: rotate by R of F = RU in a VUMAT wrapper)
 !>   status(nblock)             GRANBED_OK or the point's error code
 !>
+!> For a host with its own state layout, granbed_update_points updates n
+!> points in the C ABI's layout (arrays stored point by point: F(9, n)
+!> row-major per point, cp_inv(6, n) and stress(6, n) in Voigt order xx yy
+!> zz yz xz xy, from granbed_state_init), Kirchhoff or Cauchy stress, with
+!> each point's record (J, eta, dissipation, plastic flag, iterations).
+!>
 !> Link with the static library: gfortran ... libgranbed.a -lm
 module granbed
   use, intrinsic :: iso_c_binding, only: c_int32_t, c_size_t, c_double, c_char, c_ptr, &
@@ -23,12 +29,19 @@ module granbed
   implicit none
   private
   public :: granbed_vumat_block, granbed_preset_props, granbed_check_props, granbed_derived_props, &
-       granbed_message
+       granbed_message, granbed_state_init, granbed_update_points
 
   integer(c_int32_t), parameter, public :: GRANBED_OK = 0
   integer(c_int32_t), parameter, public :: GRANBED_ERR_INVALID_PARAMETER = 2
   integer(c_int32_t), parameter, public :: GRANBED_ERR_POINT_FAILED = 9
   integer, parameter, public :: GRANBED_VUMAT_NPROPS = 8, GRANBED_VUMAT_NSTATEV = 8
+  integer(c_int32_t), parameter, public :: GRANBED_STRESS_KIRCHHOFF = 0, GRANBED_STRESS_CAUCHY = 1
+
+  !> struct GranbedPointInfo: one point's record of granbed_update_points.
+  type, bind(c), public :: granbed_point_info
+     real(c_double) :: j, eta, dissipation_density, hourglass_energy
+     integer(c_int32_t) :: plastic, iterations
+  end type granbed_point_info
 
   !> struct GranbedMaterialParams (8 doubles) and GranbedParamError.
   type, bind(c), public :: granbed_material_params
@@ -80,6 +93,25 @@ module granbed
        type(granbed_param_error), intent(out) :: error
      end function c_granbed_material_derived
 
+     integer(c_int32_t) function c_granbed_state_init(n, cp_inv) bind(c, name='granbed_state_init')
+       import :: c_int32_t, c_size_t, c_double
+       integer(c_size_t), value :: n
+       real(c_double), intent(out) :: cp_inv(*)
+     end function c_granbed_state_init
+
+     integer(c_int32_t) function c_granbed_update_points(params, volume_fix, n, f, cp_inv, &
+          stress_measure, stress, info, point_status) bind(c, name='granbed_update_points')
+       import :: c_int32_t, c_size_t, c_double, granbed_material_params, granbed_point_info
+       type(granbed_material_params), intent(in) :: params
+       integer(c_int32_t), value :: volume_fix, stress_measure
+       integer(c_size_t), value :: n
+       real(c_double), intent(in) :: f(*)
+       real(c_double), intent(inout) :: cp_inv(*)
+       real(c_double), intent(out) :: stress(*)
+       type(granbed_point_info), intent(out) :: info(*)
+       integer(c_int32_t), intent(out) :: point_status(*)
+     end function c_granbed_update_points
+
      type(c_ptr) function c_granbed_status_message(code) bind(c, name='granbed_status_message')
        import :: c_ptr, c_int32_t
        integer(c_int32_t), value :: code
@@ -101,6 +133,38 @@ contains
     ierr = c_granbed_vumat(int(nblock, c_size_t), int(nstatev, c_size_t), int(nprops, c_size_t), &
          props, defgradNew, stateOld, stateNew, stressNew, status)
   end subroutine granbed_vumat_block
+
+  !> The initial plastic state C_p^-1 = identity of n points: cp_inv(6, n).
+  subroutine granbed_state_init(n, cp_inv, ierr)
+    integer, intent(in) :: n
+    real(c_double), intent(out) :: cp_inv(6, n)
+    integer(c_int32_t), intent(out) :: ierr
+    ierr = c_granbed_state_init(int(n, c_size_t), cp_inv)
+  end subroutine granbed_state_init
+
+  !> Updates n points to their end-of-step deformation gradients F(9, n)
+  !> (F11 F12 F13 F21 ... F33 per point); cp_inv(6, n) in/out (a failed
+  !> point keeps its state); stress(6, n) out, Pa, GRANBED_STRESS_KIRCHHOFF
+  !> or GRANBED_STRESS_CAUCHY; info(n) and status(n) per point. volume_fix:
+  !> .true. as recommended. ierr: GRANBED_OK, GRANBED_ERR_POINT_FAILED (see
+  !> status) or an argument error (nothing written).
+  subroutine granbed_update_points(props, volume_fix, n, f, cp_inv, stress_measure, stress, info, &
+       status, ierr)
+    real(c_double), intent(in) :: props(GRANBED_VUMAT_NPROPS)
+    logical, intent(in) :: volume_fix
+    integer, intent(in) :: n
+    real(c_double), intent(in) :: f(9, n)
+    real(c_double), intent(inout) :: cp_inv(6, n)
+    integer(c_int32_t), intent(in) :: stress_measure
+    real(c_double), intent(out) :: stress(6, n)
+    type(granbed_point_info), intent(out) :: info(n)
+    integer(c_int32_t), intent(out) :: status(n), ierr
+    integer(c_int32_t) :: fix
+    fix = 0
+    if (volume_fix) fix = 1
+    ierr = c_granbed_update_points(params_of(props), fix, int(n, c_size_t), f, cp_inv, &
+         stress_measure, stress, info, status)
+  end subroutine granbed_update_points
 
   !> props(1:8) of the standard granule type name ('A1' ... 'C3').
   subroutine granbed_preset_props(name, props, ierr)

@@ -1,8 +1,9 @@
 !> Drives a block of material points through granbed_vumat_block along the
 !> paths of `granbed-cli point` CSV files (point k follows file k) and checks
 !> that the Cauchy stress and the relative density equal the CLI's bit for
-!> bit; then checks the derived constants against their formulas and that a
-!> bad Poisson ratio is named.
+!> bit, and that granbed_update_points (the C ABI's own layout) gives the
+!> same Cauchy stresses and relative densities; then checks the derived
+!> constants against their formulas and that a bad Poisson ratio is named.
 !>
 !> usage: material_paths_f TYPE FILE.csv [FILE.csv ...]   (TYPE: A1 ... C3)
 program material_paths_f
@@ -14,10 +15,12 @@ program material_paths_f
   ! CSV columns (1-based): f_xx 3, f_yy 4, f_zz 5, f_xy 6, sigma_xx..xy 14-19, eta 22, plastic 23
   integer, parameter :: nstatev = GRANBED_VUMAT_NSTATEV
   real(c_double), allocatable :: rows(:, :, :), defgrad(:, :), state_old(:, :), state_new(:, :), stress(:, :)
-  integer(c_int32_t), allocatable :: status(:)
+  real(c_double), allocatable :: f_points(:, :), cp_inv(:, :), stress_points(:, :)
+  type(granbed_point_info), allocatable :: info(:)
+  integer(c_int32_t), allocatable :: status(:), point_status(:)
   real(c_double) :: props(GRANBED_VUMAT_NPROPS), expect(6), derived(6), expect_derived(6), mu, lambda
   integer(c_int32_t) :: ierr
-  integer :: nblock, nrows, k, r, u, ios, mismatches, plastic
+  integer :: nblock, nrows, k, r, u, ios, mismatches, plastic, point_mismatches
   character(len=512) :: arg, message
   ! VUMAT stress order 11 22 33 12 23 31 from the CSV's sigma xx yy zz yz xz xy.
   integer, parameter :: csv_of(6) = [14, 15, 16, 19, 17, 18]
@@ -50,8 +53,13 @@ program material_paths_f
 
   allocate (defgrad(nblock, 9), state_old(nblock, nstatev), state_new(nblock, nstatev), &
        stress(nblock, 6), status(nblock))
+  allocate (f_points(9, nblock), cp_inv(6, nblock), stress_points(6, nblock), info(nblock), &
+       point_status(nblock))
   state_old = 0 ! zero state variables = virgin state
+  call granbed_state_init(nblock, cp_inv, ierr)
+  if (ierr /= GRANBED_OK) stop 'granbed_state_init failed'
   mismatches = 0
+  point_mismatches = 0
   plastic = 0
   do r = 1, nrows
      defgrad = 0
@@ -67,6 +75,24 @@ program material_paths_f
         print '(a,i0,2a)', 'row ', r, ': ', trim(granbed_message(ierr))
         stop 1
      end if
+     ! The same points through granbed_update_points: F row-major per point
+     ! (the CSV's F is diagonal plus F12), stress in Voigt xx yy zz yz xz xy.
+     f_points = 0
+     do k = 1, nblock
+        f_points([1, 5, 9, 2], k) = rows(3:6, r, k)
+     end do
+     call granbed_update_points(props, .true., nblock, f_points, cp_inv, GRANBED_STRESS_CAUCHY, &
+          stress_points, info, point_status, ierr)
+     if (ierr /= GRANBED_OK) then
+        print '(a,i0,2a)', 'row ', r, ': granbed_update_points: ', trim(granbed_message(ierr))
+        stop 1
+     end if
+     do k = 1, nblock
+        if (any(transfer(stress_points(:, k), 0_int64, 6) /= &
+             transfer(rows(14:19, r, k), 0_int64, 6)) .or. &
+             transfer(info(k)%eta, 0_int64) /= transfer(rows(22, r, k), 0_int64)) &
+             point_mismatches = point_mismatches + 1
+     end do
      do k = 1, nblock
         expect = rows(csv_of, r, k)
         if (any(transfer(stress(k, :), 0_int64, 6) /= transfer(expect, 0_int64, 6)) .or. &
@@ -106,5 +132,6 @@ program material_paths_f
      print '(a)', 'FAIL: nu = 0.6 was not rejected by name'
      stop 1
   end if
-  if (mismatches /= 0 .or. plastic == 0) stop 1
+  print '(a,i0,a)', 'material_paths_f: granbed_update_points: ', point_mismatches, ' mismatches'
+  if (mismatches /= 0 .or. point_mismatches /= 0 .or. plastic == 0) stop 1
 end program material_paths_f
