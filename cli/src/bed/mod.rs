@@ -638,9 +638,6 @@ impl BedArgs {
             return self.run_seeds(&scene, &seeds.0, &notes, &pool, streams);
         }
         if let Some(types) = &self.types {
-            for t in &types.0 {
-                self.keep_unfinished(&self.out.join(t.name()))?;
-            }
             return self.run_types(&scene, &types.0, &notes, &pool, streams);
         }
         if resume.is_none() {
@@ -854,34 +851,23 @@ impl BedArgs {
     ) -> anyhow::Result<()> {
         // Every type's scene is validated (the material overrides apply to
         // each) before anything runs.
-        let scenes: Vec<Scene> = types
+        let members: Vec<series::Member> = types
             .iter()
-            .map(|t| {
-                let scene = Scene {
-                    granule_type: t.name().to_string(),
-                    ..base.clone()
-                };
-                scene
-                    .validate()
-                    .with_context(|| format!("granule type {t}"))?;
-                Ok(scene)
-            })
-            .collect::<anyhow::Result<_>>()?;
+            .map(|&t| series::Member::of_type(&self.out, t, base))
+            .collect();
+        for m in &members {
+            m.scene.validate().with_context(|| m.name.clone())?;
+            self.keep_unfinished(&m.dir)?;
+        }
+        let scenes: Vec<Scene> = members.iter().map(|m| m.scene.clone()).collect();
         let mut notes = notes.to_vec();
-        let given = [
-            (
-                base.material.yield_stress_pa,
-                "the scene's material.yield_stress_pa",
-            ),
-            (base.material.eta0, "the scene's material.eta0"),
-        ];
+        let given = series::type_overrides(base);
         if let Some(w) = crate::material_args::check_type_overrides(types, given)? {
             writeln!(streams.stderr, "warning: {w}")?;
             notes.push(w);
         }
-        let members: Vec<std::path::PathBuf> =
-            types.iter().map(|t| self.out.join(t.name())).collect();
-        series::prepare_fresh(&self.out, &members, self.overwrite)?;
+        let dirs: Vec<std::path::PathBuf> = members.iter().map(|m| m.dir.clone()).collect();
+        series::prepare_fresh(&self.out, &dirs, self.overwrite)?;
         // One pour for all types, as the published study compares the nine
         // types on one bed. The pour depends on the type only through the
         // sphere density (η0, the type's digit): it uses the scene's own
@@ -926,17 +912,10 @@ impl BedArgs {
             pour: Some(series::StoredPacking::new(pour_type, &packing)),
         }
         .write(&self.out)?;
-        let mut series: Vec<SeriesRun> = types
+        let mut series: Vec<SeriesRun> = members
             .iter()
             .zip(&scenes)
-            .map(|(t, scene)| SeriesRun {
-                name: format!("granule type {t}"),
-                label: format!("bed {t}"),
-                dir: self.out.join(t.name()),
-                scene,
-                packing: Some(packing.clone()),
-                resume: None,
-            })
+            .map(|(m, scene)| m.run(scene, Some(packing.clone()), None))
             .collect();
         let runs =
             self.compress_series(pool, &mut series, &self.out, "comparison", &notes, streams)?;

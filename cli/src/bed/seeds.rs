@@ -214,19 +214,16 @@ impl BedArgs {
         pool: &rayon::ThreadPool,
         streams: &mut Streams<'_>,
     ) -> anyhow::Result<()> {
-        let scenes: Vec<Scene> = seeds
+        let members: Vec<series::Member> = seeds
             .iter()
-            .map(|&seed| Scene {
-                seed,
-                ..base.clone()
-            })
+            .map(|&seed| series::Member::of_seed(&self.out, seed, base))
             .collect();
-        for &seed in seeds {
-            self.keep_unfinished(&self.out.join(seed_dir(seed)))?;
+        let scenes: Vec<Scene> = members.iter().map(|m| m.scene.clone()).collect();
+        for m in &members {
+            self.keep_unfinished(&m.dir)?;
         }
-        let members: Vec<std::path::PathBuf> =
-            seeds.iter().map(|&s| self.out.join(seed_dir(s))).collect();
-        series::prepare_fresh(&self.out, &members, self.overwrite)?;
+        let dirs: Vec<std::path::PathBuf> = members.iter().map(|m| m.dir.clone()).collect();
+        series::prepare_fresh(&self.out, &dirs, self.overwrite)?;
         crate::output::create_out_dir(&self.out)?;
         if !self.quiet {
             writeln!(
@@ -251,17 +248,10 @@ impl BedArgs {
             pour: None,
         }
         .write(&self.out)?;
-        let mut series: Vec<SeriesRun> = seeds
+        let mut series: Vec<SeriesRun> = members
             .iter()
             .zip(&scenes)
-            .map(|(seed, scene)| SeriesRun {
-                name: format!("seed {seed}"),
-                label: format!("bed seed {seed}"),
-                dir: self.out.join(seed_dir(*seed)),
-                scene,
-                packing: None,
-                resume: None,
-            })
+            .map(|(m, scene)| m.run(scene, None, None))
             .collect();
         let runs = self.compress_series(pool, &mut series, &self.out, "spread", notes, streams)?;
         write_seed_tables(&self.out, &scenes, &runs)?;

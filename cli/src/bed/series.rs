@@ -102,15 +102,60 @@ pub struct SeriesFile {
 }
 
 /// One member of a series: its name in messages, its label on the
-/// progress bar, its directory and its scene when started afresh.
-struct Member {
-    name: String,
-    label: String,
-    dir: PathBuf,
-    scene: Scene,
+/// progress bar, its directory and its scene when started afresh. The one
+/// place a fresh series and its resume both take them from.
+pub(super) struct Member {
+    pub(super) name: String,
+    pub(super) label: String,
+    pub(super) dir: PathBuf,
+    pub(super) scene: Scene,
 }
 
 impl Member {
+    /// Granule type `t` of a `--types` series in `dir` on the scene `base`.
+    pub(super) fn of_type(dir: &Path, t: GranuleType, base: &Scene) -> Self {
+        Self {
+            name: format!("granule type {t}"),
+            label: format!("bed {t}"),
+            dir: dir.join(t.name()),
+            scene: Scene {
+                granule_type: t.name().to_owned(),
+                ..base.clone()
+            },
+        }
+    }
+
+    /// Seed `seed` of a `--seeds` series in `dir` on the scene `base`.
+    pub(super) fn of_seed(dir: &Path, seed: u64, base: &Scene) -> Self {
+        Self {
+            name: format!("seed {seed}"),
+            label: format!("bed seed {seed}"),
+            dir: dir.join(seed_dir(seed)),
+            scene: Scene {
+                seed,
+                ..base.clone()
+            },
+        }
+    }
+
+    /// The member's run on `scene` (its own, or as a resume overrides it),
+    /// from `packing` or the checkpoint `resume`.
+    pub(super) fn run<'a>(
+        &self,
+        scene: &'a Scene,
+        packing: Option<run::Packing>,
+        resume: Option<checkpoint::Checkpoint>,
+    ) -> SeriesRun<'a> {
+        SeriesRun {
+            name: self.name.clone(),
+            label: self.label.clone(),
+            dir: self.dir.clone(),
+            scene,
+            packing,
+            resume,
+        }
+    }
+
     /// `Err` unless the checkpoint `c` in the member's directory is a run
     /// of the member: the same granule type, seed, bed and material as its
     /// fresh scene (the fields `--resume` may change aside).
@@ -206,34 +251,25 @@ impl SeriesFile {
                 let bad =
                     || input_error(format!("`{}`: member `{m}`", dir.join(FILE_NAME).display()));
                 Ok(match self.kind {
-                    SeriesKind::Types => {
-                        let t: GranuleType = m.parse().map_err(|_| bad())?;
-                        Member {
-                            name: format!("granule type {t}"),
-                            label: format!("bed {t}"),
-                            dir: dir.join(t.name()),
-                            scene: Scene {
-                                granule_type: t.name().to_owned(),
-                                ..base.clone()
-                            },
-                        }
-                    }
-                    SeriesKind::Seeds => {
-                        let seed: u64 = m.parse().map_err(|_| bad())?;
-                        Member {
-                            name: format!("seed {seed}"),
-                            label: format!("bed seed {seed}"),
-                            dir: dir.join(seed_dir(seed)),
-                            scene: Scene {
-                                seed,
-                                ..base.clone()
-                            },
-                        }
-                    }
+                    SeriesKind::Types => Member::of_type(dir, m.parse().map_err(|_| bad())?, &base),
+                    SeriesKind::Seeds => Member::of_seed(dir, m.parse().map_err(|_| bad())?, &base),
                 })
             })
             .collect()
     }
+}
+
+/// The overrides of a scene's `[material]` that a `--types` series checks
+/// ([`crate::material_args::check_type_overrides`]), named as the scene
+/// spells them.
+pub(super) fn type_overrides(scene: &Scene) -> [(Option<f64>, &'static str); 2] {
+    [
+        (
+            scene.material.yield_stress_pa,
+            "the scene's material.yield_stress_pa",
+        ),
+        (scene.material.eta0, "the scene's material.eta0"),
+    ]
 }
 
 /// `Err` naming the runs in `dir`'s sub-directories when `dir` holds no
@@ -442,14 +478,7 @@ impl BedArgs {
             .iter()
             .zip(&scenes)
             .zip(resumes)
-            .map(|((m, scene), resume)| SeriesRun {
-                name: m.name.clone(),
-                label: m.label.clone(),
-                dir: m.dir.clone(),
-                scene,
-                packing: packing.clone(),
-                resume,
-            })
+            .map(|((m, scene), resume)| m.run(scene, packing.clone(), resume))
             .collect();
         let what = match file.kind {
             SeriesKind::Types => "comparison",
@@ -463,11 +492,7 @@ impl BedArgs {
                 .iter()
                 .map(Scene::granule_type)
                 .collect::<anyhow::Result<_>>()?;
-            let base = &members[0].scene.material;
-            let given = [
-                (base.yield_stress_pa, "the scene's material.yield_stress_pa"),
-                (base.eta0, "the scene's material.eta0"),
-            ];
+            let given = type_overrides(&members[0].scene);
             if let Some(w) = crate::material_args::check_type_overrides(&types, given)? {
                 notes.push(w);
             }
