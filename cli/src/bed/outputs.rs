@@ -977,22 +977,25 @@ mod tests {
     /// first row that reaches it (the unit die and bed of `of_samples`:
     /// D = 1/(π(1 − C)), 1 from C = 1 − 1/π ≈ 0.682); one that stays
     /// below is not.
+    /// A run of healthy elements through the rows (strain, upper-punch
+    /// pressure in Pa).
+    fn run_of(rows: impl Iterator<Item = (Real, Real)>) -> crate::bed::run::BedRun {
+        use crate::bed::run::{BedRun, BedSample};
+        BedRun::of_samples(
+            rows.map(|(strain, upper_pressure_pa)| BedSample {
+                strain,
+                upper_pressure_pa,
+                min_jacobian: 0.9,
+                min_gauss_jacobian: 0.9,
+                ..BedSample::default()
+            })
+            .collect(),
+        )
+    }
+
     #[test]
     fn a_solid_fraction_of_one_is_warned_about() {
-        use crate::bed::run::{BedRun, BedSample};
-        let run = |strains: &[Real]| {
-            BedRun::of_samples(
-                strains
-                    .iter()
-                    .map(|&strain| BedSample {
-                        strain,
-                        min_jacobian: 0.9,
-                        min_gauss_jacobian: 0.9,
-                        ..BedSample::default()
-                    })
-                    .collect(),
-            )
-        };
+        let run = |strains: &[Real]| run_of(strains.iter().map(|&c| (c, 0.0)));
         let scene = Scene::published();
         let solid = |w: &[String]| w.iter().find(|w| w.contains("solid fraction D")).cloned();
         let w = summary(&scene, &run(&[0.0, 0.5, 0.7, 0.75])).warnings;
@@ -1010,20 +1013,12 @@ mod tests {
     /// pressures (no line); rows that make a fit are not.
     #[test]
     fn a_fit_that_cannot_be_made_is_warned_about() {
-        use crate::bed::run::{BedRun, BedSample};
         let run = |pressures: &[Real]| {
-            BedRun::of_samples(
+            run_of(
                 pressures
                     .iter()
                     .enumerate()
-                    .map(|(i, &upper_pressure_pa)| BedSample {
-                        strain: 0.25 + 0.01 * i as Real,
-                        upper_pressure_pa,
-                        min_jacobian: 0.9,
-                        min_gauss_jacobian: 0.9,
-                        ..BedSample::default()
-                    })
-                    .collect(),
+                    .map(|(i, &p)| (0.25 + 0.01 * i as Real, p)),
             )
         };
         let scene = Scene::published();
