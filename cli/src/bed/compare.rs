@@ -11,7 +11,7 @@ use granbed_kernel::Real;
 use granbed_kernel::material::GranuleType;
 use serde::Serialize;
 
-use super::outputs::{FIT_MIN_R_SQUARED, KawakitaSummary, Summary, kawakita_doubts};
+use super::outputs::{KawakitaSummary, Summary, fit_linear, kawakita_doubts};
 use super::plots::overlay_svg;
 use super::run::BedSample;
 use crate::csv::{CsvWriter, Field};
@@ -73,14 +73,14 @@ pub struct ComparisonRow {
     pub kawakita_points: usize,
     /// The Kawakita fit exists and describes the bed (1 in the CSV): none
     /// of the summary's doubts ([`kawakita_doubts`]: a in (0, 1], 1/b > 0,
-    /// R² at least [`FIT_MIN_R_SQUARED`]). A fit with 0 is no material
+    /// R² at least [`super::outputs::FIT_MIN_R_SQUARED`]). A fit with 0 is no material
     /// figure; the summary's warning says why.
     pub kawakita_ok: bool,
     /// Heckel mean yield pressure, Pa.
     pub heckel_yield_pressure_pa: Option<Real>,
     /// R² of the Heckel fit.
     pub heckel_r_squared: Option<Real>,
-    /// The Heckel fit exists with R² at least [`FIT_MIN_R_SQUARED`] (1 in
+    /// The Heckel fit exists with [`fit_linear`] R² (1 in
     /// the CSV; 0: no material figure, as the summary warns).
     pub heckel_ok: bool,
     /// The poured bed's solid fraction D0.
@@ -135,8 +135,8 @@ impl ComparisonRow {
     }
 
     /// The row with `kawakita_ok` and `heckel_ok` set from its own fit
-    /// values by the summary's rules ([`kawakita_doubts`]; Heckel R² at
-    /// least [`FIT_MIN_R_SQUARED`]).
+    /// values by the summary's rules ([`kawakita_doubts`],
+    /// [`fit_linear`]).
     pub fn with_fit_flags(mut self) -> Self {
         let kawakita = KawakitaSummary {
             a: self.kawakita_a,
@@ -147,9 +147,7 @@ impl ComparisonRow {
         };
         self.kawakita_ok = self.kawakita_a.is_some() && kawakita_doubts(&kawakita).is_empty();
         self.heckel_ok = self.heckel_yield_pressure_pa.is_some()
-            && self
-                .heckel_r_squared
-                .is_some_and(|r2| r2 >= FIT_MIN_R_SQUARED);
+            && self.heckel_r_squared.is_some_and(fit_linear);
         self
     }
 

@@ -514,10 +514,18 @@ pub fn kawakita_doubts(k: &KawakitaSummary) -> Vec<String> {
     if let Some(inv_b) = k.inv_b_pa.filter(|&x| x <= 0.0) {
         why.push(format!("1/b = {inv_b:.3e} Pa <= 0"));
     }
-    if let Some(r2) = k.r_squared.filter(|&r| r < FIT_MIN_R_SQUARED) {
+    if let Some(r2) = k.r_squared.filter(|&r| !fit_linear(r)) {
         why.push(format!("R^2 = {r2:.3} < {FIT_MIN_R_SQUARED}"));
     }
     why
+}
+
+/// Whether a fit (Kawakita's or Heckel's) with this R² is linear enough
+/// for its figures to be material figures: R² at least
+/// [`FIT_MIN_R_SQUARED`] (NaN is not). The one R² rule of the summary's
+/// warnings, [`kawakita_doubts`] and the comparison tables' flags.
+pub fn fit_linear(r_squared: Real) -> bool {
+    r_squared >= FIT_MIN_R_SQUARED
 }
 
 /// The summary's warnings: `run.warnings`, then those its figures call
@@ -674,7 +682,7 @@ fn warnings(
             heckel.min_strain, heckel.points
         ));
     }
-    if let Some(r2) = heckel.r_squared.filter(|&r| r < FIT_MIN_R_SQUARED) {
+    if let Some(r2) = heckel.r_squared.filter(|&r| !fit_linear(r)) {
         w.push(format!(
             "the Heckel fit over C >= {} ({} points) has R^2 = {r2:.3} < {FIT_MIN_R_SQUARED}: \
              ln(1/(1 - D)) is not linear in P there, and its yield pressure is not a material \
@@ -868,6 +876,14 @@ mod tests {
             min_strain: 0.25,
         };
         assert!(kawakita_doubts(&none).is_empty());
+    }
+
+    /// The R² rule of both fits: 0.9 and above is linear, below it and NaN
+    /// are not.
+    #[test]
+    fn a_fit_is_linear_from_r_squared_0_9() {
+        assert!(fit_linear(0.9) && fit_linear(1.0));
+        assert!(!fit_linear(0.899) && !fit_linear(Real::NAN));
     }
 
     /// A row with a Gauss-point Jacobian ratio ≤ 0 is a fold: the first
