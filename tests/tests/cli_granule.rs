@@ -164,16 +164,14 @@ fn outputs_exist_and_parse() {
 
 /// The summary's numbers follow from the CSV it came with: the slope re-fitted
 /// here from the written (round-trip exact) rows, σ_est = 4/(πd)·slope, and
-/// the extremes and ledger ratios of the rows.
+/// the extremes and ledger ratios of the rows. The run goes to the default
+/// 40 %, whose sample lies a step past 0.4 and is fitted too (the fit takes
+/// the samples nominally at 10 % to 40 %: the bounds widened by half the
+/// 0.005 output interval).
 #[test]
 fn summary_is_consistent_with_the_csv() {
     let dir = out_dir("consistent");
-    granule_ok(
-        &dir,
-        &[
-            "--quiet", "--type", "C2", "--mesh", "4x1", "--strain", "0.2",
-        ],
-    );
+    granule_ok(&dir, &["--quiet", "--type", "C2", "--mesh", "4x1"]);
     let t = Table::read(&dir.join("force_displacement.csv"));
     let s = summary(&dir);
     let d = number(&s, "diameter_m");
@@ -183,10 +181,18 @@ fn summary_is_consistent_with_the_csv() {
     let pts: Vec<(f64, f64)> = x
         .iter()
         .zip(&f)
-        .filter(|(x, _)| (0.1..=0.4).contains(&(**x / d)))
+        .filter(|(x, _)| (0.0975..=0.4025).contains(&(**x / d)))
         .map(|(x, f)| (*x, *f))
         .collect();
     let n = pts.len() as f64;
+    let last = *t.num("strain").last().unwrap();
+    assert!(
+        last > 0.4 && last < 0.4001,
+        "the run ends a step past 0.4: {last}"
+    );
+    let range = &s["sigma_est_strain_range"];
+    assert_eq!(range[1].as_f64(), Some(last), "the 40 % sample is fitted");
+    assert!(s["notes"].as_array().unwrap().is_empty(), "{s}");
     let (mx, my) = (
         pts.iter().map(|p| p.0).sum::<f64>() / n,
         pts.iter().map(|p| p.1).sum::<f64>() / n,
@@ -196,7 +202,7 @@ fn summary_is_consistent_with_the_csv() {
     let slope = sxy / sxx;
     // Same data, same two-pass formula: only summation order could differ.
     assert_eq!(number(&s, "fit_points"), n);
-    assert_eq!(n, 21.0, "samples at strain 0.1, 0.105, …, 0.2");
+    assert_eq!(n, 61.0, "samples at strain 0.1, 0.105, …, 0.4");
     assert_close("slope", number(&s, "slope_n_per_m"), slope, 1e-12, 0.0);
     assert_close(
         "sigma_est",

@@ -12,7 +12,9 @@ use core::fmt::Write as _;
 use granbed_host::OwnedReference;
 use granbed_kernel::Real;
 use granbed_kernel::analysis::fit::LineFit;
-use granbed_kernel::analysis::granule::{initial_effective_yield_stress, yield_stress_estimate};
+use granbed_kernel::analysis::granule::{
+    fit_window, initial_effective_yield_stress, yield_stress_estimate,
+};
 use granbed_kernel::analysis::quasi_static::Certificate;
 use granbed_kernel::material::{GranuleType, MaterialParams, ParamError};
 use granbed_kernel::scene::platens::{
@@ -21,8 +23,7 @@ use granbed_kernel::scene::platens::{
 
 use crate::mesh::{give_back, octant_mesh, take_buffers};
 
-/// Strain range of the σ_est fit, x/d (as `granbed-cli granule`).
-pub const FIT_STRAIN_RANGE: [Real; 2] = [0.1, 0.4];
+pub use granbed_kernel::analysis::granule::FIT_STRAIN_RANGE;
 
 /// The standard granule diameter, m (the CLI's 1 mm granule).
 pub const STANDARD_DIAMETER_M: Real = 1.0e-3;
@@ -199,7 +200,7 @@ impl From<SceneError> for Error {
 /// σ_est and the fit behind it, σ_y,eff0.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Measures {
-    /// σ_est = 4/(πd)·dF/dx over [`FIT_STRAIN_RANGE`], Pa (`None` with
+    /// σ_est = 4/(πd)·dF/dx over [`FIT_STRAIN_RANGE`] ([`fit_window`]), Pa (`None` with
     /// fewer than two samples there).
     pub sigma_est_pa: Option<Real>,
     /// The least-squares fit of F(x).
@@ -360,7 +361,7 @@ impl Experiment {
     /// `granbed-cli granule` writes to `summary.json` as `sigma_est_pa`,
     /// `slope_n_per_m`, … and `sigma_eff0_pa`.
     pub fn measures(&self) -> Measures {
-        let [lo, hi] = FIT_STRAIN_RANGE;
+        let [lo, hi] = fit_window(self.params.output_strain_interval);
         let points = self.samples.iter().map(|s| (s.approach_m, s.mean_force()));
         let fit = yield_stress_estimate(points, self.diameter(), lo, hi);
         Measures {

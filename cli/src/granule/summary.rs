@@ -4,7 +4,9 @@
 
 use crate::output::finite_ratio as ratio;
 use granbed_kernel::Real;
-use granbed_kernel::analysis::granule::{initial_effective_yield_stress, yield_stress_estimate};
+use granbed_kernel::analysis::granule::{
+    fit_window, initial_effective_yield_stress, yield_stress_estimate,
+};
 use granbed_kernel::granule::forces::ElementKind;
 use granbed_kernel::granule::timestep::TimeStepMethod;
 use granbed_kernel::scene::platens::{PlatenParams, PlatenSample, SceneError, Symmetry};
@@ -23,8 +25,7 @@ pub const FORMAT: &str = "granbed-granule-summary";
 /// without a fit), no longer always the nominal [0.1, 0.4].
 pub const FORMAT_VERSION: u32 = 2;
 
-/// Strain range of the σ_est fit, x/d (physics.md §7 item 7).
-pub const FIT_STRAIN_RANGE: [Real; 2] = [0.1, 0.4];
+pub use granbed_kernel::analysis::granule::FIT_STRAIN_RANGE;
 
 /// The command-line name of a symmetry mode (`octant` or `full`).
 pub fn symmetry_name(s: Symmetry) -> &'static str {
@@ -122,7 +123,9 @@ pub struct Summary {
     /// samples in range.
     pub sigma_est_pa: Option<Real>,
     /// Strain range the fit actually covered, x/d: the first and the last
-    /// sample within [`FIT_STRAIN_RANGE`] (narrower when the run ends
+    /// sample within [`FIT_STRAIN_RANGE`], each end widened by half an
+    /// output interval ([`fit_window`]: a sample lies up to a step past its
+    /// nominal strain, so the 40 % sample is 0.4000019) (narrower when the run ends
     /// before 0.4, which `notes` and stderr then say); `null` without a
     /// fit.
     pub sigma_est_strain_range: Option<[Real; 2]>,
@@ -183,14 +186,15 @@ impl Summary {
         let samples = &result.samples;
         let last = samples.last();
         let [lo, hi] = FIT_STRAIN_RANGE;
+        let [from, to] = fit_window(p.output_strain_interval);
         let points = samples.iter().map(|s| (s.approach_m, s.mean_force()));
-        let fit = yield_stress_estimate(points, result.diameter_m, lo, hi);
+        let fit = yield_stress_estimate(points, result.diameter_m, from, to);
         let final_strain = last.map_or(0.0, |s| s.strain);
         // The samples the fit took (the kernel's filter, on x/d).
         let fitted: Vec<Real> = samples
             .iter()
             .map(|s| s.approach_m / result.diameter_m)
-            .filter(|c| *c >= lo && *c <= hi)
+            .filter(|c| *c >= from && *c <= to)
             .collect();
         let fitted_range = match (fit, fitted.first(), fitted.last()) {
             (Some(_), Some(&a), Some(&b)) => Some([a, b]),

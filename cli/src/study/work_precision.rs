@@ -22,7 +22,7 @@ use std::path::Path;
 
 use anyhow::Context as _;
 use granbed_kernel::Real;
-use granbed_kernel::analysis::granule::yield_stress_estimate;
+use granbed_kernel::analysis::granule::{fit_window, yield_stress_estimate};
 use granbed_kernel::granule::forces::ElementKind;
 use granbed_kernel::material::{GranuleType, Material};
 use granbed_kernel::scene::platens::{PlatenParams, STANDARD_MASS_SCALING};
@@ -32,7 +32,6 @@ use super::{StudyScene, WorkPrecisionArgs};
 use crate::csv::{CsvWriter, Field};
 use crate::granule::GRANULE_RADIUS_M;
 use crate::granule::run::run_platens;
-use crate::granule::summary::FIT_STRAIN_RANGE;
 use crate::material_args::MaterialArgs;
 use crate::model::{MeshLevel, OwnedReference};
 use crate::output::{Streams, create_file, finish_file, write_text};
@@ -247,7 +246,7 @@ pub fn run_granule(setting: &Setting, material: &Material) -> anyhow::Result<Mea
         .iter()
         .map(|s| (s.strain, s.mean_force()))
         .collect();
-    let [lo, hi] = FIT_STRAIN_RANGE;
+    let [lo, hi] = fit_window(p.output_strain_interval);
     let sigma_est_pa = yield_stress_estimate(
         result
             .samples

@@ -10,6 +10,21 @@ pub fn initial_effective_yield_stress(p: &MaterialParams) -> Real {
     crate::math::sqrt(coefficients(p, p.eta0).a2) * p.yield_stress_pa
 }
 
+/// Strain range x/d of the σ_est fit (physics.md §7 item 7): 10 % to 40 %.
+pub const FIT_STRAIN_RANGE: [Real; 2] = [0.1, 0.4];
+
+/// The window of x/d that the σ_est fit takes from samples written every
+/// `interval` of strain: [`FIT_STRAIN_RANGE`] widened by half an interval
+/// at each end. A sample lies up to one time step past its nominal strain
+/// (a run stops once it has reached 40 %, at 0.4000019 for the standard
+/// granule), so the nominal bounds would drop the 40 % sample; the half
+/// interval takes the samples nominally at 10 % and 40 % and no others.
+/// `interval` must be positive (the scene's `output_strain_interval`).
+pub fn fit_window(interval: Real) -> [Real; 2] {
+    let [lo, hi] = FIT_STRAIN_RANGE;
+    [lo - 0.5 * interval, hi + 0.5 * interval]
+}
+
 /// Estimated granule yield stress from the platen force: the least-squares
 /// slope dF/dx of `(approach x [m], force F [N])` samples with
 /// `lo ≤ x/d ≤ hi`, and σ_est = 4/(πd)·dF/dx (Thornton–Ning, F = πR p_y x/2).
@@ -68,5 +83,38 @@ mod tests {
         let (sigma, fit) = yield_stress_estimate(samples, d, 0.1, 0.4).unwrap();
         assert!((sigma - p).abs() < 1e-9 * p);
         assert_eq!(fit.points, 61);
+    }
+
+    /// Samples every 0.5 % of strain, each one step (2e-6) past its nominal
+    /// strain, to 40 %: the window fits those from 10 % to 40 % — both ends
+    /// included, 9.5 % and 40.5 % not — where the nominal bounds lose 40 %.
+    #[test]
+    fn the_fit_window_takes_the_samples_at_10_and_40_percent() {
+        let (d, interval, past) = (1e-3, 0.005, 2e-6);
+        let strains: [Real; 82] = core::array::from_fn(|k| k as Real * interval + past);
+        let samples = strains.iter().map(|&c| (c * d, c));
+        let [lo, hi] = fit_window(interval);
+        let inside = |c: &&Real| **c >= lo && **c <= hi;
+        assert_eq!(strains.iter().filter(inside).count(), 61);
+        assert_eq!(strains.iter().find(inside), Some(&(20.0 * interval + past)));
+        assert_eq!(
+            strains.iter().rfind(inside),
+            Some(&(80.0 * interval + past))
+        );
+        assert_eq!(
+            yield_stress_estimate(samples.clone(), d, lo, hi)
+                .unwrap()
+                .1
+                .points,
+            61
+        );
+        let [nlo, nhi] = FIT_STRAIN_RANGE;
+        assert_eq!(
+            yield_stress_estimate(samples, d, nlo, nhi)
+                .unwrap()
+                .1
+                .points,
+            60
+        );
     }
 }
