@@ -152,7 +152,13 @@ pub fn xy_svg(
         let x_labels = exponent_labels(&x_range);
         let y_labels = exponent_labels(&y_range);
         let mut mesh = chart.configure_mesh();
-        mesh.x_desc(x_desc).y_desc(y_desc);
+        // Text a little larger than plotters' default (about 10 px on the
+        // 900 × 600 canvas), and the minor grid lighter, for a printed page.
+        mesh.x_desc(x_desc)
+            .y_desc(y_desc)
+            .label_style(("sans-serif", 13))
+            .axis_desc_style(("sans-serif", 15))
+            .light_line_style(BLACK.mix(0.05));
         if let Some(f) = &x_labels {
             mesh.x_label_formatter(f);
         }
@@ -189,12 +195,18 @@ pub fn xy_svg(
                     chart
                         .draw_series(DashedLineSeries::new(pts, 6, 4, style))?
                         .label(label)
-                        .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], style));
+                        // Dashed in the legend too: two dashes.
+                        .legend(move |(x, y)| {
+                            EmptyElement::at((x, y))
+                                + PathElement::new(vec![(0, 0), (6, 0)], style)
+                                + PathElement::new(vec![(10, 0), (16, 0)], style)
+                        });
                 }
             }
         }
         chart
             .configure_series_labels()
+            .label_font(("sans-serif", 13))
             .position(SeriesLabelPosition::UpperLeft)
             .background_style(WHITE.mix(0.85))
             .border_style(BLACK)

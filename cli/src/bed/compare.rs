@@ -151,6 +151,19 @@ impl ComparisonRow {
         self
     }
 
+    /// The legend of this run's curve in the overlaid plots: `name`, and
+    /// what the table's columns would otherwise have to tell, that the run
+    /// failed or did not pass its quasi-static certificate.
+    pub fn curve_label(&self, name: &str) -> String {
+        if self.error.is_some() {
+            format!("{name} (failed)")
+        } else if !self.quasi_static_passed {
+            format!("{name} (not quasi-static)")
+        } else {
+            name.to_owned()
+        }
+    }
+
     fn fields(&self) -> [Field; COMPARISON_COLUMNS.len()] {
         let opt = |x: Option<Real>| Field::Real(x.unwrap_or(Real::NAN));
         [
@@ -201,7 +214,12 @@ pub fn write_comparison(
 ) -> anyhow::Result<()> {
     write_rows(&dir.join(COMPARISON_CSV), comparison.types)?;
     write_json(&dir.join(COMPARISON_JSON), comparison)?;
-    let labels: Vec<&str> = comparison.types.iter().map(|r| r.granule_type).collect();
+    let labels: Vec<String> = comparison
+        .types
+        .iter()
+        .map(|r| r.curve_label(r.granule_type))
+        .collect();
+    let labels: Vec<&str> = labels.iter().map(String::as_str).collect();
     let suffix = format!(
         "by granule type (one pour, sphere density of {})",
         comparison.pour_granule_type

@@ -19,7 +19,9 @@
 
 use std::path::Path;
 
-use super::outputs::{HeckelSummary, KawakitaSummary, Summary, heckel_rows};
+use super::outputs::{
+    HeckelSummary, KawakitaSummary, Summary, fit_linear, heckel_rows, kawakita_doubts,
+};
 use super::run::{BedRun, BedSample};
 use crate::output::write_text;
 use crate::plot::{Mark, Series, xy_svg};
@@ -75,13 +77,15 @@ fn against_strain(samples: &[BedSample], curves: [(&str, Quantity); 2]) -> [Seri
 
 /// A fit's plot: `rows` (x, y, C) before the strain window `min_strain`
 /// as rings, those in it as dots, and the fitted `line` (its legend and
-/// y(x)), if any, over the window's x range.
+/// y(x)), if any, over the window's x range; the y axis from zero if
+/// `y_from_zero`.
 fn fit_svg(
     title: &str,
     (x_desc, y_desc): (&str, &str),
     rows: impl Iterator<Item = (f64, f64, f64)> + Clone,
     min_strain: f64,
     line: Option<(String, &dyn Fn(f64) -> f64)>,
+    y_from_zero: bool,
 ) -> anyhow::Result<String> {
     let before = rows.clone().filter(|&(_, _, c)| c < min_strain);
     let within = rows.filter(|&(_, _, c)| c >= min_strain);
@@ -112,7 +116,17 @@ fn fit_svg(
             ));
         }
     }
-    xy_svg(title, x_desc, y_desc, &series, true)
+    xy_svg(title, x_desc, y_desc, &series, y_from_zero)
+}
+
+/// The legend of a fit line: `figures`, marked as rejected when the
+/// summary warns that the fit is no material figure (`material` false).
+fn fit_label(figures: String, material: bool) -> String {
+    if material {
+        format!("fit: {figures}")
+    } else {
+        format!("rejected fit (see the warnings): {figures}")
+    }
 }
 
 /// The R² of a fit for a legend.
@@ -137,10 +151,13 @@ pub fn kawakita_svg(samples: &[BedSample], fit: &KawakitaSummary) -> anyhow::Res
         .zip(fit.inv_b_pa)
         .map(|(a, inv_b)| (a, inv_b, move |p: f64| p / a + inv_b * 1e-3 / a));
     let line = line.as_ref().map(|(a, inv_b, y)| {
-        let label = format!(
-            "fit: a = {a:.4}, 1/b = {:.4} kPa, R² = {}",
-            inv_b * 1e-3,
-            r2_text(fit.r_squared)
+        let label = fit_label(
+            format!(
+                "a = {a:.4}, 1/b = {:.4} kPa, R² = {}",
+                inv_b * 1e-3,
+                r2_text(fit.r_squared)
+            ),
+            kawakita_doubts(fit).is_empty(),
         );
         (label, y as &dyn Fn(f64) -> f64)
     });
@@ -150,6 +167,7 @@ pub fn kawakita_svg(samples: &[BedSample], fit: &KawakitaSummary) -> anyhow::Res
         rows,
         fit.min_strain,
         line,
+        true,
     )
 }
 
@@ -169,11 +187,14 @@ pub fn heckel_svg(
         .zip(fit.a)
         .map(|(k, a)| move |p: f64| k * 1e3 * p + a);
     let line = line.as_ref().map(|y| {
-        let label = format!(
-            "fit: P_y = {:.4} kPa, A = {:.4}, R² = {}",
-            fit.yield_pressure_pa.unwrap_or(f64::NAN) * 1e-3,
-            fit.a.unwrap_or(f64::NAN),
-            r2_text(fit.r_squared)
+        let label = fit_label(
+            format!(
+                "P_y = {:.4} kPa, A = {:.4}, R² = {}",
+                fit.yield_pressure_pa.unwrap_or(f64::NAN) * 1e-3,
+                fit.a.unwrap_or(f64::NAN),
+                r2_text(fit.r_squared)
+            ),
+            fit.r_squared.is_some_and(fit_linear),
         );
         (label, y as &dyn Fn(f64) -> f64)
     });
@@ -186,6 +207,8 @@ pub fn heckel_svg(
         rows,
         fit.min_strain,
         line,
+        // ln(1/(1 - D)) of a bed starts near ln(1/(1 - D0)), far from 0.
+        false,
     )
 }
 
@@ -330,6 +353,16 @@ mod tests {
         assert!(svg.starts_with("<svg"), "{}", &svg[..100]);
         assert!(svg.contains("fit: a = 0.5000, 1/b = 100.0000 kPa"), "{svg}");
         assert!(svg.contains("C &lt; 0.25"));
+        // A fit outside the law's regime (a > 1) is drawn, marked rejected.
+        let odd = KawakitaSummary {
+            a: Some(3.5),
+            ..summary
+        };
+        let svg = kawakita_svg(&samples, &odd).unwrap();
+        assert!(
+            svg.contains("rejected fit (see the warnings): a = 3.5000"),
+            "{svg}"
+        );
     }
 
     #[test]
@@ -355,6 +388,12 @@ mod tests {
         };
         let svg = heckel_svg(rows.iter().copied(), &summary).unwrap();
         assert!(svg.contains("fit: P_y = 80.0000 kPa, A = 0.5000"), "{svg}");
+        let bent = HeckelSummary {
+            r_squared: Some(0.5),
+            ..summary
+        };
+        let svg_bent = heckel_svg(rows.iter().copied(), &bent).unwrap();
+        assert!(svg_bent.contains("rejected fit (see the warnings): P_y = 80.0000 kPa"));
         assert!(svg.contains("C &lt; 0.2") && svg.contains("(fitted)"));
         // Rows the law does not cover are not drawn: D = 0 would plot at
         // ln 1 = 0, D < 0 below it (D > 1 gives NaN, which no plot draws).

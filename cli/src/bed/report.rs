@@ -17,9 +17,9 @@ pub const REPORT_FILE: &str = "report.html";
 
 /// The fields of `summary.json` shown first, in this order, with their
 /// meaning; any other field follows (nested objects such as `kawakita` and
-/// `heckel` are flattened to `kawakita.<field>`; the scene is shown as TOML
-/// instead).
-const FIELDS: [(&str, &str); 63] = [
+/// `heckel` are flattened to `kawakita.<field>`; the scene, `scene` and
+/// `scene_toml`, is shown as TOML instead).
+const FIELDS: [(&str, &str); 68] = [
     ("kawakita_a", "Kawakita a (limiting strain)"),
     ("kawakita_inv_b_pa", "Kawakita 1/b, Pa"),
     (
@@ -131,12 +131,32 @@ const FIELDS: [(&str, &str); 63] = [
         "that overlap / the element size (accepted below 0.01)",
     ),
     (
+        "final_hidden_overlap",
+        "overlap by geometry at the end: not measured (a run stopped early)",
+    ),
+    (
         "final_hidden_overlap.depth_m",
         "deepest overlap measured by geometry at the end, m",
     ),
     (
         "final_hidden_overlap.rel_element",
         "that overlap / the element size (accepted below 0.01)",
+    ),
+    (
+        "final_hidden_overlap.granule",
+        "the granule whose surface node lies deepest in another",
+    ),
+    (
+        "final_hidden_overlap.node",
+        "that node, an index into the granule's nodes",
+    ),
+    (
+        "final_hidden_overlap.inside_granule",
+        "the granule it lies inside",
+    ),
+    (
+        "final_hidden_overlap.wall_time_s",
+        "wall time of that measurement, s (not in wall_time_s)",
     ),
     (
         "hourglass_to_internal",
@@ -220,7 +240,8 @@ fn rows(summary: &Summary<'_>) -> anyhow::Result<Vec<(String, &'static str, Stri
         .collect();
     out.extend(
         flat.iter()
-            .filter(|(k, _)| known(k).is_none() && !k.starts_with("scene."))
+            // The scene is shown as TOML below the table, not as a row.
+            .filter(|(k, _)| known(k).is_none() && !k.starts_with("scene.") && k != "scene_toml")
             .map(|(k, v)| (k.clone(), "", show(v))),
     );
     Ok(out)
@@ -325,6 +346,52 @@ pub fn write_report(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Every row of the summary table says what it is, whether the
+    /// overlap by geometry was measured or not, and the scene is not a row
+    /// (it is shown as TOML below the table).
+    #[test]
+    fn every_row_has_a_meaning_and_the_scene_is_no_row() {
+        use crate::assembly::overlap::Overlap;
+        use crate::bed::run::{BedRun, BedSample, HiddenOverlap};
+        let scene = Scene::published();
+        let samples = (0..40)
+            .map(|i| BedSample {
+                strain: 0.01 * f64::from(i),
+                upper_pressure_pa: 1e3 * f64::from(i),
+                min_jacobian: 0.9,
+                min_gauss_jacobian: 0.9,
+                ..BedSample::default()
+            })
+            .collect();
+        let mut run = BedRun::of_samples(samples);
+        for measured in [false, true] {
+            if measured {
+                run.hidden_overlap = Some(HiddenOverlap {
+                    deepest: Overlap {
+                        depth_m: 1e-7,
+                        granule: 3,
+                        node: 17,
+                        inside: 5,
+                    },
+                    wall_time_s: 0.1,
+                });
+            }
+            let summary = crate::bed::outputs::summary(&scene, &run);
+            let rows = rows(&summary).unwrap();
+            let blank: Vec<&str> = rows
+                .iter()
+                .filter(|r| r.1.is_empty())
+                .map(|r| r.0.as_str())
+                .collect();
+            assert!(blank.is_empty(), "rows without a meaning: {blank:?}");
+            assert!(rows.iter().all(|r| !r.0.starts_with("scene")), "{rows:?}");
+            let overlap_rows = rows
+                .iter()
+                .filter(|r| r.0.starts_with("final_hidden_overlap"));
+            assert_eq!(overlap_rows.count(), if measured { 6 } else { 1 });
+        }
+    }
 
     #[test]
     fn escaping() {

@@ -192,7 +192,10 @@ pub fn write_seeds(
             spread: &spreads,
         },
     )?;
-    let labels: Vec<String> = rows.iter().map(|r| format!("seed {}", r.seed)).collect();
+    let labels: Vec<String> = rows
+        .iter()
+        .map(|r| r.curve_label(&format!("seed {}", r.seed)))
+        .collect();
     let labels: Vec<&str> = labels.iter().map(String::as_str).collect();
     let suffix = rows.first().map_or(String::new(), |r| {
         format!("by seed ({} granules, one pour each)", r.granule_type)
@@ -352,6 +355,17 @@ mod tests {
         let none = spread("kawakita_a", a, &rows[1..2]);
         assert_eq!((none.runs, none.mean, none.min), (0, None, None));
         assert_eq!((s.left_out, none.left_out), (2, 1));
+
+        // The overlaid plots' legends say what the table's columns say of
+        // a run: failed, or not quasi-static.
+        let mut labels = [row(Some(0.3)), row(Some(0.3)), row(Some(0.3))];
+        labels[1].quasi_static_passed = false;
+        labels[2].error = Some("stopped".into());
+        let labels = labels.map(|r| r.curve_label("seed 1"));
+        assert_eq!(
+            labels,
+            ["seed 1", "seed 1 (not quasi-static)", "seed 1 (failed)"]
+        );
 
         // The reported figures leave out the fits the summary warns about:
         // a Kawakita a outside (0, 1] or with 1/b <= 0 (both its figures),

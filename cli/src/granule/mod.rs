@@ -563,6 +563,19 @@ fn rate_change(
         .context("the curves do not cover the rate check's strain window")
 }
 
+/// A stress for a legend: in kPa with four significant digits from 1 kPa
+/// to 1 GPa (granule yield stresses), otherwise in Pa with an exponent.
+fn stress_text(pa: Real) -> String {
+    let kpa = pa * 1e-3;
+    if (1.0..1e6).contains(&kpa) {
+        // 1 ≤ kPa < 10⁶: the exponent is 0..=5, the decimals 3 down to 0.
+        let decimals = (3 - kpa.log10().floor() as i32).max(0) as usize;
+        format!("{kpa:.decimals$} kPa")
+    } else {
+        format!("{pa:.4e} Pa")
+    }
+}
+
 /// Writes the CSV, summary and plot of one run into `dir`.
 fn write_outputs(dir: &Path, result: &RunResult, summary: &Summary) -> anyhow::Result<()> {
     outputs::write_force_csv(&dir.join(outputs::FORCE_CSV), &result.samples)?;
@@ -580,7 +593,7 @@ fn write_outputs(dir: &Path, result: &RunResult, summary: &Summary) -> anyhow::R
                 slope_n_per_m: slope,
                 intercept_n: intercept,
                 x_range_m: [lo, hi].map(|e| e * result.diameter_m),
-                label: format!("fit: sigma_est = {sigma:.4e} Pa"),
+                label: format!("fit: σ_est = {}", stress_text(sigma)),
             })
         }
         _ => None,
@@ -647,6 +660,15 @@ fn kernel_failures(outcomes: &[Outcome]) -> anyhow::Result<()> {
 mod tests {
     use super::*;
     use granbed_kernel::element::force::DEFAULT_HOURGLASS_KAPPA;
+
+    #[test]
+    fn legend_stresses_are_in_kpa_with_four_digits() {
+        assert_eq!(stress_text(44_609.6), "44.61 kPa");
+        assert_eq!(stress_text(1_000.0), "1.000 kPa");
+        assert_eq!(stress_text(162_131.0), "162.1 kPa");
+        assert_eq!(stress_text(12.5), "1.2500e1 Pa");
+        assert_eq!(stress_text(999_999_000.0), "999999 kPa");
+    }
 
     #[test]
     fn defaults_are_the_kernels_standard_experiment() {
