@@ -122,10 +122,19 @@ fn three_types_from_one_pour_are_ordered_by_yield_stress() {
     for name in ["comparison_pressure.svg", "comparison_density.svg"] {
         let svg = std::fs::read_to_string(dir.join(name)).unwrap();
         assert!(svg.starts_with("<svg"), "{name}");
-        for t in TYPES {
+        // Each type's legend, marked as its row of the table says.
+        for (t, row) in TYPES.iter().zip(json["types"].as_array().unwrap()) {
+            assert_eq!(row["type"], *t);
+            let label = if !row["error"].is_null() {
+                format!("{t} (failed)")
+            } else if row["quasi_static_passed"] == false {
+                format!("{t} (not quasi-static)")
+            } else {
+                t.to_string()
+            };
             assert!(
-                svg.contains(&format!(">\n{t}\n</text>")),
-                "{name} lacks the legend {t}"
+                svg.contains(&format!(">\n{label}\n</text>")),
+                "{name} lacks the legend {label}"
             );
         }
     }

@@ -313,7 +313,14 @@ pub fn report_html(
             html_escape(meaning)
         )?;
     }
-    writeln!(h, "</table>\n<h2>Plots</h2>")?;
+    writeln!(
+        h,
+        "</table>\n<h2>Plots</h2>\n<p>Each granule's mesh has its nodes on the poured sphere and \
+         flat faces between them, so it holds less volume than the sphere (D at C = 0 lies \
+         below the pour's packing fraction), and spheres the pour left touching start a few \
+         µm apart: the coordination number Z and the lower-punch pressure stay near 0 until the \
+         first strain closes those gaps.</p>"
+    )?;
     for (name, svg) in svgs {
         // The SVG is plotters' output: well-formed XML with its text
         // already escaped, so it is embedded as it is.
