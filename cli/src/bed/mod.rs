@@ -84,7 +84,7 @@ Output, in --out DIR (created if missing):
                    coefficient against strain; Kawakita plot P/C vs P and
                    Heckel plot ln(1/(1 - D)) vs P, each with its fit; the
                    compaction profile, the bed's solid fraction D vs P
-  report.html      one page: the summary table, the plots and the scene
+  report.html      one page: the warnings, the plots, the summary table and the scene
   checkpoint.bin   the state to continue from with --resume (every
                    checkpoint_interval_minutes and checkpoint_strain_interval,
                    and at the end)

@@ -1,6 +1,7 @@
-//! `report.html`: one self-contained page of a bed run: the summary table
-//! (the fields of `summary.json`, values as written there), the plots
-//! inline as SVG, and the scene as TOML. All text is HTML-escaped.
+//! `report.html`: one self-contained page of a bed run: its warnings, the
+//! plots inline as SVG (first: what a reader looks at), the summary table
+//! (the fields of `summary.json`, values as written there), and the scene
+//! as TOML. All text is HTML-escaped.
 
 use core::fmt::Write as _;
 use std::path::Path;
@@ -302,20 +303,7 @@ pub fn report_html(
     )?;
     writeln!(
         h,
-        "<h2>Summary</h2>\n<table>\n<tr><th>field</th><th>value</th><th>meaning</th></tr>"
-    )?;
-    for (key, meaning, value) in rows(summary)? {
-        writeln!(
-            h,
-            "<tr><td>{}</td><td class=\"value\">{}</td><td>{}</td></tr>",
-            html_escape(&key),
-            html_escape(&value),
-            html_escape(meaning)
-        )?;
-    }
-    writeln!(
-        h,
-        "</table>\n<h2>Plots</h2>\n<p>Each granule's mesh has its nodes on the poured sphere and \
+        "<h2>Plots</h2>\n<p>Each granule's mesh has its nodes on the poured sphere and \
          flat faces between them, so it holds less volume than the sphere (D at C = 0 lies \
          below the pour's packing fraction), and spheres the pour left touching start a few \
          µm apart: the coordination number Z and the lower-punch pressure stay near 0 until the \
@@ -330,6 +318,20 @@ pub fn report_html(
             "<figure>\n{svg}\n<figcaption><a href=\"plots/{name}\">plots/{name}</a></figcaption>\n</figure>"
         )?;
     }
+    writeln!(
+        h,
+        "<h2>Summary</h2>\n<table>\n<tr><th>field</th><th>value</th><th>meaning</th></tr>"
+    )?;
+    for (key, meaning, value) in rows(summary)? {
+        writeln!(
+            h,
+            "<tr><td>{}</td><td class=\"value\">{}</td><td>{}</td></tr>",
+            html_escape(&key),
+            html_escape(&value),
+            html_escape(meaning)
+        )?;
+    }
+    writeln!(h, "</table>")?;
     writeln!(
         h,
         "<h2>Scene</h2>\n<pre>{}</pre>\n</body>\n</html>",
