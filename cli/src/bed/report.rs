@@ -307,7 +307,9 @@ pub fn report_html(
          flat faces between them, so it holds less volume than the sphere (D at C = 0 lies \
          below the pour's packing fraction), and spheres the pour left touching start a few \
          µm apart: the coordination number Z and the lower-punch pressure stay near 0 until the \
-         first strain closes those gaps.</p>"
+         first strain closes those gaps. For the same reason the Heywood coefficient α_SV \
+         starts a little above the sphere's 6 (more surface per volume), most on coarse \
+         meshes.</p>"
     )?;
     for (name, svg) in svgs {
         // The SVG is plotters' output: well-formed XML with its text
