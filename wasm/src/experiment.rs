@@ -12,9 +12,7 @@ use core::fmt::Write as _;
 use granbed_host::OwnedReference;
 use granbed_kernel::Real;
 use granbed_kernel::analysis::fit::LineFit;
-use granbed_kernel::analysis::granule::{
-    fit_window, initial_effective_yield_stress, yield_stress_estimate,
-};
+use granbed_kernel::analysis::granule::initial_effective_yield_stress;
 use granbed_kernel::analysis::quasi_static::Certificate;
 use granbed_kernel::material::{GranuleType, MaterialParams, ParamError};
 use granbed_kernel::scene::platens::{
@@ -200,7 +198,7 @@ impl From<SceneError> for Error {
 /// σ_est and the fit behind it, σ_y,eff0.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Measures {
-    /// σ_est = 4/(πd)·dF/dx over [`FIT_STRAIN_RANGE`] ([`fit_window`]), Pa (`None` with
+    /// σ_est = 4/(πd)·dF/dx over [`FIT_STRAIN_RANGE`] ([`PlatenSample::sigma_est`]), Pa (`None` with
     /// fewer than two samples there).
     pub sigma_est_pa: Option<Real>,
     /// The least-squares fit of F(x).
@@ -361,12 +359,14 @@ impl Experiment {
     /// `granbed-cli granule` writes to `summary.json` as `sigma_est_pa`,
     /// `slope_n_per_m`, … and `sigma_eff0_pa`.
     pub fn measures(&self) -> Measures {
-        let [lo, hi] = fit_window(self.params.output_strain_interval);
-        let points = self.samples.iter().map(|s| (s.approach_m, s.mean_force()));
-        let fit = yield_stress_estimate(points, self.diameter(), lo, hi);
+        let fit = PlatenSample::sigma_est(
+            &self.samples,
+            self.diameter(),
+            self.params.output_strain_interval,
+        );
         Measures {
-            sigma_est_pa: fit.map(|(s, _)| s),
-            fit: fit.map(|(_, f)| f),
+            sigma_est_pa: fit.map(|s| s.sigma_pa),
+            fit: fit.map(|s| s.fit),
             sigma_eff0_pa: initial_effective_yield_stress(&self.params.material.params),
             quasi_static: PlatenSample::certificate(&self.samples, self.params.symmetry, None),
         }

@@ -4,9 +4,7 @@
 
 use crate::output::finite_ratio as ratio;
 use granbed_kernel::Real;
-use granbed_kernel::analysis::granule::{
-    fit_window, initial_effective_yield_stress, yield_stress_estimate,
-};
+use granbed_kernel::analysis::granule::initial_effective_yield_stress;
 use granbed_kernel::granule::forces::ElementKind;
 use granbed_kernel::granule::timestep::TimeStepMethod;
 use granbed_kernel::scene::platens::{PlatenParams, PlatenSample, SceneError, Symmetry};
@@ -124,7 +122,7 @@ pub struct Summary {
     pub sigma_est_pa: Option<Real>,
     /// Strain range the fit actually covered, x/d: the first and the last
     /// sample within [`FIT_STRAIN_RANGE`], each end widened by half an
-    /// output interval ([`fit_window`]: a sample lies up to a step past its
+    /// output interval ([`granbed_kernel::analysis::granule::fit_window`]: a sample lies up to a step past its
     /// nominal strain, so the 40 % sample is 0.4000019) (narrower when the run ends
     /// before 0.4, which `notes` and stderr then say); `null` without a
     /// fit.
@@ -186,20 +184,11 @@ impl Summary {
         let samples = &result.samples;
         let last = samples.last();
         let [lo, hi] = FIT_STRAIN_RANGE;
-        let [from, to] = fit_window(p.output_strain_interval);
-        let points = samples.iter().map(|s| (s.approach_m, s.mean_force()));
-        let fit = yield_stress_estimate(points, result.diameter_m, from, to);
+        let sigma_est =
+            PlatenSample::sigma_est(samples, result.diameter_m, p.output_strain_interval);
         let final_strain = last.map_or(0.0, |s| s.strain);
-        // The samples the fit took (the kernel's filter, on x/d).
-        let fitted: Vec<Real> = samples
-            .iter()
-            .map(|s| s.approach_m / result.diameter_m)
-            .filter(|c| *c >= from && *c <= to)
-            .collect();
-        let fitted_range = match (fit, fitted.first(), fitted.last()) {
-            (Some(_), Some(&a), Some(&b)) => Some([a, b]),
-            _ => None,
-        };
+        let fitted_range = sigma_est.map(|s| s.strain_range);
+        let fit = sigma_est.map(|s| (s.sigma_pa, s.fit));
         let mut notes = Vec::new();
         match fitted_range {
             None => notes.push(format!(

@@ -22,10 +22,9 @@ use std::path::Path;
 
 use anyhow::Context as _;
 use granbed_kernel::Real;
-use granbed_kernel::analysis::granule::{fit_window, yield_stress_estimate};
 use granbed_kernel::granule::forces::ElementKind;
 use granbed_kernel::material::{GranuleType, Material};
-use granbed_kernel::scene::platens::{PlatenParams, STANDARD_MASS_SCALING};
+use granbed_kernel::scene::platens::{PlatenParams, PlatenSample, STANDARD_MASS_SCALING};
 use plotters::prelude::*;
 
 use super::{StudyScene, WorkPrecisionArgs};
@@ -246,17 +245,9 @@ pub fn run_granule(setting: &Setting, material: &Material) -> anyhow::Result<Mea
         .iter()
         .map(|s| (s.strain, s.mean_force()))
         .collect();
-    let [lo, hi] = fit_window(p.output_strain_interval);
-    let sigma_est_pa = yield_stress_estimate(
-        result
-            .samples
-            .iter()
-            .map(|s| (s.approach_m, s.mean_force())),
-        result.diameter_m,
-        lo,
-        hi,
-    )
-    .map(|(sigma, _)| sigma);
+    let sigma_est_pa =
+        PlatenSample::sigma_est(&result.samples, result.diameter_m, p.output_strain_interval)
+            .map(|s| s.sigma_pa);
     Ok(Measured {
         setting: *setting,
         seed: 0,

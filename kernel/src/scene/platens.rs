@@ -466,11 +466,45 @@ pub const SAMPLE_COLUMNS: [&str; 18] = [
     "steps",
 ];
 
+/// σ_est of a run ([`PlatenSample::sigma_est`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SigmaEst {
+    /// σ_est = 4/(πd)·dF/dx, Pa.
+    pub sigma_pa: Real,
+    /// The least-squares line F(x) behind it.
+    pub fit: crate::analysis::fit::LineFit,
+    /// x/d of the first and the last sample fitted.
+    pub strain_range: [Real; 2],
+}
+
 impl PlatenSample {
     /// The platen force: the mean of the upper and lower platen forces, N
     /// (the table's `force_n`; the σ_est fit uses it too).
     pub fn mean_force(&self) -> Real {
         0.5 * (self.force_upper_n + self.force_lower_n)
+    }
+
+    /// σ_est of a run's `samples` (written every `interval` of strain) on a
+    /// granule of diameter `diameter` (m): the fit of the mean platen force
+    /// against the approach over [`crate::analysis::granule::fit_window`]
+    /// (`yield_stress_estimate`), with the strains x/d of the first and the
+    /// last sample it took. `None` with fewer than two samples there.
+    pub fn sigma_est(samples: &[PlatenSample], diameter: Real, interval: Real) -> Option<SigmaEst> {
+        use crate::analysis::granule::{fit_window, yield_stress_estimate};
+        let [lo, hi] = fit_window(interval);
+        let points = samples.iter().map(|s| (s.approach_m, s.mean_force()));
+        let (sigma_pa, fit) = yield_stress_estimate(points, diameter, lo, hi)?;
+        let strains = samples
+            .iter()
+            .map(|s| s.approach_m / diameter)
+            .filter(|c| *c >= lo && *c <= hi);
+        let first = strains.clone().next()?;
+        let last = strains.clone().next_back()?;
+        Some(SigmaEst {
+            sigma_pa,
+            fit,
+            strain_range: [first, last],
+        })
     }
 
     /// The quasi-static certificate of a run's `samples` (in time order;
