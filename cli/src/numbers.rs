@@ -48,6 +48,30 @@ mod tests {
     use super::*;
 
     #[test]
+    fn significant_digits_for_tables() {
+        let cases = [
+            (0.300_001_234_5, "0.3000"),
+            (123.456, "123.5"),
+            (123_456.7, "123457"),
+            (9.9996, "10.00"),
+            (999_999.9, "1.000e6"),
+            (1.23e-7, "1.230e-7"),
+            (0.001_234_56, "0.001235"),
+            (-0.000_999_96, "-0.001000"),
+            (-0.000_099_996, "-1.000e-4"),
+            (-42.0, "-42.00"),
+            (0.0, "0.000"),
+            (f64::NAN, "n/a"),
+            (f64::NEG_INFINITY, "−∞"),
+        ];
+        for (x, text) in cases {
+            assert_eq!(significant(x, 4), text, "{x}");
+        }
+        assert_eq!(significant(0.5, 0), "0.5");
+        assert_eq!(significant(2.0 / 3.0, 2), "0.67");
+    }
+
+    #[test]
     fn distinct_list_names_the_item_it_refuses() {
         let parse = |t: &str| t.parse::<u8>().map_err(|_| "not a byte".to_owned());
         assert_eq!(distinct_list(" 1, 2,3", parse), Ok(vec![1, 2, 3]));
@@ -99,6 +123,33 @@ pub fn short(x: f64) -> String {
         scientific
     } else {
         plain
+    }
+}
+
+/// `x` rounded to `digits` significant digits (at least 1) for a table a
+/// reader scans: plain decimals for 10⁻³ ≤ |x| < 10⁶ (`0.3000`, `123.5`,
+/// `123457`), scientific notation outside (`1.230e-7`), "n/a" for NaN and
+/// "∞"/"−∞" for infinities. The full value stays in the machine-readable
+/// output (`summary.json`, CSV); this is for pages and tables only.
+pub fn significant(x: f64, digits: usize) -> String {
+    if x.is_nan() {
+        return "n/a".to_owned();
+    }
+    if x.is_infinite() {
+        return if x > 0.0 { "∞" } else { "−∞" }.to_owned();
+    }
+    let digits = digits.max(1);
+    // The exponent after rounding: 9.9996 to four digits is 1.000e1.
+    let scientific = format!("{:.*e}", digits - 1, x);
+    let exponent: i32 = scientific
+        .rsplit_once('e')
+        .and_then(|(_, e)| e.parse().ok())
+        .unwrap_or(0);
+    if x == 0.0 || (-3..6).contains(&exponent) {
+        let decimals = (digits as i32 - 1 - exponent).max(0) as usize;
+        format!("{x:.decimals$}")
+    } else {
+        scientific
     }
 }
 

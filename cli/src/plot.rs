@@ -36,6 +36,10 @@ pub enum Mark {
     Rings,
     /// A dashed black line (a fit).
     Dashed,
+    /// A dashed line in the series' colour: a second curve that may lie
+    /// on the first (the lower punch's pressure on the upper's), both
+    /// visible where they coincide.
+    DashedLine,
 }
 
 /// One series of a plot.
@@ -91,8 +95,8 @@ fn range(values: impl Iterator<Item = f64>, from_zero: bool) -> core::ops::Range
     }
 }
 
-/// The tick labels of an axis over `r`: `None` (plotters' own, plain
-/// decimals) when its largest magnitude lies in [0.01, 10⁵); otherwise
+/// The tick labels of an axis over `r`: `None` (plain decimals,
+/// [`plain_labels`]) when its largest magnitude lies in [0.01, 10⁵); otherwise
 /// numbers with an exponent (`2.5e-5`, `1.8e7`), where plain decimals
 /// would be rows of zeros or eight digits wide, with the significant
 /// digits the span needs (trailing zeros dropped). Round-off beside zero
@@ -128,6 +132,36 @@ fn exponent_labels(r: &Range<f64>) -> Option<impl Fn(&f64) -> String + use<>> {
     })
 }
 
+/// Tick labels a plot draws on an axis (plotters' default count).
+const AXIS_TICKS: usize = 11;
+
+/// The tick labels of an axis over `r` with plain decimals, all with the
+/// same number of decimals — as many as the finest tick needs (`0.800`,
+/// `0.805`, `0.810`, not `0.8`, `0.805`, `0.81`; `0`, `2`, `4`, not
+/// `0.0`, `2.0`) — for the axes [`exponent_labels`] leaves plain. The
+/// ticks are plotters' own for the axis ([`AXIS_TICKS`] of them at most).
+fn plain_labels(r: &Range<f64>) -> impl Fn(&f64) -> String + use<> {
+    use plotters::coord::ranged1d::{BoldPoints, Ranged};
+    use plotters::coord::types::RangedCoordf64;
+    let span = (r.end - r.start).abs();
+    let close = 1.0e-9 * span.max(f64::MIN_POSITIVE);
+    let needs = |v: f64| {
+        (0..=12)
+            .find(|&d| {
+                let scale = 10f64.powi(d);
+                ((v * scale).round() / scale - v).abs() <= close
+            })
+            .unwrap_or(12)
+    };
+    let ticks = RangedCoordf64::from(r.clone()).key_points(BoldPoints(AXIS_TICKS));
+    let decimals = ticks.iter().map(|&v| needs(v)).max().unwrap_or(0) as usize;
+    move |v: &f64| {
+        // Round-off beside zero prints as 0, not -0.000.
+        let v = if v.abs() <= close { 0.0 } else { *v };
+        format!("{v:.decimals$}")
+    }
+}
+
 /// The SVG text of `series` under `title`, with axis labels.
 pub fn xy_svg(
     title: &str,
@@ -151,6 +185,7 @@ pub fn xy_svg(
             .build_cartesian_2d(x_range.clone(), y_range.clone())?;
         let x_labels = exponent_labels(&x_range);
         let y_labels = exponent_labels(&y_range);
+        let (x_plain, y_plain) = (plain_labels(&x_range), plain_labels(&y_range));
         let mut mesh = chart.configure_mesh();
         // Text a little larger than plotters' default (about 10 px on the
         // 900 × 600 canvas), and the minor grid lighter, for a printed page.
@@ -159,12 +194,14 @@ pub fn xy_svg(
             .label_style(("sans-serif", 13))
             .axis_desc_style(("sans-serif", 15))
             .light_line_style(BLACK.mix(0.05));
-        if let Some(f) = &x_labels {
-            mesh.x_label_formatter(f);
-        }
-        if let Some(f) = &y_labels {
-            mesh.y_label_formatter(f);
-        }
+        match &x_labels {
+            Some(f) => mesh.x_label_formatter(f),
+            None => mesh.x_label_formatter(&x_plain),
+        };
+        match &y_labels {
+            Some(f) => mesh.y_label_formatter(f),
+            None => mesh.y_label_formatter(&y_plain),
+        };
         mesh.draw()?;
         let mut colour = COLOURS.iter().cycle();
         for s in series {
@@ -190,8 +227,12 @@ pub fn xy_svg(
                         .label(label)
                         .legend(move |(x, y)| Circle::new((x + 10, y), 3, style));
                 }
-                Mark::Dashed => {
-                    let style = BLACK.stroke_width(1);
+                Mark::Dashed | Mark::DashedLine => {
+                    let style = if s.mark == Mark::Dashed {
+                        BLACK.stroke_width(1)
+                    } else {
+                        colour.next().unwrap_or(&BLACK).stroke_width(2)
+                    };
                     chart
                         .draw_series(DashedLineSeries::new(pts, 6, 4, style))?
                         .label(label)
@@ -204,13 +245,16 @@ pub fn xy_svg(
                 }
             }
         }
-        chart
-            .configure_series_labels()
-            .label_font(("sans-serif", 13))
-            .position(SeriesLabelPosition::UpperLeft)
-            .background_style(WHITE.mix(0.85))
-            .border_style(BLACK)
-            .draw()?;
+        // One series needs no legend: the title and the axes name it.
+        if series.len() > 1 {
+            chart
+                .configure_series_labels()
+                .label_font(("sans-serif", 13))
+                .position(SeriesLabelPosition::UpperLeft)
+                .background_style(WHITE.mix(0.85))
+                .border_style(BLACK)
+                .draw()?;
+        }
         root.present()?;
     }
     Ok(svg)
@@ -219,6 +263,39 @@ pub fn xy_svg(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Every tick of a plain axis has the decimals of the finest one.
+    #[test]
+    fn plain_ticks_share_their_decimals() {
+        let density = plain_labels(&(0.799..0.826));
+        assert_eq!(
+            [density(&0.8), density(&0.805), density(&0.81)],
+            ["0.800", "0.805", "0.810"]
+        );
+        let pressure = plain_labels(&(-0.5..18.9));
+        assert_eq!([pressure(&0.0), pressure(&2.0)], ["0", "2"]);
+        let strain = plain_labels(&(-0.01..0.315));
+        assert_eq!(
+            [strain(&0.0), strain(&0.05), strain(&0.1)],
+            ["0.00", "0.05", "0.10"]
+        );
+        assert_eq!(strain(&-1e-17), "0.00");
+        // In a plot: the labels of one axis all alike.
+        let svg = xy_svg(
+            "t",
+            "x",
+            "y",
+            &[Series::new(
+                "s",
+                Mark::Line,
+                (0..=10).map(|i| (0.03 * f64::from(i), 0.8 + 0.0025 * f64::from(i))),
+            )],
+            false,
+        )
+        .unwrap();
+        let label = |text: &str| svg.lines().any(|l| l.trim() == text);
+        assert!(label("0.810") && label("0.800") && !label("0.81"), "{svg}");
+    }
 
     #[test]
     fn tiny_and_huge_axes_get_exponents() {

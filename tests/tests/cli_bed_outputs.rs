@@ -165,6 +165,33 @@ fn snapshots_plots_and_report() {
             .collect::<Vec<_>>()
     );
 
+    // Beside each snapshot its section picture: hexes cut by y = 0, all
+    // of the darkest colour before any load, several colours at the end;
+    // report.html shows them in strain order.
+    let report = std::fs::read_to_string(dir.join("report.html")).unwrap();
+    let mut at = 0;
+    for k in 0..files.len() {
+        let name = format!("vtk/section_{k}.svg");
+        let svg = std::fs::read_to_string(dir.join(&name)).unwrap();
+        parse_xml(&svg);
+        let fills: std::collections::BTreeSet<&str> = svg
+            .lines()
+            .filter(|l| l.starts_with("<polygon"))
+            .filter_map(|l| l.split("fill=\"").nth(1)?.split('"').next())
+            .collect();
+        assert!(!fills.is_empty(), "{name}: no hex cut");
+        if k == 0 {
+            assert_eq!(fills.into_iter().collect::<Vec<_>>(), ["#440154"], "{name}");
+        } else if k + 1 == files.len() {
+            assert!(fills.len() > 5, "{name}: {fills:?}");
+        }
+        let img = format!("<img src=\"{name}\"");
+        let found = report[at..]
+            .find(&img)
+            .unwrap_or_else(|| panic!("report lacks {img}"));
+        at += found + img.len();
+    }
+
     let mut mean_density = Vec::new();
     let mut max_axial = Vec::new();
     for file in &files {
@@ -251,8 +278,9 @@ fn snapshots_plots_and_report() {
         assert!(svg.contains("</svg>"), "{name}");
     }
 
-    // The report: the summary's values (as written in summary.json), the
-    // plots inline and the scene.
+    // The report: the summary's values (as written in summary.json, in
+    // the cell's title; the cell shows them to four digits), the plots
+    // inline and the scene.
     let html = std::fs::read_to_string(dir.join("report.html")).unwrap();
     assert!(html.starts_with("<!DOCTYPE html>"));
     assert!(html.trim_end().ends_with("</html>"));
@@ -270,13 +298,19 @@ fn snapshots_plots_and_report() {
         "energy_residual_rel",
     ] {
         let value = s[key].to_string();
+        let shown = match s[key].as_u64() {
+            Some(count) => count.to_string(),
+            None => granbed_cli::numbers::significant(s[key].as_f64().unwrap(), 4),
+        };
         assert!(
-            html.contains(&format!("<td class=\"value\">{value}</td>")),
-            "report lacks {key} = {value}"
+            html.contains(&format!(
+                "<td class=\"value\" title=\"{value}\">{shown}</td>"
+            )),
+            "report lacks {key} = {value} shown as {shown}"
         );
     }
     assert!(html.contains(&format!(
-        "<td>version</td><td class=\"value\">{}</td>",
+        "<td>version</td><td class=\"value\" title=\"{0}\">{0}</td>",
         s["version"].as_str().unwrap()
     )));
     for line in [

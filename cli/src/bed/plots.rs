@@ -69,10 +69,14 @@ pub fn overlay_svg(
     )
 }
 
-/// Two curves (label, value) of the samples against the strain.
+/// Two curves (label, value) of the samples against the strain, the
+/// second dashed, so that both show where they lie on each other (the
+/// two relative densities of a bed of one granule size nearly do).
 fn against_strain(samples: &[BedSample], curves: [(&str, Quantity); 2]) -> [Series; 2] {
-    curves
-        .map(|(label, y)| Series::new(label, Mark::Line, samples.iter().map(|s| (s.strain, y(s)))))
+    let [first, second] = curves;
+    [(first, Mark::Line), (second, Mark::DashedLine)].map(|((label, y), mark)| {
+        Series::new(label, mark, samples.iter().map(|s| (s.strain, y(s))))
+    })
 }
 
 /// A fit's plot: `rows` (x, y, C) before the strain window `min_strain`

@@ -11,6 +11,7 @@ use serde_json::Value;
 use super::outputs::Summary;
 use super::scene::{DEFAULT_SCENE, Scene};
 use super::snapshots::{PVD_FILE, VTK_DIR};
+use crate::numbers::significant;
 use crate::output::write_text;
 
 /// File name of the report in the output directory.
@@ -206,8 +207,8 @@ pub fn html_escape(text: &str) -> String {
     crate::output::escape_markup(text)
 }
 
-/// A JSON value as the table shows it: numbers as in `summary.json`,
-/// strings without quotes, `null` as "n/a".
+/// A JSON value as `summary.json` writes it: numbers with all their
+/// digits, strings without quotes, `null` as "n/a".
 fn show(value: &Value) -> String {
     match value {
         Value::Null => "n/a".to_string(),
@@ -216,8 +217,46 @@ fn show(value: &Value) -> String {
     }
 }
 
-/// The summary's fields as (key, meaning, value) rows.
-fn rows(summary: &Summary<'_>) -> anyhow::Result<Vec<(String, &'static str, String)>> {
+/// A JSON value as the table's cell shows it: a float to
+/// [`TABLE_DIGITS`] significant digits ([`significant`]), anything else
+/// as [`show`] gives it.
+fn shown_in_cell(value: &Value) -> String {
+    match value {
+        Value::Number(n) if !(n.is_u64() || n.is_i64()) => n
+            .as_f64()
+            .map_or_else(|| show(value), |x| significant(x, TABLE_DIGITS)),
+        v => show(v),
+    }
+}
+
+/// Significant digits of the floats in the report's tables; the cell's
+/// `title` (shown on hover) and `summary.json` keep all of them.
+pub const TABLE_DIGITS: usize = 4;
+
+/// One row of the summary table.
+#[derive(Debug)]
+struct Row {
+    key: String,
+    meaning: &'static str,
+    /// As `summary.json` has it.
+    full: String,
+    /// As the cell shows it.
+    cell: String,
+}
+
+impl Row {
+    fn new(key: String, meaning: &'static str, value: &Value) -> Self {
+        Self {
+            key,
+            meaning,
+            full: show(value),
+            cell: shown_in_cell(value),
+        }
+    }
+}
+
+/// The summary's fields as rows, in [`FIELDS`]' order, then the others.
+fn rows(summary: &Summary<'_>) -> anyhow::Result<Vec<Row>> {
     let Value::Object(map) = serde_json::to_value(summary)? else {
         anyhow::bail!("the summary is not a JSON object");
     };
@@ -231,29 +270,59 @@ fn rows(summary: &Summary<'_>) -> anyhow::Result<Vec<(String, &'static str, Stri
         }
     }
     let known = |k: &str| FIELDS.iter().position(|f| f.0 == k);
-    let mut out: Vec<(String, &'static str, String)> = FIELDS
+    let mut out: Vec<Row> = FIELDS
         .iter()
         .filter(|f| !f.1.is_empty())
         .filter_map(|&(key, meaning)| {
             let v = flat.iter().find(|(k, _)| k == key)?.1;
-            Some((key.to_string(), meaning, show(v)))
+            Some(Row::new(key.to_string(), meaning, v))
         })
         .collect();
     out.extend(
         flat.iter()
             // The scene is shown as TOML below the table, not as a row.
             .filter(|(k, _)| known(k).is_none() && !k.starts_with("scene.") && k != "scene_toml")
-            .map(|(k, v)| (k.clone(), "", show(v))),
+            .map(|(k, v)| Row::new(k.clone(), "", v)),
     );
     Ok(out)
 }
 
-/// The report page of a run of `scene` with `summary` and the plots
-/// `svgs` (file name in `plots/`, SVG text).
+/// The start of a report page titled `title`, to its `<h1>`: the
+/// document's head with the pages' one style sheet (shared by a run's
+/// report and a series' report).
+pub(super) fn page_head(title: &str) -> String {
+    let title = html_escape(title);
+    format!(
+        "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n<title>{title}</title>\n\
+         <style>\nbody {{ font-family: sans-serif; max-width: 960px; margin: 1em auto; padding: 0 1em; }}\n\
+         table {{ border-collapse: collapse; }}\n\
+         td, th {{ border: 1px solid #ccc; padding: 0.2em 0.6em; text-align: left; }}\n\
+         td.value, td.num {{ font-family: monospace; }}\ntd.num {{ text-align: right; }}\n\
+         tr.doubt td {{ background: #fff4e0; }}\n\
+         figure {{ margin: 1em 0; }}\nfigure svg {{ max-width: 100%; height: auto; }}\n\
+         pre {{ background: #f4f4f4; padding: 0.8em; overflow-x: auto; }}\n</style>\n</head>\n<body>\n\
+         <h1>{title}</h1>\n"
+    )
+}
+
+/// A plot inline: the SVG `svg`, captioned with a link to its file `href`
+/// (relative to the page).
+pub(super) fn figure(href: &str, svg: &str) -> String {
+    // The SVG is plotters' output: well-formed XML with its text already
+    // escaped, so it is embedded as it is.
+    let href = html_escape(href);
+    format!("<figure>\n{svg}\n<figcaption><a href=\"{href}\">{href}</a></figcaption>\n</figure>\n")
+}
+
+/// The report page of a run of `scene` with `summary`, the plots `svgs`
+/// (file name in `plots/`, SVG text) and the section pictures `sections`
+/// (paths relative to the page, in strain order; shown as images, not
+/// inline: each holds thousands of polygons).
 pub fn report_html(
     scene: &Scene,
     summary: &Summary<'_>,
     svgs: &[(&str, String)],
+    sections: &[String],
 ) -> anyhow::Result<String> {
     let toml = if *scene == Scene::published() {
         DEFAULT_SCENE.to_string()
@@ -264,19 +333,7 @@ pub fn report_html(
         "granbed bed: {} × {} granules, mesh {}",
         scene.granules, scene.granule_type, scene.mesh
     );
-    let mut h = String::new();
-    writeln!(
-        h,
-        "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n<title>{}</title>\n\
-         <style>\nbody {{ font-family: sans-serif; max-width: 960px; margin: 1em auto; padding: 0 1em; }}\n\
-         table {{ border-collapse: collapse; }}\n\
-         td, th {{ border: 1px solid #ccc; padding: 0.2em 0.6em; text-align: left; }}\n\
-         td.value {{ font-family: monospace; }}\n\
-         figure {{ margin: 1em 0; }}\nfigure svg {{ max-width: 100%; height: auto; }}\n\
-         pre {{ background: #f4f4f4; padding: 0.8em; overflow-x: auto; }}\n</style>\n</head>\n<body>",
-        html_escape(&title)
-    )?;
-    writeln!(h, "<h1>{}</h1>", html_escape(&title))?;
+    let mut h = page_head(&title);
     if let Some(e) = &summary.error {
         writeln!(
             h,
@@ -312,25 +369,37 @@ pub fn report_html(
          meshes.</p>"
     )?;
     for (name, svg) in svgs {
-        // The SVG is plotters' output: well-formed XML with its text
-        // already escaped, so it is embedded as it is.
-        let name = html_escape(name);
+        h.push_str(&figure(&format!("plots/{name}"), svg));
+    }
+    if !sections.is_empty() {
         writeln!(
             h,
-            "<figure>\n{svg}\n<figcaption><a href=\"plots/{name}\">plots/{name}</a></figcaption>\n</figure>"
+            "<h2>Sections through the die axis</h2>\n<p>The bed cut by the plane y = 0 at each \
+             snapshot: every hex the plane cuts, coloured by its axial stress −σ<sub>zz</sub> (the \
+             load runs along the bright chains from granule to granule), the granules' outlines, \
+             the die wall and the punches. The VTU snapshots beside them hold the whole bed.</p>"
         )?;
+        for path in sections {
+            let path = html_escape(path);
+            writeln!(
+                h,
+                "<figure>\n<img src=\"{path}\" alt=\"section of the bed: {path}\" \
+                 style=\"max-width: 100%\">\n<figcaption><a href=\"{path}\">{path}</a></figcaption>\n</figure>"
+            )?;
+        }
     }
     writeln!(
         h,
         "<h2>Summary</h2>\n<table>\n<tr><th>field</th><th>value</th><th>meaning</th></tr>"
     )?;
-    for (key, meaning, value) in rows(summary)? {
+    for row in rows(summary)? {
         writeln!(
             h,
-            "<tr><td>{}</td><td class=\"value\">{}</td><td>{}</td></tr>",
-            html_escape(&key),
-            html_escape(&value),
-            html_escape(meaning)
+            "<tr><td>{}</td><td class=\"value\" title=\"{}\">{}</td><td>{}</td></tr>",
+            html_escape(&row.key),
+            html_escape(&row.full),
+            html_escape(&row.cell),
+            html_escape(row.meaning)
         )?;
     }
     writeln!(h, "</table>")?;
@@ -342,6 +411,28 @@ pub fn report_html(
     Ok(h)
 }
 
+/// The section pictures in `dir`/[`VTK_DIR`] (`section_<k>.svg`), as paths
+/// relative to `dir`, in the order of k (the snapshots' strain order).
+fn section_files(dir: &Path) -> Vec<String> {
+    let Ok(entries) = std::fs::read_dir(dir.join(VTK_DIR)) else {
+        return Vec::new();
+    };
+    let mut numbered: Vec<(usize, String)> = entries
+        .filter_map(Result::ok)
+        .filter_map(|e| {
+            let name = e.file_name().into_string().ok()?;
+            let k = name
+                .strip_prefix("section_")?
+                .strip_suffix(".svg")?
+                .parse()
+                .ok()?;
+            Some((k, format!("{VTK_DIR}/{name}")))
+        })
+        .collect();
+    numbered.sort();
+    numbered.into_iter().map(|(_, path)| path).collect()
+}
+
 /// Writes [`REPORT_FILE`] into `dir`.
 pub fn write_report(
     dir: &Path,
@@ -350,7 +441,7 @@ pub fn write_report(
     svgs: &[(&str, String)],
 ) -> anyhow::Result<()> {
     let path = dir.join(REPORT_FILE);
-    let html = report_html(scene, summary, svgs)?;
+    let html = report_html(scene, summary, svgs, &section_files(dir))?;
     write_text(&path, &html)
 }
 
@@ -392,15 +483,37 @@ mod tests {
             let rows = rows(&summary).unwrap();
             let blank: Vec<&str> = rows
                 .iter()
-                .filter(|r| r.1.is_empty())
-                .map(|r| r.0.as_str())
+                .filter(|r| r.meaning.is_empty())
+                .map(|r| r.key.as_str())
                 .collect();
             assert!(blank.is_empty(), "rows without a meaning: {blank:?}");
-            assert!(rows.iter().all(|r| !r.0.starts_with("scene")), "{rows:?}");
+            assert!(rows.iter().all(|r| !r.key.starts_with("scene")), "{rows:?}");
             let overlap_rows = rows
                 .iter()
-                .filter(|r| r.0.starts_with("final_hidden_overlap"));
+                .filter(|r| r.key.starts_with("final_hidden_overlap"));
             assert_eq!(overlap_rows.count(), if measured { 6 } else { 1 });
+        }
+    }
+
+    /// A cell rounds floats to [`TABLE_DIGITS`] and keeps counts and text
+    /// whole; the row's full value is what `summary.json` holds.
+    #[test]
+    fn cells_round_floats_only() {
+        let float = serde_json::json!(0.123_456_789);
+        let row = Row::new("x".into(), "", &float);
+        assert_eq!(
+            (row.full.as_str(), row.cell.as_str()),
+            ("0.123456789", "0.1235")
+        );
+        for (value, text) in [
+            (serde_json::json!(1_234_567_u64), "1234567"),
+            (serde_json::json!(-3), "-3"),
+            (serde_json::json!(true), "true"),
+            (serde_json::json!("0.5.0"), "0.5.0"),
+            (Value::Null, "n/a"),
+        ] {
+            let row = Row::new("x".into(), "", &value);
+            assert_eq!((row.full.as_str(), row.cell.as_str()), (text, text));
         }
     }
 
