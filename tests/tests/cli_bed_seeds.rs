@@ -77,6 +77,20 @@ fn each_seed_is_its_own_run_and_the_spread_is_of_their_figures() {
     assert_ne!(d0[0], d0[1]);
 
     // The spread of each figure from the rows.
+    // The series' page links the runs in the order given and shows the
+    // spread.
+    let report = std::fs::read_to_string(dir.join("report.html")).unwrap();
+    let (at2, at1) = (
+        report.find("<a href=\"seed_2/report.html\">seed_2</a></td>"),
+        report.find("<a href=\"seed_1/report.html\">seed_1</a></td>"),
+    );
+    assert!(
+        at2.is_some() && at1.is_some() && at2 < at1,
+        "rows: {report}"
+    );
+    assert!(report.contains("<h2>Spread over the runs</h2>"));
+    assert_eq!(report.matches("<svg").count(), 2);
+
     let spread = Table::read(&dir.join("seeds_spread.csv"));
     let figures = spread.text("figure");
     assert!(

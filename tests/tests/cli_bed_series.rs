@@ -216,18 +216,20 @@ fn a_series_and_a_single_run_keep_out_of_each_other() {
     assert!(!dir.join("series.json").exists());
     let run = series(&["--overwrite"]);
     assert_eq!(run.code, 0, "{}", run.stderr);
-    for f in [
-        "checkpoint.bin",
-        "summary.json",
-        "compression.csv",
-        "report.html",
-    ] {
+    for f in ["checkpoint.bin", "summary.json", "compression.csv"] {
         assert!(
             !dir.join(f).exists(),
             "{f} of the single run left beside the series"
         );
     }
     assert!(dir.join("series.json").is_file() && dir.join("B1/summary.json").is_file());
+    // report.html is now the series' page, linking each member's report.
+    let report = std::fs::read_to_string(dir.join("report.html")).unwrap();
+    assert!(report.contains("granule types B1, B2"), "{report}");
+    for t in ["B1", "B2"] {
+        assert!(report.contains(&format!("<a href=\"{t}/report.html\">{t}</a>")));
+        assert!(dir.join(t).join("report.html").is_file());
+    }
 
     // A series refused for its scene after --overwrite was given removes
     // nothing: the checks come first.
@@ -254,6 +256,11 @@ fn a_series_and_a_single_run_keep_out_of_each_other() {
     assert_eq!(run.code, 0, "{}", run.stderr);
     assert!(!dir.join("series.json").exists() && !dir.join("comparison.csv").exists());
     assert!(dir.join("checkpoint.bin").is_file() && dir.join("B1/summary.json").is_file());
+    let report = std::fs::read_to_string(dir.join("report.html")).unwrap();
+    assert!(
+        !report.contains("granule types B1, B2") && report.contains("<h2>Summary</h2>"),
+        "report.html is not the single run's"
+    );
 }
 
 /// A checkpoint in a member's directory that is not a run of the member

@@ -2,7 +2,8 @@
 //! compressed from the same poured bed, one row per type in
 //! `comparison.csv` and `comparison.json`, and the overlaid plots
 //! `comparison_pressure.svg` (P against C) and `comparison_density.svg`
-//! (mean granule relative density against C).
+//! (mean granule relative density against C), and the series'
+//! `report.html` ([`super::series_report`]).
 
 use std::path::Path;
 
@@ -14,6 +15,7 @@ use serde::Serialize;
 use super::outputs::{KawakitaSummary, Summary, fit_linear, kawakita_doubts};
 use super::plots::overlay_svg;
 use super::run::BedSample;
+use super::series_report::{SeriesReport, write_series_report};
 use crate::csv::{CsvWriter, Field};
 use crate::output::{create_file, finish_file, write_json, write_text};
 
@@ -224,7 +226,25 @@ pub fn write_comparison(
         "by granule type (one pour, sphere density of {})",
         comparison.pour_granule_type
     );
-    write_overlays(dir, [PRESSURE_SVG, DENSITY_SVG], &labels, samples, &suffix)
+    let svgs = write_overlays(dir, [PRESSURE_SVG, DENSITY_SVG], &labels, samples, &suffix)?;
+    let names: Vec<&str> = comparison.types.iter().map(|r| r.granule_type).collect();
+    write_series_report(
+        dir,
+        &SeriesReport {
+            title: format!("granbed bed series: granule types {}", names.join(", ")),
+            about: format!(
+                "Each granule type compressed from the same poured bed (the pour used the \
+                 sphere density of {}, and took {:.1} s), so the rows differ by the material \
+                 alone.",
+                comparison.pour_granule_type, comparison.pour_wall_time_s
+            ),
+            member_dirs: names.iter().map(|&n| n.to_owned()).collect(),
+            rows: comparison.types,
+            spreads: None,
+            files: &[COMPARISON_CSV, COMPARISON_JSON],
+            svgs: &svgs,
+        },
+    )
 }
 
 /// Writes `rows` as a table of [`COMPARISON_COLUMNS`] to `path`.
@@ -239,14 +259,14 @@ pub fn write_rows(path: &Path, rows: &[ComparisonRow]) -> anyhow::Result<()> {
 
 /// Writes the overlaid plots `[pressure, density]` (file names in `dir`)
 /// of the runs' `samples`, one curve per run named by `labels`, the titles
-/// ending with `suffix`.
-pub fn write_overlays(
+/// ending with `suffix`; returns them as (file name, SVG text).
+pub fn write_overlays<'a>(
     dir: &Path,
-    [pressure_file, density_file]: [&str; 2],
+    [pressure_file, density_file]: [&'a str; 2],
     labels: &[&str],
     samples: &[&[BedSample]],
     suffix: &str,
-) -> anyhow::Result<()> {
+) -> anyhow::Result<[(&'a str, String); 2]> {
     let curves: Vec<(&str, &[BedSample])> = labels
         .iter()
         .copied()
@@ -266,8 +286,9 @@ pub fn write_overlays(
         |s| s.relative_density_mean,
         false,
     )?;
-    for (name, svg) in [(pressure_file, pressure), (density_file, density)] {
-        write_text(&dir.join(name), &svg)?;
+    let svgs = [(pressure_file, pressure), (density_file, density)];
+    for (name, svg) in &svgs {
+        write_text(&dir.join(name), svg)?;
     }
-    Ok(())
+    Ok(svgs)
 }

@@ -6,9 +6,12 @@
 //! * [`scene`]: the TOML scene format and the embedded published scene;
 //! * [`run`](mod@run): the run itself, sampled every output interval;
 //! * [`outputs`]: `compression.csv` and `summary.json`;
-//! * [`snapshots`]: the VTU snapshots (`vtk/`), [`plots`]: the SVG plots
-//!   (`plots/`), [`report`]: `report.html`;
-//! * [`compare`]: `--types`, several granule types from one pour.
+//! * [`snapshots`]: the VTU snapshots (`vtk/`) and, by [`section`], their
+//!   section pictures; [`plots`]: the SVG plots (`plots/`), [`report`]:
+//!   `report.html`;
+//! * [`compare`]: `--types`, several granule types from one pour; [`seeds`]:
+//!   `--seeds`; [`series`]: either kept resumable as a whole;
+//!   [`series_report`]: the series' `report.html`.
 
 use std::path::PathBuf;
 
@@ -31,8 +34,10 @@ pub mod plots;
 pub mod report;
 pub mod run;
 pub mod scene;
+pub mod section;
 pub mod seeds;
 pub mod series;
+pub mod series_report;
 pub mod snapshots;
 
 pub use scene::{DEFAULT_SCENE, Scene};
@@ -80,11 +85,16 @@ Output, in --out DIR (created if missing):
                    axial_stress_pa (-sigma_zz), and element_relative_density
                    eta0/J
   vtk/bed.pvd      ParaView collection of the snapshots (timestep = strain)
+  vtk/section_<k>.svg
+                   each snapshot cut through the die axis (plane y = 0): the
+                   cut hexes coloured by axial stress -sigma_zz, the granules'
+                   outlines, the die wall and the punches
   plots/*.svg      pressure, coordination number, relative density and Heywood
                    coefficient against strain; Kawakita plot P/C vs P and
                    Heckel plot ln(1/(1 - D)) vs P, each with its fit; the
                    compaction profile, the bed's solid fraction D vs P
-  report.html      one page: the warnings, the plots, the summary table and the scene
+  report.html      one page: the warnings, the plots, the sections, the summary
+                   table (rounded; hover a value for all its digits) and the scene
   checkpoint.bin   the state to continue from with --resume (every
                    checkpoint_interval_minutes and checkpoint_strain_interval,
                    and at the end)
@@ -114,6 +124,8 @@ alone with --resume DIR/<TYPE>), and DIR holds the comparison:
   comparison_pressure.svg, comparison_density.svg
                    upper-punch pressure and mean relative density against
                    strain, one curve per type
+  report.html      one page: the plots, a row per type linked to its report
+                   (pressures in kPa, rejected fits marked), what to doubt
   series.json      the series (types, scene, the pour) for --resume DIR
 With --seeds S1,S2,..., the scene is poured and compressed once per seed into
 `DIR/seed_<S>/` (each resumable alone with --resume), and DIR holds the
@@ -126,6 +138,7 @@ run-to-run spread:
   seeds.json       both tables
   seeds_pressure.svg, seeds_density.svg
                    one curve per seed
+  report.html      as for --types, with the spread as a second table
   series.json      the series (seeds, scene) for --resume DIR
 
 All types start from ONE pour (as the published study compares the nine

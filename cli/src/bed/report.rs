@@ -1,6 +1,8 @@
-//! `report.html`: one self-contained page of a bed run: its warnings, the
-//! plots inline as SVG (first: what a reader looks at), the summary table
-//! (the fields of `summary.json`, values as written there), and the scene
+//! `report.html`: one page of a bed run: its warnings, the plots inline as
+//! SVG (first: what a reader looks at), the section pictures of its
+//! snapshots (as images of `vtk/section_<k>.svg`, too large to inline),
+//! the summary table (the fields of `summary.json`, floats rounded to
+//! [`TABLE_DIGITS`], all their digits in the cell's title), and the scene
 //! as TOML. All text is HTML-escaped.
 
 use core::fmt::Write as _;

@@ -20,6 +20,7 @@ use granbed_kernel::Real;
 use serde::Serialize;
 
 use super::compare::{ComparisonRow, write_overlays, write_rows};
+use super::series_report::{SeriesReport, write_series_report};
 use super::{BedArgs, Scene, SeriesRun, outputs, run, series, series_failures};
 use crate::csv::{CsvWriter, Field};
 use crate::output::{Streams, create_file, finish_file, write_json};
@@ -200,7 +201,23 @@ pub fn write_seeds(
     let suffix = rows.first().map_or(String::new(), |r| {
         format!("by seed ({} granules, one pour each)", r.granule_type)
     });
-    write_overlays(dir, SEEDS_SVG, &labels, samples, &suffix)
+    let svgs = write_overlays(dir, SEEDS_SVG, &labels, samples, &suffix)?;
+    let granule_type = rows.first().map_or("", |r| r.granule_type);
+    write_series_report(
+        dir,
+        &SeriesReport {
+            title: format!("granbed bed series: {} pours of {granule_type}", rows.len()),
+            about: "Each seed pours its own bed and compresses it; the spread of a figure over \
+                    the seeds is the run-to-run variation that the choice of a setting is \
+                    judged against."
+                .to_owned(),
+            member_dirs: rows.iter().map(|r| seed_dir(r.seed)).collect(),
+            rows,
+            spreads: Some(&spreads),
+            files: &[SEEDS_CSV, SPREAD_CSV, SEEDS_JSON],
+            svgs: &svgs,
+        },
+    )
 }
 
 impl BedArgs {

@@ -317,11 +317,12 @@ fn single_run_files(dir: &Path) -> Vec<PathBuf> {
     files
 }
 
-/// The tables a series writes into its directory (both kinds), and the
-/// series file.
+/// The tables a series writes into its directory (both kinds), its
+/// report (named as a single run's) and the series file.
 fn series_files(dir: &Path) -> Vec<PathBuf> {
     [
         FILE_NAME,
+        report::REPORT_FILE,
         compare::COMPARISON_CSV,
         compare::COMPARISON_JSON,
         compare::PRESSURE_SVG,

@@ -27,6 +27,7 @@ use vtkio::model::{
     Version, VertexNumbers, Vtk,
 };
 
+use super::section::{SectionInput, section_svg};
 use crate::assembly::Assembly;
 use crate::model::OwnedReference;
 use crate::output::{create_file, finish_file, write_text};
@@ -174,10 +175,12 @@ pub fn quad_hexes(mesh: &OwnedReference) -> anyhow::Result<Vec<usize>> {
 }
 
 /// The snapshot of `asm` as a VTK unstructured grid: the granules one
-/// after the other (points, then cells, in granule order).
+/// after the other (points, then cells, in granule order), with the
+/// element fields `elements` ([`element_fields`]).
 pub fn snapshot_vtk(
     asm: &Assembly<'_>,
     mesh: &OwnedReference,
+    elements: &ElementFields,
     content: SnapshotContent,
     d_fixed_m: Real,
 ) -> anyhow::Result<Vtk> {
@@ -233,7 +236,6 @@ pub fn snapshot_vtk(
         SnapshotContent::Surfaces => quad_hexes(mesh)?,
         SnapshotContent::Hexes => (0..mesh.hexes.len()).collect(),
     };
-    let elements = element_fields(asm, mesh);
     let per_element = |v: &[Real]| -> Vec<Real> {
         v.chunks(mesh.hexes.len().max(1))
             .flat_map(|granule| cell_hex.iter().map(|&h| granule[h]))
@@ -296,8 +298,43 @@ pub fn snapshot_file(k: usize) -> String {
     format!("bed_{k}.vtu")
 }
 
+/// File name of the section picture of snapshot `k` ([`section_svg`]).
+pub fn section_file(k: usize) -> String {
+    format!("section_{k}.svg")
+}
+
+/// What the section picture of `asm` at `strain` shows: the granules'
+/// positions, the mesh, the axial stress of `elements`, the die's radius
+/// and the upper punch's height (from the walls).
+fn section_input<'a>(
+    asm: &'a Assembly<'_>,
+    mesh: &'a OwnedReference,
+    elements: &'a ElementFields,
+    strain: Real,
+) -> SectionInput<'a> {
+    use granbed_kernel::contact::wall::Wall;
+    let (mut die_radius_m, mut upper_z_m) = (Real::NAN, 0.0);
+    for wall in asm.walls() {
+        match wall {
+            Wall::Die { radius } => die_radius_m = radius,
+            // The upper punch: normal −z, gap −z − offset.
+            Wall::Plane(p) if p.normal[2] < 0.0 => upper_z_m = -p.offset,
+            Wall::Plane(_) => {}
+        }
+    }
+    SectionInput {
+        granules: asm.granules().iter().map(|g| g.x.as_slice()).collect(),
+        hexes: &mesh.hexes,
+        quads: &mesh.quads,
+        axial_stress_pa: &elements.axial_stress_pa,
+        die_radius_m,
+        upper_z_m,
+        strain,
+    }
+}
+
 /// Removes the snapshots an earlier run left in `out`/[`VTK_DIR`]
-/// (`bed_<k>.vtu` and [`PVD_FILE`]; nothing else), so that a fresh run
+/// (`bed_<k>.vtu`, `section_<k>.svg` and [`PVD_FILE`]; nothing else), so that a fresh run
 /// into the same directory does not leave stale snapshots beside its own
 /// (e.g. of strains it does not reach). Returns how many files went.
 pub fn remove_old(out: &Path) -> anyhow::Result<usize> {
@@ -310,10 +347,12 @@ pub fn remove_old(out: &Path) -> anyhow::Result<usize> {
         let entry = entry.with_context(|| format!("cannot list `{}`", dir.display()))?;
         let name = entry.file_name();
         let Some(name) = name.to_str() else { continue };
-        let snapshot = name
-            .strip_prefix("bed_")
-            .and_then(|n| n.strip_suffix(".vtu"))
-            .is_some_and(|k| !k.is_empty() && k.bytes().all(|b| b.is_ascii_digit()));
+        let numbered = |prefix: &str, suffix: &str| {
+            name.strip_prefix(prefix)
+                .and_then(|n| n.strip_suffix(suffix))
+                .is_some_and(|k| !k.is_empty() && k.bytes().all(|b| b.is_ascii_digit()))
+        };
+        let snapshot = numbered("bed_", ".vtu") || numbered("section_", ".svg");
         if (snapshot || name == PVD_FILE) && entry.path().is_file() {
             std::fs::remove_file(entry.path())
                 .with_context(|| format!("cannot remove `{}`", entry.path().display()))?;
@@ -377,12 +416,17 @@ impl SnapshotWriter {
             .with_context(|| format!("cannot create directory `{}`", self.dir.display()))?;
         let k = self.index(strain);
         let path = self.dir.join(snapshot_file(k));
-        let vtk = snapshot_vtk(asm, mesh, self.content, self.d_fixed_m)?;
+        let elements = element_fields(asm, mesh);
+        let vtk = snapshot_vtk(asm, mesh, &elements, self.content, self.d_fixed_m)?;
         let mut file = create_file(&path)?;
         vtk.write_xml(&mut file)
             .map_err(|e| anyhow::anyhow!("{e}"))
             .with_context(|| format!("cannot write `{}`", path.display()))?;
         finish_file(file, &path)?;
+        write_text(
+            &self.dir.join(section_file(k)),
+            &section_svg(&section_input(asm, mesh, &elements, strain)),
+        )?;
         let entries: Vec<(Real, String)> = self.strains[..=k]
             .iter()
             .enumerate()

@@ -1,0 +1,408 @@
+//! A picture of the bed without ParaView: its cross-section through the
+//! die axis (the plane y = 0), each hex the plane cuts filled with its
+//! axial stress −σ_zz (the force chains run where the stress is high), the
+//! granules' outlines (their surface quads cut by the plane) drawn over
+//! them, and the die wall and the punches around them. Written as
+//! `vtk/section_<k>.svg` beside each VTU snapshot (`snapshots.rs`) and shown
+//! by `report.html`.
+//!
+//! The cut of a hex by the plane is the polygon through the points where
+//! its twelve edges cross y = 0, in angular order about their centroid
+//! (exact for a hex whose cut is convex, as for every hex that is not
+//! folded).
+
+use core::fmt::Write as _;
+
+use granbed_kernel::Real;
+
+/// The hex8 edges (corners 0–3 the bottom face, 4–7 the top, i + 4 above i).
+const HEX_EDGES: [(usize, usize); 12] = [
+    (0, 1),
+    (1, 2),
+    (2, 3),
+    (3, 0),
+    (4, 5),
+    (5, 6),
+    (6, 7),
+    (7, 4),
+    (0, 4),
+    (1, 5),
+    (2, 6),
+    (3, 7),
+];
+
+/// Width of the picture, px (its height follows the bed's aspect ratio).
+const WIDTH: f64 = 900.0;
+/// Margins: left, right (the colour bar), top (the title), bottom, px.
+const MARGIN: [f64; 4] = [40.0, 110.0, 60.0, 40.0];
+
+/// The points (x, z) where the segments `edges` of `corners` cross the
+/// plane y = 0, each point once. A corner on the plane counts as on its
+/// positive side (y ≥ 0), so that of two hexes sharing a face in the plane
+/// only the one below it is cut (in that face), not both.
+fn crossings(corners: &[[Real; 3]], edges: &[(usize, usize)]) -> Vec<[Real; 2]> {
+    let mut points: Vec<[Real; 2]> = Vec::with_capacity(6);
+    for &(a, b) in edges {
+        let (pa, pb) = (corners[a], corners[b]);
+        let (ya, yb) = (pa[1], pb[1]);
+        if (ya >= 0.0) != (yb >= 0.0) {
+            let t = ya / (ya - yb);
+            let p = [pa[0] + t * (pb[0] - pa[0]), pa[2] + t * (pb[2] - pa[2])];
+            if !points.contains(&p) {
+                points.push(p);
+            }
+        }
+    }
+    points
+}
+
+/// The cut of the hex with `corners` (hex8 order) by the plane y = 0, as a
+/// polygon (x, z) in angular order; `None` if the plane misses it or
+/// touches it in fewer than three points.
+pub fn cut_hex(corners: &[[Real; 3]; 8]) -> Option<Vec<[Real; 2]>> {
+    let mut points = crossings(corners, &HEX_EDGES);
+    if points.len() < 3 {
+        return None;
+    }
+    let n = points.len() as Real;
+    let cx = points.iter().map(|p| p[0]).sum::<Real>() / n;
+    let cz = points.iter().map(|p| p[1]).sum::<Real>() / n;
+    let angle = |p: &[Real; 2]| (p[1] - cz).atan2(p[0] - cx);
+    points.sort_by(|a, b| angle(a).total_cmp(&angle(b)));
+    Some(points)
+}
+
+/// The cut of a quad with `corners` by the plane y = 0: the segment (x, z)
+/// it leaves, if it crosses the plane.
+pub fn cut_quad(corners: &[[Real; 3]; 4]) -> Option<[[Real; 2]; 2]> {
+    let points = crossings(corners, &[(0, 1), (1, 2), (2, 3), (3, 0)]);
+    match points[..] {
+        [a, b] => Some([a, b]),
+        _ => None,
+    }
+}
+
+/// The area of a polygon (shoelace), m² for points in m.
+pub fn polygon_area(points: &[[Real; 2]]) -> Real {
+    let n = points.len();
+    0.5 * (0..n)
+        .map(|i| {
+            let (p, q) = (points[i], points[(i + 1) % n]);
+            p[0] * q[1] - q[0] * p[1]
+        })
+        .sum::<Real>()
+        .abs()
+}
+
+/// Matplotlib's viridis at `t` ∈ [0, 1] (clamped; NaN gives grey), as
+/// `#rrggbb`: nine of its colours, linearly between them.
+pub fn viridis(t: Real) -> String {
+    const STOPS: [[u8; 3]; 9] = [
+        [0x44, 0x01, 0x54],
+        [0x47, 0x2c, 0x7a],
+        [0x3b, 0x51, 0x8b],
+        [0x2c, 0x71, 0x8e],
+        [0x21, 0x90, 0x8d],
+        [0x27, 0xad, 0x81],
+        [0x5c, 0xc8, 0x63],
+        [0xaa, 0xdc, 0x32],
+        [0xfd, 0xe7, 0x25],
+    ];
+    if t.is_nan() {
+        return "#999999".to_owned();
+    }
+    let s = t.clamp(0.0, 1.0) * (STOPS.len() - 1) as Real;
+    let i = (s.floor() as usize).min(STOPS.len() - 2);
+    let f = s - i as Real;
+    let c: Vec<u8> = (0..3)
+        .map(|k| {
+            let (a, b) = (Real::from(STOPS[i][k]), Real::from(STOPS[i + 1][k]));
+            (a + f * (b - a)).round() as u8
+        })
+        .collect();
+    format!("#{:02x}{:02x}{:02x}", c[0], c[1], c[2])
+}
+
+/// What a section picture shows.
+pub struct SectionInput<'a> {
+    /// Node positions of each granule, m.
+    pub granules: Vec<&'a [[Real; 3]]>,
+    /// The granules' hexes (one mesh for all), node indices.
+    pub hexes: &'a [[u32; 8]],
+    /// The granules' outer surface quads, node indices.
+    pub quads: &'a [[u32; 4]],
+    /// Axial stress −σ_zz of each hex, `[granule][hex]` flattened, Pa.
+    pub axial_stress_pa: &'a [Real],
+    /// Die radius, m.
+    pub die_radius_m: Real,
+    /// Height of the upper punch above the lower (z = 0), m.
+    pub upper_z_m: Real,
+    /// The bed's axial strain, for the title.
+    pub strain: Real,
+}
+
+/// The cut hexes of `input`: (polygon, axial stress).
+fn cut_hexes(input: &SectionInput<'_>) -> Vec<(Vec<[Real; 2]>, Real)> {
+    let per_granule = input.hexes.len();
+    let mut out = Vec::new();
+    for (g, x) in input.granules.iter().enumerate() {
+        for (h, hex) in input.hexes.iter().enumerate() {
+            let corner = |i: usize| x.get(hex[i] as usize).copied();
+            let Some(corners) = (0..8)
+                .map(corner)
+                .collect::<Option<Vec<_>>>()
+                .and_then(|c| <[[Real; 3]; 8]>::try_from(c).ok())
+            else {
+                continue;
+            };
+            if let Some(polygon) = cut_hex(&corners) {
+                let value = input
+                    .axial_stress_pa
+                    .get(g * per_granule + h)
+                    .copied()
+                    .unwrap_or(Real::NAN);
+                out.push((polygon, value));
+            }
+        }
+    }
+    out
+}
+
+/// The top of the colour scale, Pa: the 99th percentile of the finite
+/// positive stresses (so that one extreme element does not wash the
+/// picture out), at least 1 Pa.
+fn scale_top(values: impl Iterator<Item = Real>) -> Real {
+    let mut v: Vec<Real> = values.filter(|v| v.is_finite() && *v > 0.0).collect();
+    if v.is_empty() {
+        return 1.0;
+    }
+    v.sort_by(Real::total_cmp);
+    let i = ((v.len() - 1) as Real * 0.99).round() as usize;
+    v[i].max(1.0)
+}
+
+/// The SVG text of the section picture of `input`.
+pub fn section_svg(input: &SectionInput<'_>) -> String {
+    let [left, right, top, bottom] = MARGIN;
+    let r = input.die_radius_m.max(Real::MIN_POSITIVE);
+    let h = input.upper_z_m.max(0.05 * r);
+    let scale = (WIDTH - left - right) / (2.0 * r);
+    let height = (top + bottom + scale * h).ceil();
+    let px = |x: Real| left + scale * (x + r);
+    let pz = |z: Real| top + scale * (h - z);
+    let cuts = cut_hexes(input);
+    let vmax = scale_top(cuts.iter().map(|c| c.1));
+    let mut s = String::new();
+    let _ = writeln!(
+        s,
+        "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"{WIDTH}\" height=\"{height}\" \
+         viewBox=\"0 0 {WIDTH} {height}\" font-family=\"sans-serif\">\n\
+         <rect width=\"100%\" height=\"100%\" fill=\"white\"/>\n\
+         <text x=\"{:.1}\" y=\"26\" font-size=\"18\" text-anchor=\"middle\">Section through the die \
+         axis at C = {:.3}: axial stress −σzz</text>",
+        left + 0.5 * (WIDTH - left - right),
+        input.strain
+    );
+    // The hexes, then the granules' outlines over them.
+    for (polygon, value) in &cuts {
+        let colour = viridis(value / vmax);
+        let points: Vec<String> = polygon
+            .iter()
+            .map(|p| format!("{:.1},{:.1}", px(p[0]), pz(p[1])))
+            .collect();
+        let _ = writeln!(
+            s,
+            "<polygon points=\"{}\" fill=\"{colour}\" stroke=\"{colour}\" stroke-width=\"0.4\"/>",
+            points.join(" ")
+        );
+    }
+    let mut outline = String::new();
+    for x in &input.granules {
+        for quad in input.quads {
+            let corners = quad.map(|n| x.get(n as usize).copied().unwrap_or([Real::NAN; 3]));
+            if let Some([a, b]) = cut_quad(&corners) {
+                let _ = write!(
+                    outline,
+                    "M{:.1},{:.1}L{:.1},{:.1}",
+                    px(a[0]),
+                    pz(a[1]),
+                    px(b[0]),
+                    pz(b[1])
+                );
+            }
+        }
+    }
+    let _ = writeln!(
+        s,
+        "<path d=\"{outline}\" fill=\"none\" stroke=\"#222\" stroke-width=\"0.7\"/>"
+    );
+    // The die wall and the punches.
+    let _ = writeln!(
+        s,
+        "<g stroke=\"#555\" stroke-width=\"4\" fill=\"none\">\
+         <line x1=\"{0:.1}\" y1=\"{2:.1}\" x2=\"{0:.1}\" y2=\"{3:.1}\"/>\
+         <line x1=\"{1:.1}\" y1=\"{2:.1}\" x2=\"{1:.1}\" y2=\"{3:.1}\"/>\
+         <line x1=\"{0:.1}\" y1=\"{3:.1}\" x2=\"{1:.1}\" y2=\"{3:.1}\"/>\
+         <line x1=\"{0:.1}\" y1=\"{2:.1}\" x2=\"{1:.1}\" y2=\"{2:.1}\"/></g>",
+        px(-r) - 2.0,
+        px(r) + 2.0,
+        pz(h) - 2.0,
+        pz(0.0) + 2.0,
+    );
+    // A 1 mm scale bar under the die.
+    let bar = 1e-3 * scale;
+    let _ = writeln!(
+        s,
+        "<line x1=\"{left}\" y1=\"{0:.1}\" x2=\"{1:.1}\" y2=\"{0:.1}\" stroke=\"black\" stroke-width=\"2\"/>\
+         <text x=\"{2:.1}\" y=\"{3:.1}\" font-size=\"13\">1 mm</text>",
+        height - 18.0,
+        left + bar,
+        left + bar + 6.0,
+        height - 13.0
+    );
+    // The colour bar.
+    let (bx, by, bh) = (WIDTH - right + 30.0, top, (height - top - bottom).max(60.0));
+    let steps = 50;
+    for i in 0..steps {
+        let t = (i as Real + 0.5) / steps as Real;
+        let y = by + bh * (1.0 - (i + 1) as Real / steps as Real);
+        let _ = writeln!(
+            s,
+            "<rect x=\"{bx:.1}\" y=\"{y:.1}\" width=\"18\" height=\"{:.2}\" fill=\"{}\"/>",
+            bh / steps as Real + 0.5,
+            viridis(t)
+        );
+    }
+    for i in 0..=4 {
+        let f = i as Real / 4.0;
+        let y = by + bh * (1.0 - f);
+        let _ = writeln!(
+            s,
+            "<text x=\"{:.1}\" y=\"{:.1}\" font-size=\"13\">{}</text>",
+            bx + 24.0,
+            y + 4.0,
+            crate::numbers::significant(f * vmax * 1e-3, 3)
+        );
+    }
+    let _ = writeln!(
+        s,
+        "<text x=\"{bx:.1}\" y=\"{:.1}\" font-size=\"13\">−σzz, kPa</text>\n\
+         <text x=\"{:.1}\" y=\"{:.1}\" font-size=\"12\" text-anchor=\"end\">darkest: no \
+         compression; grey: no value; the scale ends at the 99th percentile</text>\n</svg>",
+        by - 16.0,
+        WIDTH - right,
+        height - 13.0
+    );
+    s
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::model::MeshLevel;
+
+    /// The cube [−1, 1]³ turned by `angle` about z, in hex8 order.
+    fn cube(angle: Real) -> [[Real; 3]; 8] {
+        let (c, s) = (angle.cos(), angle.sin());
+        let base = [[-1.0, -1.0], [1.0, -1.0], [1.0, 1.0], [-1.0, 1.0]];
+        let mut out = [[0.0; 3]; 8];
+        for (i, z) in [-1.0, 1.0].into_iter().enumerate() {
+            for (j, [x, y]) in base.into_iter().enumerate() {
+                out[4 * i + j] = [c * x - s * y, s * x + c * y, z];
+            }
+        }
+        out
+    }
+
+    #[test]
+    fn a_cube_cut_through_its_middle() {
+        let square = cut_hex(&cube(0.0)).unwrap();
+        assert_eq!(square.len(), 4);
+        assert!((polygon_area(&square) - 4.0).abs() < 1e-12);
+        // Turned by 45°, the plane cuts it along a diagonal: 2√2 by 2.
+        let diagonal = cut_hex(&cube(core::f64::consts::FRAC_PI_4)).unwrap();
+        assert!((polygon_area(&diagonal) - 4.0 * 2f64.sqrt()).abs() < 1e-12);
+        // Turned by 30°: width 2/cos 30° (the plane crosses two faces).
+        let turned = cut_hex(&cube(core::f64::consts::FRAC_PI_6)).unwrap();
+        let width = 2.0 / (core::f64::consts::FRAC_PI_6).cos();
+        assert!((polygon_area(&turned) - 2.0 * width).abs() < 1e-12);
+        // Moved off the plane: no cut.
+        let mut off = cube(0.3);
+        for p in &mut off {
+            p[1] += 3.0;
+        }
+        assert!(cut_hex(&off).is_none());
+        let face = [
+            [0.0, -1.0, 0.0],
+            [1.0, 1.0, 0.0],
+            [1.0, 1.0, 1.0],
+            [0.0, -1.0, 1.0],
+        ];
+        let [a, b] = cut_quad(&face).unwrap();
+        assert_eq!([a, b], [[0.5, 0.0], [0.5, 1.0]]);
+        // Two cubes sharing the face y = 0: only the one below is cut.
+        let mut below = cube(0.0);
+        let mut above = cube(0.0);
+        for (p, q) in below.iter_mut().zip(&mut above) {
+            p[1] -= 1.0;
+            q[1] += 1.0;
+        }
+        assert!((polygon_area(&cut_hex(&below).unwrap()) - 4.0).abs() < 1e-12);
+        assert!(cut_hex(&above).is_none());
+    }
+
+    /// The standard granule cut through its centre: the hexes' polygons
+    /// tile the faceted great circle, whose area lies within the
+    /// faceting's few per cent below πR² (0.983 of the sphere's volume
+    /// on 8x2, README), and its outline is as long as about 2πR.
+    #[test]
+    fn a_granule_cut_through_its_centre_tiles_its_great_circle() {
+        let r = 0.5e-3;
+        let mesh = crate::model::OwnedReference::sphere(r, MeshLevel::new(8, 2), false).unwrap();
+        let values = vec![1.0e3; mesh.hexes.len()];
+        let input = SectionInput {
+            granules: vec![&mesh.positions],
+            hexes: &mesh.hexes,
+            quads: &mesh.quads,
+            axial_stress_pa: &values,
+            die_radius_m: 1e-3,
+            upper_z_m: 1e-3,
+            strain: 0.0,
+        };
+        let cuts = cut_hexes(&input);
+        let area: Real = cuts.iter().map(|c| polygon_area(&c.0)).sum();
+        let circle = core::f64::consts::PI * r * r;
+        assert!(
+            area < circle && area > 0.97 * circle,
+            "cut area {area:e} against πR² {circle:e}"
+        );
+        let outline: Real = mesh
+            .quads
+            .iter()
+            .filter_map(|q| cut_quad(&q.map(|n| mesh.positions[n as usize])))
+            .map(|[a, b]| ((a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2)).sqrt())
+            .sum();
+        let circumference = 2.0 * core::f64::consts::PI * r;
+        assert!(
+            (outline / circumference - 1.0).abs() < 0.02,
+            "outline {outline:e} against 2πR {circumference:e}"
+        );
+        let svg = section_svg(&input);
+        assert!(svg.starts_with("<svg") && svg.trim_end().ends_with("</svg>"));
+        assert_eq!(svg.matches("<polygon").count(), cuts.len());
+    }
+
+    #[test]
+    fn colours_and_scale() {
+        assert_eq!(viridis(0.0), "#440154");
+        assert_eq!(viridis(1.0), "#fde725");
+        assert_eq!(viridis(7.0), "#fde725");
+        assert_eq!(viridis(-1.0), "#440154");
+        assert_eq!(viridis(Real::NAN), "#999999");
+        // One extreme element does not set the scale.
+        let mut v: Vec<Real> = (1..=1000).map(Real::from).collect();
+        v.push(1e9);
+        assert_eq!(scale_top(v.into_iter()), 991.0);
+        assert_eq!(scale_top([Real::NAN, -3.0].into_iter()), 1.0);
+    }
+}
