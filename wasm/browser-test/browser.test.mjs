@@ -1,8 +1,8 @@
 // The page in Debian's headless chromium: run B2, compare the shown σ_est
 // with granbed-cli's, download the CSV (the CLI's bytes, named by the inputs
 // that ran), cancel a run (the inputs locked while it goes), provoke bad
-// inputs (ν = 0.6, a decimal comma), and lay the page out at a phone's
-// width. Screenshots go to out/.
+// inputs (ν = 0.6, a decimal comma, two at once, 1e400), mark results
+// stale when the inputs change, and lay the page out at a phone's width. Screenshots go to out/.
 import { test, before, after } from 'node:test';
 import assert from 'node:assert/strict';
 import { mkdirSync, readFileSync } from 'node:fs';
@@ -53,9 +53,14 @@ test('B2: the shown sigma_est is the native one; the CSV is the CLI\'s', async (
   // The quasi-static row is the CLI summary's certificate (same masses).
   assert.equal(ref.summary.mass_scaling, 1);
   assert.equal(await page.getAttribute('#quasi-static', 'data-value'), String(ref.summary.quasi_static.passed));
-  assert.match(
+  const percent = +(100 * ref.summary.quasi_static.max_kinetic_to_internal).toPrecision(2);
+  assert.equal(
     await page.textContent('#quasi-static'),
-    new RegExp(`^yes: kinetic/internal work ≤ ${ref.summary.quasi_static.max_kinetic_to_internal.toExponential(1).replace('+', '\\+')} \\(limit 1 %\\), masses ×1$`),
+    `yes: kinetic energy at most ${percent} % of the internal work (limit 1 %)`,
+  );
+  assert.equal(
+    Number(await page.getAttribute('#ratio', 'data-value')),
+    ref.summary.sigma_est_pa / ref.summary.sigma_eff0_pa,
   );
   const wall = Number(await page.getAttribute('#wall', 'data-value'));
   console.log(
@@ -83,6 +88,8 @@ test('Cancel stops a run and the page can run again', async () => {
   await page.waitForSelector('#results[data-state="cancelled"]');
   await page.waitForSelector('#run:not([disabled])', { timeout: 60_000 });
   assert.equal(await page.textContent('#sigma-est'), '–');
+  // The status keeps saying that the run was cancelled, and where.
+  assert.match(await page.textContent('#status'), /^cancelled at strain \d+\.\d % \(the curve so far is shown\); ready$/);
   assert.deepEqual(problems, []);
 });
 
@@ -123,6 +130,64 @@ test('a run without the fit window says why sigma_est is missing', async () => {
   await page.waitForSelector('#results[data-state="done"], #results[data-state="failed"]', { timeout: 60_000 });
   assert.match(await page.textContent('#sigma-est'), /^n\/a \(no two samples in the 10–40 % window: the run ended at strain \d/);
   await page.uncheck('#custom');
+  assert.deepEqual(problems, []);
+});
+
+test('results are marked once the inputs change, and cleared when inputs are refused', async () => {
+  await page.uncheck('#custom');
+  await page.selectOption('#type', 'B2');
+  await page.selectOption('#mesh', '4x1');
+  await page.click('#run');
+  await page.waitForSelector('#results[data-state="done"]', { timeout: 120_000 });
+  assert.equal(await page.isHidden('#stale'), true);
+  // Another type: its values fill the fields, and B2's results are marked.
+  await page.selectOption('#type', 'C1');
+  await page.waitForFunction(() => document.getElementById('yield_stress_pa').value === '100000');
+  assert.equal(await page.inputValue('#eta0'), '0.6');
+  assert.equal(await page.isVisible('#stale'), true);
+  assert.equal(await page.getAttribute('#results', 'data-stale'), 'true');
+  assert.match(await page.textContent('#run-inputs'), /^B2, mesh 4x1/);
+  // With "custom" on, a type chosen still sets the fields to its values.
+  await page.check('#custom');
+  await page.selectOption('#type', 'B1');
+  await page.waitForFunction(() => document.getElementById('yield_stress_pa').value === '30000');
+  assert.equal(await page.inputValue('#eta0'), '0.6');
+  // Two fields unreadable: both named and marked; the old results go.
+  await page.fill('#youngs_modulus_pa', '1 MPa');
+  await page.fill('#poisson_ratio', '0,3');
+  await page.click('#run');
+  await page.waitForSelector('#results[data-state="rejected"]');
+  const text = await page.textContent('#error');
+  assert.match(text, /^E: “1 MPa” is not a number/);
+  assert.match(text, /\nν: “0,3” has a decimal comma/);
+  for (const id of ['#youngs_modulus_pa', '#poisson_ratio']) {
+    assert.equal(await page.getAttribute(id, 'aria-invalid'), 'true', id);
+    const border = await page.$eval(id, (e) => getComputedStyle(e).borderTopColor);
+    assert.equal(border, 'rgb(221, 51, 51)', `${id} not marked`);
+  }
+  assert.equal(await page.textContent('#sigma-est'), '–');
+  assert.equal(await page.isHidden('#download'), true);
+  assert.equal(await page.getAttribute('#plot', 'aria-label'), 'platen force against displacement (no run yet)');
+  // A number beyond a double is refused, not read as infinity...
+  await page.fill('#youngs_modulus_pa', '1e6');
+  await page.fill('#poisson_ratio', '0.3');
+  await page.fill('#yield_stress_pa', '1e400');
+  await page.click('#run');
+  await page.waitForSelector('#results[data-state="rejected"]');
+  assert.match(await page.textContent('#error'), /^σy: “1e400” is too large for a number/);
+  // ... while inf, as the kernel's range allows for σy, runs elastic.
+  await page.fill('#yield_stress_pa', 'inf');
+  await page.click('#run');
+  await page.waitForSelector('#results[data-state="done"]', { timeout: 120_000 });
+  assert.match(await page.textContent('#run-inputs'), /^custom \(from B1\), mesh 4x1: σy = Infinity Pa/);
+  assert.equal(await page.textContent('#sigma-eff0'), 'n/a');
+  const [download] = await Promise.all([page.waitForEvent('download'), page.click('#download')]);
+  assert.match(download.suggestedFilename(), /^granule_custom-[0-9a-f]{8}_4x1_force_displacement\.csv$/);
+  await page.screenshot({ path: join(OUT, 'custom.png'), fullPage: true });
+  await page.fill('#yield_stress_pa', '30000');
+  await page.uncheck('#custom');
+  await page.selectOption('#type', 'B2');
+  await page.selectOption('#mesh', '8x2');
   assert.deepEqual(problems, []);
 });
 

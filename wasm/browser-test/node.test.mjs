@@ -88,8 +88,14 @@ test('typed numbers: a decimal point is read, a comma or junk refused', () => {
     assert.equal(parseDecimal(text, 'x', 'f'), v, text);
   }
   assert.throws(() => parseDecimal('0,3', 'μ', 'friction'), (e) => e.field === 'friction' && /decimal comma: write 0\.3/.test(e.message));
-  for (const bad of ['', '1.5.2', '0x10', 'Infinity', '1,000.5', 'abc', '1e']) {
+  for (const bad of ['', '1.5.2', '0x10', 'Infinity', '1,000.5', 'abc', '1e', '-inf']) {
     assert.throws(() => parseDecimal(bad, 'x', 'f'), /“.*” (is empty|is not a number)/, bad);
+  }
+  // inf as typed (the kernel judges the field: σy takes it); a number too
+  // large for a double is refused, not read as infinity.
+  for (const inf of ['inf', '+inf', ' INF ']) assert.equal(parseDecimal(inf, 'x', 'f'), Infinity, inf);
+  for (const huge of ['1e400', '-1e309']) {
+    assert.throws(() => parseDecimal(huge, 'σy', 'yield_stress_pa'), (e) => e.field === 'yield_stress_pa' && /too large for a number .* write inf/.test(e.message), huge);
   }
 });
 

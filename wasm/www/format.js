@@ -13,19 +13,30 @@ export function formatSlope(nPerM) {
 }
 
 // A decimal number as typed: digits with a decimal point and an optional
-// exponent (0.3, .5, 3e4, -1E-2). Anything else is refused, a decimal comma
-// with its own message, never read as another number.
+// exponent (0.3, .5, 3e4, -1E-2), or inf (the kernel judges whether the
+// field takes it: σy does, for a purely elastic granule). Anything else is
+// refused, a decimal comma with its own message, never read as another
+// number; so is a number too large for a double (1e400), which would
+// otherwise be read as infinity without a word.
 const DECIMAL = /^[+-]?(\d+\.?\d*|\.\d+)([eE][+-]?\d+)?$/;
+const INFINITY = /^\+?inf$/i;
 
 export function parseDecimal(text, label, field) {
   const t = text.trim();
-  if (DECIMAL.test(t)) return Number(t);
-  const why = t === ''
-    ? 'is empty'
-    : /^[+-]?\d*,\d+$/.test(t)
-      ? `has a decimal comma: write ${t.replace(',', '.')} (with a point)`
-      : 'is not a number such as 0.3 or 3e4';
-  throw Object.assign(new Error(`${label}: “${t}” ${why} (field \`${field}\`)`), { field });
+  if (INFINITY.test(t)) return Infinity;
+  let why;
+  if (DECIMAL.test(t)) {
+    const v = Number(t);
+    if (Number.isFinite(v)) return v;
+    why = 'is too large for a number (the largest is about 1.8e308; write inf for infinity)';
+  } else {
+    why = t === ''
+      ? 'is empty'
+      : /^[+-]?\d*,\d+$/.test(t)
+        ? `has a decimal comma: write ${t.replace(',', '.')} (with a point)`
+        : 'is not a number such as 0.3 or 3e4';
+  }
+  throw Object.assign(new Error(`${label}: “${t}” ${why}`), { field });
 }
 
 // A tick label that fits the margin: plain digits for 0.001 ≤ |v| < 1e5,

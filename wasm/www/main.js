@@ -13,24 +13,43 @@ let worker = null;
 let running = false;
 let view = null; // { quads, positions, diameter, x, f, fit }
 let csvUrl = null;
+// The status line's note on the last cancelled run (kept when the new
+// worker says it is ready), and the strain the run had reached.
+let cancelNote = null;
+let lastStrain = 0;
 // The run in progress or last run: its type (or "custom"), mesh, the
 // parameters it used (from the worker) and its start time.
 let current = null;
 
 function setStatus(text) { $('status').textContent = text; }
 
-function showError(message, field) {
+// The error box shows `message`; the inputs named by `fields` (one field
+// or a list; the kernel's `diameter_m` is the page's `diameter_mm`) are
+// marked invalid, described by the box, and the first one is focused.
+function showError(message, fields) {
   const box = $('error');
   box.textContent = message;
   box.hidden = false;
-  for (const input of document.querySelectorAll('#params input')) input.removeAttribute('aria-invalid');
-  const id = field === 'diameter_m' ? 'diameter_mm' : field;
-  if (id && $(id)) $(id).setAttribute('aria-invalid', 'true');
+  for (const input of document.querySelectorAll('#params input')) {
+    input.removeAttribute('aria-invalid');
+    input.removeAttribute('aria-describedby');
+  }
+  const ids = [].concat(fields ?? []).map((f) => (f === 'diameter_m' ? 'diameter_mm' : f)).filter((id) => $(id));
+  for (const id of ids) {
+    $(id).setAttribute('aria-invalid', 'true');
+    $(id).setAttribute('aria-describedby', 'error');
+  }
+  if (ids.length && !$(ids[0]).disabled) $(ids[0]).focus();
 }
 
-// Refused before or at the start of a run: nothing runs.
-function refuse(message, field) {
-  showError(message, field);
+// Refused before or at the start of a run: nothing runs, and nothing of an
+// earlier run is left on the page to be read as this one's.
+function refuse(message, fields) {
+  resetResults();
+  view = null;
+  drawAll();
+  $('plot').setAttribute('aria-label', 'platen force against displacement (no run yet)');
+  showError(message, fields);
   $('run-inputs').textContent = '–';
   $('results').dataset.state = 'rejected';
 }
@@ -38,7 +57,24 @@ function refuse(message, field) {
 function clearError() {
   $('error').hidden = true;
   $('error').textContent = '';
-  for (const input of document.querySelectorAll('#params input')) input.removeAttribute('aria-invalid');
+  for (const input of document.querySelectorAll('#params input')) {
+    input.removeAttribute('aria-invalid');
+    input.removeAttribute('aria-describedby');
+  }
+}
+
+// After a run, any change of the inputs marks its results as those of the
+// inputs shown under "inputs of this run", not of the form as it now is.
+function markStale() {
+  const state = $('results').dataset.state;
+  if (running || !['done', 'failed', 'cancelled'].includes(state)) return;
+  $('results').dataset.stale = 'true';
+  $('stale').hidden = false;
+}
+
+function clearStale() {
+  delete $('results').dataset.stale;
+  $('stale').hidden = true;
 }
 
 // While a run goes, its inputs are locked: the results, the picture and
@@ -65,11 +101,14 @@ function onWorker(msg) {
   switch (msg.kind) {
     case 'ready':
       $('run').disabled = running;
-      setStatus('ready');
-      requestPreset();
+      setStatus(cancelNote ? `${cancelNote}; ready` : 'ready');
+      if (!$('custom').checked) requestPreset();
       break;
     case 'preset':
-      if (!$('custom').checked) fillParams(msg.values);
+      // A type chosen while "custom" is on sets the fields to that type's
+      // values too: the fields always start from the type shown.
+      if (!$('custom').checked || msg.chosen) fillParams(msg.values);
+      if (msg.chosen && $('custom').checked) setStatus(`parameters set to ${msg.type}'s values; edit them and Run`);
       break;
     case 'error':
       setRunning(false);
@@ -83,6 +122,7 @@ function onWorker(msg) {
       drawAll();
       break;
     case 'progress':
+      lastStrain = msg.strain;
       $('progress').value = msg.progress;
       setStatus(`strain ${(100 * msg.strain).toFixed(1)} %, ${msg.steps} steps${timeLeft(msg.progress)}`);
       Object.assign(view, { positions: msg.positions, x: msg.x, f: msg.f });
@@ -101,16 +141,30 @@ function fillParams(values) {
   $('diameter_mm').value = values.diameter_m * 1e3;
 }
 
-function requestPreset() {
-  worker.postMessage({ cmd: 'preset', type: $('type').value });
+// Asks the worker for the type's parameters; `chosen`: the user picked
+// the type (the fields follow it even with "custom" on).
+function requestPreset(chosen = false) {
+  worker.postMessage({ cmd: 'preset', type: $('type').value, chosen });
 }
 
 // The inputs object of granbed-wasm's Granule: the type and mesh, and with
-// "custom" every parameter field (the diameter in mm, as typed).
+// "custom" every parameter field (the diameter in mm, as typed). Every
+// field that cannot be read is named at once (an Error with `field` the
+// list of them); the ranges are the kernel's to check.
 function readInputs() {
   const inputs = { type: $('type').value, mesh: $('mesh').value };
   if (!$('custom').checked) return inputs;
-  for (const k of [...FIELDS, 'diameter_mm']) inputs[k] = parseDecimal($(k).value, LABELS[k], k);
+  const errors = [];
+  for (const k of [...FIELDS, 'diameter_mm']) {
+    try {
+      inputs[k] = parseDecimal($(k).value, LABELS[k], k);
+    } catch (e) {
+      errors.push(e);
+    }
+  }
+  if (errors.length) {
+    throw Object.assign(new Error(errors.map((e) => e.message).join('\n')), { field: errors.map((e) => e.field) });
+  }
   return inputs;
 }
 
@@ -134,8 +188,17 @@ function timeLeft(progress) {
   return `, about ${(left / 3600).toFixed(1)} h left`;
 }
 
+// A short tag of a run's inputs for the download's name, so that two
+// custom runs do not download under one name: FNV-1a of `text`, 8 hex
+// digits.
+function tag(text) {
+  let h = 0x811c9dc5;
+  for (const c of new TextEncoder().encode(text)) h = Math.imul(h ^ c, 0x01000193) >>> 0;
+  return h.toString(16).padStart(8, '0');
+}
+
 function resetResults() {
-  for (const id of ['sigma-est', 'sigma-eff0', 'slope', 'r2', 'steps', 'quasi-static', 'wall', 'run-inputs']) {
+  for (const id of ['sigma-est', 'sigma-eff0', 'ratio', 'slope', 'r2', 'steps', 'quasi-static', 'wall', 'run-inputs']) {
     $(id).textContent = '–';
     delete $(id).dataset.value;
   }
@@ -157,6 +220,9 @@ function run(ev) {
     return;
   }
   resetResults();
+  clearStale();
+  cancelNote = null;
+  lastStrain = 0;
   current = {
     type: inputs.type, mesh: inputs.mesh, custom: $('custom').checked, params: null, t0: performance.now(),
   };
@@ -190,6 +256,8 @@ function finish(msg) {
     : msg.strain < 0.4 ? ` (fitted over 10 % to ${reached} only: the run ended there)` : '';
   set('sigma-est', formatStress(msg.sigmaEst) + sigmaNote, msg.sigmaEst);
   set('sigma-eff0', formatStress(msg.sigmaEff0), msg.sigmaEff0);
+  const ratio = msg.sigmaEst !== null && Number.isFinite(msg.sigmaEff0) && msg.sigmaEff0 > 0 ? msg.sigmaEst / msg.sigmaEff0 : null;
+  set('ratio', ratio === null ? 'n/a' : ratio.toFixed(3), ratio);
   set('slope', formatSlope(msg.slope), msg.slope);
   set('r2', msg.r2 === null ? 'n/a' : msg.r2.toFixed(5), msg.r2);
   set('steps', String(msg.steps), msg.steps);
@@ -198,18 +266,22 @@ function finish(msg) {
       ? 'n/a: the run stopped early'
       : msg.kineticToInternal === null
       ? 'n/a'
-      : `${msg.quasiStatic ? 'yes' : 'NO'}: kinetic/internal work ≤ ${msg.kineticToInternal.toExponential(1)} (limit ${100 * msg.kineticLimit} %), masses ×${msg.massScaling}`,
+      : `${msg.quasiStatic ? 'yes' : 'NO'}: kinetic energy at most ${percent(msg.kineticToInternal)} of the internal work ` +
+        `(limit ${100 * msg.kineticLimit} %)${msg.massScaling === 1 ? '' : `, masses ×${msg.massScaling}`}`,
     msg.quasiStatic);
   set('wall', `${(msg.wallMs / 1e3).toFixed(2)} s`, msg.wallMs / 1e3);
   csvUrl = URL.createObjectURL(new Blob([msg.csv], { type: 'text/csv' }));
   const a = $('download');
   a.href = csvUrl;
-  a.download = `granule_${current.custom ? 'custom' : current.type}_${current.mesh}_force_displacement.csv`;
+  const name = current.custom ? `custom-${tag(describeRun(current))}` : current.type;
+  a.download = `granule_${name}_${current.mesh}_force_displacement.csv`;
+  a.textContent = `Download CSV (${a.download})`;
   a.hidden = false;
   $('progress').value = msg.failure ? $('progress').value : 1;
   if (msg.failure) {
     setStatus('stopped by an error');
-    showError(`${msg.failure.message}\nThe curve up to that point is shown and in the CSV.`, msg.failure.field);
+    showError(`${msg.failure.message}\n${advice(msg.failure.message)}The curve up to that point is shown and in the CSV; ` +
+      'the picture shows the granule at the last step that succeeded.', msg.failure.field);
     $('results').dataset.state = 'failed';
   } else {
     setStatus(`done: strain ${(100 * msg.strain).toFixed(1)} % in ${(msg.wallMs / 1e3).toFixed(2)} s`);
@@ -217,12 +289,30 @@ function finish(msg) {
   }
 }
 
+// What a student can do about a run that stopped: the kernel's message
+// names what broke; this says what to change.
+function advice(message) {
+  if (/inverted element|det F/.test(message)) {
+    return 'An element turned inside out: the granule is too soft for the platen speed (a larger E or σy), ' +
+      'or the coarse mesh is too coarse for this deformation. ';
+  }
+  if (/converge/.test(message)) return 'The plastic return did not converge: check that σy, cp and ηc are in their usual ranges. ';
+  return '';
+}
+
+// "0.00057 %" for a ratio.
+function percent(ratio) {
+  return `${+(100 * ratio).toPrecision(2)} %`;
+}
+
 function cancel() {
   if (!running) return;
   worker.terminate();
   setRunning(false);
   $('run').disabled = true;
-  setStatus('cancelled; restarting the worker…');
+  cancelNote = `cancelled at strain ${(100 * lastStrain).toFixed(1)} % (the curve so far is shown)`;
+  setStatus(`${cancelNote}; restarting…`);
+  $('progress').value = 0;
   $('results').dataset.state = 'cancelled';
   startWorker();
 }
@@ -351,11 +441,18 @@ function drawAll() { drawPlot(); drawGranule(); }
 
 $('inputs').addEventListener('submit', run);
 $('cancel').addEventListener('click', cancel);
-$('type').addEventListener('change', () => { if (!$('custom').checked) requestPreset(); });
+$('type').addEventListener('change', () => requestPreset(true));
 $('custom').addEventListener('change', () => {
   $('params').disabled = !$('custom').checked;
-  if (!$('custom').checked) requestPreset();
+  if (!$('custom').checked) {
+    clearError();
+    requestPreset();
+  }
 });
+// Typing in a field or choosing another type, mesh or "custom" after a
+// run marks its results as no longer those of the form.
+$('inputs').addEventListener('input', markStale);
+$('inputs').addEventListener('change', markStale);
 // Drag on the picture (or use the arrow keys on it) to turn the granule.
 {
   const c = $('granule');

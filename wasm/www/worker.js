@@ -42,15 +42,19 @@ function run(inputs) {
     params,
   });
   let failure = null;
+  // The positions after the last chunk that succeeded: after a failure the
+  // granule's own are not a state to show.
+  let positions = g.positions();
   try {
     while (!g.finished()) {
       const progress = g.step(CHUNK);
+      positions = g.positions();
       postMessage({
         kind: 'progress',
         progress,
         strain: g.strain(),
         steps: g.steps(),
-        positions: g.positions(),
+        positions,
         ...curve(g),
       });
     }
@@ -73,7 +77,7 @@ function run(inputs) {
     steps: g.steps(),
     strain: g.strain(),
     diameter: g.diameter_m(),
-    positions: g.positions(),
+    positions,
     csv: g.csv(),
     failure,
     ...curve(g),
@@ -93,7 +97,7 @@ onmessage = async (ev) => {
     postMessage({ kind: 'ready' });
   } else if (msg.cmd === 'preset') {
     try {
-      postMessage({ kind: 'preset', type: msg.type, values: preset(msg.type) });
+      postMessage({ kind: 'preset', type: msg.type, chosen: msg.chosen === true, values: preset(msg.type) });
     } catch (e) {
       postMessage({ kind: 'error', ...errorMessage(e) });
     }
