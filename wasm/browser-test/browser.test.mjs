@@ -49,6 +49,10 @@ test('B2: the shown sigma_est is the native one; the CSV is the CLI\'s', async (
   assert.equal(shown, formatStress(ref.summary.sigma_est_pa));
   assert.equal(value, ref.summary.sigma_est_pa);
   assert.equal(await page.textContent('#sigma-eff0'), formatStress(ref.summary.sigma_eff0_pa));
+  // The result in the status line too (the table may be below the fold),
+  // and the version the page runs.
+  assert.match(await page.textContent('#status'), new RegExp(`^done: strain 40\\.0 % in .* s; σ_est = ${shown}$`));
+  assert.match(await page.textContent('#version'), /^granbed \d+\.\d+\.\d+/);
   assert.equal(await page.textContent('#slope'), formatSlope(ref.summary.slope_n_per_m));
   // The quasi-static row is the CLI summary's certificate (same masses).
   assert.equal(ref.summary.mass_scaling, 1);
@@ -197,6 +201,20 @@ test('the page fits a phone: nothing wider than its 375 px', async () => {
   assert.ok(width <= 375, `the page is ${width} px wide`);
   const plot = await page.evaluate(() => document.getElementById('plot').getBoundingClientRect().width);
   assert.ok(plot <= 375, `the plot is ${plot} px wide`);
+  // Drawn at the width it is shown (one device pixel per CSS pixel here),
+  // not a 560 px drawing scaled down with its labels.
+  // (The page redraws on its resize event, which follows the new size.)
+  const drawn = await page
+    .waitForFunction(() => {
+      const c = document.getElementById('plot');
+      return c.clientWidth < 560 && c.width === c.clientWidth;
+    }, null, { timeout: 5_000 })
+    .then(() => true, () => false);
+  const [backing, shownWidth] = await page.evaluate(() => {
+    const c = document.getElementById('plot');
+    return [c.width, c.clientWidth];
+  });
+  assert.ok(drawn, `canvas ${backing} px for ${shownWidth} px shown`);
   await page.screenshot({ path: join(OUT, 'phone.png'), fullPage: true });
   await page.setViewportSize({ width: 1000, height: 1100 });
 });

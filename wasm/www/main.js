@@ -102,6 +102,7 @@ function onWorker(msg) {
     case 'ready':
       $('run').disabled = running;
       setStatus(cancelNote ? `${cancelNote}; ready` : 'ready');
+      $('version').textContent = `granbed ${msg.version}`;
       if (!$('custom').checked) requestPreset();
       break;
     case 'preset':
@@ -284,7 +285,9 @@ function finish(msg) {
       'the picture shows the granule at the last step that succeeded.', msg.failure.field);
     $('results').dataset.state = 'failed';
   } else {
-    setStatus(`done: strain ${(100 * msg.strain).toFixed(1)} % in ${(msg.wallMs / 1e3).toFixed(2)} s`);
+    // The result in the status line too: the table may be below the fold.
+    setStatus(`done: strain ${(100 * msg.strain).toFixed(1)} % in ${(msg.wallMs / 1e3).toFixed(2)} s; ` +
+      `σ_est = ${formatStress(msg.sigmaEst)}`);
     $('results').dataset.state = 'done';
   }
 }
@@ -326,10 +329,29 @@ function niceStep(range, count) {
   return (m < 1.5 ? 1 : m < 3 ? 2 : m < 7 ? 5 : 10) * p;
 }
 
+// A canvas's 2D context drawn in CSS pixels at the width the page gives it
+// (its aspect ratio kept), with a backing store of device pixels: on a
+// phone the labels stay 12 px and sharp instead of scaled down. Returns
+// [context, width, height] in CSS pixels.
+function sized(c) {
+  const aspect = Number(c.dataset.aspect ?? (c.dataset.aspect = String(c.height / c.width)));
+  const W = Math.max(1, Math.round(c.clientWidth || c.width));
+  const H = Math.round(W * aspect);
+  const dpr = window.devicePixelRatio || 1;
+  const w = Math.round(W * dpr), h = Math.round(H * dpr);
+  if (c.width !== w || c.height !== h) {
+    c.width = w;
+    c.height = h;
+  }
+  const g = c.getContext('2d');
+  g.setTransform(dpr, 0, 0, dpr, 0, 0);
+  return [g, W, H];
+}
+
 function drawPlot() {
   const c = $('plot');
-  const g = c.getContext('2d');
-  const W = c.width, H = c.height, L = 64, R = 16, T = 16, B = 44;
+  const [g, W, H] = sized(c);
+  const L = 64, R = 16, T = 16, B = 44;
   g.clearRect(0, 0, W, H);
   const x = view ? Array.from(view.x, (v) => v * 1e3) : [];
   const f = view ? Array.from(view.f) : [];
@@ -378,8 +400,7 @@ const viewAngles = { phi: 0.5, theta: 0.35 };
 // angles; painter's order, back faces culled, Lambert shading.
 function drawGranule() {
   const c = $('granule');
-  const g = c.getContext('2d');
-  const W = c.width, H = c.height;
+  const [g, W, H] = sized(c);
   g.clearRect(0, 0, W, H);
   if (!view) return;
   const p = view.positions, q = view.quads, d = view.diameter;
@@ -423,7 +444,10 @@ function drawGranule() {
     corners.forEach((v, i) => (i ? g.lineTo(sx(v), sy(v)) : g.moveTo(sx(v), sy(v))));
     g.closePath(); g.fill(); g.stroke();
   };
-  plate(-top);
+  // Painter's order for the platens too: the one farther from the eye
+  // first (the lower one when seen from above, theta > 0).
+  const [far, near] = theta >= 0 ? [-top, top] : [top, -top];
+  plate(far);
   for (const face of faces) {
     const s = Math.round(90 + 150 * face.shade);
     g.fillStyle = `rgb(${Math.round(s * 0.75)},${Math.round(s * 0.85)},${s})`;
@@ -432,7 +456,7 @@ function drawGranule() {
     face.v.forEach((v, i) => (i ? g.lineTo(sx(v), sy(v)) : g.moveTo(sx(v), sy(v))));
     g.closePath(); g.fill(); g.stroke();
   }
-  plate(top);
+  plate(near);
 }
 
 function drawAll() { drawPlot(); drawGranule(); }
@@ -476,5 +500,6 @@ $('inputs').addEventListener('change', markStale);
     drawGranule();
   });
 }
+window.addEventListener('resize', drawAll);
 drawAll();
 startWorker();
