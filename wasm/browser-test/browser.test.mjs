@@ -171,7 +171,8 @@ test('results are marked once the inputs change, and cleared when inputs are ref
   }
   assert.equal(await page.textContent('#sigma-est'), '–');
   assert.equal(await page.isHidden('#download'), true);
-  assert.equal(await page.getAttribute('#plot', 'aria-label'), 'platen force against displacement (no run yet)');
+  // The earlier runs' curves stay, named (B2 8x2 twice, B2 4x1 once).
+  assert.match(await page.getAttribute('#plot', 'aria-label'), /^platen force against displacement of \d earlier run\(s\): .*B2 4x1$/);
   // A number beyond a double is refused, not read as infinity...
   await page.fill('#youngs_modulus_pa', '1e6');
   await page.fill('#poisson_ratio', '0.3');
@@ -190,6 +191,26 @@ test('results are marked once the inputs change, and cleared when inputs are ref
   await page.screenshot({ path: join(OUT, 'custom.png'), fullPage: true });
   await page.fill('#yield_stress_pa', '30000');
   await page.uncheck('#custom');
+  await page.selectOption('#type', 'B2');
+  await page.selectOption('#mesh', '8x2');
+  assert.deepEqual(problems, []);
+});
+
+test('finished runs stay drawn to compare with, until cleared', async () => {
+  await page.selectOption('#mesh', '4x1');
+  for (const type of ['A2', 'C2']) {
+    await page.selectOption('#type', type);
+    await page.waitForFunction((t) => document.getElementById('yield_stress_pa').value === (t === 'A2' ? '10000' : '100000'), type);
+    await page.click('#run');
+    await page.waitForSelector('#results[data-state="done"]', { timeout: 120_000 });
+  }
+  const curves = Number(await page.getAttribute('#plot', 'data-curves'));
+  assert.ok(curves >= 2, `${curves} curves drawn`);
+  assert.equal(await page.isVisible('#clear-history'), true);
+  await page.screenshot({ path: join(OUT, 'compare.png') });
+  await page.click('#clear-history');
+  assert.equal(await page.getAttribute('#plot', 'data-curves'), '1');
+  assert.equal(await page.isHidden('#clear-history'), true);
   await page.selectOption('#type', 'B2');
   await page.selectOption('#mesh', '8x2');
   assert.deepEqual(problems, []);

@@ -13,6 +13,13 @@ let worker = null;
 let running = false;
 let view = null; // { quads, positions, diameter, x, f, fit }
 let csvUrl = null;
+// Finished runs' curves, kept to compare the next runs with (oldest
+// first, at most HISTORY_MAX): { id, label, x (mm), f (N) }. The run shown
+// (view.historyId) is drawn in blue, the others behind it in their colours.
+const HISTORY_MAX = 5;
+const HISTORY_COLOURS = ['#e08a2c', '#3a9d3a', '#9467bd', '#8c564b', '#e377c2'];
+let history = [];
+let runCount = 0;
 // The status line's note on the last cancelled run (kept when the new
 // worker says it is ready), and the strain the run had reached.
 let cancelNote = null;
@@ -48,7 +55,9 @@ function refuse(message, fields) {
   resetResults();
   view = null;
   drawAll();
-  $('plot').setAttribute('aria-label', 'platen force against displacement (no run yet)');
+  $('plot').setAttribute('aria-label', history.length
+    ? `platen force against displacement of ${history.length} earlier run(s): ${history.map((h) => h.label).join(', ')}`
+    : 'platen force against displacement (no run yet)');
   showError(message, fields);
   $('run-inputs').textContent = '–';
   $('results').dataset.state = 'rejected';
@@ -279,6 +288,15 @@ function finish(msg) {
   a.textContent = `Download CSV (${a.download})`;
   a.hidden = false;
   $('progress').value = msg.failure ? $('progress').value : 1;
+  if (!msg.failure) {
+    runCount += 1;
+    const label = `${current.custom ? `custom-${tag(describeRun(current)).slice(0, 4)}` : current.type} ${current.mesh}`;
+    history.push({ id: runCount, label, x: Array.from(msg.x, (v) => v * 1e3), f: Array.from(msg.f) });
+    if (history.length > HISTORY_MAX) history.shift();
+    view.historyId = runCount;
+    $('clear-history').hidden = history.length < 2;
+    drawPlot();
+  }
   if (msg.failure) {
     setStatus('stopped by an error');
     showError(`${msg.failure.message}\n${advice(msg.failure.message)}The curve up to that point is shown and in the CSV; ` +
@@ -356,8 +374,11 @@ function drawPlot() {
   const x = view ? Array.from(view.x, (v) => v * 1e3) : [];
   const f = view ? Array.from(view.f) : [];
   const d = view ? view.diameter * 1e3 : 1;
-  const xMax = 0.4 * d * 1.02;
-  const fMax = Math.max(1e-12, ...f) * 1.08;
+  const earlier = history
+    .map((h, i) => ({ ...h, colour: HISTORY_COLOURS[i % HISTORY_COLOURS.length] }))
+    .filter((h) => !view || h.id !== view.historyId);
+  const xMax = Math.max(view || !earlier.length ? 0.4 * d : 0, ...earlier.flatMap((h) => h.x)) * 1.02;
+  const fMax = Math.max(1e-12, ...f, ...earlier.flatMap((h) => h.f)) * 1.08;
   const px = (v) => L + (v / xMax) * (W - L - R);
   const py = (v) => H - B - (v / fMax) * (H - T - B);
   g.strokeStyle = '#999'; g.fillStyle = '#333'; g.lineWidth = 1; g.font = '12px system-ui, sans-serif';
@@ -370,7 +391,7 @@ function drawPlot() {
   }
   g.fillText('platen approach x, mm', (L + W - R) / 2, H - 18);
   g.textAlign = 'right'; g.textBaseline = 'middle';
-  if (f.length) {
+  if (f.length || earlier.length) {
     const fs = niceStep(fMax, 6);
     for (let v = 0; v <= fMax + 1e-15 * fMax; v += fs) {
       g.fillText(tick(v), L - 6, py(v));
@@ -379,6 +400,24 @@ function drawPlot() {
   }
   g.save(); g.translate(14, (T + H - B) / 2); g.rotate(-Math.PI / 2); g.textAlign = 'center';
   g.fillStyle = '#333'; g.fillText('platen force F, N', 0, 0); g.restore();
+  for (const h of earlier) {
+    g.strokeStyle = h.colour; g.lineWidth = 1.5; g.beginPath();
+    h.x.forEach((v, i) => (i ? g.lineTo(px(v), py(h.f[i])) : g.moveTo(px(v), py(h.f[i]))));
+    g.stroke();
+  }
+  const shown = earlier.length + (x.length > 1 ? 1 : 0);
+  c.dataset.curves = String(shown);
+  if (earlier.length) {
+    // The legend: the earlier runs, then this one.
+    const mine = history.find((h) => view && h.id === view.historyId);
+    const entries = [...earlier.map((h) => [h.colour, h.label]), ...(x.length > 1 ? [['#1f5fbf', mine ? `${mine.label} (this run)` : 'this run']] : [])];
+    g.textAlign = 'left'; g.textBaseline = 'middle'; g.font = '11px system-ui, sans-serif';
+    entries.forEach(([colour, label], i) => {
+      const y = T + 8 + 15 * i;
+      g.strokeStyle = colour; g.lineWidth = 2; g.beginPath(); g.moveTo(L + 10, y); g.lineTo(L + 28, y); g.stroke();
+      g.fillStyle = '#333'; g.fillText(label, L + 33, y);
+    });
+  }
   if (x.length > 1) {
     g.strokeStyle = '#1f5fbf'; g.lineWidth = 2; g.beginPath();
     x.forEach((v, i) => (i ? g.lineTo(px(v), py(f[i])) : g.moveTo(px(v), py(f[i]))));
@@ -465,6 +504,12 @@ function drawAll() { drawPlot(); drawGranule(); }
 
 $('inputs').addEventListener('submit', run);
 $('cancel').addEventListener('click', cancel);
+// Forget the earlier runs' curves (the run shown stays).
+$('clear-history').addEventListener('click', () => {
+  history = history.filter((h) => view && h.id === view.historyId);
+  $('clear-history').hidden = true;
+  drawPlot();
+});
 $('type').addEventListener('change', () => requestPreset(true));
 $('custom').addEventListener('change', () => {
   $('params').disabled = !$('custom').checked;
