@@ -181,6 +181,27 @@ fn scale_top(values: impl Iterator<Item = Real>) -> Real {
     v[i].max(1.0)
 }
 
+/// The colour bar's unit for a scale up to `vmax` Pa: kPa, or Pa below
+/// 10 Pa (a bed not yet loaded); as (name, Pa per unit).
+fn scale_unit(vmax: Real) -> (&'static str, Real) {
+    if vmax < 10.0 {
+        ("Pa", 1.0)
+    } else {
+        ("kPa", 1e3)
+    }
+}
+
+/// A tick of the colour bar: `value` with the decimals that three
+/// significant digits of the tick `step` need, the same for every tick.
+fn tick_text(value: Real, step: Real) -> String {
+    let decimals = if step > 0.0 && step.is_finite() {
+        (2 - step.log10().floor() as i32).clamp(0, 6) as usize
+    } else {
+        0
+    };
+    format!("{value:.decimals$}")
+}
+
 /// The SVG text of the section picture of `input`.
 pub fn section_svg(input: &SectionInput<'_>) -> String {
     let [left, right, top, bottom] = MARGIN;
@@ -273,6 +294,8 @@ pub fn section_svg(input: &SectionInput<'_>) -> String {
             viridis(t)
         );
     }
+    let (unit, pa_per_unit) = scale_unit(vmax);
+    let step = 0.25 * vmax / pa_per_unit;
     for i in 0..=4 {
         let f = i as Real / 4.0;
         let y = by + bh * (1.0 - f);
@@ -281,12 +304,12 @@ pub fn section_svg(input: &SectionInput<'_>) -> String {
             "<text x=\"{:.1}\" y=\"{:.1}\" font-size=\"13\">{}</text>",
             bx + 24.0,
             y + 4.0,
-            crate::numbers::significant(f * vmax * 1e-3, 3)
+            tick_text(f * vmax / pa_per_unit, step)
         );
     }
     let _ = writeln!(
         s,
-        "<text x=\"{bx:.1}\" y=\"{:.1}\" font-size=\"13\">−σzz, kPa</text>\n\
+        "<text x=\"{bx:.1}\" y=\"{:.1}\" font-size=\"13\">−σzz, {unit}</text>\n\
          <text x=\"{:.1}\" y=\"{:.1}\" font-size=\"12\" text-anchor=\"end\">darkest: no \
          compression; grey: no value; the scale ends at the 99th percentile</text>\n</svg>",
         by - 16.0,
@@ -404,5 +427,14 @@ mod tests {
         v.push(1e9);
         assert_eq!(scale_top(v.into_iter()), 991.0);
         assert_eq!(scale_top([Real::NAN, -3.0].into_iter()), 1.0);
+        // Ticks share their decimals: three digits of the step.
+        let (unit, per) = scale_unit(43_200.0);
+        assert_eq!((unit, per), ("kPa", 1e3));
+        let ticks: Vec<String> = (0..=4)
+            .map(|i| tick_text(Real::from(i) * 10.8, 10.8))
+            .collect();
+        assert_eq!(ticks, ["0.0", "10.8", "21.6", "32.4", "43.2"]);
+        assert_eq!(scale_unit(1.0), ("Pa", 1.0));
+        assert_eq!(tick_text(0.75, 0.25), "0.750");
     }
 }
