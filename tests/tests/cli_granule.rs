@@ -160,6 +160,20 @@ fn outputs_exist_and_parse() {
     );
     assert!(svg.contains("platen approach x, mm"), "axis label");
     assert!(svg.trim_end().ends_with("</svg>"));
+
+    // The final state cut through the centre: hexes filled, the octant
+    // mirrored (its cut hexes in all four quarters), the strain named.
+    let section = std::fs::read_to_string(dir.join("section.svg")).unwrap();
+    common::parse_xml(&section);
+    let polygons = section.matches("<polygon").count();
+    assert!(
+        polygons >= 4 && polygons.is_multiple_of(4),
+        "{polygons} cut hexes"
+    );
+    assert!(
+        section.contains("Granule B2 (4x1 octant) at 15.0 % strain"),
+        "title"
+    );
 }
 
 /// The summary's numbers follow from the CSV it came with: the slope re-fitted
@@ -640,4 +654,6 @@ fn kernel_failure_keeps_partial_results() {
     assert!(error.contains("element"), "{error}");
     assert_eq!(number(&s, "samples"), t.cells.len() as f64);
     assert!(dir.join("force_displacement.svg").exists());
+    // A failed step's state is no picture to show.
+    assert!(!dir.join("section.svg").exists());
 }

@@ -1,10 +1,11 @@
-//! A picture of the bed without ParaView: its cross-section through the
-//! die axis (the plane y = 0), each hex the plane cuts filled with its
-//! axial stress −σ_zz (the force chains run where the stress is high), the
-//! granules' outlines (their surface quads cut by the plane) drawn over
-//! them, and the die wall and the punches around them. Written as
-//! `vtk/section_<k>.svg` beside each VTU snapshot (`snapshots.rs`) and shown
-//! by `report.html`.
+//! A picture without ParaView: a cross-section through the axis of
+//! compression (the plane y = 0), each hex the plane cuts filled with its
+//! axial stress −σ_zz (in a bed the force chains run where it is high),
+//! the granules' outlines (their surface quads cut by the plane) drawn over
+//! them, and the walls ([`Frame`]: die and punches, or two platens) around
+//! them. The bed writes one as `vtk/section_<k>.svg` beside each VTU
+//! snapshot (`snapshots.rs`), shown by `report.html`; `granbed-cli granule`
+//! one of its final state (`granule/section`).
 //!
 //! The cut of a hex by the plane is the polygon through the points where
 //! its twelve edges cross y = 0, in angular order about their centroid
@@ -133,12 +134,71 @@ pub struct SectionInput<'a> {
     pub quads: &'a [[u32; 4]],
     /// Axial stress −σ_zz of each hex, `[granule][hex]` flattened, Pa.
     pub axial_stress_pa: &'a [Real],
-    /// Die radius, m.
-    pub die_radius_m: Real,
-    /// Height of the upper punch above the lower (z = 0), m.
-    pub upper_z_m: Real,
-    /// The bed's axial strain, for the title.
-    pub strain: Real,
+    /// What holds the granules.
+    pub frame: Frame,
+    /// The picture's title.
+    pub title: String,
+}
+
+/// The walls around a section, which also set its extent.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Frame {
+    /// The die: its wall at |x| = `radius_m`, the punches at z = 0 and
+    /// z = `upper_z_m`.
+    Die {
+        /// Die radius, m.
+        radius_m: Real,
+        /// Height of the upper punch above the lower, m.
+        upper_z_m: Real,
+    },
+    /// Two platens at z = ±`half_height_m`, the picture ±`half_width_m`
+    /// wide (a single granule).
+    Platens {
+        /// Half the picture's width, m.
+        half_width_m: Real,
+        /// The platens' distance from z = 0, m.
+        half_height_m: Real,
+    },
+}
+
+impl Frame {
+    /// The picture's extent ([x_lo, x_hi], [z_lo, z_hi]), m.
+    fn extent(&self) -> ([Real; 2], [Real; 2]) {
+        match *self {
+            Frame::Die {
+                radius_m,
+                upper_z_m,
+            } => {
+                let r = radius_m.max(Real::MIN_POSITIVE);
+                ([-r, r], [0.0, upper_z_m.max(0.05 * r)])
+            }
+            Frame::Platens {
+                half_width_m,
+                half_height_m,
+            } => {
+                let w = half_width_m.max(Real::MIN_POSITIVE);
+                (
+                    [-w, w],
+                    [-half_height_m.max(0.05 * w), half_height_m.max(0.05 * w)],
+                )
+            }
+        }
+    }
+}
+
+/// A scale bar for a picture `width` (m) wide: a power of ten at most a
+/// quarter of it, and its label in mm or µm.
+fn scale_bar(width: Real) -> (Real, String) {
+    let bar = 10f64.powf((0.25 * width).log10().floor());
+    let label = if bar >= 1e-3 {
+        format!("{} mm", crate::numbers::short(bar * 1e3))
+    } else {
+        format!(
+            "{} µm",
+            crate::numbers::short((bar * 1e6 * 1e6).round() / 1e6)
+        )
+    };
+    (bar, label)
 }
 
 /// The cut hexes of `input`: (polygon, axial stress).
@@ -205,12 +265,11 @@ fn tick_text(value: Real, step: Real) -> String {
 /// The SVG text of the section picture of `input`.
 pub fn section_svg(input: &SectionInput<'_>) -> String {
     let [left, right, top, bottom] = MARGIN;
-    let r = input.die_radius_m.max(Real::MIN_POSITIVE);
-    let h = input.upper_z_m.max(0.05 * r);
-    let scale = (WIDTH - left - right) / (2.0 * r);
-    let height = (top + bottom + scale * h).ceil();
-    let px = |x: Real| left + scale * (x + r);
-    let pz = |z: Real| top + scale * (h - z);
+    let ([x_lo, x_hi], [z_lo, z_hi]) = input.frame.extent();
+    let scale = (WIDTH - left - right) / (x_hi - x_lo);
+    let height = (top + bottom + scale * (z_hi - z_lo)).ceil();
+    let px = |x: Real| left + scale * (x - x_lo);
+    let pz = |z: Real| top + scale * (z_hi - z);
     let cuts = cut_hexes(input);
     let vmax = scale_top(cuts.iter().map(|c| c.1));
     let mut s = String::new();
@@ -219,10 +278,9 @@ pub fn section_svg(input: &SectionInput<'_>) -> String {
         "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"{WIDTH}\" height=\"{height}\" \
          viewBox=\"0 0 {WIDTH} {height}\" font-family=\"sans-serif\">\n\
          <rect width=\"100%\" height=\"100%\" fill=\"white\"/>\n\
-         <text x=\"{:.1}\" y=\"26\" font-size=\"18\" text-anchor=\"middle\">Section through the die \
-         axis at C = {:.3}: axial stress −σzz</text>",
+         <text x=\"{:.1}\" y=\"26\" font-size=\"18\" text-anchor=\"middle\">{}</text>",
         left + 0.5 * (WIDTH - left - right),
-        input.strain
+        crate::output::escape_markup(&input.title)
     );
     // The hexes, then the granules' outlines over them.
     for (polygon, value) in &cuts {
@@ -257,25 +315,34 @@ pub fn section_svg(input: &SectionInput<'_>) -> String {
         s,
         "<path d=\"{outline}\" fill=\"none\" stroke=\"#222\" stroke-width=\"0.7\"/>"
     );
-    // The die wall and the punches.
-    let _ = writeln!(
+    // The punches or platens, and the die wall.
+    let (x0, x1, z0, z1) = (
+        px(x_lo) - 2.0,
+        px(x_hi) + 2.0,
+        pz(z_lo) + 2.0,
+        pz(z_hi) - 2.0,
+    );
+    let _ = write!(
         s,
         "<g stroke=\"#555\" stroke-width=\"4\" fill=\"none\">\
-         <line x1=\"{0:.1}\" y1=\"{2:.1}\" x2=\"{0:.1}\" y2=\"{3:.1}\"/>\
-         <line x1=\"{1:.1}\" y1=\"{2:.1}\" x2=\"{1:.1}\" y2=\"{3:.1}\"/>\
-         <line x1=\"{0:.1}\" y1=\"{3:.1}\" x2=\"{1:.1}\" y2=\"{3:.1}\"/>\
-         <line x1=\"{0:.1}\" y1=\"{2:.1}\" x2=\"{1:.1}\" y2=\"{2:.1}\"/></g>",
-        px(-r) - 2.0,
-        px(r) + 2.0,
-        pz(h) - 2.0,
-        pz(0.0) + 2.0,
+         <line x1=\"{x0:.1}\" y1=\"{z0:.1}\" x2=\"{x1:.1}\" y2=\"{z0:.1}\"/>\
+         <line x1=\"{x0:.1}\" y1=\"{z1:.1}\" x2=\"{x1:.1}\" y2=\"{z1:.1}\"/>"
     );
-    // A 1 mm scale bar under the die.
-    let bar = 1e-3 * scale;
+    if let Frame::Die { .. } = input.frame {
+        let _ = write!(
+            s,
+            "<line x1=\"{x0:.1}\" y1=\"{z1:.1}\" x2=\"{x0:.1}\" y2=\"{z0:.1}\"/>\
+             <line x1=\"{x1:.1}\" y1=\"{z1:.1}\" x2=\"{x1:.1}\" y2=\"{z0:.1}\"/>"
+        );
+    }
+    let _ = writeln!(s, "</g>");
+    // A scale bar under the picture.
+    let (bar_m, bar_label) = scale_bar(x_hi - x_lo);
+    let bar = bar_m * scale;
     let _ = writeln!(
         s,
         "<line x1=\"{left}\" y1=\"{0:.1}\" x2=\"{1:.1}\" y2=\"{0:.1}\" stroke=\"black\" stroke-width=\"2\"/>\
-         <text x=\"{2:.1}\" y=\"{3:.1}\" font-size=\"13\">1 mm</text>",
+         <text x=\"{2:.1}\" y=\"{3:.1}\" font-size=\"13\">{bar_label}</text>",
         height - 18.0,
         left + bar,
         left + bar + 6.0,
@@ -388,9 +455,11 @@ mod tests {
             hexes: &mesh.hexes,
             quads: &mesh.quads,
             axial_stress_pa: &values,
-            die_radius_m: 1e-3,
-            upper_z_m: 1e-3,
-            strain: 0.0,
+            frame: Frame::Platens {
+                half_width_m: 0.6e-3,
+                half_height_m: 0.5e-3,
+            },
+            title: "t".into(),
         };
         let cuts = cut_hexes(&input);
         let area: Real = cuts.iter().map(|c| polygon_area(&c.0)).sum();
@@ -436,5 +505,9 @@ mod tests {
         assert_eq!(ticks, ["0.0", "10.8", "21.6", "32.4", "43.2"]);
         assert_eq!(scale_unit(1.0), ("Pa", 1.0));
         assert_eq!(tick_text(0.75, 0.25), "0.750");
+        // A scale bar a power of ten, named in mm or µm.
+        assert_eq!(scale_bar(11.3e-3), (1e-3, "1 mm".to_owned()));
+        assert_eq!(scale_bar(1.2e-3), (1e-4, "100 µm".to_owned()));
+        assert_eq!(scale_bar(50e-3), (10e-3, "10 mm".to_owned()));
     }
 }

@@ -27,7 +27,7 @@ use vtkio::model::{
     Version, VertexNumbers, Vtk,
 };
 
-use super::section::{SectionInput, section_svg};
+use super::section::{Frame, SectionInput, section_svg};
 use crate::assembly::Assembly;
 use crate::model::OwnedReference;
 use crate::output::{create_file, finish_file, write_text};
@@ -327,9 +327,11 @@ fn section_input<'a>(
         hexes: &mesh.hexes,
         quads: &mesh.quads,
         axial_stress_pa: &elements.axial_stress_pa,
-        die_radius_m,
-        upper_z_m,
-        strain,
+        frame: Frame::Die {
+            radius_m: die_radius_m,
+            upper_z_m,
+        },
+        title: format!("Section through the die axis at C = {strain:.3}: axial stress −σzz"),
     }
 }
 

@@ -32,6 +32,7 @@ pub mod outputs;
 pub mod plot;
 pub mod progress;
 pub mod run;
+pub mod section;
 pub mod summary;
 
 use run::RunResult;
@@ -89,6 +90,10 @@ Output, in --out DIR (created if missing; with --types in DIR/<TYPE>/ per type):
                           speed), cost, and \"error\" if the kernel stopped the
                           run
   force_displacement.svg  force against approach, with the sigma_est fit line
+  section.svg             the final state cut through the centre (plane y = 0;
+                          an octant mirrored), each hex coloured by its axial
+                          stress -sigma_zz, between the platens (not written
+                          for a run that failed)
 With --types, also in DIR: types.csv (one row per type: sigma_y, eta0,
 sigma_eff0, sigma_est, the fit's slope and R^2, quasi_static_passed 1/0, steps,
 wall time, energy residual, return-map gap) and force_displacement_types.svg
@@ -462,6 +467,17 @@ impl GranuleArgs {
         let mut summary = Summary::new(&setup, &result, None);
         write_outputs(&job.dir, &result, &summary)
             .with_context(|| format!("granule {name}: writing the outputs"))?;
+        let title = format!(
+            "Granule {name} ({} {}) at {:.1} % strain: axial stress −σzz",
+            summary.mesh,
+            summary.symmetry,
+            100.0 * result.samples.last().map_or(0.0, |s| s.strain)
+        );
+        if let Some(svg) = section::granule_section_svg(mesh, &job.params, &result, &title)
+            .with_context(|| format!("granule {name}: the section picture"))?
+        {
+            outputs::write_text(&job.dir.join(section::SECTION_SVG), &svg)?;
+        }
         // The rate check after the run's own outputs are written: a failed
         // check loses nothing.
         if self.rate_check && result.error.is_none() {

@@ -34,6 +34,11 @@ pub struct RunResult {
     pub wall_time_s: f64,
     /// The kernel error that stopped the run early, if any.
     pub error: Option<SceneError>,
+    /// Node positions at the end of the run, m (the state a failed step
+    /// left: not one to show).
+    pub final_x: Vec<[Real; 3]>,
+    /// The integration points' C_p⁻¹ at the end of the run (Voigt).
+    pub final_cp_inv: Vec<[Real; 6]>,
 }
 
 /// Checks `params` against `mesh` the way a run would (the kernel's
@@ -80,13 +85,18 @@ pub fn run_platens(
         }
     }
     let wall_time_s = start.elapsed().as_secs_f64();
+    // The scene borrows the store's buffers up to here.
+    let (diameter_m, steps, element_steps) =
+        (scene.diameter(), scene.steps(), scene.element_steps());
     Ok(RunResult {
         samples,
-        diameter_m: scene.diameter(),
+        diameter_m,
         initial_dt_s,
-        steps: scene.steps(),
-        element_steps: scene.element_steps(),
+        steps,
+        element_steps,
         wall_time_s,
         error,
+        final_x: store.granule.x.clone(),
+        final_cp_inv: store.granule.cp_inv.clone(),
     })
 }
