@@ -62,7 +62,8 @@ mod tests {
             (-42.0, "-42.00"),
             (0.0, "0.000"),
             (f64::NAN, "n/a"),
-            (f64::NEG_INFINITY, "−∞"),
+            (f64::NEG_INFINITY, "-∞"),
+            (-0.0, "0.000"),
         ];
         for (x, text) in cases {
             assert_eq!(significant(x, 4), text, "{x}");
@@ -129,15 +130,17 @@ pub fn short(x: f64) -> String {
 /// `x` rounded to `digits` significant digits (at least 1) for a table a
 /// reader scans: plain decimals for 10⁻³ ≤ |x| < 10⁶ (`0.3000`, `123.5`,
 /// `123457`), scientific notation outside (`1.230e-7`), "n/a" for NaN and
-/// "∞"/"−∞" for infinities. The full value stays in the machine-readable
+/// "∞"/"-∞" for infinities. The full value stays in the machine-readable
 /// output (`summary.json`, CSV); this is for pages and tables only.
 pub fn significant(x: f64, digits: usize) -> String {
     if x.is_nan() {
         return "n/a".to_owned();
     }
     if x.is_infinite() {
-        return if x > 0.0 { "∞" } else { "−∞" }.to_owned();
+        return if x > 0.0 { "∞" } else { "-∞" }.to_owned();
     }
+    // -0.0 (a zero from round-off below zero) prints as 0.
+    let x = if x == 0.0 { 0.0 } else { x };
     let digits = digits.max(1);
     // The exponent after rounding: 9.9996 to four digits is 1.000e1.
     let scientific = format!("{:.*e}", digits - 1, x);

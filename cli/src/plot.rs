@@ -245,8 +245,10 @@ pub fn xy_svg(
                 }
             }
         }
-        // One series needs no legend: the title and the axes name it.
-        if series.len() > 1 {
+        // The legend, unless its only entry would be an empty label (a
+        // single curve that the title and axes name). A single labelled
+        // curve keeps it: a one-member series' "(failed)" is said there.
+        if series.len() > 1 || series.iter().any(|s| !s.label.is_empty()) {
             chart
                 .configure_series_labels()
                 .label_font(("sans-serif", 13))
@@ -263,6 +265,26 @@ pub fn xy_svg(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A single curve has a legend only if it is labelled: a one-member
+    /// series' "(failed)" is said there.
+    #[test]
+    fn a_single_curve_has_a_legend_only_if_labelled() {
+        let curve = |label: &str| {
+            let points = (0..=4).map(|i| (f64::from(i), f64::from(i * i)));
+            xy_svg(
+                "t",
+                "x",
+                "y",
+                &[Series::new(label, Mark::Line, points)],
+                true,
+            )
+            .unwrap()
+        };
+        let (named, bare) = (curve("B2 (failed)"), curve(""));
+        assert!(named.contains("B2 (failed)"));
+        assert!(named.matches("<rect").count() > bare.matches("<rect").count());
+    }
 
     /// Every tick of a plain axis has the decimals of the finest one.
     #[test]

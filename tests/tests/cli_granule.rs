@@ -170,6 +170,57 @@ fn outputs_exist_and_parse() {
         polygons >= 4 && polygons.is_multiple_of(4),
         "{polygons} cut hexes"
     );
+    // The four quarters lie about the centre: the cut's extent is
+    // symmetric in x about the picture's middle and in z about the middle
+    // between the platens (the first two lines drawn).
+    let numbers = |text: &str| -> Vec<f64> {
+        text.split([' ', ','])
+            .filter_map(|t| t.parse().ok())
+            .collect()
+    };
+    let (mut xs, mut zs) = (Vec::new(), Vec::new());
+    for line in section.lines().filter(|l| l.starts_with("<polygon")) {
+        let points = line
+            .split("points=\"")
+            .nth(1)
+            .unwrap()
+            .split('"')
+            .next()
+            .unwrap();
+        for pair in numbers(points).chunks(2) {
+            xs.push(pair[0]);
+            zs.push(pair[1]);
+        }
+    }
+    let extent = |v: &[f64]| {
+        v.iter()
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), &x| {
+                (lo.min(x), hi.max(x))
+            })
+    };
+    let attr = |tag: &str, name: &str| -> f64 {
+        tag.split(&format!("{name}=\""))
+            .nth(1)
+            .unwrap()
+            .split('"')
+            .next()
+            .unwrap()
+            .parse()
+            .unwrap()
+    };
+    let lines: Vec<&str> = section.split("<line").skip(1).take(2).collect();
+    let ((x_lo, x_hi), (z_lo, z_hi)) = (extent(&xs), extent(&zs));
+    let x_mid = 0.5 * (attr(lines[0], "x1") + attr(lines[0], "x2"));
+    let z_mid = 0.5 * (attr(lines[0], "y1") + attr(lines[1], "y1"));
+    assert!(
+        (x_lo + x_hi - 2.0 * x_mid).abs() < 1.0,
+        "x {x_lo}..{x_hi} about {x_mid}"
+    );
+    assert!(
+        (z_lo + z_hi - 2.0 * z_mid).abs() < 1.0,
+        "z {z_lo}..{z_hi} about {z_mid}"
+    );
+    assert!(x_hi - x_lo > 100.0 && z_hi - z_lo > 100.0);
     assert!(
         section.contains("Granule B2 (4x1 octant) at 15.0 % strain"),
         "title"
@@ -639,6 +690,9 @@ fn a_folded_element_is_named() {
 #[test]
 fn kernel_failure_keeps_partial_results() {
     let dir = out_dir("failure");
+    // A finished run first, whose picture the failed run must not keep.
+    granule_ok(&dir, &QUICK);
+    assert!(dir.join("section.svg").is_file());
     let run = granule_fails(&dir, &["--speed-mm-s", "10000", "--strain", "0.9"]);
     for part in ["granule B2", "step ", "strain ", "element ", "summary.json"] {
         assert!(
@@ -654,6 +708,7 @@ fn kernel_failure_keeps_partial_results() {
     assert!(error.contains("element"), "{error}");
     assert_eq!(number(&s, "samples"), t.cells.len() as f64);
     assert!(dir.join("force_displacement.svg").exists());
-    // A failed step's state is no picture to show.
+    // A failed step's state is no picture to show, and an earlier run's
+    // picture in the directory is removed (the test writes one first).
     assert!(!dir.join("section.svg").exists());
 }

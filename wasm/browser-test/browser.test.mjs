@@ -171,6 +171,9 @@ test('results are marked once the inputs change, and cleared when inputs are ref
   }
   assert.equal(await page.textContent('#sigma-est'), '–');
   assert.equal(await page.isHidden('#download'), true);
+  // No notice about results that are no longer shown.
+  assert.equal(await page.isHidden('#stale'), true);
+  assert.equal(await page.getAttribute('#results', 'data-stale'), null);
   // The earlier runs' curves stay, named (B2 8x2 twice, B2 4x1 once).
   assert.match(await page.getAttribute('#plot', 'aria-label'), /^platen force against displacement of \d earlier run\(s\): .*B2 4x1$/);
   // A number beyond a double is refused, not read as infinity...

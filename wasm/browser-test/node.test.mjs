@@ -5,7 +5,7 @@ import assert from 'node:assert/strict';
 import { readFileSync } from 'node:fs';
 import { join } from 'node:path';
 import { WWW, native } from './common.js';
-import { parseDecimal, tick } from '../www/format.js';
+import { advice, parseDecimal, tick } from '../www/format.js';
 
 const pkg = await import(join(WWW, 'pkg', 'granbed_wasm.js'));
 pkg.initSync({ module: readFileSync(join(WWW, 'pkg', 'granbed_wasm_bg.wasm')) });
@@ -94,9 +94,25 @@ test('typed numbers: a decimal point is read, a comma or junk refused', () => {
   // inf as typed (the kernel judges the field: σy takes it); a number too
   // large for a double is refused, not read as infinity.
   for (const inf of ['inf', '+inf', ' INF ']) assert.equal(parseDecimal(inf, 'x', 'f'), Infinity, inf);
-  for (const huge of ['1e400', '-1e309']) {
-    assert.throws(() => parseDecimal(huge, 'σy', 'yield_stress_pa'), (e) => e.field === 'yield_stress_pa' && /too large for a number .* write inf/.test(e.message), huge);
+  assert.throws(() => parseDecimal('1e400', 'σy', 'yield_stress_pa'), (e) => e.field === 'yield_stress_pa' && /too large for a number .* write inf/.test(e.message));
+  assert.throws(() => parseDecimal('-1e309', 'ν', 'poisson_ratio'), (e) => /too large for a number \(the largest is about 1\.8e308\)$/.test(e.message));
+  // Below the smallest double: refused, not read as 0; zero itself is read.
+  assert.throws(() => parseDecimal('1e-400', 'μ', 'friction'), /too small for a number/);
+  for (const zero of ['0', '0.0', '-0', '0e5', '.0']) assert.equal(parseDecimal(zero, 'x', 'f'), 0, zero);
+});
+
+test('a stopped run gets advice for the kernel\'s failures', () => {
+  // The messages of ElementFailure::InvertedDeformation and of
+  // SceneError::Unstable and its kin (kernel/src/scene/platens.rs).
+  for (const message of [
+    'granule step 120: element 129: inverted element: det F = -2.96e-1',
+    'the motion became unstable at step 88 (node 17 moved 3e-4 m in one step)',
+    'element 4 folded or inverted (Jacobian ratio -0.2)',
+    'non-finite position of node 3',
+  ]) {
+    assert.match(advice(message), /too soft for the platen speed/, message);
   }
+  assert.equal(advice('the output directory cannot be written'), '');
 });
 
 test('tick labels fit the margin at any scale', () => {

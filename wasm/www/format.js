@@ -27,8 +27,14 @@ export function parseDecimal(text, label, field) {
   let why;
   if (DECIMAL.test(t)) {
     const v = Number(t);
-    if (Number.isFinite(v)) return v;
-    why = 'is too large for a number (the largest is about 1.8e308; write inf for infinity)';
+    const zero = /^[+-]?[0.]*([eE].*)?$/.test(t);
+    // (-0 is read as 0.)
+    if (Number.isFinite(v) && (v !== 0 || zero)) return v === 0 ? 0 : v;
+    why = v === 0
+      ? 'is too small for a number (the smallest is about 5e-324; write 0 for zero)'
+      : v > 0
+        ? 'is too large for a number (the largest is about 1.8e308; write inf for infinity)'
+        : 'is too large for a number (the largest is about 1.8e308)';
   } else {
     why = t === ''
       ? 'is empty'
@@ -46,4 +52,16 @@ export function tick(v) {
   if (a === 0) return '0';
   if (a >= 1e5 || a < 1e-3) return v.toExponential(1).replace('.0e', 'e');
   return +v.toPrecision(4) + '';
+}
+
+// What a student can do about a run that stopped: the kernel's message
+// names what broke (an element turned inside out or folded, the motion
+// unstable, a value not finite); this says what to change, or nothing.
+export function advice(message) {
+  if (/inverted|folded|unstable|non-finite/.test(message)) {
+    return 'The granule deformed too violently for the simulation: it is probably too soft for the platen speed ' +
+      '(try a larger E or σy), or the coarse mesh is too coarse for this deformation (try the standard mesh). ';
+  }
+  if (/converge/.test(message)) return 'The plastic return did not converge: check that σy, cp and ηc are in their usual ranges. ';
+  return '';
 }

@@ -1,6 +1,6 @@
 // The page: the form, the worker that runs the simulation, the live plot,
 // the granule view, the results table and the CSV download.
-import { formatStress, formatSlope, parseDecimal, tick } from './format.js';
+import { advice, formatStress, formatSlope, parseDecimal, tick } from './format.js';
 
 const $ = (id) => document.getElementById(id);
 const FIELDS = ['yield_stress_pa', 'eta0', 'youngs_modulus_pa', 'poisson_ratio', 'cp', 'eta_c', 'friction'];
@@ -53,6 +53,7 @@ function showError(message, fields) {
 // earlier run is left on the page to be read as this one's.
 function refuse(message, fields) {
   resetResults();
+  clearStale();
   view = null;
   drawAll();
   $('plot').setAttribute('aria-label', history.length
@@ -291,16 +292,18 @@ function finish(msg) {
   if (!msg.failure) {
     runCount += 1;
     const label = `${current.custom ? `custom-${tag(describeRun(current)).slice(0, 4)}` : current.type} ${current.mesh}`;
-    history.push({ id: runCount, label, x: Array.from(msg.x, (v) => v * 1e3), f: Array.from(msg.f) });
+    // Its colour for as long as it is drawn (by run, not by place in the list).
+    const colour = HISTORY_COLOURS[(runCount - 1) % HISTORY_COLOURS.length];
+    history.push({ id: runCount, label, colour, x: Array.from(msg.x, (v) => v * 1e3), f: Array.from(msg.f) });
     if (history.length > HISTORY_MAX) history.shift();
     view.historyId = runCount;
-    $('clear-history').hidden = history.length < 2;
     drawPlot();
   }
   if (msg.failure) {
     setStatus('stopped by an error');
     showError(`${msg.failure.message}\n${advice(msg.failure.message)}The curve up to that point is shown and in the CSV; ` +
-      'the picture shows the granule at the last step that succeeded.', msg.failure.field);
+      'the picture shows the granule after the last chunk of steps that succeeded (within about 1 % strain of the failure).',
+    msg.failure.field);
     $('results').dataset.state = 'failed';
   } else {
     // The result in the status line too: the table may be below the fold.
@@ -308,17 +311,6 @@ function finish(msg) {
       `σ_est = ${formatStress(msg.sigmaEst)}`);
     $('results').dataset.state = 'done';
   }
-}
-
-// What a student can do about a run that stopped: the kernel's message
-// names what broke; this says what to change.
-function advice(message) {
-  if (/inverted element|det F/.test(message)) {
-    return 'An element turned inside out: the granule is too soft for the platen speed (a larger E or σy), ' +
-      'or the coarse mesh is too coarse for this deformation. ';
-  }
-  if (/converge/.test(message)) return 'The plastic return did not converge: check that σy, cp and ηc are in their usual ranges. ';
-  return '';
 }
 
 // "0.00057 %" for a ratio.
@@ -352,8 +344,12 @@ function niceStep(range, count) {
 // phone the labels stay 12 px and sharp instead of scaled down. Returns
 // [context, width, height] in CSS pixels.
 function sized(c) {
+  // The drawing's own size, read once from the canvas's attributes: its
+  // aspect ratio, and the width to draw at while the canvas has no layout
+  // box (its backing store, once resized, is in device pixels).
   const aspect = Number(c.dataset.aspect ?? (c.dataset.aspect = String(c.height / c.width)));
-  const W = Math.max(1, Math.round(c.clientWidth || c.width));
+  const natural = Number(c.dataset.width ?? (c.dataset.width = String(c.width)));
+  const W = Math.max(1, Math.round(c.clientWidth || natural));
   const H = Math.round(W * aspect);
   const dpr = window.devicePixelRatio || 1;
   const w = Math.round(W * dpr), h = Math.round(H * dpr);
@@ -374,9 +370,9 @@ function drawPlot() {
   const x = view ? Array.from(view.x, (v) => v * 1e3) : [];
   const f = view ? Array.from(view.f) : [];
   const d = view ? view.diameter * 1e3 : 1;
-  const earlier = history
-    .map((h, i) => ({ ...h, colour: HISTORY_COLOURS[i % HISTORY_COLOURS.length] }))
-    .filter((h) => !view || h.id !== view.historyId);
+  const earlier = history.filter((h) => !view || h.id !== view.historyId);
+  // The button to forget them whenever there are any drawn.
+  $('clear-history').hidden = earlier.length === 0;
   const xMax = Math.max(view || !earlier.length ? 0.4 * d : 0, ...earlier.flatMap((h) => h.x)) * 1.02;
   const fMax = Math.max(1e-12, ...f, ...earlier.flatMap((h) => h.f)) * 1.08;
   const px = (v) => L + (v / xMax) * (W - L - R);
@@ -507,7 +503,6 @@ $('cancel').addEventListener('click', cancel);
 // Forget the earlier runs' curves (the run shown stays).
 $('clear-history').addEventListener('click', () => {
   history = history.filter((h) => view && h.id === view.historyId);
-  $('clear-history').hidden = true;
   drawPlot();
 });
 $('type').addEventListener('change', () => requestPreset(true));

@@ -261,8 +261,9 @@ pub fn plots(
         heywood_f,
         profile_f,
     ] = PLOT_FILES;
+    // Unlabelled: the title and axes say what the one curve is (no legend).
     let profile = [Series::new(
-        "D against the upper-punch P",
+        "",
         Mark::Line,
         heckel_rows(run).map(|(p, d, _)| (p * 1e-3, d)),
     )];

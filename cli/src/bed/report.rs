@@ -419,20 +419,16 @@ fn section_files(dir: &Path) -> Vec<String> {
     let Ok(entries) = std::fs::read_dir(dir.join(VTK_DIR)) else {
         return Vec::new();
     };
-    let mut numbered: Vec<(usize, String)> = entries
+    let mut sections: Vec<(usize, String)> = entries
         .filter_map(Result::ok)
         .filter_map(|e| {
             let name = e.file_name().into_string().ok()?;
-            let k = name
-                .strip_prefix("section_")?
-                .strip_suffix(".svg")?
-                .parse()
-                .ok()?;
+            let k = super::snapshots::numbered(&name, "section_", ".svg")?;
             Some((k, format!("{VTK_DIR}/{name}")))
         })
         .collect();
-    numbered.sort();
-    numbered.into_iter().map(|(_, path)| path).collect()
+    sections.sort();
+    sections.into_iter().map(|(_, path)| path).collect()
 }
 
 /// Writes [`REPORT_FILE`] into `dir`.

@@ -44,9 +44,14 @@ fn kpa(x: Option<f64>) -> String {
     num(x.map(|p| p * 1e-3))
 }
 
-/// A fit's cell: its figure, marked ✗ if the run's summary rejects the fit,
-/// with its R² in the cell's title.
-fn fit_cell(value: String, r_squared: Option<f64>, ok: bool) -> String {
+/// A fit's cell: its figure `value` (`None`: no fit, the run did not reach
+/// its window), marked ✗ if the run's summary rejects the fit, with its R²
+/// in the cell's title.
+fn fit_cell(value: Option<String>, r_squared: Option<f64>, ok: bool) -> String {
+    let Some(value) = value else {
+        return "<td class=\"num\" title=\"no fit: the run ended before its window\">n/a</td>"
+            .to_owned();
+    };
     let title = format!("R² = {}", num(r_squared));
     let (class, mark) = if ok {
         ("num", "")
@@ -69,17 +74,21 @@ fn cell(text: &str) -> String {
 /// empty if nothing is wrong.
 fn doubts(row: &ComparisonRow) -> Vec<&'static str> {
     let mut out = Vec::new();
+    // A failed run's certificate is not judged (as its summary does).
     if row.error.is_some() {
         out.push("the run failed (see its report)");
-    }
-    if !row.quasi_static_passed {
+    } else if !row.quasi_static_passed {
         out.push("not quasi-static: inertia is in its pressures");
     }
-    if !row.kawakita_ok {
-        out.push("Kawakita fit rejected");
+    match (row.kawakita_a, row.kawakita_ok) {
+        (None, _) => out.push("no Kawakita fit (the run ended before its window)"),
+        (Some(_), false) => out.push("Kawakita fit rejected"),
+        (Some(_), true) => {}
     }
-    if !row.heckel_ok {
-        out.push("Heckel fit rejected");
+    match (row.heckel_yield_pressure_pa, row.heckel_ok) {
+        (None, _) => out.push("no Heckel fit (the run ended before its window)"),
+        (Some(_), false) => out.push("Heckel fit rejected"),
+        (Some(_), true) => {}
     }
     out
 }
@@ -173,14 +182,18 @@ pub fn series_report_html(report: &SeriesReport<'_>) -> anyhow::Result<String> {
             cell(&kpa(Some(row.yield_stress_pa))),
             cell(&num(Some(row.eta0))),
             cell(&num(Some(row.initial_solid_fraction))),
-            fit_cell(num(row.kawakita_a), row.kawakita_r_squared, row.kawakita_ok),
             fit_cell(
-                kpa(row.kawakita_inv_b_pa),
+                row.kawakita_a.map(|a| num(Some(a))),
                 row.kawakita_r_squared,
                 row.kawakita_ok
             ),
             fit_cell(
-                kpa(row.heckel_yield_pressure_pa),
+                row.kawakita_inv_b_pa.map(|b| kpa(Some(b))),
+                row.kawakita_r_squared,
+                row.kawakita_ok
+            ),
+            fit_cell(
+                row.heckel_yield_pressure_pa.map(|p| kpa(Some(p))),
                 row.heckel_r_squared,
                 row.heckel_ok
             ),
@@ -196,7 +209,7 @@ pub fn series_report_html(report: &SeriesReport<'_>) -> anyhow::Result<String> {
         writeln!(
             h,
             "<h2>Spread over the runs</h2>\n<p>The run-to-run spread of each figure: a change of \
-             setting moves a figure by less than this, and it cannot be told from the pour's \
+             setting that moves a figure by less than this cannot be told from the pour's \
              chance. A fit a run's summary rejects is left out.</p>\n<table>\n<tr><th>figure</th>\
              <th>runs</th><th>left out</th><th>mean</th><th>std</th><th>min</th><th>max</th>\
              <th>max − min</th></tr>"
@@ -266,7 +279,12 @@ mod tests {
     /// a sound run is not; the spread is a table of its own.
     #[test]
     fn a_row_per_run_with_its_doubts_marked() {
-        let rows = [row(1, 0.41, true), row(2, 1.7, false)];
+        let mut failed = row(3, 0.5, false);
+        failed.error = Some("step 9: element 2 inverted".into());
+        failed.kawakita_a = None;
+        failed.kawakita_inv_b_pa = None;
+        let failed = failed.with_fit_flags();
+        let rows = [row(1, 0.41, true), row(2, 1.7, false), failed];
         assert!(rows[0].kawakita_ok && !rows[1].kawakita_ok, "{rows:?}");
         let spreads: Vec<Spread> = SPREAD_FIGURES
             .iter()
@@ -276,7 +294,7 @@ mod tests {
         let report = SeriesReport {
             title: "series <B2>".into(),
             about: "two seeds".into(),
-            member_dirs: vec!["seed_1".into(), "seed_2".into()],
+            member_dirs: vec!["seed_1".into(), "seed_2".into(), "seed_3".into()],
             rows: &rows,
             spreads: Some(&spreads),
             files: &["seeds.csv"],
@@ -295,15 +313,24 @@ mod tests {
         assert!(html.contains(">0.4100</td>"), "seed 1's a is not marked");
         assert!(html.contains(">1.700 ✗</td>"), "seed 2's a is not marked");
         assert!(html.contains("title=\"R² = 0.9912\""));
-        assert_eq!(html.matches("<tr class=\"doubt\">").count(), 1);
+        assert_eq!(html.matches("<tr class=\"doubt\">").count(), 2);
+        // A failed run is not also called not quasi-static, and a fit its
+        // run never reached is no rejected fit: n/a without a mark.
+        assert!(html.contains(
+            "seed_3</a>: the run failed (see its report); no Kawakita fit (the run ended before \
+             its window)</li>"
+        ));
+        assert!(html.contains("title=\"no fit: the run ended before its window\">n/a</td>"));
+        assert!(!html.contains("n/a ✗"));
         assert!(html.contains(
             "seed_2</a>: not quasi-static: inertia is in its pressures; Kawakita fit rejected</li>"
         ));
         assert!(!html.contains("seed_1</a>: "), "a sound run is listed");
-        // The spread leaves seed 2's rejected a out: one run, mean 0.41.
+        // The spread leaves seed 2's rejected a and seed 3's missing one
+        // out: one run, mean 0.41.
         assert!(html.contains(
             "<td title=\"kawakita_a\">Kawakita a</td><td class=\"num\">1</td>\
-             <td class=\"num\">1</td><td class=\"num\">0.4100</td>"
+             <td class=\"num\">2</td><td class=\"num\">0.4100</td>"
         ));
         assert!(
             SPREAD_FIGURES

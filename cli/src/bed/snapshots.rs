@@ -303,6 +303,17 @@ pub fn section_file(k: usize) -> String {
     format!("section_{k}.svg")
 }
 
+/// The k of a file `name` of the form `<prefix><k><suffix>` with k in
+/// decimal digits (a snapshot `bed_<k>.vtu`, a section picture
+/// `section_<k>.svg`), or `None`.
+pub fn numbered(name: &str, prefix: &str, suffix: &str) -> Option<usize> {
+    let k = name.strip_prefix(prefix)?.strip_suffix(suffix)?;
+    if k.is_empty() || !k.bytes().all(|b| b.is_ascii_digit()) {
+        return None;
+    }
+    k.parse().ok()
+}
+
 /// What the section picture of `asm` at `strain` shows: the granules'
 /// positions, the mesh, the axial stress of `elements`, the die's radius
 /// and the upper punch's height (from the walls).
@@ -349,12 +360,8 @@ pub fn remove_old(out: &Path) -> anyhow::Result<usize> {
         let entry = entry.with_context(|| format!("cannot list `{}`", dir.display()))?;
         let name = entry.file_name();
         let Some(name) = name.to_str() else { continue };
-        let numbered = |prefix: &str, suffix: &str| {
-            name.strip_prefix(prefix)
-                .and_then(|n| n.strip_suffix(suffix))
-                .is_some_and(|k| !k.is_empty() && k.bytes().all(|b| b.is_ascii_digit()))
-        };
-        let snapshot = numbered("bed_", ".vtu") || numbered("section_", ".svg");
+        let snapshot = numbered(name, "bed_", ".vtu").is_some()
+            || numbered(name, "section_", ".svg").is_some();
         if (snapshot || name == PVD_FILE) && entry.path().is_file() {
             std::fs::remove_file(entry.path())
                 .with_context(|| format!("cannot remove `{}`", entry.path().display()))?;

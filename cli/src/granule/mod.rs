@@ -473,10 +473,15 @@ impl GranuleArgs {
             summary.symmetry,
             100.0 * result.samples.last().map_or(0.0, |s| s.strain)
         );
-        if let Some(svg) = section::granule_section_svg(mesh, &job.params, &result, &title)
+        let section_path = job.dir.join(section::SECTION_SVG);
+        match section::granule_section_svg(mesh, &job.params, &result, &title)
             .with_context(|| format!("granule {name}: the section picture"))?
         {
-            outputs::write_text(&job.dir.join(section::SECTION_SVG), &svg)?;
+            Some(svg) => outputs::write_text(&section_path, &svg)?,
+            // A failed run has none; an earlier run's must not stand in.
+            None if section_path.is_file() => std::fs::remove_file(&section_path)
+                .with_context(|| format!("cannot remove `{}`", section_path.display()))?,
+            None => {}
         }
         // The rate check after the run's own outputs are written: a failed
         // check loses nothing.
