@@ -221,6 +221,11 @@ fn outputs_exist_and_parse() {
         "z {z_lo}..{z_hi} about {z_mid}"
     );
     assert!(x_hi - x_lo > 100.0 && z_hi - z_lo > 100.0);
+    // The same cut coloured by the local relative density η0/J.
+    let density = std::fs::read_to_string(dir.join("section_density.svg")).unwrap();
+    common::parse_xml(&density);
+    assert_eq!(density.matches("<polygon").count(), polygons);
+    assert!(density.contains("at 15.0 % strain: local relative density η0/J"));
     assert!(
         section.contains("Granule B2 (4x1 octant) at 15.0 % strain"),
         "title"
@@ -690,9 +695,9 @@ fn a_folded_element_is_named() {
 #[test]
 fn kernel_failure_keeps_partial_results() {
     let dir = out_dir("failure");
-    // A finished run first, whose picture the failed run must not keep.
+    // A finished run first, whose pictures the failed run must not keep.
     granule_ok(&dir, &QUICK);
-    assert!(dir.join("section.svg").is_file());
+    assert!(dir.join("section.svg").is_file() && dir.join("section_density.svg").is_file());
     let run = granule_fails(&dir, &["--speed-mm-s", "10000", "--strain", "0.9"]);
     for part in ["granule B2", "step ", "strain ", "element ", "summary.json"] {
         assert!(
@@ -711,4 +716,5 @@ fn kernel_failure_keeps_partial_results() {
     // A failed step's state is no picture to show, and an earlier run's
     // picture in the directory is removed (the test writes one first).
     assert!(!dir.join("section.svg").exists());
+    assert!(!dir.join("section_density.svg").exists());
 }

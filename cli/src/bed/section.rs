@@ -132,12 +132,71 @@ pub struct SectionInput<'a> {
     pub hexes: &'a [[u32; 8]],
     /// The granules' outer surface quads, node indices.
     pub quads: &'a [[u32; 4]],
-    /// Axial stress −σ_zz of each hex, `[granule][hex]` flattened, Pa.
-    pub axial_stress_pa: &'a [Real],
+    /// The value of each hex, `[granule][hex]` flattened, in the
+    /// quantity's unit (Pa for a stress).
+    pub values: &'a [Real],
+    /// What `values` are.
+    pub quantity: Quantity,
     /// What holds the granules.
     pub frame: Frame,
     /// The picture's title.
     pub title: String,
+}
+
+/// What the colours of a section show.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Quantity {
+    /// Axial stress −σ_zz, Pa (positive in compression): the colours from
+    /// 0 to the 99th percentile of the positive values.
+    AxialStress,
+    /// Local relative density η0/J: the colours from the 1st to the 99th
+    /// percentile.
+    RelativeDensity,
+}
+
+impl Quantity {
+    /// The colour scale (lo, hi) of `values` (so that one extreme element
+    /// does not wash the picture out).
+    fn scale(self, values: impl Iterator<Item = Real>) -> (Real, Real) {
+        match self {
+            Quantity::AxialStress => (0.0, scale_top(values)),
+            Quantity::RelativeDensity => {
+                let mut v: Vec<Real> = values.filter(|v| v.is_finite()).collect();
+                v.sort_by(Real::total_cmp);
+                let at = |q: Real| v[((v.len() - 1) as Real * q).round() as usize];
+                let (lo, hi) = if v.is_empty() {
+                    (0.0, 1.0)
+                } else {
+                    (at(0.01), at(0.99))
+                };
+                if hi - lo < 1e-3 {
+                    (lo - 5e-4, hi + 5e-4)
+                } else {
+                    (lo, hi)
+                }
+            }
+        }
+    }
+
+    /// The colour bar's name, the value of its unit (Pa per kPa, say) for
+    /// a scale up to `hi`, and the picture's footnote.
+    fn legend(self, hi: Real) -> (String, Real, &'static str) {
+        match self {
+            Quantity::AxialStress => {
+                let (unit, per) = scale_unit(hi);
+                (
+                    format!("−σzz, {unit}"),
+                    per,
+                    "darkest: no compression; grey: no value; the scale ends at the 99th percentile",
+                )
+            }
+            Quantity::RelativeDensity => (
+                "η0/J".to_owned(),
+                1.0,
+                "the scale spans the 1st to the 99th percentile; grey: no value",
+            ),
+        }
+    }
 }
 
 /// The walls around a section, which also set its extent.
@@ -217,7 +276,7 @@ fn cut_hexes(input: &SectionInput<'_>) -> Vec<(Vec<[Real; 2]>, Real)> {
             };
             if let Some(polygon) = cut_hex(&corners) {
                 let value = input
-                    .axial_stress_pa
+                    .values
                     .get(g * per_granule + h)
                     .copied()
                     .unwrap_or(Real::NAN);
@@ -271,7 +330,7 @@ pub fn section_svg(input: &SectionInput<'_>) -> String {
     let px = |x: Real| left + scale * (x - x_lo);
     let pz = |z: Real| top + scale * (z_hi - z);
     let cuts = cut_hexes(input);
-    let vmax = scale_top(cuts.iter().map(|c| c.1));
+    let (lo, hi) = input.quantity.scale(cuts.iter().map(|c| c.1));
     let mut s = String::new();
     let _ = writeln!(
         s,
@@ -284,7 +343,7 @@ pub fn section_svg(input: &SectionInput<'_>) -> String {
     );
     // The hexes, then the granules' outlines over them.
     for (polygon, value) in &cuts {
-        let colour = viridis(value / vmax);
+        let colour = viridis((value - lo) / (hi - lo));
         let points: Vec<String> = polygon
             .iter()
             .map(|p| format!("{:.1},{:.1}", px(p[0]), pz(p[1])))
@@ -361,8 +420,8 @@ pub fn section_svg(input: &SectionInput<'_>) -> String {
             viridis(t)
         );
     }
-    let (unit, pa_per_unit) = scale_unit(vmax);
-    let step = 0.25 * vmax / pa_per_unit;
+    let (name, per_unit, footnote) = input.quantity.legend(hi);
+    let step = 0.25 * (hi - lo) / per_unit;
     for i in 0..=4 {
         let f = i as Real / 4.0;
         let y = by + bh * (1.0 - f);
@@ -371,14 +430,13 @@ pub fn section_svg(input: &SectionInput<'_>) -> String {
             "<text x=\"{:.1}\" y=\"{:.1}\" font-size=\"13\">{}</text>",
             bx + 24.0,
             y + 4.0,
-            tick_text(f * vmax / pa_per_unit, step)
+            tick_text((lo + f * (hi - lo)) / per_unit, step)
         );
     }
     let _ = writeln!(
         s,
-        "<text x=\"{bx:.1}\" y=\"{:.1}\" font-size=\"13\">−σzz, {unit}</text>\n\
-         <text x=\"{:.1}\" y=\"{:.1}\" font-size=\"12\" text-anchor=\"end\">darkest: no \
-         compression; grey: no value; the scale ends at the 99th percentile</text>\n</svg>",
+        "<text x=\"{bx:.1}\" y=\"{:.1}\" font-size=\"13\">{name}</text>\n\
+         <text x=\"{:.1}\" y=\"{:.1}\" font-size=\"12\" text-anchor=\"end\">{footnote}</text>\n</svg>",
         by - 16.0,
         WIDTH - right,
         height - 13.0
@@ -454,7 +512,8 @@ mod tests {
             granules: vec![&mesh.positions],
             hexes: &mesh.hexes,
             quads: &mesh.quads,
-            axial_stress_pa: &values,
+            values: &values,
+            quantity: Quantity::AxialStress,
             frame: Frame::Platens {
                 half_width_m: 0.6e-3,
                 half_height_m: 0.5e-3,
@@ -505,6 +564,16 @@ mod tests {
         assert_eq!(ticks, ["0.0", "10.8", "21.6", "32.4", "43.2"]);
         assert_eq!(scale_unit(1.0), ("Pa", 1.0));
         assert_eq!(tick_text(0.75, 0.25), "0.750");
+        // Densities span their 1st to 99th percentile; a uniform field
+        // still gets a scale.
+        let rho: Vec<Real> = (0..=100).map(|i| 0.8 + 0.001 * Real::from(i)).collect();
+        let (lo, hi) = Quantity::RelativeDensity.scale(rho.into_iter());
+        assert!(
+            (lo - 0.801).abs() < 1e-12 && (hi - 0.899).abs() < 1e-12,
+            "{lo} {hi}"
+        );
+        let (lo, hi) = Quantity::RelativeDensity.scale([0.8; 5].into_iter());
+        assert!(lo < 0.8 && hi > 0.8);
         // A scale bar a power of ten, named in mm or µm.
         assert_eq!(scale_bar(11.3e-3), (1e-3, "1 mm".to_owned()));
         assert_eq!(scale_bar(1.2e-3), (1e-4, "100 µm".to_owned()));

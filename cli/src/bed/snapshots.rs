@@ -27,7 +27,7 @@ use vtkio::model::{
     Version, VertexNumbers, Vtk,
 };
 
-use super::section::{Frame, SectionInput, section_svg};
+use super::section::{Frame, Quantity, SectionInput, section_svg};
 use crate::assembly::Assembly;
 use crate::model::OwnedReference;
 use crate::output::{create_file, finish_file, write_text};
@@ -337,7 +337,8 @@ fn section_input<'a>(
         granules: asm.granules().iter().map(|g| g.x.as_slice()).collect(),
         hexes: &mesh.hexes,
         quads: &mesh.quads,
-        axial_stress_pa: &elements.axial_stress_pa,
+        values: &elements.axial_stress_pa,
+        quantity: Quantity::AxialStress,
         frame: Frame::Die {
             radius_m: die_radius_m,
             upper_z_m,

@@ -94,6 +94,8 @@ Output, in --out DIR (created if missing; with --types in DIR/<TYPE>/ per type):
                           an octant mirrored), each hex coloured by its axial
                           stress -sigma_zz, between the platens (not written
                           for a run that failed)
+  section_density.svg     the same section coloured by the local relative
+                          density eta0/J
 With --types, also in DIR: types.csv (one row per type: sigma_y, eta0,
 sigma_eff0, sigma_est, the fit's slope and R^2, quasi_static_passed 1/0, steps,
 wall time, energy residual, return-map gap) and force_displacement_types.svg
@@ -468,20 +470,22 @@ impl GranuleArgs {
         write_outputs(&job.dir, &result, &summary)
             .with_context(|| format!("granule {name}: writing the outputs"))?;
         let title = format!(
-            "Granule {name} ({} {}) at {:.1} % strain: axial stress −σzz",
+            "Granule {name} ({} {}) at {:.1} % strain",
             summary.mesh,
             summary.symmetry,
             100.0 * result.samples.last().map_or(0.0, |s| s.strain)
         );
-        let section_path = job.dir.join(section::SECTION_SVG);
-        match section::granule_section_svg(mesh, &job.params, &result, &title)
-            .with_context(|| format!("granule {name}: the section picture"))?
-        {
-            Some(svg) => outputs::write_text(&section_path, &svg)?,
-            // A failed run has none; an earlier run's must not stand in.
-            None if section_path.is_file() => std::fs::remove_file(&section_path)
-                .with_context(|| format!("cannot remove `{}`", section_path.display()))?,
-            None => {}
+        let pictures = section::granule_sections(mesh, &job.params, &result, &title)
+            .with_context(|| format!("granule {name}: the section pictures"))?;
+        for file in [section::SECTION_SVG, section::DENSITY_SVG] {
+            let path = job.dir.join(file);
+            match pictures.iter().find(|(name, _)| *name == file) {
+                Some((_, svg)) => outputs::write_text(&path, svg)?,
+                // A failed run has none; an earlier run's must not stand in.
+                None if path.is_file() => std::fs::remove_file(&path)
+                    .with_context(|| format!("cannot remove `{}`", path.display()))?,
+                None => {}
+            }
         }
         // The rate check after the run's own outputs are written: a failed
         // check loses nothing.

@@ -1,6 +1,7 @@
-//! `section.svg` of `granbed-cli granule`: the granule at the end of its
-//! run cut through its centre by the plane y = 0, each hex coloured by its
-//! axial stress −σ_zz, between the two platens ([`crate::bed::section`]).
+//! `section.svg` and `section_density.svg` of `granbed-cli granule`: the
+//! granule at the end of its run cut through its centre by the plane
+//! y = 0, each hex coloured by its axial stress −σ_zz or its local relative
+//! density η0/J, between the two platens ([`crate::bed::section`]).
 //! An octant run is mirrored into the whole section: its copy in y < 0
 //! (the plane y = 0 is one of its symmetry planes, whose hexes the cut
 //! takes from the side below), turned into the four quarters ±x, ±z.
@@ -10,11 +11,13 @@ use granbed_kernel::granule::forces::{ElementStress, element_stresses};
 use granbed_kernel::scene::platens::{PlatenParams, Symmetry};
 
 use super::run::RunResult;
-use crate::bed::section::{Frame, SectionInput, section_svg};
+use crate::bed::section::{Frame, Quantity, SectionInput, section_svg};
 use crate::model::OwnedReference;
 
-/// File name of the section picture in the output directory.
+/// File name of the section picture coloured by axial stress.
 pub const SECTION_SVG: &str = "section.svg";
+/// File name of the section picture coloured by local relative density.
+pub const DENSITY_SVG: &str = "section_density.svg";
 
 /// The granule's node positions as the section takes them: the whole
 /// granule's `x` as it is, an octant's mirrored to y ≤ 0 and into the
@@ -29,20 +32,22 @@ pub fn section_copies(x: &[[Real; 3]], symmetry: Symmetry) -> Vec<Vec<[Real; 3]>
     }
 }
 
-/// The section picture of `result`'s final state (run with `params` on
-/// `mesh`) titled `title`; `None` for a run that stopped on an error (its
-/// last state is not one to show) or has no final state.
-pub fn granule_section_svg(
+/// The section pictures of `result`'s final state (run with `params` on
+/// `mesh`), each as (file name, SVG text): [`SECTION_SVG`], coloured by the
+/// axial stress, and [`DENSITY_SVG`], by the local relative density η0/J;
+/// titled `title` and the quantity. None for a run that stopped on an
+/// error (its last state is not one to show) or has no final state.
+pub fn granule_sections(
     mesh: &OwnedReference,
     params: &PlatenParams,
     result: &RunResult,
     title: &str,
-) -> anyhow::Result<Option<String>> {
+) -> anyhow::Result<Vec<(&'static str, String)>> {
     let (Some(last), None) = (result.samples.last(), &result.error) else {
-        return Ok(None);
+        return Ok(Vec::new());
     };
     if result.final_x.is_empty() {
-        return Ok(None);
+        return Ok(Vec::new());
     }
     let mut stresses = vec![ElementStress::default(); mesh.hexes.len()];
     element_stresses(
@@ -54,26 +59,45 @@ pub fn granule_section_svg(
         &mut stresses,
     )
     .map_err(|e| anyhow::anyhow!("the final state's element stresses: {e:?}"))?;
-    let axial: Vec<Real> = stresses.iter().map(|s| -s.sigma[2]).collect();
+    let eta0 = params.material.params.eta0;
     let copies = section_copies(&result.final_x, params.symmetry);
-    let values: Vec<Real> = axial.repeat(copies.len());
     let radius = result
         .final_x
         .iter()
         .map(|p| p[0].hypot(p[1]))
         .fold(0.0, Real::max);
-    let input = SectionInput {
-        granules: copies.iter().map(Vec::as_slice).collect(),
-        hexes: &mesh.hexes,
-        quads: &mesh.quads,
-        axial_stress_pa: &values,
-        frame: Frame::Platens {
-            half_width_m: 1.15 * radius,
-            half_height_m: 0.5 * (result.diameter_m - last.approach_m),
-        },
-        title: title.to_owned(),
+    let picture = |quantity: Quantity, name: &str, of: fn(&ElementStress, Real) -> Real| {
+        let values: Vec<Real> = stresses.iter().map(|s| of(s, eta0)).collect();
+        let values = values.repeat(copies.len());
+        section_svg(&SectionInput {
+            granules: copies.iter().map(Vec::as_slice).collect(),
+            hexes: &mesh.hexes,
+            quads: &mesh.quads,
+            values: &values,
+            quantity,
+            frame: Frame::Platens {
+                half_width_m: 1.15 * radius,
+                half_height_m: 0.5 * (result.diameter_m - last.approach_m),
+            },
+            title: format!("{title}: {name}"),
+        })
     };
-    Ok(Some(section_svg(&input)))
+    Ok(vec![
+        (
+            SECTION_SVG,
+            picture(Quantity::AxialStress, "axial stress −σzz", |s, _| {
+                -s.sigma[2]
+            }),
+        ),
+        (
+            DENSITY_SVG,
+            picture(
+                Quantity::RelativeDensity,
+                "local relative density η0/J",
+                |s, eta0| eta0 / s.j,
+            ),
+        ),
+    ])
 }
 
 #[cfg(test)]
