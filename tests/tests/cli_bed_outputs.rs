@@ -286,6 +286,21 @@ fn snapshots_plots_and_report() {
     assert!(html.trim_end().ends_with("</html>"));
     assert_eq!(html.matches("<svg").count(), 7);
     let s = summary(&dir);
+    // The final solid fraction is the last row's, and the material every
+    // parameter of the type (B2: E 1 MPa, true density 1500 kg/m³).
+    let rows = common::Table::read(&dir.join("compression.csv"));
+    assert_eq!(
+        s["final_solid_fraction"].as_f64().unwrap(),
+        *rows.num("bed_solid_fraction").last().unwrap()
+    );
+    assert_eq!(s["material"]["youngs_modulus_pa"], 1e6);
+    assert_eq!(s["material"]["true_density_kg_m3"], 1500.0);
+    assert_eq!(s["material"]["eta0"], s["eta0"]);
+    // The key results first, each plot captioned.
+    let key = html.find("<h2>Key results</h2>").expect("no key results");
+    assert!(key < html.find("<h2>Plots</h2>").unwrap());
+    assert!(html.contains("solid fraction D: poured (D0) → at the end, in the die"));
+    assert_eq!(html.matches("<p class=\"caption\">").count(), 7);
     for key in [
         "final_strain",
         "max_pressure_pa",

@@ -58,7 +58,8 @@ Output, in --out DIR (created if missing):
                    with C >= kawakita_min_strain, 0.25), Heckel fit of
                    ln(1/(1 - D)) = K P + A (yield pressure P_y = 1/K, A,
                    D_A = 1 - exp(-A), R^2, points; C >= heckel_min_strain,
-                   0.25), the poured bed's solid fraction D0, final strain,
+                   0.25), the poured bed's solid fraction D0 and the final
+                   D in the die, the material (every parameter), final strain,
                    max pressure, initial bed height, counts, wall time, ns per
                    element-step, cost figures (over the whole run,
                    resumed segments included), threads, min Jacobian, max nodal
@@ -93,8 +94,10 @@ Output, in --out DIR (created if missing):
                    coefficient against strain; Kawakita plot P/C vs P and
                    Heckel plot ln(1/(1 - D)) vs P, each with its fit; the
                    compaction profile, the bed's solid fraction D vs P
-  report.html      one page: the warnings, the plots, the sections, the summary
-                   table (rounded; hover a value for all its digits) and the scene
+  report.html      one page: the warnings (or that there are none), the key
+                   results, the plots with captions, the sections, the
+                   summary table (rounded; hover a value for all its digits)
+                   and the scene
   checkpoint.bin   the state to continue from with --resume (every
                    checkpoint_interval_minutes and checkpoint_strain_interval,
                    and at the end)

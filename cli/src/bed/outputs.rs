@@ -8,6 +8,7 @@ use anyhow::Context as _;
 use granbed_kernel::Real;
 use granbed_kernel::analysis::bed::{heckel_fit, heckel_usable};
 use granbed_kernel::analysis::quasi_static::LoadSample;
+use granbed_kernel::material::MaterialParams;
 use indicatif::ProgressBar;
 use serde::Serialize;
 
@@ -95,6 +96,44 @@ fn row(s: &BedSample, run: &BedRun) -> [Field; 29] {
     ]
 }
 
+/// The granule material of a run as `summary.json` records it: every
+/// parameter, the type's preset with the scene's overrides applied (what
+/// a methods section needs).
+#[derive(Clone, Copy, Debug, Serialize)]
+pub struct MaterialSummary {
+    /// Young's modulus E, Pa.
+    pub youngs_modulus_pa: Real,
+    /// Poisson's ratio ν.
+    pub poisson_ratio: Real,
+    /// Yield stress σ_y, Pa (`null`: ∞, purely elastic).
+    pub yield_stress_pa: Real,
+    /// Initial relative density η0.
+    pub eta0: Real,
+    /// Yield-surface constant c_p.
+    pub cp: Real,
+    /// Critical relative density η_c.
+    pub eta_c: Real,
+    /// True (solid) density, kg/m³.
+    pub true_density_kg_m3: Real,
+    /// Friction coefficient μ of the contacts.
+    pub friction: Real,
+}
+
+impl From<MaterialParams> for MaterialSummary {
+    fn from(m: MaterialParams) -> Self {
+        Self {
+            youngs_modulus_pa: m.youngs_modulus_pa,
+            poisson_ratio: m.poisson_ratio,
+            yield_stress_pa: m.yield_stress_pa,
+            eta0: m.eta0,
+            cp: m.cp,
+            eta_c: m.eta_c,
+            true_density_kg_m3: m.true_density_kg_m3,
+            friction: m.friction,
+        }
+    }
+}
+
 /// The Kawakita fit of `summary.json`.
 #[derive(Clone, Copy, Debug, Serialize)]
 pub struct KawakitaSummary {
@@ -173,6 +212,12 @@ pub struct Summary<'a> {
     /// The bed's solid fraction D0 at C = 0 (the poured bed: the granules'
     /// solid volume over the die volume below H0).
     pub initial_solid_fraction: Real,
+    /// The bed's solid fraction D at the final strain (in the die, under
+    /// load: D0/(1 − C)).
+    pub final_solid_fraction: Real,
+    /// The granule material, every parameter (`None` if the scene's is
+    /// invalid).
+    pub material: Option<MaterialSummary>,
     /// Yield stress of the granules as run (the type's, or the scene's
     /// override), Pa.
     pub yield_stress_pa: Real,
@@ -408,6 +453,8 @@ pub fn summary<'a>(scene: &'a Scene, run: &BedRun) -> Summary<'a> {
         heckel_yield_pressure_pa: heckel.yield_pressure_pa,
         heckel,
         initial_solid_fraction: bed_solid_fraction(run, 0.0),
+        final_solid_fraction: bed_solid_fraction(run, last.strain),
+        material: material.map(MaterialSummary::from),
         yield_stress_pa: material.map_or(Real::NAN, |m| m.yield_stress_pa),
         eta0: material.map_or(Real::NAN, |m| m.eta0),
         final_strain: last.strain,

@@ -13,7 +13,7 @@ use serde_json::Value;
 use super::outputs::Summary;
 use super::scene::{DEFAULT_SCENE, Scene};
 use super::snapshots::{PVD_FILE, VTK_DIR};
-use crate::numbers::significant;
+use crate::numbers::{short, significant};
 use crate::output::write_text;
 
 /// File name of the report in the output directory.
@@ -23,7 +23,7 @@ pub const REPORT_FILE: &str = "report.html";
 /// meaning; any other field follows (nested objects such as `kawakita` and
 /// `heckel` are flattened to `kawakita.<field>`; the scene, `scene` and
 /// `scene_toml`, is shown as TOML instead).
-const FIELDS: [(&str, &str); 68] = [
+const FIELDS: [(&str, &str); 77] = [
     ("kawakita_a", "Kawakita a (limiting strain)"),
     ("kawakita_inv_b_pa", "Kawakita 1/b, Pa"),
     (
@@ -55,8 +55,32 @@ const FIELDS: [(&str, &str); 68] = [
         "initial_solid_fraction",
         "the poured bed's solid fraction D0 (solid volume / die volume below H0)",
     ),
-    ("yield_stress_pa", "granule yield stress, Pa"),
-    ("eta0", "granule initial relative density η0"),
+    (
+        "final_solid_fraction",
+        "the bed's solid fraction D at the end, in the die under load",
+    ),
+    (
+        "material.youngs_modulus_pa",
+        "granule Young's modulus E, Pa",
+    ),
+    ("material.poisson_ratio", "granule Poisson's ratio ν"),
+    ("material.yield_stress_pa", "granule yield stress σ_y, Pa"),
+    ("material.eta0", "granule initial relative density η0"),
+    ("material.cp", "yield-surface constant c_p"),
+    ("material.eta_c", "critical relative density η_c"),
+    ("material.true_density_kg_m3", "true (solid) density, kg/m³"),
+    (
+        "material.friction",
+        "friction coefficient μ of every contact",
+    ),
+    (
+        "yield_stress_pa",
+        "granule yield stress, Pa (as material.yield_stress_pa)",
+    ),
+    (
+        "eta0",
+        "granule initial relative density η0 (as material.eta0)",
+    ),
     ("final_strain", "axial strain reached"),
     ("final_pressure_pa", "upper-punch pressure at the end, Pa"),
     (
@@ -302,9 +326,131 @@ pub(super) fn page_head(title: &str) -> String {
          td.value, td.num {{ font-family: monospace; }}\ntd.num {{ text-align: right; }}\n\
          tr.doubt td {{ background: #fff4e0; }}\n\
          figure {{ margin: 1em 0; }}\nfigure svg {{ max-width: 100%; height: auto; }}\n\
-         pre {{ background: #f4f4f4; padding: 0.8em; overflow-x: auto; }}\n</style>\n</head>\n<body>\n\
+         pre {{ background: #f4f4f4; padding: 0.8em; overflow-x: auto; }}\n\
+         p.caption {{ font-size: 0.9em; color: #444; margin-top: -0.4em; }}\n</style>\n</head>\n<body>\n\
          <h1>{title}</h1>\n"
     )
+}
+
+/// The run's key figures as a short table with units, for the top of the
+/// page (the full, unrounded set is the summary table below).
+fn key_results(summary: &Summary<'_>) -> String {
+    let n = |x: Option<f64>| x.map_or_else(|| "n/a".to_owned(), |x| significant(x, TABLE_DIGITS));
+    let kpa = |x: Option<f64>| n(x.map(|p| p * 1e-3));
+    let k = &summary.kawakita;
+    let rows = [
+        (
+            "Kawakita a (limiting strain; extrapolated past the strain reached)".to_owned(),
+            n(summary.kawakita_a),
+        ),
+        (
+            "Kawakita 1/b, kPa".to_owned(),
+            kpa(summary.kawakita_inv_b_pa),
+        ),
+        (
+            format!("Kawakita fit: rows with C ≥ {}, R²", short(k.min_strain)),
+            format!("{} rows, {}", k.points, n(k.r_squared)),
+        ),
+        (
+            "Heckel mean yield pressure P_y (upper punch, in the die), kPa".to_owned(),
+            kpa(summary.heckel_yield_pressure_pa),
+        ),
+        (
+            format!(
+                "Heckel fit: rows with C ≥ {}, R²",
+                short(summary.heckel.min_strain)
+            ),
+            format!(
+                "{} rows, {}",
+                summary.heckel.points,
+                n(summary.heckel.r_squared)
+            ),
+        ),
+        (
+            "solid fraction D: poured (D0) → at the end, in the die".to_owned(),
+            format!(
+                "{} → {}",
+                n(Some(summary.initial_solid_fraction)),
+                n(Some(summary.final_solid_fraction))
+            ),
+        ),
+        (
+            "upper-punch pressure at the end, kPa".to_owned(),
+            kpa(Some(summary.final_pressure_pa)),
+        ),
+        (
+            "coordination number Z at the end".to_owned(),
+            n(Some(summary.final_coordination)),
+        ),
+        (
+            "mean granule relative density at the end".to_owned(),
+            n(Some(summary.final_relative_density)),
+        ),
+        (
+            "quasi-static certificate".to_owned(),
+            if summary.quasi_static.passed {
+                "passed".to_owned()
+            } else {
+                "NOT passed".to_owned()
+            },
+        ),
+    ];
+    let mut h = String::from("<h2>Key results</h2>\n<table>\n");
+    for (what, value) in rows {
+        h.push_str(&format!(
+            "<tr><td>{}</td><td class=\"value\">{}</td></tr>\n",
+            html_escape(&what),
+            html_escape(&value)
+        ));
+    }
+    h.push_str("</table>\n");
+    h
+}
+
+/// What the plot `name` (a file of `plots/`) shows and how it was made,
+/// for its caption.
+fn plot_caption(name: &str, summary: &Summary<'_>) -> Option<String> {
+    let window = short;
+    Some(match name {
+        "pressure_strain.svg" => {
+            "The punches' pressures against the axial strain C = (H0 − H)/H0: \
+             force over the die's cross-section. Early on the lower punch carries the bed's \
+             weight, so its pressure can lie above the upper one's; later the die wall's friction \
+             keeps it below."
+                .to_owned()
+        }
+        "kawakita.svg" => format!(
+            "Kawakita's P/C against P (upper-punch pressure); filled: the rows fitted (C ≥ {}), \
+             rings: the others. The line's slope is 1/a and its intercept 1/(ab); a is the \
+             limiting strain, extrapolated beyond the strain reached, and the fit depends on its \
+             window (kawakita_min_strain).",
+            window(summary.kawakita.min_strain)
+        ),
+        "heckel.svg" => format!(
+            "Heckel's ln(1/(1 − D)) against the upper-punch pressure P, with D the bed's solid \
+             fraction in the die under load (compression.csv's bed_solid_fraction); filled: the \
+             rows fitted (C ≥ {}). P_y = 1/K, the slope's inverse.",
+            window(summary.heckel.min_strain)
+        ),
+        "coordination_strain.svg" => "The mean coordination number Z against the strain: \
+             granule–granule contacts per granule, and with the die and punch contacts counted \
+             too."
+            .to_owned(),
+        "relative_density_strain.svg" => "The granules' own relative density against the \
+             strain (their solid over their volume, without the voids between them): the mean \
+             of η0 V0/V over the granules, and the bed's total solid over the granules' total \
+             volume."
+            .to_owned(),
+        "heywood_strain.svg" => "The Heywood shape coefficient α_SV = d S/V (6 for a sphere) \
+             against the strain, with d the granule's volume-equivalent diameter d_V or its \
+             nominal diameter: how far the granules flatten."
+            .to_owned(),
+        "solid_fraction_pressure.svg" => "The compaction profile: the bed's solid fraction D \
+             (the granules' solid over the die volume below the upper punch) against the \
+             upper-punch pressure P."
+            .to_owned(),
+        _ => return None,
+    })
 }
 
 /// A plot inline: the SVG `svg`, captioned with a link to its file `href`
@@ -343,7 +489,13 @@ pub fn report_html(
             html_escape(e)
         )?;
     }
-    if !summary.warnings.is_empty() {
+    if summary.warnings.is_empty() {
+        writeln!(
+            h,
+            "<h2>Warnings</h2>\n<p>None: the run passed its checks (the quasi-static \
+             certificate, the overlaps, the elements, the fits).</p>"
+        )?;
+    } else {
         writeln!(
             h,
             "<h2>Warnings</h2>\n<p>What the figures below hide (also in summary.json and on \
@@ -354,6 +506,7 @@ pub fn report_html(
         }
         writeln!(h, "</ul>")?;
     }
+    h.push_str(&key_results(summary));
     writeln!(
         h,
         "<p>Files: <a href=\"compression.csv\">compression.csv</a>, \
@@ -372,14 +525,20 @@ pub fn report_html(
     )?;
     for (name, svg) in svgs {
         h.push_str(&figure(&format!("plots/{name}"), svg));
+        if let Some(caption) = plot_caption(name, summary) {
+            writeln!(h, "<p class=\"caption\">{}</p>", html_escape(&caption))?;
+        }
     }
     if !sections.is_empty() {
         writeln!(
             h,
             "<h2>Sections through the die axis</h2>\n<p>The bed cut by the plane y = 0 at each \
              snapshot: every hex the plane cuts, coloured by its axial stress −σ<sub>zz</sub> (the \
-             load runs along the bright chains from granule to granule), the granules' outlines, \
-             the die wall and the punches. The VTU snapshots beside them hold the whole bed.</p>"
+             load runs along the bright chains from granule to granule; red: tension), the \
+             granules' outlines, the die wall and the punches (the upper one moves down). The \
+             granules are all of one size: a small circle is a cut off their centre. Each \
+             picture has its own colour scale, up to the 99th percentile of its stresses. The \
+             VTU snapshots beside them hold the whole bed.</p>"
         )?;
         for path in sections {
             let path = html_escape(path);
@@ -513,6 +672,27 @@ mod tests {
             let row = Row::new("x".into(), "", &value);
             assert_eq!((row.full.as_str(), row.cell.as_str()), (text, text));
         }
+    }
+
+    /// A run without warnings says so rather than showing nothing.
+    #[test]
+    fn no_warnings_is_said() {
+        use crate::bed::run::{BedRun, BedSample};
+        let scene = Scene::published();
+        let samples = (0..40)
+            .map(|i| BedSample {
+                strain: 0.01 * f64::from(i),
+                upper_pressure_pa: 1e3 * f64::from(i),
+                ..BedSample::default()
+            })
+            .collect();
+        let run = BedRun::of_samples(samples);
+        let mut summary = crate::bed::outputs::summary(&scene, &run);
+        let some = report_html(&scene, &summary, &[], &[]).unwrap();
+        assert!(!summary.warnings.is_empty() && !some.contains("None: the run passed"));
+        summary.warnings.clear();
+        let none = report_html(&scene, &summary, &[], &[]).unwrap();
+        assert!(none.contains("<h2>Warnings</h2>\n<p>None: the run passed its checks"));
     }
 
     #[test]

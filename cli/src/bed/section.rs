@@ -124,6 +124,18 @@ pub fn viridis(t: Real) -> String {
     format!("#{:02x}{:02x}{:02x}", c[0], c[1], c[2])
 }
 
+/// A tension's colour at `t` ∈ [0, 1] (clamped): light to deep red.
+pub fn tension_red(t: Real) -> String {
+    let t = if t.is_nan() { 0.0 } else { t.clamp(0.0, 1.0) };
+    let mix = |a: Real, b: Real| (a + t * (b - a)).round() as u8;
+    format!(
+        "#{:02x}{:02x}{:02x}",
+        mix(251.0, 165.0),
+        mix(180.0, 15.0),
+        mix(180.0, 21.0)
+    )
+}
+
 /// What a section picture shows.
 pub struct SectionInput<'a> {
     /// Node positions of each granule, m.
@@ -178,6 +190,16 @@ impl Quantity {
         }
     }
 
+    /// The colour of `value` on the scale (lo, hi): viridis; an axial
+    /// tension beyond 1 % of `hi` in reds instead, by its size against
+    /// `hi` (a smaller one, round-off in an unloaded bed, is no load).
+    fn colour(self, value: Real, lo: Real, hi: Real) -> String {
+        match self {
+            Quantity::AxialStress if value < -0.01 * hi => tension_red(-value / hi),
+            _ => viridis((value - lo) / (hi - lo)),
+        }
+    }
+
     /// The colour bar's name, the value of its unit (Pa per kPa, say) for
     /// a scale up to `hi`, and the picture's footnote.
     fn legend(self, hi: Real) -> (String, Real, &'static str) {
@@ -187,7 +209,7 @@ impl Quantity {
                 (
                     format!("−σzz, {unit}"),
                     per,
-                    "darkest: no compression; grey: no value; the scale ends at the 99th percentile",
+                    "darkest: no load; red: tension; grey: no value; the scale ends at the 99th percentile",
                 )
             }
             Quantity::RelativeDensity => (
@@ -343,7 +365,7 @@ pub fn section_svg(input: &SectionInput<'_>) -> String {
     );
     // The hexes, then the granules' outlines over them.
     for (polygon, value) in &cuts {
-        let colour = viridis((value - lo) / (hi - lo));
+        let colour = input.quantity.colour(*value, lo, hi);
         let points: Vec<String> = polygon
             .iter()
             .map(|p| format!("{:.1},{:.1}", px(p[0]), pz(p[1])))
@@ -550,6 +572,14 @@ mod tests {
         assert_eq!(viridis(7.0), "#fde725");
         assert_eq!(viridis(-1.0), "#440154");
         assert_eq!(viridis(Real::NAN), "#999999");
+        // Tension in reds, compression and no load in viridis.
+        let q = Quantity::AxialStress;
+        assert_eq!(q.colour(-1e3, 0.0, 1e3), "#a50f15");
+        assert_eq!(q.colour(-1e9, 0.0, 1e3), "#a50f15");
+        assert_eq!(q.colour(0.0, 0.0, 1e3), "#440154");
+        assert_eq!(q.colour(-5.0, 0.0, 1e3), "#440154");
+        assert_eq!(q.colour(1e3, 0.0, 1e3), "#fde725");
+        assert_eq!(Quantity::RelativeDensity.colour(-1.0, 0.5, 1.0), "#440154");
         // One extreme element does not set the scale.
         let mut v: Vec<Real> = (1..=1000).map(Real::from).collect();
         v.push(1e9);
