@@ -89,7 +89,8 @@ fn each_seed_is_its_own_run_and_the_spread_is_of_their_figures() {
         "rows: {report}"
     );
     assert!(report.contains("<h2>Spread over the runs</h2>"));
-    assert_eq!(report.matches("<svg").count(), 2);
+    assert_eq!(report.matches("<svg").count(), 3);
+    assert!(dir.join("seeds_profile.svg").is_file());
 
     let spread = Table::read(&dir.join("seeds_spread.csv"));
     let figures = spread.text("figure");

@@ -119,9 +119,9 @@ fn three_types_from_one_pour_are_ordered_by_yield_stress() {
         "the scene's type is listed"
     );
     assert_eq!(json["types"].as_array().unwrap().len(), 3);
-    // The series' page: both plots inline, one linked row per type.
+    // The series' page: the three overlays inline, one linked row per type.
     let report = std::fs::read_to_string(dir.join("report.html")).unwrap();
-    assert_eq!(report.matches("<svg").count(), 2);
+    assert_eq!(report.matches("<svg").count(), 3);
     for t in TYPES {
         assert!(
             report.contains(&format!("<tr><td><a href=\"{t}/report.html\">{t}</a>"))
@@ -131,7 +131,11 @@ fn three_types_from_one_pour_are_ordered_by_yield_stress() {
             "report.html lacks the row of {t}"
         );
     }
-    for name in ["comparison_pressure.svg", "comparison_density.svg"] {
+    for name in [
+        "comparison_pressure.svg",
+        "comparison_density.svg",
+        "comparison_profile.svg",
+    ] {
         let svg = std::fs::read_to_string(dir.join(name)).unwrap();
         assert!(svg.starts_with("<svg"), "{name}");
         // Each type's legend, marked as its row of the table says.

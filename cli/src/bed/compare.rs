@@ -1,9 +1,10 @@
 //! The comparison of `granbed-cli bed --types`: several granule types
 //! compressed from the same poured bed, one row per type in
 //! `comparison.csv` and `comparison.json`, and the overlaid plots
-//! `comparison_pressure.svg` (P against C) and `comparison_density.svg`
-//! (mean granule relative density against C), and the series'
-//! `report.html` ([`super::series_report`]).
+//! `comparison_pressure.svg` (P against C), `comparison_density.svg`
+//! (mean granule relative density against C) and `comparison_profile.svg`
+//! (the compaction profile, the bed's solid fraction D against P), and the
+//! series' `report.html` ([`super::series_report`]).
 
 use std::path::Path;
 
@@ -12,9 +13,11 @@ use granbed_kernel::Real;
 use granbed_kernel::material::GranuleType;
 use serde::Serialize;
 
+use super::outputs::heckel_rows;
 use super::outputs::{KawakitaSummary, Summary, fit_linear, kawakita_doubts};
 use super::plots::overlay_svg;
-use super::run::BedSample;
+use super::plots::profile_svg;
+use super::run::{BedRun, BedSample};
 use super::series_report::{SeriesReport, write_series_report};
 use crate::csv::{CsvWriter, Field};
 use crate::output::{create_file, finish_file, write_json, write_text};
@@ -27,6 +30,8 @@ pub const COMPARISON_JSON: &str = "comparison.json";
 pub const PRESSURE_SVG: &str = "comparison_pressure.svg";
 /// File name of the overlaid relative-density plot.
 pub const DENSITY_SVG: &str = "comparison_density.svg";
+/// File name of the overlaid compaction profiles (D against P).
+pub const PROFILE_SVG: &str = "comparison_profile.svg";
 
 /// Columns of [`COMPARISON_CSV`], in order (`NaN` where the summary has
 /// `null`, e.g. no Kawakita fit for a run that ended before its window).
@@ -206,13 +211,13 @@ pub struct Comparison<'a> {
     pub types: &'a [ComparisonRow],
 }
 
-/// Writes [`COMPARISON_CSV`], [`COMPARISON_JSON`], [`PRESSURE_SVG`] and
-/// [`DENSITY_SVG`] into `dir`: `rows` and `samples` are per type, in the
-/// same order.
+/// Writes [`COMPARISON_CSV`], [`COMPARISON_JSON`], [`PRESSURE_SVG`],
+/// [`DENSITY_SVG`] and [`PROFILE_SVG`] into `dir`: the rows and `runs`
+/// are per type, in the same order.
 pub fn write_comparison(
     dir: &Path,
     comparison: &Comparison<'_>,
-    samples: &[&[BedSample]],
+    runs: &[&BedRun],
 ) -> anyhow::Result<()> {
     write_rows(&dir.join(COMPARISON_CSV), comparison.types)?;
     write_json(&dir.join(COMPARISON_JSON), comparison)?;
@@ -226,7 +231,13 @@ pub fn write_comparison(
         "by granule type (one pour, sphere density of {})",
         comparison.pour_granule_type
     );
-    let svgs = write_overlays(dir, [PRESSURE_SVG, DENSITY_SVG], &labels, samples, &suffix)?;
+    let svgs = write_overlays(
+        dir,
+        [PRESSURE_SVG, DENSITY_SVG, PROFILE_SVG],
+        &labels,
+        runs,
+        &suffix,
+    )?;
     let names: Vec<&str> = comparison.types.iter().map(|r| r.granule_type).collect();
     write_series_report(
         dir,
@@ -257,20 +268,22 @@ pub fn write_rows(path: &Path, rows: &[ComparisonRow]) -> anyhow::Result<()> {
     finish_file(csv.into_inner(), path)
 }
 
-/// Writes the overlaid plots `[pressure, density]` (file names in `dir`)
-/// of the runs' `samples`, one curve per run named by `labels`, the titles
-/// ending with `suffix`; returns them as (file name, SVG text).
+/// Writes the overlaid plots `[pressure, density, profile]` (file names
+/// in `dir`) of the `runs`, one curve per run named by `labels`, the
+/// titles ending with `suffix`; returns them as (file name, SVG text). The
+/// profile, D against P, is what tells the runs apart: against the strain
+/// every bed's D is D0/(1 − C).
 pub fn write_overlays<'a>(
     dir: &Path,
-    [pressure_file, density_file]: [&'a str; 2],
+    [pressure_file, density_file, profile_file]: [&'a str; 3],
     labels: &[&str],
-    samples: &[&[BedSample]],
+    runs: &[&BedRun],
     suffix: &str,
-) -> anyhow::Result<[(&'a str, String); 2]> {
+) -> anyhow::Result<[(&'a str, String); 3]> {
     let curves: Vec<(&str, &[BedSample])> = labels
         .iter()
         .copied()
-        .zip(samples.iter().copied())
+        .zip(runs.iter().map(|r| r.samples.as_slice()))
         .collect();
     let pressure = overlay_svg(
         &format!("Upper-punch pressure {suffix}"),
@@ -286,7 +299,21 @@ pub fn write_overlays<'a>(
         |s| s.relative_density_mean,
         false,
     )?;
-    let svgs = [(pressure_file, pressure), (density_file, density)];
+    let profiles: Vec<(&str, Vec<(f64, f64)>)> = labels
+        .iter()
+        .copied()
+        .zip(runs)
+        .map(|(label, run)| {
+            let points = heckel_rows(run).map(|(p, d, _)| (p * 1e-3, d)).collect();
+            (label, points)
+        })
+        .collect();
+    let profile = profile_svg(&format!("Compaction profile {suffix}"), &profiles)?;
+    let svgs = [
+        (pressure_file, pressure),
+        (density_file, density),
+        (profile_file, profile),
+    ];
     for (name, svg) in &svgs {
         write_text(&dir.join(name), svg)?;
     }

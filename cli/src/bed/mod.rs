@@ -124,9 +124,10 @@ alone with --resume DIR/<TYPE>), and DIR holds the comparison:
                    material figure, 0 if absent or warned about (summary.json
                    says why)
   comparison.json  the same rows, the errors, and the type of the pour
-  comparison_pressure.svg, comparison_density.svg
+  comparison_pressure.svg, comparison_density.svg, comparison_profile.svg
                    upper-punch pressure and mean relative density against
-                   strain, one curve per type
+                   strain, and the compaction profile D against P (what
+                   tells the types apart), one curve per type
   report.html      one page: the plots, a row per type linked to its report
                    (pressures in kPa, rejected fits marked), what to doubt
   series.json      the series (types, scene, the pour) for --resume DIR
@@ -139,7 +140,7 @@ run-to-run spread:
                    fit, or a fit the run's summary warns about), mean, sample
                    standard deviation, min, max, spread = max - min
   seeds.json       both tables
-  seeds_pressure.svg, seeds_density.svg
+  seeds_pressure.svg, seeds_density.svg, seeds_profile.svg
                    one curve per seed
   report.html      as for --types, with the spread as a second table
   series.json      the series (seeds, scene) for --resume DIR
@@ -960,14 +961,14 @@ fn write_types_tables(
             ))
         })
         .collect::<anyhow::Result<_>>()?;
-    let samples: Vec<&[run::BedSample]> = runs.iter().map(|r| r.samples.as_slice()).collect();
+    let run_refs: Vec<&run::BedRun> = runs.iter().collect();
     let comparison = compare::Comparison {
         version: env!("CARGO_PKG_VERSION"),
         pour_granule_type: pour_type.name(),
         pour_wall_time_s,
         types: &rows,
     };
-    compare::write_comparison(dir, &comparison, &samples)
+    compare::write_comparison(dir, &comparison, &run_refs)
 }
 
 /// One run of a series (`--types`, `--seeds`): what it is called in

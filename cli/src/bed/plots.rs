@@ -69,6 +69,23 @@ pub fn overlay_svg(
     )
 }
 
+/// The compaction profile of each run (label, its (P in kPa, D) points):
+/// the bed's solid fraction D against the upper-punch pressure P, under
+/// `title`.
+pub fn profile_svg(title: &str, runs: &[(&str, Vec<(f64, f64)>)]) -> anyhow::Result<String> {
+    let series: Vec<Series> = runs
+        .iter()
+        .map(|(label, points)| Series::new(*label, Mark::Line, points.iter().copied()))
+        .collect();
+    xy_svg(
+        title,
+        "upper-punch pressure P, kPa",
+        "bed solid fraction D",
+        &series,
+        false,
+    )
+}
+
 /// Two curves (label, value) of the samples against the strain, the
 /// second dashed, so that both show where they lie on each other (the
 /// two relative densities of a bed of one granule size nearly do).
@@ -262,10 +279,9 @@ pub fn plots(
         profile_f,
     ] = PLOT_FILES;
     // Unlabelled: the title and axes say what the one curve is (no legend).
-    let profile = [Series::new(
+    let profile = [(
         "",
-        Mark::Line,
-        heckel_rows(run).map(|(p, d, _)| (p * 1e-3, d)),
+        heckel_rows(run).map(|(p, d, _)| (p * 1e-3, d)).collect(),
     )];
     Ok([
         (
@@ -300,13 +316,7 @@ pub fn plots(
         ),
         (
             profile_f,
-            xy_svg(
-                "Compaction profile: the bed's solid fraction",
-                "upper-punch pressure P, kPa",
-                "bed solid fraction D",
-                &profile,
-                false,
-            )?,
+            profile_svg("Compaction profile: the bed's solid fraction", &profile)?,
         ),
     ])
 }

@@ -32,7 +32,11 @@ pub const SPREAD_CSV: &str = "seeds_spread.csv";
 /// File name of both tables as JSON.
 pub const SEEDS_JSON: &str = "seeds.json";
 /// File names of the overlaid pressure and density plots.
-pub const SEEDS_SVG: [&str; 2] = ["seeds_pressure.svg", "seeds_density.svg"];
+pub const SEEDS_SVG: [&str; 3] = [
+    "seeds_pressure.svg",
+    "seeds_density.svg",
+    "seeds_profile.svg",
+];
 
 /// The most seeds one command takes (each is a whole run).
 pub const MAX_SEEDS: usize = 100;
@@ -156,11 +160,11 @@ pub struct SeedComparison<'a> {
 }
 
 /// Writes [`SEEDS_CSV`], [`SPREAD_CSV`], [`SEEDS_JSON`] and [`SEEDS_SVG`]
-/// into `dir`; `rows` and `samples` per seed, in the same order.
+/// into `dir`; `rows` and `runs` per seed, in the same order.
 pub fn write_seeds(
     dir: &std::path::Path,
     rows: &[ComparisonRow],
-    samples: &[&[run::BedSample]],
+    runs: &[&run::BedRun],
 ) -> anyhow::Result<()> {
     write_rows(&dir.join(SEEDS_CSV), rows)?;
     let spreads: Vec<Spread> = SPREAD_FIGURES
@@ -201,7 +205,7 @@ pub fn write_seeds(
     let suffix = rows.first().map_or(String::new(), |r| {
         format!("by seed ({} granules, one pour each)", r.granule_type)
     });
-    let svgs = write_overlays(dir, SEEDS_SVG, &labels, samples, &suffix)?;
+    let svgs = write_overlays(dir, SEEDS_SVG, &labels, runs, &suffix)?;
     let granule_type = rows.first().map_or("", |r| r.granule_type);
     write_series_report(
         dir,
@@ -294,8 +298,8 @@ pub(super) fn write_seed_tables(
             Ok(ComparisonRow::new(t, &outputs::summary(scene, r)))
         })
         .collect::<anyhow::Result<_>>()?;
-    let samples: Vec<&[run::BedSample]> = runs.iter().map(|r| r.samples.as_slice()).collect();
-    write_seeds(dir, &rows, &samples)
+    let run_refs: Vec<&run::BedRun> = runs.iter().collect();
+    write_seeds(dir, &rows, &run_refs)
 }
 
 #[cfg(test)]

@@ -327,6 +327,7 @@ fn series_files(dir: &Path) -> Vec<PathBuf> {
         compare::COMPARISON_JSON,
         compare::PRESSURE_SVG,
         compare::DENSITY_SVG,
+        compare::PROFILE_SVG,
         seeds::SEEDS_CSV,
         seeds::SPREAD_CSV,
         seeds::SEEDS_JSON,
