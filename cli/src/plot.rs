@@ -162,6 +162,47 @@ fn plain_labels(r: &Range<f64>) -> impl Fn(&f64) -> String + use<> {
     }
 }
 
+/// The corner of the plot for the legend: the one whose region (a third
+/// of the width, up to 40 % of the height for `entries` lines) holds the
+/// fewest points of `series` over the axes `x` and `y`; the upper left on
+/// a tie.
+fn legend_corner(
+    series: &[Series],
+    x: &Range<f64>,
+    y: &Range<f64>,
+    entries: usize,
+) -> SeriesLabelPosition {
+    let height = (0.08 * entries as f64 + 0.06).min(0.4);
+    let (w, h) = (x.end - x.start, y.end - y.start);
+    let inside = |(px, py): (f64, f64), left: bool, upper: bool| {
+        let fx = (px - x.start) / w;
+        let fy = (py - y.start) / h;
+        (if left { fx <= 0.34 } else { fx >= 0.66 })
+            && (if upper {
+                fy >= 1.0 - height
+            } else {
+                fy <= height
+            })
+    };
+    [
+        (SeriesLabelPosition::UpperLeft, true, true),
+        (SeriesLabelPosition::UpperRight, false, true),
+        (SeriesLabelPosition::LowerRight, false, false),
+        (SeriesLabelPosition::LowerLeft, true, false),
+    ]
+    .into_iter()
+    .map(|(corner, left, upper)| {
+        let count = series
+            .iter()
+            .flat_map(|s| s.points.iter())
+            .filter(|&&p| inside(p, left, upper))
+            .count();
+        (count, corner)
+    })
+    .min_by_key(|(count, _)| *count)
+    .map_or(SeriesLabelPosition::UpperLeft, |(_, corner)| corner)
+}
+
 /// The SVG text of `series` under `title`, with axis labels.
 pub fn xy_svg(
     title: &str,
@@ -249,10 +290,11 @@ pub fn xy_svg(
         // single curve that the title and axes name). A single labelled
         // curve keeps it: a one-member series' "(failed)" is said there.
         if series.len() > 1 || series.iter().any(|s| !s.label.is_empty()) {
+            let corner = legend_corner(series, &x_range, &y_range, series.len());
             chart
                 .configure_series_labels()
                 .label_font(("sans-serif", 13))
-                .position(SeriesLabelPosition::UpperLeft)
+                .position(corner)
                 .background_style(WHITE.mix(0.85))
                 .border_style(BLACK)
                 .draw()?;
@@ -265,6 +307,31 @@ pub fn xy_svg(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The legend goes to the emptiest corner: the upper left for a
+    /// rising curve, elsewhere when the points crowd it.
+    #[test]
+    fn the_legend_avoids_the_points() {
+        let (x, y) = (0.0..10.0, 0.0..10.0);
+        let corner = |points: Vec<(f64, f64)>| {
+            legend_corner(
+                &[Series::new("s", Mark::Dots, points.into_iter())],
+                &x,
+                &y,
+                3,
+            )
+        };
+        let rising: Vec<(f64, f64)> = (0..=10).map(|i| (f64::from(i), f64::from(i))).collect();
+        assert!(matches!(corner(rising), SeriesLabelPosition::UpperLeft));
+        // Falling from the upper left, with a cluster in the upper right
+        // (a Kawakita plot's early rows, say): the lower left is free.
+        let mut crowded: Vec<(f64, f64)> = (0..=10)
+            .map(|i| (f64::from(i), 10.0 - f64::from(i)))
+            .collect();
+        crowded.extend((0..5).map(|i| (9.0 + 0.1 * f64::from(i), 9.5)));
+        crowded.extend((0..5).map(|i| (8.0 + 0.1 * f64::from(i), 0.5)));
+        assert!(matches!(corner(crowded), SeriesLabelPosition::LowerLeft));
+    }
 
     /// A single curve has a legend only if it is labelled: a one-member
     /// series' "(failed)" is said there.
