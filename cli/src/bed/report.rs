@@ -332,16 +332,24 @@ pub(super) fn page_head(title: &str) -> String {
     )
 }
 
+/// A float of the table: `x` to [`TABLE_DIGITS`] digits, "n/a" if none.
+pub(super) fn num(x: Option<f64>) -> String {
+    x.map_or_else(|| "n/a".to_owned(), |x| significant(x, TABLE_DIGITS))
+}
+
+/// A pressure of the table in kPa, from Pa.
+pub(super) fn kpa(x: Option<f64>) -> String {
+    num(x.map(|p| p * 1e-3))
+}
+
 /// The run's key figures as a short table with units, for the top of the
 /// page (the full, unrounded set is the summary table below).
 fn key_results(summary: &Summary<'_>) -> String {
-    let n = |x: Option<f64>| x.map_or_else(|| "n/a".to_owned(), |x| significant(x, TABLE_DIGITS));
-    let kpa = |x: Option<f64>| n(x.map(|p| p * 1e-3));
     let k = &summary.kawakita;
     let rows = [
         (
             "Kawakita a (limiting strain; extrapolated past the strain reached)".to_owned(),
-            n(summary.kawakita_a),
+            num(summary.kawakita_a),
         ),
         (
             "Kawakita 1/b, kPa".to_owned(),
@@ -349,7 +357,7 @@ fn key_results(summary: &Summary<'_>) -> String {
         ),
         (
             format!("Kawakita fit: rows with C ≥ {}, R²", short(k.min_strain)),
-            format!("{} rows, {}", k.points, n(k.r_squared)),
+            format!("{} rows, {}", k.points, num(k.r_squared)),
         ),
         (
             "Heckel mean yield pressure P_y (upper punch, in the die), kPa".to_owned(),
@@ -363,15 +371,15 @@ fn key_results(summary: &Summary<'_>) -> String {
             format!(
                 "{} rows, {}",
                 summary.heckel.points,
-                n(summary.heckel.r_squared)
+                num(summary.heckel.r_squared)
             ),
         ),
         (
             "solid fraction D: poured (D0) → at the end, in the die".to_owned(),
             format!(
                 "{} → {}",
-                n(Some(summary.initial_solid_fraction)),
-                n(Some(summary.final_solid_fraction))
+                num(Some(summary.initial_solid_fraction)),
+                num(Some(summary.final_solid_fraction))
             ),
         ),
         (
@@ -380,11 +388,11 @@ fn key_results(summary: &Summary<'_>) -> String {
         ),
         (
             "coordination number Z at the end".to_owned(),
-            n(Some(summary.final_coordination)),
+            num(Some(summary.final_coordination)),
         ),
         (
             "mean granule relative density at the end".to_owned(),
-            n(Some(summary.final_relative_density)),
+            num(Some(summary.final_relative_density)),
         ),
         (
             "quasi-static certificate".to_owned(),
@@ -606,14 +614,10 @@ pub fn write_report(
 mod tests {
     use super::*;
 
-    /// Every row of the summary table says what it is, whether the
-    /// overlap by geometry was measured or not, and the scene is not a row
-    /// (it is shown as TOML below the table).
-    #[test]
-    fn every_row_has_a_meaning_and_the_scene_is_no_row() {
-        use crate::assembly::overlap::Overlap;
-        use crate::bed::run::{BedRun, BedSample, HiddenOverlap};
-        let scene = Scene::published();
+    /// A run of 40 output rows to C = 0.39, the pressure rising 1 kPa per
+    /// row, the elements sound.
+    fn loading_run() -> crate::bed::run::BedRun {
+        use crate::bed::run::{BedRun, BedSample};
         let samples = (0..40)
             .map(|i| BedSample {
                 strain: 0.01 * f64::from(i),
@@ -623,7 +627,18 @@ mod tests {
                 ..BedSample::default()
             })
             .collect();
-        let mut run = BedRun::of_samples(samples);
+        BedRun::of_samples(samples)
+    }
+
+    /// Every row of the summary table says what it is, whether the
+    /// overlap by geometry was measured or not, and the scene is not a row
+    /// (it is shown as TOML below the table).
+    #[test]
+    fn every_row_has_a_meaning_and_the_scene_is_no_row() {
+        use crate::assembly::overlap::Overlap;
+        use crate::bed::run::HiddenOverlap;
+        let scene = Scene::published();
+        let mut run = loading_run();
         for measured in [false, true] {
             if measured {
                 run.hidden_overlap = Some(HiddenOverlap {
@@ -677,16 +692,8 @@ mod tests {
     /// A run without warnings says so rather than showing nothing.
     #[test]
     fn no_warnings_is_said() {
-        use crate::bed::run::{BedRun, BedSample};
         let scene = Scene::published();
-        let samples = (0..40)
-            .map(|i| BedSample {
-                strain: 0.01 * f64::from(i),
-                upper_pressure_pa: 1e3 * f64::from(i),
-                ..BedSample::default()
-            })
-            .collect();
-        let run = BedRun::of_samples(samples);
+        let run = loading_run();
         let mut summary = crate::bed::outputs::summary(&scene, &run);
         let some = report_html(&scene, &summary, &[], &[]).unwrap();
         assert!(!summary.warnings.is_empty() && !some.contains("None: the run passed"));

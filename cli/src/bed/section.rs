@@ -173,13 +173,10 @@ impl Quantity {
         match self {
             Quantity::AxialStress => (0.0, scale_top(values)),
             Quantity::RelativeDensity => {
-                let mut v: Vec<Real> = values.filter(|v| v.is_finite()).collect();
-                v.sort_by(Real::total_cmp);
-                let at = |q: Real| v[((v.len() - 1) as Real * q).round() as usize];
-                let (lo, hi) = if v.is_empty() {
-                    (0.0, 1.0)
-                } else {
-                    (at(0.01), at(0.99))
+                let v = sorted(values.filter(|v| v.is_finite()));
+                let (lo, hi) = match (percentile(&v, 0.01), percentile(&v, 0.99)) {
+                    (Some(lo), Some(hi)) => (lo, hi),
+                    _ => (0.0, 1.0),
                 };
                 if hi - lo < 1e-3 {
                     (lo - 5e-4, hi + 5e-4)
@@ -288,15 +285,10 @@ fn cut_hexes(input: &SectionInput<'_>) -> Vec<(Vec<[Real; 2]>, Real)> {
     let mut out = Vec::new();
     for (g, x) in input.granules.iter().enumerate() {
         for (h, hex) in input.hexes.iter().enumerate() {
-            let corner = |i: usize| x.get(hex[i] as usize).copied();
-            let Some(corners) = (0..8)
-                .map(corner)
-                .collect::<Option<Vec<_>>>()
-                .and_then(|c| <[[Real; 3]; 8]>::try_from(c).ok())
-            else {
+            if hex.iter().any(|&n| n as usize >= x.len()) {
                 continue;
-            };
-            if let Some(polygon) = cut_hex(&corners) {
+            }
+            if let Some(polygon) = cut_hex(&hex.map(|n| x[n as usize])) {
                 let value = input
                     .values
                     .get(g * per_granule + h)
@@ -313,13 +305,22 @@ fn cut_hexes(input: &SectionInput<'_>) -> Vec<(Vec<[Real; 2]>, Real)> {
 /// positive stresses (so that one extreme element does not wash the
 /// picture out), at least 1 Pa.
 fn scale_top(values: impl Iterator<Item = Real>) -> Real {
-    let mut v: Vec<Real> = values.filter(|v| v.is_finite() && *v > 0.0).collect();
-    if v.is_empty() {
-        return 1.0;
-    }
+    let v = sorted(values.filter(|v| v.is_finite() && *v > 0.0));
+    percentile(&v, 0.99).map_or(1.0, |top| top.max(1.0))
+}
+
+/// `values` in ascending order.
+fn sorted(values: impl Iterator<Item = Real>) -> Vec<Real> {
+    let mut v: Vec<Real> = values.collect();
     v.sort_by(Real::total_cmp);
-    let i = ((v.len() - 1) as Real * 0.99).round() as usize;
-    v[i].max(1.0)
+    v
+}
+
+/// The `q`-quantile of the ascending `sorted` (the nearest rank), or
+/// `None` if it is empty.
+fn percentile(sorted: &[Real], q: Real) -> Option<Real> {
+    let last = sorted.len().checked_sub(1)?;
+    sorted.get((last as Real * q).round() as usize).copied()
 }
 
 /// The colour bar's unit for a scale up to `vmax` Pa: kPa, or Pa below

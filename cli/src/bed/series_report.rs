@@ -10,9 +10,8 @@ use core::fmt::Write as _;
 use std::path::Path;
 
 use super::compare::ComparisonRow;
-use super::report::{REPORT_FILE, TABLE_DIGITS, figure, html_escape, page_head};
+use super::report::{REPORT_FILE, TABLE_DIGITS, figure, html_escape, kpa, num, page_head};
 use super::seeds::Spread;
-use crate::numbers::significant;
 use crate::output::write_text;
 
 /// What a series' page shows.
@@ -32,16 +31,6 @@ pub struct SeriesReport<'a> {
     pub files: &'a [&'a str],
     /// The overlaid plots: file name in the series directory, SVG text.
     pub svgs: &'a [(&'a str, String)],
-}
-
-/// A float of the table: `x` to [`TABLE_DIGITS`] digits, "n/a" if none.
-fn num(x: Option<f64>) -> String {
-    x.map_or_else(|| "n/a".to_owned(), |x| significant(x, TABLE_DIGITS))
-}
-
-/// A pressure of the table in kPa, from Pa.
-fn kpa(x: Option<f64>) -> String {
-    num(x.map(|p| p * 1e-3))
 }
 
 /// A fit's cell: its figure `value` (`None`: no fit, the run did not reach

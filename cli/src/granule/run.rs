@@ -96,7 +96,8 @@ pub fn run_platens(
         element_steps,
         wall_time_s,
         error,
-        final_x: store.granule.x.clone(),
-        final_cp_inv: store.granule.cp_inv.clone(),
+        // The store goes out of scope here: its final state is moved.
+        final_x: core::mem::take(&mut store.granule.x),
+        final_cp_inv: core::mem::take(&mut store.granule.cp_inv),
     })
 }
