@@ -7,7 +7,9 @@
 //! rejection names the flag as well as the field and its allowed range.
 
 use clap::Args;
+use granbed_kernel::Real;
 use granbed_kernel::material::{GranuleType, Material, MaterialParams, ParamError};
+use serde::Serialize;
 
 use crate::error::InputError;
 
@@ -189,6 +191,46 @@ pub fn check_type_overrides(
             replaced.join("; ")
         )
     }))
+}
+
+/// The granule material of a run as a `summary.json` records it (`bed`'s
+/// as `material`, `granule`'s flattened into its fields): every parameter,
+/// the type's preset with the overrides applied (what a methods section
+/// needs).
+#[derive(Clone, Copy, Debug, Serialize)]
+pub struct MaterialSummary {
+    /// Young's modulus E, Pa.
+    pub youngs_modulus_pa: Real,
+    /// Poisson's ratio ν.
+    pub poisson_ratio: Real,
+    /// Yield stress σ_y, Pa (`null`: ∞, purely elastic).
+    pub yield_stress_pa: Real,
+    /// Initial relative density η0.
+    pub eta0: Real,
+    /// Yield-surface constant c_p.
+    pub cp: Real,
+    /// Critical relative density η_c.
+    pub eta_c: Real,
+    /// True (solid) density, kg/m³.
+    pub true_density_kg_m3: Real,
+    /// Friction coefficient μ of the contacts (`granule`: of the
+    /// granule–platen contact).
+    pub friction: Real,
+}
+
+impl From<MaterialParams> for MaterialSummary {
+    fn from(m: MaterialParams) -> Self {
+        Self {
+            youngs_modulus_pa: m.youngs_modulus_pa,
+            poisson_ratio: m.poisson_ratio,
+            yield_stress_pa: m.yield_stress_pa,
+            eta0: m.eta0,
+            cp: m.cp,
+            eta_c: m.eta_c,
+            true_density_kg_m3: m.true_density_kg_m3,
+            friction: m.friction,
+        }
+    }
 }
 
 #[cfg(test)]

@@ -4,11 +4,11 @@
 
 use std::path::Path;
 
+use crate::material_args::MaterialSummary;
 use anyhow::Context as _;
 use granbed_kernel::Real;
 use granbed_kernel::analysis::bed::{heckel_fit, heckel_usable};
 use granbed_kernel::analysis::quasi_static::LoadSample;
-use granbed_kernel::material::MaterialParams;
 use indicatif::ProgressBar;
 use serde::Serialize;
 
@@ -94,44 +94,6 @@ fn row(s: &BedSample, run: &BedRun) -> [Field; 29] {
         e.contact_loss().into(),
         e.residual().into(),
     ]
-}
-
-/// The granule material of a run as `summary.json` records it: every
-/// parameter, the type's preset with the scene's overrides applied (what
-/// a methods section needs).
-#[derive(Clone, Copy, Debug, Serialize)]
-pub struct MaterialSummary {
-    /// Young's modulus E, Pa.
-    pub youngs_modulus_pa: Real,
-    /// Poisson's ratio ν.
-    pub poisson_ratio: Real,
-    /// Yield stress σ_y, Pa (`null`: ∞, purely elastic).
-    pub yield_stress_pa: Real,
-    /// Initial relative density η0.
-    pub eta0: Real,
-    /// Yield-surface constant c_p.
-    pub cp: Real,
-    /// Critical relative density η_c.
-    pub eta_c: Real,
-    /// True (solid) density, kg/m³.
-    pub true_density_kg_m3: Real,
-    /// Friction coefficient μ of the contacts.
-    pub friction: Real,
-}
-
-impl From<MaterialParams> for MaterialSummary {
-    fn from(m: MaterialParams) -> Self {
-        Self {
-            youngs_modulus_pa: m.youngs_modulus_pa,
-            poisson_ratio: m.poisson_ratio,
-            yield_stress_pa: m.yield_stress_pa,
-            eta0: m.eta0,
-            cp: m.cp,
-            eta_c: m.eta_c,
-            true_density_kg_m3: m.true_density_kg_m3,
-            friction: m.friction,
-        }
-    }
 }
 
 /// The Kawakita fit of `summary.json`.

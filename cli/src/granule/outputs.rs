@@ -71,8 +71,8 @@ fn types_row(t: GranuleType, s: &Summary) -> [Field; TYPES_COLUMNS.len()] {
     let opt = |x: Option<f64>| Field::Real(x.unwrap_or(f64::NAN));
     [
         Field::Text(t.name()),
-        r(s.yield_stress_pa),
-        r(s.eta0),
+        r(s.material.yield_stress_pa),
+        r(s.material.eta0),
         r(s.sigma_eff0_pa),
         opt(s.sigma_est_pa),
         opt(s.slope_n_per_m),

@@ -11,6 +11,7 @@ use granbed_kernel::scene::platens::{PlatenParams, PlatenSample, SceneError, Sym
 use serde::Serialize;
 
 use super::run::RunResult;
+use crate::material_args::MaterialSummary;
 use crate::model::MeshLevel;
 use crate::quasi_static::QuasiStatic;
 
@@ -72,22 +73,10 @@ pub struct Summary {
     /// Granule diameter d, m.
     pub diameter_m: Real,
 
-    /// Young's modulus E, Pa.
-    pub youngs_modulus_pa: Real,
-    /// Poisson's ratio ν.
-    pub poisson_ratio: Real,
-    /// Solid yield stress σ_y, Pa.
-    pub yield_stress_pa: Real,
-    /// Initial relative density η0.
-    pub eta0: Real,
-    /// Yield-surface constant c_p.
-    pub cp: Real,
-    /// Critical relative density η_c.
-    pub eta_c: Real,
-    /// True density, kg/m³.
-    pub true_density_kg_m3: Real,
-    /// Granule–platen Coulomb friction coefficient.
-    pub friction: Real,
+    /// The material, its fields at this level of the file (friction:
+    /// the granule–platen contact's).
+    #[serde(flatten)]
+    pub material: MaterialSummary,
 
     /// Element formulation: `one-point` (production) or `f-bar`.
     pub element: &'static str,
@@ -212,14 +201,10 @@ impl Summary {
             mesh_nodes: setup.nodes,
             mesh_hexes: setup.hexes,
             diameter_m: result.diameter_m,
-            youngs_modulus_pa: m.youngs_modulus_pa,
-            poisson_ratio: m.poisson_ratio,
-            yield_stress_pa: m.yield_stress_pa,
-            eta0: m.eta0,
-            cp: m.cp,
-            eta_c: m.eta_c,
-            true_density_kg_m3: m.true_density_kg_m3,
-            friction: p.friction,
+            material: MaterialSummary {
+                friction: p.friction,
+                ..MaterialSummary::from(*m)
+            },
             element: match p.elements.kind {
                 ElementKind::OnePoint => "one-point",
                 ElementKind::FBar => "f-bar",
