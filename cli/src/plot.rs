@@ -203,7 +203,8 @@ fn legend_corner(
     .map_or(SeriesLabelPosition::UpperLeft, |(_, corner)| corner)
 }
 
-/// The SVG text of `series` under `title`, with axis labels.
+/// The SVG text of `series` under `title`, with axis labels; the x axis
+/// from zero, the y axis from zero if `y_from_zero`.
 pub fn xy_svg(
     title: &str,
     x_desc: &str,
@@ -211,8 +212,19 @@ pub fn xy_svg(
     series: &[Series],
     y_from_zero: bool,
 ) -> anyhow::Result<String> {
+    xy_svg_from(title, (x_desc, y_desc), series, (true, y_from_zero))
+}
+
+/// [`xy_svg`] with the x axis too from zero only if `x_from_zero` (as
+/// `from_zero` = (x, y)): an axis not from zero spans the data.
+pub fn xy_svg_from(
+    title: &str,
+    (x_desc, y_desc): (&str, &str),
+    series: &[Series],
+    (x_from_zero, y_from_zero): (bool, bool),
+) -> anyhow::Result<String> {
     let all = || series.iter().flat_map(|s| s.points.iter());
-    let x_range = range(all().map(|p| p.0), true);
+    let x_range = range(all().map(|p| p.0), x_from_zero);
     let y_range = range(all().map(|p| p.1), y_from_zero);
     let mut svg = String::new();
     {
@@ -354,6 +366,25 @@ mod tests {
     }
 
     /// Every tick of a plain axis has the decimals of the finest one.
+    /// An x axis not from zero spans the data; [`xy_svg`]'s starts at 0.
+    #[test]
+    fn an_x_axis_from_zero_or_over_the_data() {
+        let points = || (0..=10).map(|i| (0.30 + 0.01 * f64::from(i), f64::from(i)));
+        let svg = |from_zero| {
+            xy_svg_from(
+                "t",
+                ("x", "y"),
+                &[Series::new("", Mark::Line, points())],
+                (from_zero, true),
+            )
+            .unwrap()
+        };
+        let tick = |svg: &str, label: &str| svg.contains(&format!("\n{label}\n</text>"));
+        let (zero, data) = (svg(true), svg(false));
+        assert!(tick(&zero, "0.00") && !tick(&zero, "0.31"), "{zero}");
+        assert!(!tick(&data, "0.00") && tick(&data, "0.31"), "{data}");
+    }
+
     #[test]
     fn plain_ticks_share_their_decimals() {
         let density = plain_labels(&(0.799..0.826));

@@ -271,6 +271,8 @@ fn snapshots_plots_and_report() {
         "relative_density_strain.svg",
         "heywood_strain.svg",
         "solid_fraction_pressure.svg",
+        "coordination_density.svg",
+        "energy_strain.svg",
     ] {
         let svg = std::fs::read_to_string(dir.join("plots").join(name))
             .unwrap_or_else(|e| panic!("{name}: {e}"));
@@ -284,7 +286,7 @@ fn snapshots_plots_and_report() {
     let html = std::fs::read_to_string(dir.join("report.html")).unwrap();
     assert!(html.starts_with("<!DOCTYPE html>"));
     assert!(html.trim_end().ends_with("</html>"));
-    assert_eq!(html.matches("<svg").count(), 7);
+    assert_eq!(html.matches("<svg").count(), 9);
     let s = summary(&dir);
     // The final solid fraction is the last row's, and the material every
     // parameter of the type (B2: E 1 MPa, true density 1500 kg/m³).
@@ -300,7 +302,27 @@ fn snapshots_plots_and_report() {
     let key = html.find("<h2>Key results</h2>").expect("no key results");
     assert!(key < html.find("<h2>Plots</h2>").unwrap());
     assert!(html.contains("solid fraction D: poured (D0) → at the end, in the die"));
-    assert_eq!(html.matches("<p class=\"caption\">").count(), 7);
+    assert_eq!(html.matches("<p class=\"caption\">").count(), 9);
+    // The Kawakita fit over each window, the Heckel fit on the mean punch
+    // pressure over the Heckel rows, and a glossary row for every column
+    // of compression.csv, in its order.
+    let windows = s["kawakita_windows"].as_array().unwrap();
+    let starts: Vec<f64> = windows
+        .iter()
+        .map(|k| k["min_strain"].as_f64().unwrap())
+        .collect();
+    assert_eq!(starts, [0.10, 0.15, 0.20, 0.25]);
+    assert!(html.contains("<h3>The Kawakita fit by window</h3>"));
+    assert_eq!(s["heckel_mean_pressure"]["points"], s["heckel"]["points"]);
+    let glossary = &html[html.find("<h2>Columns of compression.csv</h2>").unwrap()..];
+    let mut at = 0;
+    for column in rows.header.split(',') {
+        let cell = format!("<tr><td class=\"value\">{column}</td>");
+        let found = glossary[at..]
+            .find(&cell)
+            .unwrap_or_else(|| panic!("glossary lacks {column}"));
+        at += found + cell.len();
+    }
     for key in [
         "final_strain",
         "max_pressure_pa",

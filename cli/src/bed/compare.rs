@@ -13,8 +13,8 @@ use granbed_kernel::Real;
 use granbed_kernel::material::GranuleType;
 use serde::Serialize;
 
-use super::outputs::heckel_rows;
 use super::outputs::{KawakitaSummary, Summary, fit_linear, kawakita_doubts};
+use super::outputs::{heckel_rows, upper_pressure};
 use super::plots::overlay_svg;
 use super::plots::profile_svg;
 use super::run::{BedRun, BedSample};
@@ -304,7 +304,9 @@ pub fn write_overlays<'a>(
         .copied()
         .zip(runs)
         .map(|(label, run)| {
-            let points = heckel_rows(run).map(|(p, d, _)| (p * 1e-3, d)).collect();
+            let points = heckel_rows(run, upper_pressure)
+                .map(|(p, d, _)| (p * 1e-3, d))
+                .collect();
             (label, points)
         })
         .collect();

@@ -19,37 +19,92 @@ use crate::output::{create_file, finish_file, finite_ratio, write_json};
 use crate::progress::{StrainBar, draw_target, steps_per_second};
 use crate::quasi_static::QuasiStatic;
 
-/// Columns of `compression.csv`, in order.
-pub const COMPRESSION_COLUMNS: [&str; 29] = [
-    "time_s",
-    "strain",
-    "upper_pressure_pa",
-    "lower_pressure_pa",
-    "upper_force_n",
-    "lower_force_n",
-    "die_friction_z_n",
-    "coordination",
-    "coordination_with_walls",
-    "relative_density_mean",
-    "relative_density_solid",
-    "bed_solid_fraction",
-    "heywood_dv",
-    "heywood_d",
-    "min_jacobian",
-    "min_gauss_jacobian",
-    "max_node_speed_m_s",
-    "penetration_m",
-    "steps",
-    "punch_work_j",
-    "internal_work_j",
-    "elastic_j",
-    "plastic_j",
-    "hourglass_j",
-    "damping_j",
-    "kinetic_j",
-    "kinetic_relative_j",
-    "contact_loss_j",
-    "energy_residual_j",
+/// Columns of `compression.csv`, in order: (name, meaning with its unit).
+/// The report's glossary ([`super::report`]) shows the meanings.
+pub const COMPRESSION_COLUMNS: [(&str, &str); 29] = [
+    ("time_s", "time since the compression began, s"),
+    ("strain", "axial strain C = (H0 − H)/H0"),
+    (
+        "upper_pressure_pa",
+        "upper-punch pressure F/(π R_d²), Pa (averaged over the output interval, as every force)",
+    ),
+    ("lower_pressure_pa", "lower-punch pressure, Pa"),
+    ("upper_force_n", "upper-punch force, N"),
+    ("lower_force_n", "lower-punch force, N"),
+    (
+        "die_friction_z_n",
+        "axial friction force of the die wall on the granules, N (positive upwards)",
+    ),
+    (
+        "coordination",
+        "coordination number Z = 2 N_pp/N: granule pairs in contact per granule (interval average)",
+    ),
+    (
+        "coordination_with_walls",
+        "(2 N_pp + N_pw)/N: Z with the granule–wall contacts counted too",
+    ),
+    (
+        "relative_density_mean",
+        "mean over the granules of their own relative density η0 V0/V",
+    ),
+    (
+        "relative_density_solid",
+        "the granules' total solid volume / their total volume",
+    ),
+    (
+        "bed_solid_fraction",
+        "the bed's solid fraction D: the granules' solid volume / the die volume below the upper punch",
+    ),
+    (
+        "heywood_dv",
+        "mean Heywood coefficient d_V S/V, d_V the volume-equivalent diameter (6 for a sphere)",
+    ),
+    ("heywood_d", "mean d S/V with the nominal diameter d"),
+    (
+        "min_jacobian",
+        "smallest element Jacobian ratio at the element centres in the interval",
+    ),
+    (
+        "min_gauss_jacobian",
+        "smallest Gauss-point Jacobian ratio at the row (≤ 0: an element folded)",
+    ),
+    (
+        "max_node_speed_m_s",
+        "largest node speed in the interval, m/s",
+    ),
+    (
+        "penetration_m",
+        "deepest granule–granule overlap the contact detection reads at the row, m",
+    ),
+    ("steps", "time steps so far"),
+    (
+        "punch_work_j",
+        "work of the moving punch on the bed so far, J",
+    ),
+    (
+        "internal_work_j",
+        "work of the internal and hourglass forces, J (≈ elastic + plastic + hourglass; the rest is the return map's energy gap)",
+    ),
+    ("elastic_j", "elastic energy Ψ stored in the granules, J"),
+    ("plastic_j", "plastic dissipation, J"),
+    (
+        "hourglass_j",
+        "energy in the one-point element's hourglass modes (spurious), J",
+    ),
+    ("damping_j", "energy removed by the damping, J"),
+    ("kinetic_j", "kinetic energy, J"),
+    (
+        "kinetic_relative_j",
+        "kinetic energy less the granules' share moving with the imposed compression, J",
+    ),
+    (
+        "contact_loss_j",
+        "energy the contacts took out of the punch work (friction and the kinematic constraints), J",
+    ),
+    (
+        "energy_residual_j",
+        "energy-ledger residual ΔK + internal work + damping − contact work − gravity work, J (round-off)",
+    ),
 ];
 
 /// The bed's solid fraction D at strain C: the granules' solid volume over
@@ -171,6 +226,13 @@ pub struct Summary<'a> {
     pub heckel_yield_pressure_pa: Option<Real>,
     /// The Heckel fit in full.
     pub heckel: HeckelSummary,
+    /// The Kawakita fit again over each window of [`KAWAKITA_WINDOWS`]
+    /// (C ≥ each; no figures for a window past the strain reached): how
+    /// much a and 1/b depend on the window.
+    pub kawakita_windows: Vec<KawakitaSummary>,
+    /// The Heckel fit over the same rows on the mean of the two punches'
+    /// pressures ([`mean_punch_pressure`]) instead of the upper one's.
+    pub heckel_mean_pressure: HeckelSummary,
     /// The bed's solid fraction D0 at C = 0 (the poured bed: the granules'
     /// solid volume over the die volume below H0).
     pub initial_solid_fraction: Real,
@@ -306,20 +368,34 @@ pub fn kawakita(samples: &[BedSample], min_strain: Real) -> KawakitaSummary {
     }
 }
 
-/// The rows of the Heckel plot: (P in Pa, D, C) of every output row.
-pub fn heckel_rows(run: &BedRun) -> impl Iterator<Item = (Real, Real, Real)> + Clone + '_ {
-    run.samples.iter().map(|s| {
-        (
-            s.upper_pressure_pa,
-            bed_solid_fraction(run, s.strain),
-            s.strain,
-        )
-    })
+/// The upper-punch pressure of a row, Pa: the pressure of the Heckel and
+/// Kawakita fits.
+pub fn upper_pressure(s: &BedSample) -> Real {
+    s.upper_pressure_pa
 }
 
-/// The Heckel fit of the run's output rows with C ≥ `min_strain`.
-pub fn heckel(run: &BedRun, min_strain: Real) -> HeckelSummary {
-    let window = heckel_rows(run)
+/// The mean of the two punches' pressures of a row, Pa: a Heckel variant
+/// that takes out most of the die wall's friction (the upper punch's
+/// pressure is the lower one's plus what the wall holds).
+pub fn mean_punch_pressure(s: &BedSample) -> Real {
+    0.5 * (s.upper_pressure_pa + s.lower_pressure_pa)
+}
+
+/// The rows of a Heckel plot: (P in Pa, D, C) of every output row, with P
+/// the row's `pressure` ([`upper_pressure`] or [`mean_punch_pressure`]).
+pub fn heckel_rows(
+    run: &BedRun,
+    pressure: fn(&BedSample) -> Real,
+) -> impl Iterator<Item = (Real, Real, Real)> + Clone + '_ {
+    run.samples
+        .iter()
+        .map(move |s| (pressure(s), bed_solid_fraction(run, s.strain), s.strain))
+}
+
+/// The Heckel fit of the run's output rows with C ≥ `min_strain`, on the
+/// punch `pressure` of [`heckel_rows`].
+pub fn heckel(run: &BedRun, min_strain: Real, pressure: fn(&BedSample) -> Real) -> HeckelSummary {
+    let window = heckel_rows(run, pressure)
         .filter(move |&(_, _, c)| c >= min_strain)
         .map(|(p, d, _)| (p, d));
     let fit = heckel_fit(window.clone());
@@ -336,6 +412,12 @@ pub fn heckel(run: &BedRun, min_strain: Real) -> HeckelSummary {
         min_strain,
     }
 }
+
+/// The starts of the strain windows over which `summary.json`'s
+/// `kawakita_windows` fits the law again: a and 1/b depend on the window
+/// (physics.md's C ≥ 0.25 is the published one), and a reader should see
+/// by how much.
+pub const KAWAKITA_WINDOWS: [Real; 4] = [0.10, 0.15, 0.20, 0.25];
 
 /// `summary.json`'s record of [`super::run::HiddenOverlap`].
 #[derive(Clone, Copy, Debug, Serialize)]
@@ -373,7 +455,9 @@ impl HiddenOverlapSummary {
 pub fn summary<'a>(scene: &'a Scene, run: &BedRun) -> Summary<'a> {
     let last = run.samples.last().copied().unwrap_or_default();
     let k = kawakita(&run.samples, scene.kawakita_min_strain);
-    let heckel = heckel(run, scene.heckel_min_strain);
+    let heckel_mean_pressure = heckel(run, scene.heckel_min_strain, mean_punch_pressure);
+    let heckel = heckel(run, scene.heckel_min_strain, upper_pressure);
+    let kawakita_windows = KAWAKITA_WINDOWS.map(|c| kawakita(&run.samples, c)).to_vec();
     let min_jacobian = run
         .samples
         .iter()
@@ -414,6 +498,8 @@ pub fn summary<'a>(scene: &'a Scene, run: &BedRun) -> Summary<'a> {
         kawakita: k,
         heckel_yield_pressure_pa: heckel.yield_pressure_pa,
         heckel,
+        kawakita_windows,
+        heckel_mean_pressure,
         initial_solid_fraction: bed_solid_fraction(run, 0.0),
         final_solid_fraction: bed_solid_fraction(run, last.strain),
         material: material.map(MaterialSummary::from),
@@ -753,7 +839,7 @@ pub const FIT_MIN_R_SQUARED: Real = 0.9;
 pub fn write_all(dir: &Path, scene: &Scene, run: &BedRun) -> anyhow::Result<()> {
     crate::output::create_out_dir(dir)?;
     let path = dir.join(COMPRESSION_CSV);
-    let mut csv = CsvWriter::new(create_file(&path)?, &COMPRESSION_COLUMNS)
+    let mut csv = CsvWriter::new(create_file(&path)?, &COMPRESSION_COLUMNS.map(|c| c.0))
         .with_context(|| format!("cannot write to `{}`", path.display()))?;
     for s in &run.samples {
         csv.write_row(&row(s, run))
@@ -1016,6 +1102,70 @@ mod tests {
             })
             .collect(),
         )
+    }
+
+    /// `kawakita_windows` refits the law over each window: rows of
+    /// C = abP/(1 + bP) give a and 1/b back in every window the run
+    /// reached, from that window's rows, and no figures past it.
+    #[test]
+    fn the_kawakita_fit_is_repeated_over_each_window() {
+        let (a, inv_b) = (0.4, 50e3);
+        let strains = || (1..=22).map(|i| 0.01 * Real::from(i));
+        let run = run_of(strains().map(|c| (c, c * inv_b / (a - c))));
+        let scene = Scene::published();
+        let s = summary(&scene, &run);
+        assert_eq!(s.kawakita_windows.len(), KAWAKITA_WINDOWS.len());
+        for (k, &from) in s.kawakita_windows.iter().zip(&KAWAKITA_WINDOWS) {
+            assert_eq!(k.min_strain, from);
+            assert_eq!(k.points, strains().filter(|&c| c >= from).count(), "{k:?}");
+            if from <= 0.22 {
+                let rel = |x: Option<Real>, want: Real| (x.unwrap() - want).abs() / want;
+                assert!(rel(k.a, a) < 1e-9 && rel(k.inv_b_pa, inv_b) < 1e-9, "{k:?}");
+            } else {
+                assert!(k.a.is_none() && k.inv_b_pa.is_none(), "{k:?}");
+            }
+        }
+        // The window at the scene's start is the run's own fit.
+        let own = s.kawakita_windows.iter().find(|k| k.min_strain == 0.25);
+        assert_eq!(own.map(|k| k.points), Some(s.kawakita.points));
+    }
+
+    /// The Heckel fit on the mean punch pressure: rows whose mean pressure
+    /// follows ln(1/(1 − D)) = P/P_y + A exactly, with the upper punch
+    /// carrying a quarter more (the wall's share), give P_y back on the
+    /// mean pressure and 1.25 P_y on the upper one.
+    #[test]
+    fn the_heckel_fit_on_the_mean_punch_pressure() {
+        use crate::bed::run::{BedRun, BedSample};
+        let (p_y, a) = (80e3, 0.3);
+        let samples = (0..=30)
+            .map(|i| {
+                let c = 0.01 * Real::from(i);
+                // of_samples' bed: D = 1/(π (1 − C)).
+                let d = 1.0 / (core::f64::consts::PI * (1.0 - c));
+                let mean = (-(-d).ln_1p() - a) * p_y;
+                BedSample {
+                    strain: c,
+                    upper_pressure_pa: 1.25 * mean,
+                    lower_pressure_pa: 0.75 * mean,
+                    min_jacobian: 0.9,
+                    min_gauss_jacobian: 0.9,
+                    ..BedSample::default()
+                }
+            })
+            .collect();
+        let scene = Scene::published();
+        let s = summary(&scene, &BedRun::of_samples(samples));
+        let rel = |x: Option<Real>, want: Real| (x.unwrap() - want).abs() / want;
+        let mean = s.heckel_mean_pressure;
+        assert!(rel(mean.yield_pressure_pa, p_y) < 1e-9, "{mean:?}");
+        assert!(rel(mean.a, a) < 1e-9, "{mean:?}");
+        assert!(
+            rel(s.heckel.yield_pressure_pa, 1.25 * p_y) < 1e-9,
+            "{:?}",
+            s.heckel
+        );
+        assert_eq!((mean.points, mean.min_strain), (6, 0.25));
     }
 
     #[test]

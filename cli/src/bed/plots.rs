@@ -15,16 +15,22 @@
 //!   the nominal diameter;
 //! * `solid_fraction_pressure.svg`: the compaction profile as the bed's
 //!   solid fraction D (relative density of the bed) against the
-//!   upper-punch pressure P.
+//!   upper-punch pressure P;
+//! * `coordination_density.svg`: Z, without and with the walls, against
+//!   the bed's solid fraction D;
+//! * `energy_strain.svg`: where the punch's work went: the energy ledger
+//!   (elastic, plastic, hourglass, contact losses, damping, kinetic)
+//!   against C, in J, mJ or µJ (as the largest needs).
 
 use std::path::Path;
 
 use super::outputs::{
-    HeckelSummary, KawakitaSummary, Summary, fit_linear, heckel_rows, kawakita_doubts,
+    HeckelSummary, KawakitaSummary, Summary, bed_solid_fraction, fit_linear, heckel_rows,
+    kawakita_doubts, upper_pressure,
 };
 use super::run::{BedRun, BedSample};
 use crate::output::write_text;
-use crate::plot::{Mark, Series, xy_svg};
+use crate::plot::{Mark, Series, xy_svg, xy_svg_from};
 use anyhow::Context as _;
 use granbed_kernel::Real;
 
@@ -32,7 +38,7 @@ use granbed_kernel::Real;
 pub const PLOTS_DIR: &str = "plots";
 
 /// The plot files, in the order [`write_plots`] writes them.
-pub const PLOT_FILES: [&str; 7] = [
+pub const PLOT_FILES: [&str; 9] = [
     "pressure_strain.svg",
     "kawakita.svg",
     "heckel.svg",
@@ -40,7 +46,60 @@ pub const PLOT_FILES: [&str; 7] = [
     "relative_density_strain.svg",
     "heywood_strain.svg",
     "solid_fraction_pressure.svg",
+    "coordination_density.svg",
+    "energy_strain.svg",
 ];
+
+/// The energy ledger's terms drawn by `energy_strain.svg`, J, with their
+/// legends: the punch's work first, then what it went into.
+const ENERGY_TERMS: [(&str, Quantity); 7] = [
+    ("punch work", |s| s.energies.punch_work),
+    ("elastic Ψ", |s| s.energies.elastic),
+    ("plastic dissipation", |s| s.energies.plastic),
+    ("contact losses (friction, constraints)", |s| {
+        s.energies.contact_loss()
+    }),
+    ("damping", |s| s.energies.damping),
+    ("hourglass", |s| s.energies.hourglass),
+    ("kinetic", |s| s.energies.kinetic),
+];
+
+/// The unit of energies up to `largest` J: (name, J per unit), the
+/// largest of J, mJ and µJ in which `largest` is at least 1 (µJ below).
+fn energy_unit(largest: Real) -> (&'static str, Real) {
+    [("J", 1.0), ("mJ", 1e-3)]
+        .into_iter()
+        .find(|&(_, unit)| largest.abs() >= unit)
+        .unwrap_or(("µJ", 1e-6))
+}
+
+/// The energy plot: each of [`ENERGY_TERMS`] against the strain, in the
+/// [`energy_unit`] of the largest value drawn.
+fn energy_svg(samples: &[BedSample]) -> anyhow::Result<String> {
+    let largest = samples
+        .iter()
+        .flat_map(|s| ENERGY_TERMS.iter().map(move |(_, y)| y(s).abs()))
+        .filter(|e| e.is_finite())
+        .fold(0.0, Real::max);
+    let (unit, scale) = energy_unit(largest);
+    let series: Vec<Series> = ENERGY_TERMS
+        .iter()
+        .map(|&(label, y)| {
+            Series::new(
+                label,
+                Mark::Line,
+                samples.iter().map(|s| (s.strain, y(s) / scale)),
+            )
+        })
+        .collect();
+    xy_svg(
+        "Energy: where the punch's work went",
+        "axial strain C = (H0 - H)/H0",
+        &format!("energy, {unit}"),
+        &series,
+        true,
+    )
+}
 
 /// The value of a sample a curve shows.
 pub type Quantity = fn(&BedSample) -> Real;
@@ -277,19 +336,40 @@ pub fn plots(
         density_f,
         heywood_f,
         profile_f,
+        coordination_density_f,
+        energy_f,
     ] = PLOT_FILES;
     // Unlabelled: the title and axes say what the one curve is (no legend).
     let profile = [(
         "",
-        heckel_rows(run).map(|(p, d, _)| (p * 1e-3, d)).collect(),
+        heckel_rows(run, upper_pressure)
+            .map(|(p, d, _)| (p * 1e-3, d))
+            .collect(),
     )];
+    let solid_fraction = |s: &BedSample| bed_solid_fraction(run, s.strain);
+    let coordination_density: [(&str, Mark, Quantity); 2] = [
+        ("granule pairs", Mark::Line, |s| s.coordination),
+        ("with walls", Mark::DashedLine, |s| {
+            s.coordination_with_walls
+        }),
+    ];
+    let coordination_density = coordination_density.map(|(label, mark, z)| {
+        Series::new(
+            label,
+            mark,
+            samples.iter().map(|s| (solid_fraction(s), z(s))),
+        )
+    });
     Ok([
         (
             pressure_f,
             xy_svg("Punch pressure", C, "pressure P, kPa", &pressure, true)?,
         ),
         (kawakita_f, kawakita_svg(samples, &summary.kawakita)?),
-        (heckel_f, heckel_svg(heckel_rows(run), &summary.heckel)?),
+        (
+            heckel_f,
+            heckel_svg(heckel_rows(run, upper_pressure), &summary.heckel)?,
+        ),
         (
             coordination_f,
             xy_svg("Coordination number", C, "Z", &coordination, true)?,
@@ -318,6 +398,16 @@ pub fn plots(
             profile_f,
             profile_svg("Compaction profile: the bed's solid fraction", &profile)?,
         ),
+        (
+            coordination_density_f,
+            xy_svg_from(
+                "Coordination number against the bed's solid fraction",
+                ("bed solid fraction D", "Z"),
+                &coordination_density,
+                (false, true),
+            )?,
+        ),
+        (energy_f, energy_svg(samples)?),
     ])
 }
 
@@ -341,6 +431,39 @@ pub fn write_plots(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Energies are drawn in the largest of J, mJ and µJ that the largest
+    /// value fills, every term of the ledger with its legend.
+    #[test]
+    fn the_energy_plot_has_every_term_in_its_unit() {
+        assert_eq!(energy_unit(2.5), ("J", 1.0));
+        assert_eq!(energy_unit(9.7e-3), ("mJ", 1e-3));
+        assert_eq!(energy_unit(9.7e-6), ("µJ", 1e-6));
+        assert_eq!(energy_unit(0.0), ("µJ", 1e-6));
+        let samples: Vec<BedSample> = (0..=10)
+            .map(|i| {
+                let c = 0.03 * f64::from(i);
+                let mut s = BedSample {
+                    strain: c,
+                    ..BedSample::default()
+                };
+                s.energies.punch_work = 0.02 * c;
+                s.energies.elastic = 0.01 * c;
+                s
+            })
+            .collect();
+        let svg = energy_svg(&samples).unwrap();
+        assert!(svg.contains("energy, mJ"), "{svg}");
+        for (label, _) in ENERGY_TERMS {
+            let label = crate::output::escape_markup(label);
+            assert!(
+                svg.contains(&format!("\n{label}\n</text>")),
+                "no legend {label}"
+            );
+        }
+        // 6 mJ of punch work at C = 0.3: a tick at 6 (mJ), none at 0.006.
+        assert!(svg.contains("\n6\n</text>") && !svg.contains("\n0.006\n</text>"));
+    }
 
     #[test]
     fn the_kawakita_plot_has_the_fit_line() {

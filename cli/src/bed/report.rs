@@ -10,7 +10,7 @@ use std::path::Path;
 
 use serde_json::Value;
 
-use super::outputs::Summary;
+use super::outputs::{COMPRESSION_COLUMNS, Summary};
 use super::scene::{DEFAULT_SCENE, Scene};
 use super::snapshots::{PVD_FILE, VTK_DIR};
 use crate::numbers::{short, significant};
@@ -23,7 +23,7 @@ pub const REPORT_FILE: &str = "report.html";
 /// meaning; any other field follows (nested objects such as `kawakita` and
 /// `heckel` are flattened to `kawakita.<field>`; the scene, `scene` and
 /// `scene_toml`, is shown as TOML instead).
-const FIELDS: [(&str, &str); 77] = [
+const FIELDS: [(&str, &str); 85] = [
     ("kawakita_a", "Kawakita a (limiting strain)"),
     ("kawakita_inv_b_pa", "Kawakita 1/b, Pa"),
     (
@@ -50,6 +50,22 @@ const FIELDS: [(&str, &str); 77] = [
     (
         "heckel.min_strain",
         "the Heckel fit takes the rows with C ≥ this",
+    ),
+    (
+        "heckel_mean_pressure.yield_pressure_pa",
+        "Heckel P_y on the mean of the two punches' pressures, Pa",
+    ),
+    (
+        "heckel_mean_pressure.a",
+        "its intercept A (the mean punch pressure)",
+    ),
+    ("heckel_mean_pressure.k_per_pa", "its slope K, 1/Pa"),
+    ("heckel_mean_pressure.d_a", "its D_A = 1 − exp(−A)"),
+    ("heckel_mean_pressure.r_squared", "its R²"),
+    ("heckel_mean_pressure.points", "output rows in that fit"),
+    (
+        "heckel_mean_pressure.min_strain",
+        "that fit takes the rows with C ≥ this (as the Heckel fit)",
     ),
     (
         "initial_solid_fraction",
@@ -225,6 +241,8 @@ const FIELDS: [(&str, &str); 77] = [
     ("kawakita.inv_b_pa", ""),
     ("heckel.yield_pressure_pa", ""),
     ("warnings", ""),
+    // Its own table, "The Kawakita fit by window".
+    ("kawakita_windows", ""),
 ];
 
 /// `text` with the HTML special characters escaped (for element content
@@ -342,6 +360,27 @@ pub(super) fn kpa(x: Option<f64>) -> String {
     num(x.map(|p| p * 1e-3))
 }
 
+/// A fit's cell: its figure `value` (`None`: no fit, the run did not reach
+/// its window), marked ✗ if the run's summary rejects the fit, with its R²
+/// in the cell's title.
+pub(super) fn fit_cell(value: Option<String>, r_squared: Option<f64>, ok: bool) -> String {
+    let Some(value) = value else {
+        return "<td class=\"num\" title=\"no fit: the run ended before its window\">n/a</td>"
+            .to_owned();
+    };
+    let title = format!("R² = {}", num(r_squared));
+    let (class, mark) = if ok {
+        ("num", "")
+    } else {
+        ("num doubt", " ✗")
+    };
+    format!(
+        "<td class=\"{class}\" title=\"{}\">{}{mark}</td>",
+        html_escape(&title),
+        html_escape(&value)
+    )
+}
+
 /// The run's key figures as a short table with units, for the top of the
 /// page (the full, unrounded set is the summary table below).
 fn key_results(summary: &Summary<'_>) -> String {
@@ -373,6 +412,10 @@ fn key_results(summary: &Summary<'_>) -> String {
                 summary.heckel.points,
                 num(summary.heckel.r_squared)
             ),
+        ),
+        (
+            "Heckel P_y on the mean punch pressure (P_upper + P_lower)/2, kPa".to_owned(),
+            kpa(summary.heckel_mean_pressure.yield_pressure_pa),
         ),
         (
             "solid fraction D: poured (D0) → at the end, in the die".to_owned(),
@@ -410,6 +453,59 @@ fn key_results(summary: &Summary<'_>) -> String {
             html_escape(&what),
             html_escape(&value)
         ));
+    }
+    h.push_str("</table>\n");
+    h
+}
+
+/// The Kawakita fit over each window of `summary.kawakita_windows`: its
+/// a, 1/b (kPa), rows and R², a rejected fit marked as in the series'
+/// tables, the run's own window named.
+fn kawakita_by_window(summary: &Summary<'_>) -> String {
+    let mut h = String::from(
+        "<h3>The Kawakita fit by window</h3>\n<p>The law fitted again to the rows from \
+         several strains on: a and 1/b depend on the window, the more the earlier it starts \
+         (rearrangement is not the law's regime). The published scene fits C ≥ 0.25, as the \
+         reference study did; ✗ marks a \
+         fit the summary would reject (its R² on hover); n/a: the run did not reach the \
+         window.</p>\n<table>\n<tr><th>rows fitted</th><th>a</th><th>1/b, kPa</th>\
+         <th>rows</th></tr>\n",
+    );
+    for k in &summary.kawakita_windows {
+        let ok = super::outputs::kawakita_doubts(k).is_empty();
+        let own = if k.min_strain == summary.kawakita.min_strain {
+            " (the run's fit)"
+        } else {
+            ""
+        };
+        let _ = writeln!(
+            h,
+            "<tr><td>C ≥ {}{own}</td>{}{}<td class=\"num\">{}</td></tr>",
+            short(k.min_strain),
+            fit_cell(k.a.map(|a| num(Some(a))), k.r_squared, ok),
+            fit_cell(k.inv_b_pa.map(|b| kpa(Some(b))), k.r_squared, ok),
+            k.points
+        );
+    }
+    h.push_str("</table>\n");
+    h
+}
+
+/// The glossary of `compression.csv`: each column's name and meaning
+/// with its unit ([`COMPRESSION_COLUMNS`]).
+fn csv_glossary() -> String {
+    let mut h = String::from(
+        "<h2>Columns of compression.csv</h2>\n<p>One row per output interval; forces and \
+         pressures are the interval's averages, energies the totals so far.</p>\n<table>\n\
+         <tr><th>column</th><th>meaning</th></tr>\n",
+    );
+    for (name, meaning) in COMPRESSION_COLUMNS {
+        let _ = writeln!(
+            h,
+            "<tr><td class=\"value\">{}</td><td>{}</td></tr>",
+            html_escape(name),
+            html_escape(meaning)
+        );
     }
     h.push_str("</table>\n");
     h
@@ -456,6 +552,18 @@ fn plot_caption(name: &str, summary: &Summary<'_>) -> Option<String> {
         "solid_fraction_pressure.svg" => "The compaction profile: the bed's solid fraction D \
              (the granules' solid over the die volume below the upper punch) against the \
              upper-punch pressure P."
+            .to_owned(),
+        "coordination_density.svg" => "The coordination number Z against the bed's solid \
+             fraction D (compression.csv's bed_solid_fraction), granule contacts only and with \
+             the wall contacts: how the contact network grows as the bed densifies, the form in \
+             which coordination is usually compared (Arzt's Z(D) for spheres)."
+            .to_owned(),
+        "energy_strain.svg" => "Where the punch's work went, totals so far against the strain \
+             (compression.csv's energy columns): the elastic energy stored in the \
+             granules, the plastic dissipation, the contact losses (friction and the \
+             kinematic contact constraints), the damping, the hourglass energy (the one-point \
+             element's spurious modes; small) and the kinetic energy (small when the run is \
+             quasi-static)."
             .to_owned(),
         _ => return None,
     })
@@ -515,6 +623,7 @@ pub fn report_html(
         writeln!(h, "</ul>")?;
     }
     h.push_str(&key_results(summary));
+    h.push_str(&kawakita_by_window(summary));
     writeln!(
         h,
         "<p>Files: <a href=\"compression.csv\">compression.csv</a>, \
@@ -572,6 +681,7 @@ pub fn report_html(
         )?;
     }
     writeln!(h, "</table>")?;
+    h.push_str(&csv_glossary());
     writeln!(
         h,
         "<h2>Scene</h2>\n<pre>{}</pre>\n</body>\n</html>",
@@ -686,6 +796,50 @@ mod tests {
         ] {
             let row = Row::new("x".into(), "", &value);
             assert_eq!((row.full.as_str(), row.cell.as_str()), (text, text));
+        }
+    }
+
+    /// The page shows the Kawakita fit of each window, the run's own
+    /// named, a window not reached as n/a, and the glossary of every
+    /// column of compression.csv.
+    #[test]
+    fn the_windows_and_the_columns_are_shown() {
+        use crate::bed::run::{BedRun, BedSample};
+        // C = abP/(1 + bP), a = 0.4, 1/b = 50 kPa, to C = 0.22.
+        let samples = (1..=22)
+            .map(|i| {
+                let c = 0.01 * f64::from(i);
+                BedSample {
+                    strain: c,
+                    upper_pressure_pa: c * 50e3 / (0.4 - c),
+                    min_jacobian: 0.9,
+                    min_gauss_jacobian: 0.9,
+                    ..BedSample::default()
+                }
+            })
+            .collect();
+        let scene = Scene::published();
+        let summary = crate::bed::outputs::summary(&scene, &BedRun::of_samples(samples));
+        let html = report_html(&scene, &summary, &[], &[]).unwrap();
+        let table = &html[html.find("The Kawakita fit by window").unwrap()..];
+        let table = &table[table.find("<table>").unwrap()..table.find("</table>").unwrap()];
+        for (from, rows) in [("0.1", 13), ("0.15", 8), ("0.2", 3)] {
+            let row = format!(
+                "<tr><td>C ≥ {from}</td><td class=\"num\" title=\"R² = 1.000\">0.4000</td>\
+                 <td class=\"num\" title=\"R² = 1.000\">50.00</td><td class=\"num\">{rows}</td></tr>"
+            );
+            assert!(table.contains(&row), "no row {row} in {table}");
+        }
+        assert!(
+            table.contains("<td>C ≥ 0.25 (the run's fit)</td><td class=\"num\" title=\"no fit")
+        );
+        assert!(!table.contains('✗'));
+        let glossary = &html[html.find("Columns of compression.csv").unwrap()..];
+        for (name, _) in crate::bed::outputs::COMPRESSION_COLUMNS {
+            assert!(
+                glossary.contains(&format!("<td class=\"value\">{name}</td>")),
+                "{name}"
+            );
         }
     }
 

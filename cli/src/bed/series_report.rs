@@ -10,7 +10,9 @@ use core::fmt::Write as _;
 use std::path::Path;
 
 use super::compare::ComparisonRow;
-use super::report::{REPORT_FILE, TABLE_DIGITS, figure, html_escape, kpa, num, page_head};
+use super::report::{
+    REPORT_FILE, TABLE_DIGITS, figure, fit_cell, html_escape, kpa, num, page_head,
+};
 use super::seeds::Spread;
 use crate::output::write_text;
 
@@ -31,27 +33,6 @@ pub struct SeriesReport<'a> {
     pub files: &'a [&'a str],
     /// The overlaid plots: file name in the series directory, SVG text.
     pub svgs: &'a [(&'a str, String)],
-}
-
-/// A fit's cell: its figure `value` (`None`: no fit, the run did not reach
-/// its window), marked ✗ if the run's summary rejects the fit, with its R²
-/// in the cell's title.
-fn fit_cell(value: Option<String>, r_squared: Option<f64>, ok: bool) -> String {
-    let Some(value) = value else {
-        return "<td class=\"num\" title=\"no fit: the run ended before its window\">n/a</td>"
-            .to_owned();
-    };
-    let title = format!("R² = {}", num(r_squared));
-    let (class, mark) = if ok {
-        ("num", "")
-    } else {
-        ("num doubt", " ✗")
-    };
-    format!(
-        "<td class=\"{class}\" title=\"{}\">{}{mark}</td>",
-        html_escape(&title),
-        html_escape(&value)
-    )
 }
 
 /// A plain number cell.
