@@ -9,6 +9,11 @@
 //! sign; non-finite values are written `NaN`, `inf`, `-inf`.
 
 use std::io::{self, Write};
+use std::path::Path;
+
+use anyhow::Context as _;
+
+use crate::output::{create_file, finish_file};
 
 /// One cell of a row.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -110,6 +115,24 @@ impl<W: Write> CsvWriter<W> {
     pub fn into_inner(self) -> W {
         self.out
     }
+}
+
+/// Writes the file `path`: a header of the names of `columns` (name,
+/// meaning: the meanings are for the reader's glossary, not the file),
+/// then `rows`. Errors name the file.
+pub fn write_table<const N: usize>(
+    path: &Path,
+    columns: &[(&str, &str); N],
+    rows: impl Iterator<Item = [Field; N]>,
+) -> anyhow::Result<()> {
+    let names = columns.map(|c| c.0);
+    let mut csv = CsvWriter::new(create_file(path)?, &names)
+        .with_context(|| format!("cannot write to `{}`", path.display()))?;
+    for row in rows {
+        csv.write_row(&row)
+            .with_context(|| format!("cannot write to `{}`", path.display()))?;
+    }
+    finish_file(csv.into_inner(), path)
 }
 
 #[cfg(test)]

@@ -190,6 +190,18 @@ fn snapshots_plots_and_report() {
             .find(&img)
             .unwrap_or_else(|| panic!("report lacks {img}"));
         at += found + img.len();
+        // The picture's caption links its snapshot's tables.
+        let caption = &report[at..at + report[at..].find("</figcaption>").unwrap()];
+        for table in [
+            format!("vtk/contacts_{k}.csv"),
+            format!("vtk/granules_{k}.csv"),
+        ] {
+            assert!(dir.join(&table).is_file(), "no {table}");
+            assert!(
+                caption.contains(&format!("<a href=\"{table}\">")),
+                "{caption}"
+            );
+        }
     }
 
     let mut mean_density = Vec::new();
@@ -314,7 +326,7 @@ fn snapshots_plots_and_report() {
     assert_eq!(starts, [0.10, 0.15, 0.20, 0.25]);
     assert!(html.contains("<h3>The Kawakita fit by window</h3>"));
     assert_eq!(s["heckel_mean_pressure"]["points"], s["heckel"]["points"]);
-    let glossary = &html[html.find("<h2>Columns of compression.csv</h2>").unwrap()..];
+    let glossary = &html[html.find("<h3>compression.csv</h3>").unwrap()..];
     let mut at = 0;
     for column in rows.header.split(',') {
         let cell = format!("<tr><td class=\"value\">{column}</td>");

@@ -38,6 +38,7 @@ pub mod section;
 pub mod seeds;
 pub mod series;
 pub mod series_report;
+pub mod snapshot_tables;
 pub mod snapshots;
 
 pub use scene::{DEFAULT_SCENE, Scene};

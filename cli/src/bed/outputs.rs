@@ -5,7 +5,6 @@
 use std::path::Path;
 
 use crate::material_args::MaterialSummary;
-use anyhow::Context as _;
 use granbed_kernel::Real;
 use granbed_kernel::analysis::bed::{heckel_fit, heckel_usable};
 use granbed_kernel::analysis::quasi_static::LoadSample;
@@ -14,8 +13,8 @@ use serde::Serialize;
 
 use super::run::{BedRun, BedSample};
 use super::scene::Scene;
-use crate::csv::{CsvWriter, Field};
-use crate::output::{create_file, finish_file, finite_ratio, write_json};
+use crate::csv::{Field, write_table};
+use crate::output::{finite_ratio, write_json};
 use crate::progress::{StrainBar, draw_target, steps_per_second};
 use crate::quasi_static::QuasiStatic;
 
@@ -838,14 +837,11 @@ pub const FIT_MIN_R_SQUARED: Real = 0.9;
 /// into `dir` (created).
 pub fn write_all(dir: &Path, scene: &Scene, run: &BedRun) -> anyhow::Result<()> {
     crate::output::create_out_dir(dir)?;
-    let path = dir.join(COMPRESSION_CSV);
-    let mut csv = CsvWriter::new(create_file(&path)?, &COMPRESSION_COLUMNS.map(|c| c.0))
-        .with_context(|| format!("cannot write to `{}`", path.display()))?;
-    for s in &run.samples {
-        csv.write_row(&row(s, run))
-            .with_context(|| format!("cannot write to `{}`", path.display()))?;
-    }
-    finish_file(csv.into_inner(), &path)?;
+    write_table(
+        &dir.join(COMPRESSION_CSV),
+        &COMPRESSION_COLUMNS,
+        run.samples.iter().map(|s| row(s, run)),
+    )?;
     let summary = summary(scene, run);
     write_json(&dir.join(SUMMARY_JSON), &summary)?;
     let svgs = super::plots::write_plots(dir, run, &summary)?;

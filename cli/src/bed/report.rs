@@ -12,6 +12,7 @@ use serde_json::Value;
 
 use super::outputs::{COMPRESSION_COLUMNS, Summary};
 use super::scene::{DEFAULT_SCENE, Scene};
+use super::snapshot_tables::{CONTACT_COLUMNS, GRANULE_COLUMNS, contacts_file, granules_file};
 use super::snapshots::{PVD_FILE, VTK_DIR};
 use crate::numbers::{short, significant};
 use crate::output::write_text;
@@ -491,15 +492,15 @@ fn kawakita_by_window(summary: &Summary<'_>) -> String {
     h
 }
 
-/// The glossary of `compression.csv`: each column's name and meaning
-/// with its unit ([`COMPRESSION_COLUMNS`]).
-fn csv_glossary() -> String {
-    let mut h = String::from(
-        "<h2>Columns of compression.csv</h2>\n<p>One row per output interval; forces and \
-         pressures are the interval's averages, energies the totals so far.</p>\n<table>\n\
-         <tr><th>column</th><th>meaning</th></tr>\n",
+/// A glossary: the columns (name, meaning with its unit) of the table
+/// `file`, under a heading, after the paragraph `about`.
+fn glossary(file: &str, about: &str, columns: &[(&str, &str)]) -> String {
+    let mut h = format!(
+        "<h3>{}</h3>\n<p>{}</p>\n<table>\n<tr><th>column</th><th>meaning</th></tr>\n",
+        html_escape(file),
+        html_escape(about)
     );
-    for (name, meaning) in COMPRESSION_COLUMNS {
+    for (name, meaning) in columns {
         let _ = writeln!(
             h,
             "<tr><td class=\"value\">{}</td><td>{}</td></tr>",
@@ -508,6 +509,31 @@ fn csv_glossary() -> String {
         );
     }
     h.push_str("</table>\n");
+    h
+}
+
+/// The glossaries of the run's tables: `compression.csv` and the
+/// snapshots' [`CONTACT_COLUMNS`] and [`GRANULE_COLUMNS`].
+fn glossaries() -> String {
+    let mut h = String::from("<h2>Columns of the tables</h2>\n");
+    h.push_str(&glossary(
+        "compression.csv",
+        "One row per output interval; forces and pressures are the interval's averages, \
+         energies the totals so far.",
+        &COMPRESSION_COLUMNS,
+    ));
+    h.push_str(&glossary(
+        "vtk/contacts_<k>.csv",
+        "Beside snapshot k: one row per granule pair in contact in the snapshot's step, \
+         ordered by the pair. The forces are the step's (the contacts are enforced anew each \
+         step), not interval averages.",
+        &CONTACT_COLUMNS,
+    ));
+    h.push_str(&glossary(
+        "vtk/granules_<k>.csv",
+        "Beside snapshot k: one row per granule.",
+        &GRANULE_COLUMNS,
+    ));
     h
 }
 
@@ -579,14 +605,14 @@ pub(super) fn figure(href: &str, svg: &str) -> String {
 }
 
 /// The report page of a run of `scene` with `summary`, the plots `svgs`
-/// (file name in `plots/`, SVG text) and the section pictures `sections`
-/// (paths relative to the page, in strain order; shown as images, not
-/// inline: each holds thousands of polygons).
+/// (file name in `plots/`, SVG text) and the snapshots' files `sections`
+/// (in strain order; the pictures shown as images, not inline: each holds
+/// thousands of polygons; the tables linked).
 pub fn report_html(
     scene: &Scene,
     summary: &Summary<'_>,
     svgs: &[(&str, String)],
-    sections: &[String],
+    sections: &[SnapshotFiles],
 ) -> anyhow::Result<String> {
     let toml = if *scene == Scene::published() {
         DEFAULT_SCENE.to_string()
@@ -655,14 +681,25 @@ pub fn report_html(
              granules' outlines, the die wall and the punches (the upper one moves down). The \
              granules are all of one size: a small circle is a cut off their centre. Each \
              picture has its own colour scale, up to the 99th percentile of its stresses. The \
-             VTU snapshots beside them hold the whole bed.</p>"
+             VTU snapshots beside them hold the whole bed; the tables beside each picture hold \
+             its contact network (contacts_<k>.csv: every pair of granules in contact, with its \
+             forces and branch vector) and its granules (granules_<k>.csv: centre, relative \
+             density, contacts), their columns explained at the end of this page.</p>"
         )?;
-        for path in sections {
-            let path = html_escape(path);
+        for files in sections {
+            let path = html_escape(&files.section);
+            let links: String = core::iter::once(&files.section)
+                .chain(&files.tables)
+                .map(|f| {
+                    let f = html_escape(f);
+                    format!("<a href=\"{f}\">{f}</a>")
+                })
+                .collect::<Vec<_>>()
+                .join(", ");
             writeln!(
                 h,
                 "<figure>\n<img src=\"{path}\" alt=\"section of the bed: {path}\" \
-                 style=\"max-width: 100%\">\n<figcaption><a href=\"{path}\">{path}</a></figcaption>\n</figure>"
+                 style=\"max-width: 100%\">\n<figcaption>{links}</figcaption>\n</figure>"
             )?;
         }
     }
@@ -681,7 +718,7 @@ pub fn report_html(
         )?;
     }
     writeln!(h, "</table>")?;
-    h.push_str(&csv_glossary());
+    h.push_str(&glossaries());
     writeln!(
         h,
         "<h2>Scene</h2>\n<pre>{}</pre>\n</body>\n</html>",
@@ -690,25 +727,45 @@ pub fn report_html(
     Ok(h)
 }
 
-/// The section pictures in `dir`/[`VTK_DIR`] (`section_<k>.svg`), as paths
-/// relative to `dir`, in the order of k (the snapshots' strain order).
-fn section_files(dir: &Path) -> Vec<String> {
+/// The files of one snapshot the report links to, as paths relative to
+/// the page: its section picture and the tables beside it
+/// ([`super::snapshot_tables`]) that exist.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct SnapshotFiles {
+    /// `vtk/section_<k>.svg`.
+    pub section: String,
+    /// `vtk/contacts_<k>.csv` and `vtk/granules_<k>.csv`, if there.
+    pub tables: Vec<String>,
+}
+
+/// The snapshots' files in `dir`/[`VTK_DIR`] (`section_<k>.svg` and the
+/// tables of the same k), in the order of k (the snapshots' strain order).
+fn snapshot_files(dir: &Path) -> Vec<SnapshotFiles> {
     let Ok(entries) = std::fs::read_dir(dir.join(VTK_DIR)) else {
         return Vec::new();
     };
-    let mut sections: Vec<(usize, String)> = entries
+    let mut ks: Vec<usize> = entries
         .filter_map(Result::ok)
         .filter_map(|e| {
             let name = e.file_name().into_string().ok()?;
-            let k = super::snapshots::numbered(&name, "section_", ".svg")?;
-            Some((k, format!("{VTK_DIR}/{name}")))
+            super::snapshots::numbered(&name, "section_", ".svg")
         })
         .collect();
-    sections.sort();
-    sections.into_iter().map(|(_, path)| path).collect()
+    ks.sort_unstable();
+    ks.into_iter()
+        .map(|k| SnapshotFiles {
+            section: format!("{VTK_DIR}/{}", super::snapshots::section_file(k)),
+            tables: [contacts_file(k), granules_file(k)]
+                .into_iter()
+                .filter(|name| dir.join(VTK_DIR).join(name).is_file())
+                .map(|name| format!("{VTK_DIR}/{name}"))
+                .collect(),
+        })
+        .collect()
 }
 
-/// Writes [`REPORT_FILE`] into `dir`.
+/// Writes `report.html` of a run into `dir`, linking the snapshots' files
+/// there.
 pub fn write_report(
     dir: &Path,
     scene: &Scene,
@@ -716,7 +773,7 @@ pub fn write_report(
     svgs: &[(&str, String)],
 ) -> anyhow::Result<()> {
     let path = dir.join(REPORT_FILE);
-    let html = report_html(scene, summary, svgs, &section_files(dir))?;
+    let html = report_html(scene, summary, svgs, &snapshot_files(dir))?;
     write_text(&path, &html)
 }
 
@@ -801,7 +858,7 @@ mod tests {
 
     /// The page shows the Kawakita fit of each window, the run's own
     /// named, a window not reached as n/a, and the glossary of every
-    /// column of compression.csv.
+    /// column of compression.csv and of the snapshots' tables.
     #[test]
     fn the_windows_and_the_columns_are_shown() {
         use crate::bed::run::{BedRun, BedSample};
@@ -834,12 +891,18 @@ mod tests {
             table.contains("<td>C ≥ 0.25 (the run's fit)</td><td class=\"num\" title=\"no fit")
         );
         assert!(!table.contains('✗'));
-        let glossary = &html[html.find("Columns of compression.csv").unwrap()..];
-        for (name, _) in crate::bed::outputs::COMPRESSION_COLUMNS {
-            assert!(
-                glossary.contains(&format!("<td class=\"value\">{name}</td>")),
-                "{name}"
-            );
+        let glossary = &html[html.find("<h2>Columns of the tables</h2>").unwrap()..];
+        for (file, columns) in [
+            ("compression.csv", &COMPRESSION_COLUMNS[..]),
+            ("vtk/contacts_&lt;k&gt;.csv", &CONTACT_COLUMNS[..]),
+            ("vtk/granules_&lt;k&gt;.csv", &GRANULE_COLUMNS[..]),
+        ] {
+            let table = &glossary[glossary.find(&format!("<h3>{file}</h3>")).unwrap()..];
+            let table = &table[..table.find("</table>").unwrap()];
+            for (name, _) in columns {
+                let cell = format!("<td class=\"value\">{name}</td>");
+                assert!(table.contains(&cell), "{file}: {name}");
+            }
         }
     }
 

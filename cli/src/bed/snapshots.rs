@@ -28,7 +28,12 @@ use vtkio::model::{
 };
 
 use super::section::{Frame, Quantity, SectionInput, section_svg};
+use super::snapshot_tables::{
+    CONTACT_COLUMNS, ContactRow, GRANULE_COLUMNS, contact_rows, contacts_file, granule_rows,
+    granules_file,
+};
 use crate::assembly::Assembly;
+use crate::csv::write_table;
 use crate::model::OwnedReference;
 use crate::output::{create_file, finish_file, write_text};
 
@@ -176,13 +181,14 @@ pub fn quad_hexes(mesh: &OwnedReference) -> anyhow::Result<Vec<usize>> {
 
 /// The snapshot of `asm` as a VTK unstructured grid: the granules one
 /// after the other (points, then cells, in granule order), with the
-/// element fields `elements` ([`element_fields`]).
+/// granule fields `fields` ([`granule_fields`]) and the element fields
+/// `elements` ([`element_fields`]).
 pub fn snapshot_vtk(
     asm: &Assembly<'_>,
     mesh: &OwnedReference,
+    fields: &GranuleFields,
     elements: &ElementFields,
     content: SnapshotContent,
-    d_fixed_m: Real,
 ) -> anyhow::Result<Vtk> {
     let nodes = mesh.positions.len();
     // Nodes written per granule and the first of them; surfaces use the
@@ -222,7 +228,6 @@ pub fn snapshot_vtk(
     }
     let cells = cells_per_granule * granules.len();
     let offsets = (1..=cells).map(|c| (c * per_cell) as u64).collect();
-    let fields = granule_fields(asm, mesh, d_fixed_m);
     let per_cell_values = |v: &[Real]| -> Vec<Real> {
         v.iter()
             .flat_map(|&x| core::iter::repeat_n(x, cells_per_granule))
@@ -348,7 +353,8 @@ fn section_input<'a>(
 }
 
 /// Removes the snapshots an earlier run left in `out`/[`VTK_DIR`]
-/// (`bed_<k>.vtu`, `section_<k>.svg` and [`PVD_FILE`]; nothing else), so that a fresh run
+/// (`bed_<k>.vtu`, `section_<k>.svg`, `contacts_<k>.csv`, `granules_<k>.csv` and
+/// [`PVD_FILE`]; nothing else), so that a fresh run
 /// into the same directory does not leave stale snapshots beside its own
 /// (e.g. of strains it does not reach). Returns how many files went.
 pub fn remove_old(out: &Path) -> anyhow::Result<usize> {
@@ -362,7 +368,9 @@ pub fn remove_old(out: &Path) -> anyhow::Result<usize> {
         let name = entry.file_name();
         let Some(name) = name.to_str() else { continue };
         let snapshot = numbered(name, "bed_", ".vtu").is_some()
-            || numbered(name, "section_", ".svg").is_some();
+            || numbered(name, "section_", ".svg").is_some()
+            || numbered(name, "contacts_", ".csv").is_some()
+            || numbered(name, "granules_", ".csv").is_some();
         if (snapshot || name == PVD_FILE) && entry.path().is_file() {
             std::fs::remove_file(entry.path())
                 .with_context(|| format!("cannot remove `{}`", entry.path().display()))?;
@@ -415,7 +423,8 @@ impl SnapshotWriter {
         }
     }
 
-    /// Writes `bed_<k>.vtu` of `asm` at `strain` and rewrites `bed.pvd`.
+    /// Writes `bed_<k>.vtu` of `asm` at `strain`, its section picture and
+    /// its tables ([`super::snapshot_tables`]), and rewrites `bed.pvd`.
     pub fn write(
         &mut self,
         strain: Real,
@@ -427,7 +436,8 @@ impl SnapshotWriter {
         let k = self.index(strain);
         let path = self.dir.join(snapshot_file(k));
         let elements = element_fields(asm, mesh);
-        let vtk = snapshot_vtk(asm, mesh, &elements, self.content, self.d_fixed_m)?;
+        let granules = granule_fields(asm, mesh, self.d_fixed_m);
+        let vtk = snapshot_vtk(asm, mesh, &granules, &elements, self.content)?;
         let mut file = create_file(&path)?;
         vtk.write_xml(&mut file)
             .map_err(|e| anyhow::anyhow!("{e}"))
@@ -436,6 +446,17 @@ impl SnapshotWriter {
         write_text(
             &self.dir.join(section_file(k)),
             &section_svg(&section_input(asm, mesh, &elements, strain)),
+        )?;
+        let contacts = contact_rows(asm);
+        write_table(
+            &self.dir.join(contacts_file(k)),
+            &CONTACT_COLUMNS,
+            contacts.iter().map(ContactRow::fields),
+        )?;
+        write_table(
+            &self.dir.join(granules_file(k)),
+            &GRANULE_COLUMNS,
+            granule_rows(asm, &granules, &contacts).into_iter(),
         )?;
         let entries: Vec<(Real, String)> = self.strains[..=k]
             .iter()

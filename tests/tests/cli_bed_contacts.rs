@@ -1,0 +1,151 @@
+//! The snapshot tables of `granbed-cli bed` (`vtk/contacts_<k>.csv`,
+//! `vtk/granules_<k>.csv`) on a bed of 100 coarse granules in a 5 mm die
+//! pressed to 15 %: the two tables agree with each other and with the
+//! summary, and the contact forces are those of a bed at rest: a granule
+//! inside the bed, away from the die and the punches, is held by its
+//! granule contacts alone, so their forces nearly cancel on it, while a
+//! granule at a wall is not balanced by them.
+
+mod common;
+
+use common::{Table, cli, fresh_dir, number, small_bed, summary};
+
+const GRANULES: usize = 100;
+
+/// (a, b, force on a, branch b − a) of each contacts row.
+type Contact = (usize, usize, [f64; 3], [f64; 3]);
+
+fn vec3(t: &Table, row: &[String], names: [&str; 3]) -> [f64; 3] {
+    names.map(|n| row[t.col(n)].parse().unwrap())
+}
+
+#[test]
+fn the_contact_network_balances_the_inner_granules() {
+    let dir = fresh_dir("cli_bed_contacts", "bed100");
+    let mut argv = vec!["bed", "--quiet", "--out", dir.to_str().unwrap()];
+    argv.extend_from_slice(&small_bed("100", "0.15"));
+    let run = cli(&argv);
+    assert_eq!(run.code, 0, "bed failed:\n{}", run.stderr);
+    let s = summary(&dir);
+    // Snapshots at 0 and 0.1 (the published list cut at the final strain)
+    // and of the final state at 0.15: k = 0, 1, 2.
+    let last = 2;
+    for k in 0..=last {
+        let contacts = Table::read(&dir.join(format!("vtk/contacts_{k}.csv")));
+        let granules = Table::read(&dir.join(format!("vtk/granules_{k}.csv")));
+        assert_eq!(granules.cells.len(), GRANULES);
+        let centre = |g: usize| vec3(&granules, &granules.cells[g], ["x_m", "y_m", "z_m"]);
+        let rows: Vec<Contact> = contacts
+            .cells
+            .iter()
+            .map(|r| {
+                let id = |n: &str| r[contacts.col(n)].parse::<usize>().unwrap();
+                (
+                    id("granule_a"),
+                    id("granule_b"),
+                    vec3(&contacts, r, ["force_x_n", "force_y_n", "force_z_n"]),
+                    vec3(&contacts, r, ["branch_x_m", "branch_y_m", "branch_z_m"]),
+                )
+            })
+            .collect();
+        // Pairs once each, in order, a < b.
+        assert!(
+            rows.windows(2).all(|w| (w[0].0, w[0].1) < (w[1].0, w[1].1)),
+            "rows out of order in contacts_{k}"
+        );
+        let d = 1e-3;
+        let mut touching = vec![0_usize; GRANULES];
+        for (row, &(a, b, f, l)) in contacts.cells.iter().zip(&rows) {
+            assert!(a < b && b < GRANULES, "pair {a}-{b}");
+            touching[a] += 1;
+            touching[b] += 1;
+            // The branch vector is the difference of the granules' centres
+            // in granules_<k>.csv, to the bit: the same granules.
+            let (ca, cb) = (centre(a), centre(b));
+            assert_eq!(l, [0, 1, 2].map(|i| cb[i] - ca[i]), "branch of {a}-{b}");
+            let length: f64 = row[contacts.col("branch_length_m")].parse().unwrap();
+            assert!(length > 0.7 * d && length < 1.01 * d, "{a}-{b}: {length}");
+            // A contact pushes the granules apart: the force on a points
+            // away from b.
+            let along: f64 = (0..3).map(|i| f[i] * l[i]).sum();
+            assert!(along < 0.0, "{a}-{b}: force on a {f:?}, branch {l:?}");
+            let normal: f64 = row[contacts.col("normal_force_n")].parse().unwrap();
+            let slipping: usize = row[contacts.col("slipping")].parse().unwrap();
+            let constraints: usize = row[contacts.col("constraints")].parse().unwrap();
+            assert!(normal > 0.0 && constraints >= 1 && slipping <= constraints);
+        }
+        let counted: Vec<usize> = granules
+            .num("contacts")
+            .iter()
+            .map(|&n| n as usize)
+            .collect();
+        assert_eq!(counted, touching, "granules_{k}'s contacts");
+        if k == 0 {
+            // The poured spheres' meshes start a few µm apart.
+            assert!(rows.is_empty(), "{} contacts at C = 0", rows.len());
+            continue;
+        }
+        assert!(!rows.is_empty());
+        if k < last {
+            continue;
+        }
+        // At the end: as many pairs as the summary's coordination says
+        // (its last row is averaged over the output interval, this is
+        // the last step's), and the balance of the contact forces.
+        let z = 2.0 * rows.len() as f64 / GRANULES as f64;
+        let z_csv = number(&s, "final_coordination");
+        assert!((z - z_csv).abs() < 0.1 * z_csv, "Z {z} against {z_csv}");
+        let mut sum = vec![[0.0_f64; 3]; GRANULES];
+        let mut size = vec![0.0_f64; GRANULES];
+        for &(a, b, f, _) in &rows {
+            let magnitude = f.iter().map(|x| x * x).sum::<f64>().sqrt();
+            for i in 0..3 {
+                sum[a][i] += f[i];
+                sum[b][i] -= f[i];
+            }
+            size[a] += magnitude;
+            size[b] += magnitude;
+        }
+        let die_radius = 2.5e-3;
+        let top = number(&s, "initial_bed_height_m") * (1.0 - 0.15);
+        let reach = 0.65 * d;
+        let mut inner = Vec::new();
+        let mut at_walls = Vec::new();
+        for g in 0..GRANULES {
+            if size[g] == 0.0 {
+                continue;
+            }
+            let [x, y, z] = centre(g);
+            let imbalance = sum[g].iter().map(|v| v * v).sum::<f64>().sqrt() / size[g];
+            let r = x.hypot(y);
+            if r < die_radius - reach && z > reach && z < top - reach {
+                inner.push(imbalance);
+            } else {
+                at_walls.push(imbalance);
+            }
+        }
+        let median = |v: &mut Vec<f64>| {
+            v.sort_by(f64::total_cmp);
+            v[v.len() / 2]
+        };
+        assert!(inner.len() >= 10, "{} inner granules", inner.len());
+        let (inner_m, walls_m) = (median(&mut inner), median(&mut at_walls));
+        assert!(
+            inner_m < 0.05 && walls_m > 4.0 * inner_m,
+            "median imbalance: inner {inner_m} ({} granules), at the walls {walls_m}",
+            inner.len()
+        );
+    }
+    // A fresh run into the same directory removes the tables of snapshots
+    // it does not reach.
+    let mut argv = vec!["bed", "--quiet", "--out", dir.to_str().unwrap()];
+    argv.extend_from_slice(&small_bed("100", "0.05"));
+    assert_eq!(cli(&argv).code, 0);
+    for k in 1..=last {
+        for table in ["contacts", "granules"] {
+            let path = dir.join(format!("vtk/{table}_{k}.csv"));
+            // k = 1 is now the final state at 0.05; k = 2 is gone.
+            assert_eq!(path.is_file(), k == 1, "{}", path.display());
+        }
+    }
+}
