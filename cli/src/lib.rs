@@ -40,6 +40,7 @@ pub mod csv;
 pub mod error;
 pub mod export_mesh;
 pub mod granule;
+pub mod html;
 pub mod material_args;
 pub mod model;
 pub mod numbers;

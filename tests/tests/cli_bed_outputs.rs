@@ -380,7 +380,7 @@ fn snapshots_plots_and_report() {
     let (head, table) = html.split_at(html.find("<h2>Summary</h2>").unwrap());
     assert!(head.contains("<h2>Warnings</h2>"));
     for w in warnings {
-        let escaped = granbed_cli::bed::report::html_escape(w.as_str().unwrap());
+        let escaped = granbed_cli::html::html_escape(w.as_str().unwrap());
         assert!(head.contains(&format!("<li>{escaped}</li>")), "{escaped}");
     }
     assert!(!table.contains("<td>warnings</td>"));

@@ -8,13 +8,15 @@
 use core::fmt::Write as _;
 use std::path::Path;
 
-use serde_json::Value;
-
 use super::outputs::{COMPRESSION_COLUMNS, Summary};
 use super::scene::{DEFAULT_SCENE, Scene};
 use super::snapshot_tables::{CONTACT_COLUMNS, GRANULE_COLUMNS, contacts_file, granules_file};
 use super::snapshots::{PVD_FILE, VTK_DIR};
-use crate::numbers::{short, significant};
+use crate::html::{
+    Row, figure, fit_cell, glossary, html_escape, key_table, kpa, num, page_head, summary_rows,
+    summary_table, warnings_section,
+};
+use crate::numbers::short;
 use crate::output::write_text;
 
 /// File name of the report in the output directory.
@@ -246,140 +248,12 @@ const FIELDS: [(&str, &str); 85] = [
     ("kawakita_windows", ""),
 ];
 
-/// `text` with the HTML special characters escaped (for element content
-/// and attribute values alike).
-pub fn html_escape(text: &str) -> String {
-    crate::output::escape_markup(text)
-}
-
-/// A JSON value as `summary.json` writes it: numbers with all their
-/// digits, strings without quotes, `null` as "n/a".
-fn show(value: &Value) -> String {
-    match value {
-        Value::Null => "n/a".to_string(),
-        Value::String(s) => s.clone(),
-        v => v.to_string(),
-    }
-}
-
-/// A JSON value as the table's cell shows it: a float to
-/// [`TABLE_DIGITS`] significant digits ([`significant`]), anything else
-/// as [`show`] gives it.
-fn shown_in_cell(value: &Value) -> String {
-    match value {
-        Value::Number(n) if !(n.is_u64() || n.is_i64()) => n
-            .as_f64()
-            .map_or_else(|| show(value), |x| significant(x, TABLE_DIGITS)),
-        v => show(v),
-    }
-}
-
-/// Significant digits of the floats in the report's tables; the cell's
-/// `title` (shown on hover) and `summary.json` keep all of them.
-pub const TABLE_DIGITS: usize = 4;
-
-/// One row of the summary table.
-#[derive(Debug)]
-struct Row {
-    key: String,
-    meaning: &'static str,
-    /// As `summary.json` has it.
-    full: String,
-    /// As the cell shows it.
-    cell: String,
-}
-
-impl Row {
-    fn new(key: String, meaning: &'static str, value: &Value) -> Self {
-        Self {
-            key,
-            meaning,
-            full: show(value),
-            cell: shown_in_cell(value),
-        }
-    }
-}
-
-/// The summary's fields as rows, in [`FIELDS`]' order, then the others.
+/// The summary's fields as rows, in [`FIELDS`]' order, then the others;
+/// the scene is shown as TOML below the table, not as rows.
 fn rows(summary: &Summary<'_>) -> anyhow::Result<Vec<Row>> {
-    let Value::Object(map) = serde_json::to_value(summary)? else {
-        anyhow::bail!("the summary is not a JSON object");
-    };
-    let mut flat: Vec<(String, &Value)> = Vec::new();
-    for (key, value) in &map {
-        match value {
-            Value::Object(inner) => {
-                flat.extend(inner.iter().map(|(k, v)| (format!("{key}.{k}"), v)))
-            }
-            v => flat.push((key.clone(), v)),
-        }
-    }
-    let known = |k: &str| FIELDS.iter().position(|f| f.0 == k);
-    let mut out: Vec<Row> = FIELDS
-        .iter()
-        .filter(|f| !f.1.is_empty())
-        .filter_map(|&(key, meaning)| {
-            let v = flat.iter().find(|(k, _)| k == key)?.1;
-            Some(Row::new(key.to_string(), meaning, v))
-        })
-        .collect();
-    out.extend(
-        flat.iter()
-            // The scene is shown as TOML below the table, not as a row.
-            .filter(|(k, _)| known(k).is_none() && !k.starts_with("scene.") && k != "scene_toml")
-            .map(|(k, v)| Row::new(k.clone(), "", v)),
-    );
-    Ok(out)
-}
-
-/// The start of a report page titled `title`, to its `<h1>`: the
-/// document's head with the pages' one style sheet (shared by a run's
-/// report and a series' report).
-pub(super) fn page_head(title: &str) -> String {
-    let title = html_escape(title);
-    format!(
-        "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n<title>{title}</title>\n\
-         <style>\nbody {{ font-family: sans-serif; max-width: 960px; margin: 1em auto; padding: 0 1em; }}\n\
-         table {{ border-collapse: collapse; }}\n\
-         td, th {{ border: 1px solid #ccc; padding: 0.2em 0.6em; text-align: left; }}\n\
-         td.value, td.num {{ font-family: monospace; }}\ntd.num {{ text-align: right; }}\n\
-         tr.doubt td {{ background: #fff4e0; }}\n\
-         figure {{ margin: 1em 0; }}\nfigure svg {{ max-width: 100%; height: auto; }}\n\
-         pre {{ background: #f4f4f4; padding: 0.8em; overflow-x: auto; }}\n\
-         p.caption {{ font-size: 0.9em; color: #444; margin-top: -0.4em; }}\n</style>\n</head>\n<body>\n\
-         <h1>{title}</h1>\n"
-    )
-}
-
-/// A float of the table: `x` to [`TABLE_DIGITS`] digits, "n/a" if none.
-pub(super) fn num(x: Option<f64>) -> String {
-    x.map_or_else(|| "n/a".to_owned(), |x| significant(x, TABLE_DIGITS))
-}
-
-/// A pressure of the table in kPa, from Pa.
-pub(super) fn kpa(x: Option<f64>) -> String {
-    num(x.map(|p| p * 1e-3))
-}
-
-/// A fit's cell: its figure `value` (`None`: no fit, the run did not reach
-/// its window), marked ✗ if the run's summary rejects the fit, with its R²
-/// in the cell's title.
-pub(super) fn fit_cell(value: Option<String>, r_squared: Option<f64>, ok: bool) -> String {
-    let Some(value) = value else {
-        return "<td class=\"num\" title=\"no fit: the run ended before its window\">n/a</td>"
-            .to_owned();
-    };
-    let title = format!("R² = {}", num(r_squared));
-    let (class, mark) = if ok {
-        ("num", "")
-    } else {
-        ("num doubt", " ✗")
-    };
-    format!(
-        "<td class=\"{class}\" title=\"{}\">{}{mark}</td>",
-        html_escape(&title),
-        html_escape(&value)
-    )
+    summary_rows(summary, &FIELDS, |k| {
+        k.starts_with("scene.") || k == "scene_toml"
+    })
 }
 
 /// The run's key figures as a short table with units, for the top of the
@@ -447,16 +321,7 @@ fn key_results(summary: &Summary<'_>) -> String {
             },
         ),
     ];
-    let mut h = String::from("<h2>Key results</h2>\n<table>\n");
-    for (what, value) in rows {
-        h.push_str(&format!(
-            "<tr><td>{}</td><td class=\"value\">{}</td></tr>\n",
-            html_escape(&what),
-            html_escape(&value)
-        ));
-    }
-    h.push_str("</table>\n");
-    h
+    key_table("Key results", &rows)
 }
 
 /// The Kawakita fit over each window of `summary.kawakita_windows`: its
@@ -486,26 +351,6 @@ fn kawakita_by_window(summary: &Summary<'_>) -> String {
             fit_cell(k.a.map(|a| num(Some(a))), k.r_squared, ok),
             fit_cell(k.inv_b_pa.map(|b| kpa(Some(b))), k.r_squared, ok),
             k.points
-        );
-    }
-    h.push_str("</table>\n");
-    h
-}
-
-/// A glossary: the columns (name, meaning with its unit) of the table
-/// `file`, under a heading, after the paragraph `about`.
-fn glossary(file: &str, about: &str, columns: &[(&str, &str)]) -> String {
-    let mut h = format!(
-        "<h3>{}</h3>\n<p>{}</p>\n<table>\n<tr><th>column</th><th>meaning</th></tr>\n",
-        html_escape(file),
-        html_escape(about)
-    );
-    for (name, meaning) in columns {
-        let _ = writeln!(
-            h,
-            "<tr><td class=\"value\">{}</td><td>{}</td></tr>",
-            html_escape(name),
-            html_escape(meaning)
         );
     }
     h.push_str("</table>\n");
@@ -595,15 +440,6 @@ fn plot_caption(name: &str, summary: &Summary<'_>) -> Option<String> {
     })
 }
 
-/// A plot inline: the SVG `svg`, captioned with a link to its file `href`
-/// (relative to the page).
-pub(super) fn figure(href: &str, svg: &str) -> String {
-    // The SVG is plotters' output: well-formed XML with its text already
-    // escaped, so it is embedded as it is.
-    let href = html_escape(href);
-    format!("<figure>\n{svg}\n<figcaption><a href=\"{href}\">{href}</a></figcaption>\n</figure>\n")
-}
-
 /// The report page of a run of `scene` with `summary`, the plots `svgs`
 /// (file name in `plots/`, SVG text) and the snapshots' files `sections`
 /// (in strain order; the pictures shown as images, not inline: each holds
@@ -624,30 +460,12 @@ pub fn report_html(
         scene.granules, scene.granule_type, scene.mesh
     );
     let mut h = page_head(&title);
-    if let Some(e) = &summary.error {
-        writeln!(
-            h,
-            "<p><strong>The run stopped early:</strong> {}</p>",
-            html_escape(e)
-        )?;
-    }
-    if summary.warnings.is_empty() {
-        writeln!(
-            h,
-            "<h2>Warnings</h2>\n<p>None: the run passed its checks (the quasi-static \
-             certificate, the overlaps, the elements, the fits).</p>"
-        )?;
-    } else {
-        writeln!(
-            h,
-            "<h2>Warnings</h2>\n<p>What the figures below hide (also in summary.json and on \
-             stderr):</p>\n<ul>"
-        )?;
-        for w in &summary.warnings {
-            writeln!(h, "<li>{}</li>", html_escape(w))?;
-        }
-        writeln!(h, "</ul>")?;
-    }
+    h.push_str(&warnings_section(
+        summary.error.as_deref(),
+        &summary.warnings,
+        "None: the run passed its checks (the quasi-static certificate, the overlaps, the \
+         elements, the fits).",
+    ));
     h.push_str(&key_results(summary));
     h.push_str(&kawakita_by_window(summary));
     writeln!(
@@ -703,21 +521,7 @@ pub fn report_html(
             )?;
         }
     }
-    writeln!(
-        h,
-        "<h2>Summary</h2>\n<table>\n<tr><th>field</th><th>value</th><th>meaning</th></tr>"
-    )?;
-    for row in rows(summary)? {
-        writeln!(
-            h,
-            "<tr><td>{}</td><td class=\"value\" title=\"{}\">{}</td><td>{}</td></tr>",
-            html_escape(&row.key),
-            html_escape(&row.full),
-            html_escape(&row.cell),
-            html_escape(row.meaning)
-        )?;
-    }
-    writeln!(h, "</table>")?;
+    h.push_str(&summary_table(&rows(summary)?));
     h.push_str(&glossaries());
     writeln!(
         h,
@@ -834,28 +638,6 @@ mod tests {
         }
     }
 
-    /// A cell rounds floats to [`TABLE_DIGITS`] and keeps counts and text
-    /// whole; the row's full value is what `summary.json` holds.
-    #[test]
-    fn cells_round_floats_only() {
-        let float = serde_json::json!(0.123_456_789);
-        let row = Row::new("x".into(), "", &float);
-        assert_eq!(
-            (row.full.as_str(), row.cell.as_str()),
-            ("0.123456789", "0.1235")
-        );
-        for (value, text) in [
-            (serde_json::json!(1_234_567_u64), "1234567"),
-            (serde_json::json!(-3), "-3"),
-            (serde_json::json!(true), "true"),
-            (serde_json::json!("0.5.0"), "0.5.0"),
-            (Value::Null, "n/a"),
-        ] {
-            let row = Row::new("x".into(), "", &value);
-            assert_eq!((row.full.as_str(), row.cell.as_str()), (text, text));
-        }
-    }
-
     /// The page shows the Kawakita fit of each window, the run's own
     /// named, a window not reached as n/a, and the glossary of every
     /// column of compression.csv and of the snapshots' tables.
@@ -917,13 +699,5 @@ mod tests {
         summary.warnings.clear();
         let none = report_html(&scene, &summary, &[], &[]).unwrap();
         assert!(none.contains("<h2>Warnings</h2>\n<p>None: the run passed its checks"));
-    }
-
-    #[test]
-    fn escaping() {
-        assert_eq!(
-            html_escape("a<b & \"c\" 'd'>"),
-            "a&lt;b &amp; &quot;c&quot; &#39;d&#39;&gt;"
-        );
     }
 }

@@ -10,10 +10,9 @@ use core::fmt::Write as _;
 use std::path::Path;
 
 use super::compare::ComparisonRow;
-use super::report::{
-    REPORT_FILE, TABLE_DIGITS, figure, fit_cell, html_escape, kpa, num, page_head,
-};
+use super::report::REPORT_FILE;
 use super::seeds::Spread;
+use crate::html::{TABLE_DIGITS, figure, fit_cell, html_escape, kpa, num, page_head};
 use crate::output::write_text;
 
 /// What a series' page shows.
