@@ -203,6 +203,42 @@ fn legend_corner(
     .map_or(SeriesLabelPosition::UpperLeft, |(_, corner)| corner)
 }
 
+/// The unit of energies up to `largest` J: (name, J per unit), the
+/// largest of J, mJ and µJ in which `largest` is at least 1 (µJ below).
+pub fn energy_unit(largest: f64) -> (&'static str, f64) {
+    [("J", 1.0), ("mJ", 1e-3)]
+        .into_iter()
+        .find(|&(_, unit)| largest.abs() >= unit)
+        .unwrap_or(("µJ", 1e-6))
+}
+
+/// An energy ledger under `title`: each term (legend, its (x, energy in
+/// J) points) against x (`x_desc`), all in the [`energy_unit`] of the
+/// largest finite value, the energy axis from zero.
+pub fn energy_svg(
+    title: &str,
+    x_desc: &str,
+    terms: &[(&str, Vec<(f64, f64)>)],
+) -> anyhow::Result<String> {
+    let largest = terms
+        .iter()
+        .flat_map(|(_, points)| points.iter().map(|p| p.1.abs()))
+        .filter(|e| e.is_finite())
+        .fold(0.0, f64::max);
+    let (unit, scale) = energy_unit(largest);
+    let series: Vec<Series> = terms
+        .iter()
+        .map(|(label, points)| {
+            Series::new(
+                *label,
+                Mark::Line,
+                points.iter().map(|&(x, e)| (x, e / scale)),
+            )
+        })
+        .collect();
+    xy_svg(title, x_desc, &format!("energy, {unit}"), &series, true)
+}
+
 /// The SVG text of `series` under `title`, with axis labels; the x axis
 /// from zero, the y axis from zero if `y_from_zero`.
 pub fn xy_svg(
@@ -366,6 +402,17 @@ mod tests {
     }
 
     /// Every tick of a plain axis has the decimals of the finest one.
+    /// Energies are drawn in the largest of J, mJ and µJ that the largest
+    /// value fills.
+    #[test]
+    fn energies_take_the_unit_of_the_largest() {
+        assert_eq!(energy_unit(2.5), ("J", 1.0));
+        assert_eq!(energy_unit(9.7e-3), ("mJ", 1e-3));
+        assert_eq!(energy_unit(9.7e-6), ("µJ", 1e-6));
+        assert_eq!(energy_unit(0.0), ("µJ", 1e-6));
+        assert_eq!(energy_unit(-2e-3), ("mJ", 1e-3));
+    }
+
     /// An x axis not from zero spans the data; [`xy_svg`]'s starts at 0.
     #[test]
     fn an_x_axis_from_zero_or_over_the_data() {

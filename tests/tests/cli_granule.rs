@@ -230,6 +230,46 @@ fn outputs_exist_and_parse() {
         section.contains("Granule B2 (4x1 octant) at 15.0 % strain"),
         "title"
     );
+
+    // The report: the note as a warning, σ_est in kPa to four digits, both
+    // plots captioned, the pictures, a meaning for every summary field and
+    // the CSV's columns explained in its order.
+    let html = std::fs::read_to_string(dir.join("report.html")).unwrap();
+    let note = granbed_cli::html::html_escape(s["notes"][0].as_str().unwrap());
+    assert!(
+        html.contains(&format!("<li>{note}</li>")),
+        "no warning {note}"
+    );
+    let sigma_kpa = granbed_cli::numbers::significant(number(&s, "sigma_est_pa") * 1e-3, 4);
+    assert!(
+        html.contains(&format!(
+            "apparent yield stress)</td><td class=\"value\">{sigma_kpa}</td>"
+        )),
+        "σ_est {sigma_kpa} kPa not in the key results"
+    );
+    assert_eq!(html.matches("<p class=\"caption\">").count(), 2);
+    assert_eq!(html.matches("<svg").count(), 2);
+    for picture in ["section.svg", "section_density.svg"] {
+        assert!(
+            html.contains(&format!("<img src=\"{picture}\"")),
+            "{picture}"
+        );
+    }
+    let energy = std::fs::read_to_string(dir.join("energy_strain.svg")).unwrap();
+    assert!(energy.contains("\nplastic dissipation\n") && energy.contains("energy, "));
+    let table = &html[html.find("<h2>Summary</h2>").unwrap()..html.find("<h2>Columns").unwrap()];
+    assert!(
+        !table.contains("<td></td></tr>"),
+        "a summary field without a meaning"
+    );
+    assert!(table.contains("<td>quasi_static.passed</td>") && !table.contains("format_version"));
+    let mut at = html.find("<h3>force_displacement.csv</h3>").unwrap();
+    for column in t.header.split(',') {
+        let cell = format!("<tr><td class=\"value\">{column}</td>");
+        at += html[at..]
+            .find(&cell)
+            .unwrap_or_else(|| panic!("glossary lacks {column}"));
+    }
 }
 
 /// The summary's numbers follow from the CSV it came with: the slope re-fitted
@@ -613,6 +653,15 @@ fn types_are_tabulated_and_independent_of_threads() {
     }
     let svg = std::fs::read_to_string(dir.join("force_displacement_types.svg")).unwrap();
     assert!(svg.starts_with("<svg"));
+    // The series' page links each type's report; both runs ended at 0.2,
+    // before σ_est's window closed, so both σ_est are marked.
+    let html = std::fs::read_to_string(dir.join("report.html")).unwrap();
+    for ty in ["A1", "C3"] {
+        assert!(html.contains(&format!("<a href=\"{ty}/report.html\">{ty}</a>")));
+        assert!(dir.join(ty).join("report.html").is_file());
+    }
+    assert_eq!(html.matches(" ✗</td>").count(), 2, "{html}");
+    assert_eq!(html.matches("<svg").count(), 1);
 
     let serial = out_dir("types-serial");
     let mut args = common.to_vec();
@@ -717,4 +766,8 @@ fn kernel_failure_keeps_partial_results() {
     // picture in the directory is removed (the test writes one first).
     assert!(!dir.join("section.svg").exists());
     assert!(!dir.join("section_density.svg").exists());
+    // The report says the run stopped and shows no picture.
+    let html = std::fs::read_to_string(dir.join("report.html")).unwrap();
+    assert!(html.contains("<p><strong>The run stopped early:</strong>"));
+    assert!(!html.contains("<img"));
 }

@@ -64,40 +64,17 @@ const ENERGY_TERMS: [(&str, Quantity); 7] = [
     ("kinetic", |s| s.energies.kinetic),
 ];
 
-/// The unit of energies up to `largest` J: (name, J per unit), the
-/// largest of J, mJ and µJ in which `largest` is at least 1 (µJ below).
-fn energy_unit(largest: Real) -> (&'static str, Real) {
-    [("J", 1.0), ("mJ", 1e-3)]
-        .into_iter()
-        .find(|&(_, unit)| largest.abs() >= unit)
-        .unwrap_or(("µJ", 1e-6))
-}
-
-/// The energy plot: each of [`ENERGY_TERMS`] against the strain, in the
-/// [`energy_unit`] of the largest value drawn.
+/// The energy plot: each of [`ENERGY_TERMS`] against the strain
+/// ([`crate::plot::energy_svg`]).
 fn energy_svg(samples: &[BedSample]) -> anyhow::Result<String> {
-    let largest = samples
+    let terms: Vec<(&str, Vec<(f64, f64)>)> = ENERGY_TERMS
         .iter()
-        .flat_map(|s| ENERGY_TERMS.iter().map(move |(_, y)| y(s).abs()))
-        .filter(|e| e.is_finite())
-        .fold(0.0, Real::max);
-    let (unit, scale) = energy_unit(largest);
-    let series: Vec<Series> = ENERGY_TERMS
-        .iter()
-        .map(|&(label, y)| {
-            Series::new(
-                label,
-                Mark::Line,
-                samples.iter().map(|s| (s.strain, y(s) / scale)),
-            )
-        })
+        .map(|&(label, y)| (label, samples.iter().map(|s| (s.strain, y(s))).collect()))
         .collect();
-    xy_svg(
+    crate::plot::energy_svg(
         "Energy: where the punch's work went",
         "axial strain C = (H0 - H)/H0",
-        &format!("energy, {unit}"),
-        &series,
-        true,
+        &terms,
     )
 }
 
@@ -432,14 +409,10 @@ pub fn write_plots(
 mod tests {
     use super::*;
 
-    /// Energies are drawn in the largest of J, mJ and µJ that the largest
-    /// value fills, every term of the ledger with its legend.
+    /// Every term of the ledger is drawn with its legend, in the unit of
+    /// the largest value.
     #[test]
     fn the_energy_plot_has_every_term_in_its_unit() {
-        assert_eq!(energy_unit(2.5), ("J", 1.0));
-        assert_eq!(energy_unit(9.7e-3), ("mJ", 1e-3));
-        assert_eq!(energy_unit(9.7e-6), ("µJ", 1e-6));
-        assert_eq!(energy_unit(0.0), ("µJ", 1e-6));
         let samples: Vec<BedSample> = (0..=10)
             .map(|i| {
                 let c = 0.03 * f64::from(i);

@@ -2,7 +2,7 @@
 //! SVG (first: what a reader looks at), the section pictures of its
 //! snapshots (as images of `vtk/section_<k>.svg`, too large to inline),
 //! the summary table (the fields of `summary.json`, floats rounded to
-//! [`TABLE_DIGITS`], all their digits in the cell's title), and the scene
+//! [`crate::html::TABLE_DIGITS`], all their digits in the cell's title), and the scene
 //! as TOML. All text is HTML-escaped.
 
 use core::fmt::Write as _;

@@ -31,6 +31,7 @@ use crate::output::Streams;
 pub mod outputs;
 pub mod plot;
 pub mod progress;
+pub mod report;
 pub mod run;
 pub mod section;
 pub mod summary;
@@ -96,10 +97,16 @@ Output, in --out DIR (created if missing; with --types in DIR/<TYPE>/ per type):
                           for a run that failed)
   section_density.svg     the same section coloured by the local relative
                           density eta0/J
+  energy_strain.svg       the energy ledger against x/d: where the platens'
+                          work went
+  report.html             one page: warnings, key results with units, the
+                          plots, the pictures, every summary field with its
+                          meaning and the CSV's columns
 With --types, also in DIR: types.csv (one row per type: sigma_y, eta0,
 sigma_eff0, sigma_est, the fit's slope and R^2, quasi_static_passed 1/0, steps,
-wall time, energy residual, return-map gap) and force_displacement_types.svg
-(all types overlaid).
+wall time, energy residual, return-map gap), force_displacement_types.svg
+(all types overlaid) and report.html (the types side by side, each linked to
+its own report).
 Floats are written round-trip exact. Progress bars go to stderr when it is a
 terminal, then one summary line per type. If the kernel fails, the rows so far,
 the summary (with its \"error\") and the plot are still written, and the error
@@ -467,7 +474,7 @@ impl GranuleArgs {
             params: &job.params,
         };
         let mut summary = Summary::new(&setup, &result, None);
-        write_outputs(&job.dir, &result, &summary)
+        let force_svg = write_outputs(&job.dir, &result, &summary)
             .with_context(|| format!("granule {name}: writing the outputs"))?;
         let title = format!(
             "Granule {name} ({} {}) at {:.1} % strain",
@@ -496,6 +503,23 @@ impl GranuleArgs {
             summary = Summary::new(&setup, &result, Some(change));
             outputs::write_summary_json(&job.dir.join(outputs::SUMMARY_JSON), &summary)?;
         }
+        let energy_svg = report::energy_svg(
+            &format!(
+                "Granule {name} ({} {}): where the platens' work went",
+                summary.mesh, summary.symmetry
+            ),
+            &result.samples,
+        )?;
+        outputs::write_text(&job.dir.join(report::ENERGY_SVG), &energy_svg)?;
+        report::write_report(
+            &job.dir,
+            &summary,
+            &[
+                (outputs::FORCE_SVG, &force_svg),
+                (report::ENERGY_SVG, &energy_svg),
+            ],
+        )
+        .with_context(|| format!("granule {name}: the report"))?;
         Ok(Outcome {
             job,
             result,
@@ -601,8 +625,9 @@ fn stress_text(pa: Real) -> String {
     }
 }
 
-/// Writes the CSV, summary and plot of one run into `dir`.
-fn write_outputs(dir: &Path, result: &RunResult, summary: &Summary) -> anyhow::Result<()> {
+/// Writes the CSV, summary and plot of one run into `dir`; returns the
+/// plot's SVG text (for the report).
+fn write_outputs(dir: &Path, result: &RunResult, summary: &Summary) -> anyhow::Result<String> {
     outputs::write_force_csv(&dir.join(outputs::FORCE_CSV), &result.samples)?;
     outputs::write_summary_json(&dir.join(outputs::SUMMARY_JSON), summary)?;
     let fit = match (
@@ -633,7 +658,8 @@ fn write_outputs(dir: &Path, result: &RunResult, summary: &Summary) -> anyhow::R
         samples: &result.samples,
     };
     let svg = plot::force_displacement_svg(&title, &[curve], fit.as_ref())?;
-    outputs::write_text(&dir.join(outputs::FORCE_SVG), &svg)
+    outputs::write_text(&dir.join(outputs::FORCE_SVG), &svg)?;
+    Ok(svg)
 }
 
 /// Writes `types.csv` and the overlaid plot of a `--types` run into `dir`.
@@ -660,7 +686,26 @@ fn write_type_outputs(
         symmetry_name(symmetry)
     );
     let svg = plot::force_displacement_svg(&title, &curves, None)?;
-    outputs::write_text(&dir.join(outputs::TYPES_SVG), &svg)
+    outputs::write_text(&dir.join(outputs::TYPES_SVG), &svg)?;
+    // Each run's directory, relative to the series' page.
+    let dirs: Vec<String> = outcomes
+        .iter()
+        .map(|o| {
+            o.job.dir.file_name().map_or_else(
+                || o.job.granule_type.name().to_owned(),
+                |n| n.to_string_lossy().into_owned(),
+            )
+        })
+        .collect();
+    let runs: Vec<(&str, &Summary)> = dirs
+        .iter()
+        .zip(outcomes)
+        .map(|(dir, o)| (dir.as_str(), &o.summary))
+        .collect();
+    outputs::write_text(
+        &dir.join(report::REPORT_FILE),
+        &report::types_report_html(&svg, &runs),
+    )
 }
 
 /// The error of the runs the kernel stopped (naming type, step, strain,
