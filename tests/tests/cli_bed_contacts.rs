@@ -4,7 +4,8 @@
 //! summary, and the contact forces are those of a bed at rest: a granule
 //! inside the bed, away from the die and the punches, is held by its
 //! granule contacts alone, so their forces nearly cancel on it, while a
-//! granule at a wall is not balanced by them.
+//! granule at a wall is not balanced by them. The summary's density by
+//! height is the table's granules averaged by layer.
 
 mod common;
 
@@ -107,7 +108,7 @@ fn the_contact_network_balances_the_inner_granules() {
             size[b] += magnitude;
         }
         let die_radius = 2.5e-3;
-        let top = number(&s, "initial_bed_height_m") * (1.0 - 0.15);
+        let top = number(&s, "initial_bed_height_m") * (1.0 - number(&s, "final_strain"));
         let reach = 0.65 * d;
         let mut inner = Vec::new();
         let mut at_walls = Vec::new();
@@ -134,6 +135,33 @@ fn the_contact_network_balances_the_inner_granules() {
             inner_m < 0.05 && walls_m > 4.0 * inner_m,
             "median imbalance: inner {inner_m} ({} granules), at the walls {walls_m}",
             inner.len()
+        );
+        // The summary's density by height is the final table's granules
+        // averaged over five layers of the compact, to round-off; and the
+        // die wall's friction leaves the bottom layer less dense than the
+        // top one.
+        let layers = s["final_density_by_height"].as_array().unwrap();
+        assert_eq!(layers.len(), 5);
+        let eta = granules.num("relative_density");
+        for (k, layer) in layers.iter().enumerate() {
+            let members: Vec<f64> = (0..GRANULES)
+                .filter(|&g| ((centre(g)[2] / top * 5.0).floor() as usize).min(4) == k)
+                .map(|g| eta[g])
+                .collect();
+            assert_eq!(layer["granules"], members.len(), "layer {k}");
+            let mean = members.iter().sum::<f64>() / members.len() as f64;
+            let stated = layer["mean_relative_density"].as_f64().unwrap();
+            assert!(
+                (stated - mean).abs() < 1e-12,
+                "layer {k}: {stated} against {mean}"
+            );
+        }
+        let mean_of = |k: usize| layers[k]["mean_relative_density"].as_f64().unwrap();
+        assert!(
+            mean_of(0) < mean_of(4),
+            "bottom {} top {}",
+            mean_of(0),
+            mean_of(4)
         );
     }
     // A fresh run into the same directory removes the tables of snapshots

@@ -11,7 +11,7 @@ use granbed_kernel::analysis::quasi_static::LoadSample;
 use indicatif::ProgressBar;
 use serde::Serialize;
 
-use super::run::{BedRun, BedSample};
+use super::run::{BedRun, BedSample, GranuleAtEnd};
 use super::scene::Scene;
 use crate::csv::{Field, write_table};
 use crate::output::{finite_ratio, write_json};
@@ -105,6 +105,11 @@ pub const COMPRESSION_COLUMNS: [(&str, &str); 29] = [
         "energy-ledger residual ΔK + internal work + damping − contact work − gravity work, J (round-off)",
     ),
 ];
+
+/// The compact's height where the run ended, H0 (1 − C), m.
+pub fn final_height_m(run: &BedRun) -> Real {
+    run.bed_height_m * (1.0 - run.strain_reached)
+}
 
 /// The bed's solid fraction D at strain C: the granules' solid volume over
 /// the die volume between the punches, `solid_volume_m3` /
@@ -238,6 +243,10 @@ pub struct Summary<'a> {
     /// The bed's solid fraction D at the final strain (in the die, under
     /// load: D0/(1 − C)).
     pub final_solid_fraction: Real,
+    /// The granules' mean relative density in each of [`DENSITY_LAYERS`]
+    /// layers of the compact where the run ended, bottom first (empty for a
+    /// run stopped by an error).
+    pub final_density_by_height: Vec<DensityLayer>,
     /// The granule material, every parameter (`None` if the scene's is
     /// invalid).
     pub material: Option<MaterialSummary>,
@@ -418,6 +427,53 @@ pub fn heckel(run: &BedRun, min_strain: Real, pressure: fn(&BedSample) -> Real) 
 /// by how much.
 pub const KAWAKITA_WINDOWS: [Real; 4] = [0.10, 0.15, 0.20, 0.25];
 
+/// Layers of equal height in which `summary.json` averages the granules'
+/// relative density at the end ([`density_by_height`]).
+pub const DENSITY_LAYERS: usize = 5;
+
+/// One layer of the compact where the run ended.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct DensityLayer {
+    /// Its bottom, a fraction of the compact's height H = H0 (1 − C).
+    pub from_height: Real,
+    /// Its top, the same way.
+    pub to_height: Real,
+    /// Granules whose centre of mass lies in it.
+    pub granules: usize,
+    /// Their mean relative density η0 V0/V (`None` if there are none).
+    pub mean_relative_density: Option<Real>,
+}
+
+/// The mean relative density of the `granules` in each of
+/// [`DENSITY_LAYERS`] layers of equal height of a compact `height_m` high
+/// (the lower punch at z = 0), by the height of their centres of mass (a
+/// centre at or above the top counts in the top layer, one below 0 in the
+/// bottom one). In single-ended pressing the die wall's friction leaves
+/// the bottom of the compact less dense than its top.
+pub fn density_by_height(granules: &[GranuleAtEnd], height_m: Real) -> Vec<DensityLayer> {
+    let n = DENSITY_LAYERS;
+    let mut sums = vec![(0_usize, 0.0); n];
+    for g in granules {
+        let at = (g.centre_m[2] / height_m * n as Real).floor();
+        let layer = if at.is_nan() {
+            continue;
+        } else {
+            (at.max(0.0) as usize).min(n - 1)
+        };
+        sums[layer].0 += 1;
+        sums[layer].1 += g.relative_density;
+    }
+    sums.iter()
+        .enumerate()
+        .map(|(k, &(count, sum))| DensityLayer {
+            from_height: k as Real / n as Real,
+            to_height: (k + 1) as Real / n as Real,
+            granules: count,
+            mean_relative_density: (count > 0).then(|| sum / count as Real),
+        })
+        .collect()
+}
+
 /// `summary.json`'s record of [`super::run::HiddenOverlap`].
 #[derive(Clone, Copy, Debug, Serialize)]
 pub struct HiddenOverlapSummary {
@@ -501,6 +557,11 @@ pub fn summary<'a>(scene: &'a Scene, run: &BedRun) -> Summary<'a> {
         heckel_mean_pressure,
         initial_solid_fraction: bed_solid_fraction(run, 0.0),
         final_solid_fraction: bed_solid_fraction(run, last.strain),
+        final_density_by_height: if run.final_granules.is_empty() {
+            Vec::new()
+        } else {
+            density_by_height(&run.final_granules, final_height_m(run))
+        },
         material: material.map(MaterialSummary::from),
         yield_stress_pa: material.map_or(Real::NAN, |m| m.yield_stress_pa),
         eta0: material.map_or(Real::NAN, |m| m.eta0),
@@ -1162,6 +1223,37 @@ mod tests {
             s.heckel
         );
         assert_eq!((mean.points, mean.min_strain), (6, 0.25));
+    }
+
+    /// Granules go to the layer of their centre's height, a centre at or
+    /// above the top to the top layer, one below the bottom to the bottom
+    /// one, a NaN height to none; an empty layer has no mean.
+    #[test]
+    fn granule_densities_are_averaged_by_layer() {
+        let at = |z: Real, relative_density: Real| GranuleAtEnd {
+            centre_m: [0.0, 0.0, z],
+            relative_density,
+        };
+        let height = 2.0;
+        let granules = [
+            at(0.1, 0.70),
+            at(-0.01, 0.72),
+            at(0.5, 0.80),
+            at(1.9, 0.90),
+            at(2.0, 0.94),
+            at(2.3, 0.92),
+            at(Real::NAN, 0.5),
+        ];
+        let layers = density_by_height(&granules, height);
+        assert_eq!(layers.len(), DENSITY_LAYERS);
+        let counts: Vec<usize> = layers.iter().map(|l| l.granules).collect();
+        assert_eq!(counts, [2, 1, 0, 0, 3]);
+        let close = |m: Option<Real>, want: Real| (m.unwrap() - want).abs() < 1e-15;
+        assert!(close(layers[0].mean_relative_density, 0.71));
+        assert!(close(layers[1].mean_relative_density, 0.80));
+        assert!(layers[2].mean_relative_density.is_none());
+        assert!(close(layers[4].mean_relative_density, 0.92));
+        assert_eq!((layers[1].from_height, layers[1].to_height), (0.2, 0.4));
     }
 
     #[test]

@@ -20,13 +20,15 @@
 //!   the bed's solid fraction D;
 //! * `energy_strain.svg`: where the punch's work went: the energy ledger
 //!   (elastic, plastic, hourglass, contact losses, damping, kinetic)
-//!   against C, in J, mJ or µJ (as the largest needs).
+//!   against C, in J, mJ or µJ (as the largest needs);
+//! * `density_height.svg`: each granule's relative density where the run
+//!   ended against its height in the compact, with the layer means.
 
 use std::path::Path;
 
 use super::outputs::{
-    HeckelSummary, KawakitaSummary, Summary, bed_solid_fraction, fit_linear, heckel_rows,
-    kawakita_doubts, upper_pressure,
+    DENSITY_LAYERS, HeckelSummary, KawakitaSummary, Summary, bed_solid_fraction, final_height_m,
+    fit_linear, heckel_rows, kawakita_doubts, upper_pressure,
 };
 use super::run::{BedRun, BedSample};
 use crate::output::write_text;
@@ -38,7 +40,7 @@ use granbed_kernel::Real;
 pub const PLOTS_DIR: &str = "plots";
 
 /// The plot files, in the order [`write_plots`] writes them.
-pub const PLOT_FILES: [&str; 9] = [
+pub const PLOT_FILES: [&str; 10] = [
     "pressure_strain.svg",
     "kawakita.svg",
     "heckel.svg",
@@ -48,6 +50,7 @@ pub const PLOT_FILES: [&str; 9] = [
     "solid_fraction_pressure.svg",
     "coordination_density.svg",
     "energy_strain.svg",
+    "density_height.svg",
 ];
 
 /// The energy ledger's terms drawn by `energy_strain.svg`, J, with their
@@ -75,6 +78,38 @@ fn energy_svg(samples: &[BedSample]) -> anyhow::Result<String> {
         "Energy: where the punch's work went",
         "axial strain C = (H0 - H)/H0",
         &terms,
+    )
+}
+
+/// The density profile where the run ended: each granule's relative
+/// density against the height of its centre in the compact, z/H, and the
+/// summary's layer means at the layers' mid-heights.
+fn density_height_svg(run: &BedRun, summary: &Summary) -> anyhow::Result<String> {
+    let height = final_height_m(run);
+    let granules = run
+        .final_granules
+        .iter()
+        .map(|g| (g.relative_density, g.centre_m[2] / height));
+    let means = summary.final_density_by_height.iter().filter_map(|l| {
+        l.mean_relative_density
+            .map(|m| (m, 0.5 * (l.from_height + l.to_height)))
+    });
+    let series = [
+        Series::new("granules", Mark::Dots, granules),
+        Series::new(
+            format!("mean of each of {DENSITY_LAYERS} layers"),
+            Mark::Line,
+            means,
+        ),
+    ];
+    xy_svg_from(
+        "Granule density by height where the run ended",
+        (
+            "granule relative density η0 V0/V",
+            "height in the compact z/H",
+        ),
+        &series,
+        (false, true),
     )
 }
 
@@ -315,6 +350,7 @@ pub fn plots(
         profile_f,
         coordination_density_f,
         energy_f,
+        density_height_f,
     ] = PLOT_FILES;
     // Unlabelled: the title and axes say what the one curve is (no legend).
     let profile = [(
@@ -385,6 +421,7 @@ pub fn plots(
             )?,
         ),
         (energy_f, energy_svg(samples)?),
+        (density_height_f, density_height_svg(run, summary)?),
     ])
 }
 

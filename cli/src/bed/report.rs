@@ -26,7 +26,7 @@ pub const REPORT_FILE: &str = "report.html";
 /// meaning; any other field follows (nested objects such as `kawakita` and
 /// `heckel` are flattened to `kawakita.<field>`; the scene, `scene` and
 /// `scene_toml`, is shown as TOML instead).
-const FIELDS: [(&str, &str); 85] = [
+const FIELDS: [(&str, &str); 86] = [
     ("kawakita_a", "Kawakita a (limiting strain)"),
     ("kawakita_inv_b_pa", "Kawakita 1/b, Pa"),
     (
@@ -246,6 +246,8 @@ const FIELDS: [(&str, &str); 85] = [
     ("warnings", ""),
     // Its own table, "The Kawakita fit by window".
     ("kawakita_windows", ""),
+    // In the key results and the plot density_height.svg.
+    ("final_density_by_height", ""),
 ];
 
 /// The summary's fields as rows, in [`FIELDS`]' order, then the others;
@@ -299,6 +301,22 @@ fn key_results(summary: &Summary<'_>) -> String {
                 num(Some(summary.initial_solid_fraction)),
                 num(Some(summary.final_solid_fraction))
             ),
+        ),
+        (
+            format!(
+                "granule relative density by height at the end, bottom → top {}ths",
+                super::outputs::DENSITY_LAYERS
+            ),
+            if summary.final_density_by_height.is_empty() {
+                "n/a".to_owned()
+            } else {
+                summary
+                    .final_density_by_height
+                    .iter()
+                    .map(|l| num(l.mean_relative_density))
+                    .collect::<Vec<_>>()
+                    .join(" → ")
+            },
         ),
         (
             "upper-punch pressure at the end, kPa".to_owned(),
@@ -429,6 +447,14 @@ fn plot_caption(name: &str, summary: &Summary<'_>) -> Option<String> {
              the wall contacts: how the contact network grows as the bed densifies, the form in \
              which coordination is usually compared (Arzt's Z(D) for spheres)."
             .to_owned(),
+        "density_height.svg" => format!(
+            "Each granule's relative density where the run ended against the height of its \
+             centre of mass in the compact (0: the lower punch, 1: the upper one), and the mean \
+             over each fifth of the height (summary.json's final_density_by_height). The die \
+             wall's friction holds back the load on its way down, so the bottom of a compact \
+             pressed from above ends less dense than its top (at C = {}).",
+            short(summary.final_strain)
+        ),
         "energy_strain.svg" => "Where the punch's work went, totals so far against the strain \
              (compression.csv's energy columns): the elastic energy stored in the \
              granules, the plastic dissipation, the contact losses (friction and the \

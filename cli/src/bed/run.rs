@@ -161,6 +161,35 @@ pub struct BedRun {
     /// The overlap by geometry at the end of the run, if
     /// [`RunControl::check_final_overlap`] asked for it.
     pub hidden_overlap: Option<HiddenOverlap>,
+    /// Each granule where the run ended, in granule order (empty for a run
+    /// stopped by an error: its last state is no state to show).
+    pub final_granules: Vec<GranuleAtEnd>,
+}
+
+/// A granule where a run ended.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct GranuleAtEnd {
+    /// Its centre of mass, m.
+    pub centre_m: [Real; 3],
+    /// Its relative density η0 V0/V (NaN for a degenerate surface).
+    pub relative_density: Real,
+}
+
+/// Every granule of `asm` (meshes `mesh`, initial relative density
+/// `eta0`) as [`GranuleAtEnd`].
+fn granules_at_end(asm: &Assembly<'_>, mesh: &OwnedReference, eta0: Real) -> Vec<GranuleAtEnd> {
+    let v0 = surface_geometry(&mesh.positions, &mesh.quads).map_or(Real::NAN, |(_, v)| v);
+    asm.granules()
+        .iter()
+        .enumerate()
+        .map(|(g, store)| GranuleAtEnd {
+            centre_m: asm.centre_of_mass(g),
+            // The nominal diameter only scales a Heywood coefficient not
+            // used here.
+            relative_density: granule_shape(&store.x, &mesh.quads, eta0, v0, 1.0)
+                .map_or(Real::NAN, |s| s.relative_density),
+        })
+        .collect()
 }
 
 /// The granules' overlap by geometry at the end of a run
@@ -205,6 +234,7 @@ impl BedRun {
             checkpoint_strain: None,
             added_mass: Default::default(),
             hidden_overlap: None,
+            final_granules: Vec::new(),
         }
     }
 }
@@ -739,6 +769,11 @@ pub fn run_bed(
                 wall_time_s: start.elapsed().as_secs_f64(),
             }
         });
+    let final_granules = if error.is_none() {
+        granules_at_end(&asm, &mesh, eta0)
+    } else {
+        Vec::new()
+    };
     let steps = asm.steps();
     let strain_reached = die.strain_at(asm.time());
     Ok(BedRun {
@@ -766,6 +801,7 @@ pub fn run_bed(
         rate_change_rel: None,
         added_mass: AddedMass::of(&asm),
         hidden_overlap,
+        final_granules,
     })
 }
 
