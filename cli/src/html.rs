@@ -193,18 +193,22 @@ pub fn num(x: Option<f64>) -> String {
     x.map_or_else(|| "n/a".to_owned(), |x| significant(x, TABLE_DIGITS))
 }
 
+/// Why a fit's cell shows n/a ([`fit_cell`]).
+pub const NO_FIT: &str = "no fit: too few rows in its window (the run ended before it) or no \
+                          line through them";
+
 /// A pressure of the table in kPa, from Pa.
 pub fn kpa(x: Option<f64>) -> String {
     num(x.map(|p| p * 1e-3))
 }
 
-/// A fit's cell: its figure `value` (`None`: no fit, the run did not reach
-/// its window), marked ✗ if the run's summary rejects the fit, with its R²
-/// in the cell's title.
+/// A fit's cell: its figure `value` (`None`: no fit — too few rows in
+/// its window, as when the run ended before it, or no line through them),
+/// marked ✗ if the run's summary rejects the fit, with its R² in the
+/// cell's title.
 pub fn fit_cell(value: Option<String>, r_squared: Option<f64>, ok: bool) -> String {
     let Some(value) = value else {
-        return "<td class=\"num\" title=\"no fit: the run ended before its window\">n/a</td>"
-            .to_owned();
+        return format!("<td class=\"num\" title=\"{NO_FIT}\">n/a</td>");
     };
     let title = format!("R² = {}", num(r_squared));
     let (class, mark) = if ok {

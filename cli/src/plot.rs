@@ -401,7 +401,6 @@ mod tests {
         assert!(named.matches("<rect").count() > bare.matches("<rect").count());
     }
 
-    /// Every tick of a plain axis has the decimals of the finest one.
     /// Energies are drawn in the largest of J, mJ and µJ that the largest
     /// value fills.
     #[test]
@@ -432,6 +431,7 @@ mod tests {
         assert!(!tick(&data, "0.00") && tick(&data, "0.31"), "{data}");
     }
 
+    /// Every tick of a plain axis has the decimals of the finest one.
     #[test]
     fn plain_ticks_share_their_decimals() {
         let density = plain_labels(&(0.799..0.826));

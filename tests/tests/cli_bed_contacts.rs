@@ -29,9 +29,14 @@ fn the_contact_network_balances_the_inner_granules() {
     assert_eq!(run.code, 0, "bed failed:\n{}", run.stderr);
     let s = summary(&dir);
     // Snapshots at 0 and 0.1 (the published list cut at the final strain)
-    // and of the final state at 0.15: k = 0, 1, 2.
+    // and of the final state at 0.15: k = 0, 1, 2. The one at C = 0 comes
+    // before the first step, which detects the contacts: it has no tables.
     let last = 2;
-    for k in 0..=last {
+    for table in ["contacts", "granules"] {
+        let path = dir.join(format!("vtk/{table}_0.csv"));
+        assert!(!path.exists(), "{}", path.display());
+    }
+    for k in 1..=last {
         let contacts = Table::read(&dir.join(format!("vtk/contacts_{k}.csv")));
         let granules = Table::read(&dir.join(format!("vtk/granules_{k}.csv")));
         assert_eq!(granules.cells.len(), GRANULES);
@@ -71,9 +76,7 @@ fn the_contact_network_balances_the_inner_granules() {
             let along: f64 = (0..3).map(|i| f[i] * l[i]).sum();
             assert!(along < 0.0, "{a}-{b}: force on a {f:?}, branch {l:?}");
             let normal: f64 = row[contacts.col("normal_force_n")].parse().unwrap();
-            let slipping: usize = row[contacts.col("slipping")].parse().unwrap();
-            let constraints: usize = row[contacts.col("constraints")].parse().unwrap();
-            assert!(normal > 0.0 && constraints >= 1 && slipping <= constraints);
+            assert!(normal > 0.0, "{a}-{b}: F_n {normal}");
         }
         let counted: Vec<usize> = granules
             .num("contacts")
@@ -81,11 +84,6 @@ fn the_contact_network_balances_the_inner_granules() {
             .map(|&n| n as usize)
             .collect();
         assert_eq!(counted, touching, "granules_{k}'s contacts");
-        if k == 0 {
-            // The poured spheres' meshes start a few µm apart.
-            assert!(rows.is_empty(), "{} contacts at C = 0", rows.len());
-            continue;
-        }
         assert!(!rows.is_empty());
         if k < last {
             continue;
@@ -164,6 +162,20 @@ fn the_contact_network_balances_the_inner_granules() {
             mean_of(4)
         );
     }
+    // The finished run resumed takes no step and writes its outputs
+    // again: the tables of its end, which need a step's forces, stay as
+    // the run left them.
+    let tables = |k: usize| {
+        ["contacts", "granules"]
+            .map(|t| std::fs::read(dir.join(format!("vtk/{t}_{k}.csv"))).unwrap())
+    };
+    let before = tables(last);
+    let again = cli(&["bed", "--quiet", "--resume", dir.to_str().unwrap()]);
+    assert_eq!(again.code, 0, "{}", again.stderr);
+    assert!(
+        tables(last) == before,
+        "the resumed run changed the end's tables"
+    );
     // A fresh run into the same directory removes the tables of snapshots
     // it does not reach.
     let mut argv = vec!["bed", "--quiet", "--out", dir.to_str().unwrap()];

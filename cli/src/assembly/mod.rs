@@ -691,6 +691,9 @@ impl<'m> Assembly<'m> {
             self.undeformed_step = state.undeformed_step;
             self.undeformed_restored = true;
         }
+        // The pairs' step results went with the restore (the state keeps
+        // no forces): no step of this assembly has run.
+        self.last = StepReport::default();
         Ok(())
     }
 
@@ -832,6 +835,14 @@ impl<'m> Assembly<'m> {
     /// What the last step did.
     pub fn last(&self) -> &StepReport {
         &self.last
+    }
+
+    /// True once this assembly has taken a step since it was built or
+    /// restored: only then do the contact phase's per-pair results
+    /// ([`ContactPhase::work`]) hold a step's forces (a step always has
+    /// Δt > 0; before one, [`Self::last`] is the default report).
+    pub fn has_stepped(&self) -> bool {
+        self.last.dt > 0.0
     }
 
     /// The contact phase (pairs, per-pair results).

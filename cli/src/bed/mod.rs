@@ -59,8 +59,13 @@ Output, in --out DIR (created if missing):
                    with C >= kawakita_min_strain, 0.25), Heckel fit of
                    ln(1/(1 - D)) = K P + A (yield pressure P_y = 1/K, A,
                    D_A = 1 - exp(-A), R^2, points; C >= heckel_min_strain,
-                   0.25), the poured bed's solid fraction D0 and the final
-                   D in the die, the material (every parameter), final strain,
+                   0.25), the Kawakita fit again over C >= 0.10, 0.15, 0.20
+                   and 0.25 (kawakita_windows), the Heckel fit on the mean
+                   punch pressure (heckel_mean_pressure), the granules' mean
+                   relative density in five layers of the compact at the end
+                   (final_density_by_height), the poured bed's solid fraction
+                   D0 and the final D in the die, the material (every
+                   parameter), final strain,
                    max pressure, initial bed height, counts, wall time, ns per
                    element-step, cost figures (over the whole run,
                    resumed segments included), threads, min Jacobian, max nodal
@@ -91,14 +96,25 @@ Output, in --out DIR (created if missing):
                    each snapshot cut through the die axis (plane y = 0): the
                    cut hexes coloured by axial stress -sigma_zz, the granules'
                    outlines, the die wall and the punches
+  vtk/contacts_<k>.csv
+                   the snapshot's contact network: per granule pair in contact
+                   in its step, the normal and friction forces, the force on
+                   the first granule and the branch vector (none at C = 0,
+                   before the first step)
+  vtk/granules_<k>.csv
+                   per granule: centre of mass, relative density, Heywood
+                   coefficients and contacts (none at C = 0)
   plots/*.svg      pressure, coordination number, relative density and Heywood
                    coefficient against strain; Kawakita plot P/C vs P and
                    Heckel plot ln(1/(1 - D)) vs P, each with its fit; the
-                   compaction profile, the bed's solid fraction D vs P
+                   compaction profile, the bed's solid fraction D vs P; Z vs D;
+                   the energy ledger vs strain; each granule's relative
+                   density vs its height at the end
   report.html      one page: the warnings (or that there are none), the key
-                   results, the plots with captions, the sections, the
-                   summary table (rounded; hover a value for all its digits)
-                   and the scene
+                   results, the Kawakita fit by window, the plots with
+                   captions, the sections with their tables linked, the
+                   summary table (rounded; hover a value for all its digits),
+                   the tables' columns explained, and the scene
   checkpoint.bin   the state to continue from with --resume (every
                    checkpoint_interval_minutes and checkpoint_strain_interval,
                    and at the end)

@@ -304,7 +304,7 @@ fn key_results(summary: &Summary<'_>) -> String {
         ),
         (
             format!(
-                "granule relative density by height at the end, bottom → top {}ths",
+                "granules' mean relative density at the end in {} layers, bottom → top",
                 super::outputs::DENSITY_LAYERS
             ),
             if summary.final_density_by_height.is_empty() {
@@ -351,8 +351,8 @@ fn kawakita_by_window(summary: &Summary<'_>) -> String {
          several strains on: a and 1/b depend on the window, the more the earlier it starts \
          (rearrangement is not the law's regime). The published scene fits C ≥ 0.25, as the \
          reference study did; ✗ marks a \
-         fit the summary would reject (its R² on hover); n/a: the run did not reach the \
-         window.</p>\n<table>\n<tr><th>rows fitted</th><th>a</th><th>1/b, kPa</th>\
+         fit the summary would reject (its R² on hover); n/a: no fit over the window (the run \
+         did not reach it, or its rows make no line).</p>\n<table>\n<tr><th>rows fitted</th><th>a</th><th>1/b, kPa</th>\
          <th>rows</th></tr>\n",
     );
     for k in &summary.kawakita_windows {
@@ -450,9 +450,10 @@ fn plot_caption(name: &str, summary: &Summary<'_>) -> Option<String> {
         "density_height.svg" => format!(
             "Each granule's relative density where the run ended against the height of its \
              centre of mass in the compact (0: the lower punch, 1: the upper one), and the mean \
-             over each fifth of the height (summary.json's final_density_by_height). The die \
-             wall's friction holds back the load on its way down, so the bottom of a compact \
-             pressed from above ends less dense than its top (at C = {}).",
+             over each fifth of the height (summary.json's final_density_by_height), at \
+             C = {}. The die wall's friction holds back the load on its way down, so in a compact \
+             pressed from above the granules at the bottom usually end less dense than those at \
+             the top.",
             short(summary.final_strain)
         ),
         "energy_strain.svg" => "Where the punch's work went, totals so far against the strain \
@@ -460,7 +461,8 @@ fn plot_caption(name: &str, summary: &Summary<'_>) -> Option<String> {
              granules, the plastic dissipation, the contact losses (friction and the \
              kinematic contact constraints), the damping, the hourglass energy (the one-point \
              element's spurious modes; small) and the kinetic energy (small when the run is \
-             quasi-static)."
+             quasi-static). Gravity's work and the return map's energy gap are not drawn, so the \
+             terms add up to the punch's work only nearly."
             .to_owned(),
         _ => return None,
     })
@@ -525,9 +527,9 @@ pub fn report_html(
              granules' outlines, the die wall and the punches (the upper one moves down). The \
              granules are all of one size: a small circle is a cut off their centre. Each \
              picture has its own colour scale, up to the 99th percentile of its stresses. The \
-             VTU snapshots beside them hold the whole bed; the tables beside each picture hold \
-             its contact network (contacts_<k>.csv: every pair of granules in contact, with its \
-             forces and branch vector) and its granules (granules_<k>.csv: centre, relative \
+             VTU snapshots beside them hold the whole bed; the tables beside each picture (none at \
+             C = 0, before the first step) hold its contact network (contacts_&lt;k&gt;.csv: every pair of granules in contact, with its \
+             forces and branch vector) and its granules (granules_&lt;k&gt;.csv: centre, relative \
              density, contacts), their columns explained at the end of this page.</p>"
         )?;
         for files in sections {

@@ -175,19 +175,16 @@ pub struct GranuleAtEnd {
     pub relative_density: Real,
 }
 
-/// Every granule of `asm` (meshes `mesh`, initial relative density
-/// `eta0`) as [`GranuleAtEnd`].
-fn granules_at_end(asm: &Assembly<'_>, mesh: &OwnedReference, eta0: Real) -> Vec<GranuleAtEnd> {
-    let v0 = surface_geometry(&mesh.positions, &mesh.quads).map_or(Real::NAN, |(_, v)| v);
-    asm.granules()
-        .iter()
+/// Every granule of `asm` (meshes `mesh`, nominal diameter `d_m`) as
+/// [`GranuleAtEnd`]: its relative density as the snapshots have it.
+fn granules_at_end(asm: &Assembly<'_>, mesh: &OwnedReference, d_m: Real) -> Vec<GranuleAtEnd> {
+    super::snapshots::granule_fields(asm, mesh, d_m)
+        .relative_density
+        .into_iter()
         .enumerate()
-        .map(|(g, store)| GranuleAtEnd {
+        .map(|(g, relative_density)| GranuleAtEnd {
             centre_m: asm.centre_of_mass(g),
-            // The nominal diameter only scales a Heywood coefficient not
-            // used here.
-            relative_density: granule_shape(&store.x, &mesh.quads, eta0, v0, 1.0)
-                .map_or(Real::NAN, |s| s.relative_density),
+            relative_density,
         })
         .collect()
 }
@@ -770,7 +767,7 @@ pub fn run_bed(
             }
         });
     let final_granules = if error.is_none() {
-        granules_at_end(&asm, &mesh, eta0)
+        granules_at_end(&asm, &mesh, d)
     } else {
         Vec::new()
     };

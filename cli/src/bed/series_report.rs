@@ -289,7 +289,7 @@ mod tests {
             "seed_3</a>: the run failed (see its report); no Kawakita fit (the run ended before \
              its window)</li>"
         ));
-        assert!(html.contains("title=\"no fit: the run ended before its window\">n/a</td>"));
+        assert!(html.contains(&format!("title=\"{}\">n/a</td>", crate::html::NO_FIT)));
         assert!(!html.contains("n/a ✗"));
         assert!(html.contains(
             "seed_2</a>: not quasi-static: inertia is in its pressures; Kawakita fit rejected</li>"

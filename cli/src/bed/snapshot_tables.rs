@@ -1,18 +1,22 @@
 //! The tables of a bed snapshot, beside `bed_<k>.vtu` in `vtk/`, for
 //! readers without ParaView (granule ids are the snapshot's `granule`
-//! field):
+//! field). A snapshot taken before the run's first step (the one at
+//! C = 0) has none: no contact has been detected yet.
 //!
 //! * `contacts_<k>.csv`, the contact network: one row per granule pair
-//!   that touched (had a constraint carrying a force) in the snapshot's
-//!   step, in the order of (granule_a, granule_b), granule_a < granule_b.
-//!   From it a reader gets the distribution of the contact forces (force
-//!   chains), the fabric tensor ⟨n ⊗ n⟩ of the branch vectors, each
-//!   granule's coordination, the granular stress Σ f ⊗ l / V.
+//!   that carried a contact force in the snapshot's step, in the order of
+//!   (granule_a, granule_b), granule_a < granule_b. From it a reader gets
+//!   the distribution of the contact forces (force chains), the fabric
+//!   tensor ⟨n ⊗ n⟩ of the branch vectors l, each granule's coordination,
+//!   and the granular stress −Σ f ⊗ l / V (f the force on granule_a: the
+//!   sum Σ f ⊗ l is negative in compression, hence the sign, to match the
+//!   snapshots' compression-positive stresses).
 //! * `granules_<k>.csv`: one row per granule: its centre of mass, relative
 //!   density, Heywood coefficients and contacts, for density profiles along
 //!   and across the die.
 //!
-//! The forces are the snapshot step's, not averaged over an interval as
+//! The forces are the snapshot step's, summed over its contact sweeps (the
+//! force the step applied), not averaged over an interval as
 //! `compression.csv`'s punch forces are: the kinematic contact enforces
 //! each constraint anew every step (physics.md §5). In a quasi-static bed
 //! they vary little from step to step: measured once (session 50, a
@@ -80,15 +84,16 @@ pub struct ContactRow {
     pub friction_n: Real,
     /// Total force on a, N.
     pub force_on_a: [Real; 3],
-    /// Constraints that carried a force.
+    /// Constraints that carried a force in the step's first sweep.
     pub constraints: usize,
-    /// Constraints at the friction cap.
+    /// The most constraints at the friction cap in one sweep.
     pub slipping: usize,
     /// Centre of mass of b − that of a, m.
     pub branch: [Real; 3],
 }
 
-/// The pairs of `asm` that touched in its last step, ordered by (a, b)
+/// The pairs of `asm` that carried a force in its last step, ordered by
+/// (a, b)
 /// (a < b in every candidate pair, [`granbed_kernel::contact::broad::GranulePair`]).
 pub fn contact_rows(asm: &Assembly<'_>) -> Vec<ContactRow> {
     let contact = asm.contact();
@@ -96,7 +101,9 @@ pub fn contact_rows(asm: &Assembly<'_>) -> Vec<ContactRow> {
         .pairs()
         .iter()
         .zip(contact.work())
-        .filter(|(_, w)| w.touching())
+        // A pair that touched only in a later sweep has no first-sweep
+        // constraint but carried a force.
+        .filter(|(_, w)| w.touching() || w.step.normal > 0.0)
         .map(|(p, w)| {
             let (ca, cb) = (
                 asm.centre_of_mass(p.a as usize),

@@ -423,8 +423,9 @@ impl SnapshotWriter {
         }
     }
 
-    /// Writes `bed_<k>.vtu` of `asm` at `strain`, its section picture and
-    /// its tables ([`super::snapshot_tables`]), and rewrites `bed.pvd`.
+    /// Writes `bed_<k>.vtu` of `asm` at `strain`, its section picture and,
+    /// if `asm` has taken a step, its tables ([`super::snapshot_tables`]),
+    /// and rewrites `bed.pvd`.
     pub fn write(
         &mut self,
         strain: Real,
@@ -447,17 +448,22 @@ impl SnapshotWriter {
             &self.dir.join(section_file(k)),
             &section_svg(&section_input(asm, mesh, &elements, strain)),
         )?;
-        let contacts = contact_rows(asm);
-        write_table(
-            &self.dir.join(contacts_file(k)),
-            &CONTACT_COLUMNS,
-            contacts.iter().map(ContactRow::fields),
-        )?;
-        write_table(
-            &self.dir.join(granules_file(k)),
-            &GRANULE_COLUMNS,
-            granule_rows(asm, &granules, &contacts).into_iter(),
-        )?;
+        // The tables need a step's contact forces: none at C = 0 (before the
+        // first step), nor at the end of a finished run resumed without a
+        // step (its tables from the run itself stay).
+        if asm.has_stepped() {
+            let contacts = contact_rows(asm);
+            write_table(
+                &self.dir.join(contacts_file(k)),
+                &CONTACT_COLUMNS,
+                contacts.iter().map(ContactRow::fields),
+            )?;
+            write_table(
+                &self.dir.join(granules_file(k)),
+                &GRANULE_COLUMNS,
+                granule_rows(asm, &granules, &contacts).into_iter(),
+            )?;
+        }
         let entries: Vec<(Real, String)> = self.strains[..=k]
             .iter()
             .enumerate()

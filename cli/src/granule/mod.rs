@@ -494,15 +494,6 @@ impl GranuleArgs {
                 None => {}
             }
         }
-        // The rate check after the run's own outputs are written: a failed
-        // check loses nothing.
-        if self.rate_check && result.error.is_none() {
-            let change = rate_change(job.params, mesh, &result).with_context(|| {
-                format!("granule {name}: the rate check's run at half the platen speed")
-            })?;
-            summary = Summary::new(&setup, &result, Some(change));
-            outputs::write_summary_json(&job.dir.join(outputs::SUMMARY_JSON), &summary)?;
-        }
         let energy_svg = report::energy_svg(
             &format!(
                 "Granule {name} ({} {}): where the platens' work went",
@@ -511,15 +502,25 @@ impl GranuleArgs {
             &result.samples,
         )?;
         outputs::write_text(&job.dir.join(report::ENERGY_SVG), &energy_svg)?;
-        report::write_report(
-            &job.dir,
-            &summary,
-            &[
-                (outputs::FORCE_SVG, &force_svg),
-                (report::ENERGY_SVG, &energy_svg),
-            ],
-        )
-        .with_context(|| format!("granule {name}: the report"))?;
+        let plots = [
+            (outputs::FORCE_SVG, force_svg.as_str()),
+            (report::ENERGY_SVG, energy_svg.as_str()),
+        ];
+        let write_report = |summary: &Summary| {
+            report::write_report(&job.dir, summary, &plots)
+                .with_context(|| format!("granule {name}: the report"))
+        };
+        write_report(&summary)?;
+        // The rate check after the run's own outputs are written: a failed
+        // check loses nothing (and leaves no earlier run's page).
+        if self.rate_check && result.error.is_none() {
+            let change = rate_change(job.params, mesh, &result).with_context(|| {
+                format!("granule {name}: the rate check's run at half the platen speed")
+            })?;
+            summary = Summary::new(&setup, &result, Some(change));
+            outputs::write_summary_json(&job.dir.join(outputs::SUMMARY_JSON), &summary)?;
+            write_report(&summary)?;
+        }
         Ok(Outcome {
             job,
             result,

@@ -103,7 +103,7 @@ const FIELDS: [(&str, &str); 56] = [
     ),
     (
         "quasi_static.force_imbalance_rel",
-        "upper − lower platen force / force (full symmetry only; limit 0.05)",
+        "mean |upper − lower platen force| / upper force over the loaded samples of the second half (full symmetry only; limit 0.05)",
     ),
     (
         "quasi_static.rate_change_rel",
@@ -240,7 +240,7 @@ pub fn energy_svg(title: &str, samples: &[PlatenSample]) -> anyhow::Result<Strin
         ("platen work", |s| s.energy.platen_work),
         ("elastic Ψ", |s| s.energy.elastic),
         ("plastic dissipation", |s| s.energy.plastic),
-        ("platen friction", |s| {
+        ("contact losses (friction, constraints)", |s| {
             s.energy.platen_work - s.energy.contact_work
         }),
         ("damping", |s| s.energy.damping),
@@ -259,13 +259,15 @@ fn plot_caption(name: &str) -> Option<&'static str> {
     Some(match name {
         FORCE_SVG => {
             "The mean platen force against the platens' approach x; dashed: the straight line \
-             fitted over x/d from 0.1 to 0.4, whose slope gives σ_est = 4/(π d) dF/dx."
+             fitted over x/d from 0.1 to 0.4 (less when the run ended before 0.4), whose slope \
+             gives σ_est = 4/(π d) dF/dx."
         }
         ENERGY_SVG => {
             "Where the platens' work went, totals so far against x/d: the elastic energy, the \
-             plastic dissipation, the platens' friction, the damping, the hourglass energy (the \
+             plastic dissipation, the platen contacts' losses (friction and the kinematic \
+             constraints: platen work − contact work), the damping, the hourglass energy (the \
              one-point element's spurious modes) and the kinetic energy (small when the run is \
-             quasi-static)."
+             quasi-static). Gravity's work and the return map's energy gap are not drawn."
         }
         _ => return None,
     })
@@ -323,7 +325,8 @@ pub fn report_html(
     h.push_str(&glossary(
         FORCE_CSV,
         "One row per sample: the unloaded state, then every output_strain_interval of \
-         approach; energies are the totals so far.",
+         approach; energies are the totals so far. An octant run reports the whole granule's \
+         forces and energies.",
         &FORCE_COLUMNS,
     ));
     h.push_str("</body>\n</html>\n");
@@ -351,7 +354,8 @@ pub fn types_report_html(overlay: &str, runs: &[(&str, &Summary)]) -> String {
         h,
         "<p>Each type compressed between the platens alone, on the same mesh and settings. \
          Values rounded to 4 digits; stresses in kPa; ✗ marks a σ_est whose run failed the \
-         quasi-static certificate or ended before the fit's window closed (R² on hover). \
+         quasi-static certificate, ended before the fit's window closed or was stopped by the \
+         kernel (R² on hover). \
          Files: <a href=\"{TYPES_CSV}\">{TYPES_CSV}</a>.</p>"
     );
     h.push_str(&figure(TYPES_SVG, overlay));
