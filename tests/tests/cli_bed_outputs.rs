@@ -11,7 +11,7 @@ mod common;
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
-use common::{cli, parse_xml, read_vtu, summary};
+use common::{cli, number, parse_xml, read_vtu, summary};
 use granbed_cli::bed::DEFAULT_SCENE;
 use granbed_cli::model::{MeshLevel, OwnedReference};
 
@@ -313,6 +313,29 @@ fn snapshots_plots_and_report() {
     assert_eq!(s["material"]["youngs_modulus_pa"], 1e6);
     assert_eq!(s["material"]["true_density_kg_m3"], 1500.0);
     assert_eq!(s["material"]["eta0"], s["eta0"]);
+    // The granules' packing fraction is D without their inner pores: times
+    // their Σsolid/ΣV it gives D back; they start near η0 = 0.8, so it lies
+    // well above D. The key results name the strains the certificate
+    // judged: the second half of the rows.
+    let (phi, d_end) = (
+        number(&s, "final_packing_fraction"),
+        number(&s, "final_solid_fraction"),
+    );
+    let inner = *rows.num("relative_density_solid").last().unwrap();
+    assert!(
+        (phi * inner - d_end).abs() < 1e-12 * d_end,
+        "{phi} × {inner} against {d_end}"
+    );
+    assert!(phi > 1.2 * d_end && phi < 1.0, "{phi}");
+    let strains = rows.num("strain");
+    let judged = &strains[strains.len() / 2..];
+    let window = s["quasi_static_strains"].as_array().unwrap();
+    assert_eq!(window[0].as_f64().unwrap(), judged[0]);
+    assert_eq!(window[1].as_f64().unwrap(), *judged.last().unwrap());
+    assert!(
+        html.contains("quasi-static certificate, judged over C = "),
+        "no window"
+    );
     // The key results first, each plot captioned.
     let key = html.find("<h2>Key results</h2>").expect("no key results");
     assert!(key < html.find("<h2>Plots</h2>").unwrap());

@@ -106,6 +106,15 @@ pub const COMPRESSION_COLUMNS: [(&str, &str); 29] = [
     ),
 ];
 
+/// The granules' packing fraction of a row: their envelope volume over
+/// the die volume below the upper punch, D / (Σ solid / Σ V) — the solid
+/// fraction D without the pores inside the granules, the fraction Arzt's
+/// coordination law and the pour's packing fraction are written in. NaN
+/// before the granules' volumes are known.
+pub fn packing_fraction(run: &BedRun, s: &BedSample) -> Real {
+    bed_solid_fraction(run, s.strain) / s.relative_density_solid
+}
+
 /// The compact's height where the run ended, H0 (1 − C), m.
 pub fn final_height_m(run: &BedRun) -> Real {
     run.bed_height_m * (1.0 - run.strain_reached)
@@ -245,6 +254,16 @@ pub struct Summary<'a> {
     /// The bed's solid fraction D at the final strain (in the die, under
     /// load: D0/(1 − C)).
     pub final_solid_fraction: Real,
+    /// The granules' packing fraction at C = 0 ([`packing_fraction`]:
+    /// their envelope volume / the die volume below H0).
+    pub initial_packing_fraction: Real,
+    /// The granules' packing fraction at the end; 1 − it is the porosity
+    /// between the granules, it × (1 − the granules' Σsolid/ΣV) the
+    /// porosity inside them.
+    pub final_packing_fraction: Real,
+    /// The strains the quasi-static certificate judged: the first and the
+    /// last of the second half of the output rows (`None`: no row).
+    pub quasi_static_strains: Option<[Real; 2]>,
     /// The granules' mean relative density in each of [`DENSITY_LAYERS`]
     /// layers of the compact where the run ended, bottom first (empty for a
     /// run stopped by an error).
@@ -562,6 +581,18 @@ pub fn summary<'a>(scene: &'a Scene, run: &BedRun) -> Summary<'a> {
         heckel_mean_pressure,
         initial_solid_fraction: bed_solid_fraction(run, 0.0),
         final_solid_fraction: bed_solid_fraction(run, last.strain),
+        initial_packing_fraction: run
+            .samples
+            .first()
+            .map_or(Real::NAN, |s| packing_fraction(run, s)),
+        final_packing_fraction: packing_fraction(run, &last),
+        quasi_static_strains: {
+            let judged = granbed_kernel::analysis::quasi_static::judged(&run.samples);
+            judged
+                .first()
+                .zip(judged.last())
+                .map(|(a, b)| [a.strain, b.strain])
+        },
         final_density_by_height: if run.final_granules.is_empty() {
             Vec::new()
         } else {

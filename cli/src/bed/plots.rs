@@ -17,7 +17,7 @@
 //!   solid fraction D (relative density of the bed) against the
 //!   upper-punch pressure P;
 //! * `coordination_density.svg`: Z, without and with the walls, against
-//!   the bed's solid fraction D;
+//!   the granules' packing fraction (D without their inner pores);
 //! * `energy_strain.svg`: where the punch's work went: the energy ledger
 //!   (elastic, plastic, hourglass, contact losses, damping, kinetic)
 //!   against C, in J, mJ or µJ (as the largest needs);
@@ -27,8 +27,8 @@
 use std::path::Path;
 
 use super::outputs::{
-    DENSITY_LAYERS, HeckelSummary, KawakitaSummary, Summary, bed_solid_fraction, final_height_m,
-    fit_linear, heckel_rows, kawakita_doubts, upper_pressure,
+    DENSITY_LAYERS, HeckelSummary, KawakitaSummary, Summary, final_height_m, fit_linear,
+    heckel_rows, kawakita_doubts, packing_fraction, upper_pressure,
 };
 use super::run::{BedRun, BedSample};
 use crate::output::write_text;
@@ -359,7 +359,7 @@ pub fn plots(
             .map(|(p, d, _)| (p * 1e-3, d))
             .collect(),
     )];
-    let solid_fraction = |s: &BedSample| bed_solid_fraction(run, s.strain);
+    let packing = |s: &BedSample| packing_fraction(run, s);
     let coordination_density: [(&str, Mark, Quantity); 2] = [
         ("granule pairs", Mark::Line, |s| s.coordination),
         ("with walls", Mark::DashedLine, |s| {
@@ -367,11 +367,7 @@ pub fn plots(
         }),
     ];
     let coordination_density = coordination_density.map(|(label, mark, z)| {
-        Series::new(
-            label,
-            mark,
-            samples.iter().map(|s| (solid_fraction(s), z(s))),
-        )
+        Series::new(label, mark, samples.iter().map(|s| (packing(s), z(s))))
     });
     Ok([
         (
@@ -414,8 +410,11 @@ pub fn plots(
         (
             coordination_density_f,
             xy_svg_from(
-                "Coordination number against the bed's solid fraction",
-                ("bed solid fraction D", "Z"),
+                "Coordination number against the granules' packing fraction",
+                (
+                    "granules' packing fraction (envelope volume / die volume)",
+                    "Z",
+                ),
                 &coordination_density,
                 (false, true),
             )?,

@@ -26,7 +26,7 @@ pub const REPORT_FILE: &str = "report.html";
 /// meaning; any other field follows (nested objects such as `kawakita` and
 /// `heckel` are flattened to `kawakita.<field>`; the scene, `scene` and
 /// `scene_toml`, is shown as TOML instead).
-const FIELDS: [(&str, &str); 86] = [
+const FIELDS: [(&str, &str); 89] = [
     ("kawakita_a", "Kawakita a (limiting strain)"),
     ("kawakita_inv_b_pa", "Kawakita 1/b, Pa"),
     (
@@ -77,6 +77,18 @@ const FIELDS: [(&str, &str); 86] = [
     (
         "final_solid_fraction",
         "the bed's solid fraction D at the end, in the die under load",
+    ),
+    (
+        "initial_packing_fraction",
+        "the granules' packing fraction at C = 0: their envelope volume / die volume",
+    ),
+    (
+        "final_packing_fraction",
+        "the granules' packing fraction at the end (1 − it: the porosity between them)",
+    ),
+    (
+        "quasi_static_strains",
+        "the strains the quasi-static certificate judged (the second half of the rows)",
     ),
     (
         "material.youngs_modulus_pa",
@@ -303,6 +315,15 @@ fn key_results(summary: &Summary<'_>) -> String {
             ),
         ),
         (
+            "granules' packing fraction (their envelope volume / die volume): start → end"
+                .to_owned(),
+            format!(
+                "{} → {}",
+                num(Some(summary.initial_packing_fraction)),
+                num(Some(summary.final_packing_fraction))
+            ),
+        ),
+        (
             format!(
                 "granules' mean relative density at the end in {} layers, bottom → top",
                 super::outputs::DENSITY_LAYERS
@@ -323,7 +344,7 @@ fn key_results(summary: &Summary<'_>) -> String {
             kpa(Some(summary.final_pressure_pa)),
         ),
         (
-            "coordination number Z at the end".to_owned(),
+            "coordination number Z at the end (averaged over the last output interval)".to_owned(),
             num(Some(summary.final_coordination)),
         ),
         (
@@ -331,7 +352,15 @@ fn key_results(summary: &Summary<'_>) -> String {
             num(Some(summary.final_relative_density)),
         ),
         (
-            "quasi-static certificate".to_owned(),
+            match summary.quasi_static_strains {
+                Some([from, to]) => format!(
+                    "quasi-static certificate, judged over C = {} to {} (the second half of \
+                     the rows)",
+                    num(Some(from)),
+                    num(Some(to))
+                ),
+                None => "quasi-static certificate".to_owned(),
+            },
             if summary.quasi_static.passed {
                 "passed".to_owned()
             } else {
@@ -407,9 +436,10 @@ fn plot_caption(name: &str, summary: &Summary<'_>) -> Option<String> {
     Some(match name {
         "pressure_strain.svg" => {
             "The punches' pressures against the axial strain C = (H0 − H)/H0: \
-             force over the die's cross-section. Early on the lower punch carries the bed's \
-             weight, so its pressure can lie above the upper one's; later the die wall's friction \
-             keeps it below."
+             force over the die's cross-section, averaged over each output interval. Early on \
+             the lower punch carries the bed's weight and takes the impulses of its settling, so \
+             its pressure lies above the upper one's; later the die wall's friction keeps it \
+             below."
                 .to_owned()
         }
         "kawakita.svg" => format!(
@@ -442,10 +472,12 @@ fn plot_caption(name: &str, summary: &Summary<'_>) -> Option<String> {
              (the granules' solid over the die volume below the upper punch) against the \
              upper-punch pressure P."
             .to_owned(),
-        "coordination_density.svg" => "The coordination number Z against the bed's solid \
-             fraction D (compression.csv's bed_solid_fraction), granule contacts only and with \
-             the wall contacts: how the contact network grows as the bed densifies, the form in \
-             which coordination is usually compared (Arzt's Z(D) for spheres)."
+        "coordination_density.svg" => "The coordination number Z against the granules' \
+             packing fraction (their envelope volume over the die volume below the upper punch: \
+             bed_solid_fraction / relative_density_solid, the pores inside the granules left \
+             out), granule contacts only and with the wall contacts: how the contact network \
+             grows as the bed densifies, in the packing fraction Arzt's Z law for spheres is \
+             written in. Z is averaged over each output interval."
             .to_owned(),
         "density_height.svg" => format!(
             "Each granule's relative density where the run ended against the height of its \
@@ -454,7 +486,7 @@ fn plot_caption(name: &str, summary: &Summary<'_>) -> Option<String> {
              C = {}. The die wall's friction holds back the load on its way down, so in a compact \
              pressed from above the granules at the bottom usually end less dense than those at \
              the top.",
-            short(summary.final_strain)
+            num(Some(summary.final_strain))
         ),
         "energy_strain.svg" => "Where the punch's work went, totals so far against the strain \
              (compression.csv's energy columns): the elastic energy stored in the \
@@ -504,12 +536,15 @@ pub fn report_html(
     )?;
     writeln!(
         h,
-        "<h2>Plots</h2>\n<p>Each granule's mesh has its nodes on the poured sphere and \
-         flat faces between them, so it holds less volume than the sphere (D at C = 0 lies \
-         below the pour's packing fraction), and spheres the pour left touching start a few \
-         µm apart: the coordination number Z and the lower-punch pressure stay near 0 until the \
-         first strain closes those gaps. For the same reason the Heywood coefficient α_SV \
-         starts a little above the sphere's 6 (more surface per volume), most on coarse \
+        "<h2>Plots</h2>\n<p>The solid fraction D is the granules' packing fraction times \
+         their own relative density (η0 at the start), so it lies well below the pour's \
+         packing fraction. Each granule's mesh has its nodes on the poured sphere and flat \
+         faces between them, so it holds a little less volume than the sphere, and spheres the \
+         pour left touching start a few µm apart; the upper punch starts on the highest \
+         granule. Over the first few per cent of strain the bed settles and rearranges under \
+         the punch: the coordination number Z and the upper-punch pressure stay low, and the \
+         fits' windows start well after. The Heywood coefficient α_SV starts a little above \
+         the sphere's 6 (the mesh's flat faces: more surface per volume), most on coarse \
          meshes.</p>"
     )?;
     for (name, svg) in svgs {
