@@ -350,7 +350,7 @@ fn snapshots_plots_and_report() {
         .map(|k| k["min_strain"].as_f64().unwrap())
         .collect();
     assert_eq!(starts, [0.10, 0.15, 0.20, 0.25]);
-    assert!(html.contains("<h3>The Kawakita fit by window</h3>"));
+    assert!(html.contains("<h3>The fits by window</h3>"));
     assert_eq!(s["heckel_mean_pressure"]["points"], s["heckel"]["points"]);
     let glossary = &html[html.find("<h3>compression.csv</h3>").unwrap()..];
     let mut at = 0;

@@ -111,7 +111,7 @@ Output, in --out DIR (created if missing):
                    the energy ledger vs strain; each granule's relative
                    density vs its height at the end
   report.html      one page: the warnings (or that there are none), the key
-                   results, the Kawakita fit by window, the plots with
+                   results, the fits by window, the plots with
                    captions, the sections with their tables linked, the
                    summary table (rounded; hover a value for all its digits),
                    the tables' columns explained, and the scene

@@ -199,7 +199,8 @@ pub struct HeckelSummary {
     /// Points used: the output rows with C ≥ `min_strain`, P finite and
     /// 0 < D < 1.
     pub points: usize,
-    /// The fit's strain window starts here (scene `heckel_min_strain`).
+    /// The fit's strain window starts here (the run's fits: scene
+    /// `heckel_min_strain`; `heckel_windows`: each window's start).
     pub min_strain: Real,
 }
 
@@ -241,10 +242,13 @@ pub struct Summary<'a> {
     pub heckel_yield_pressure_pa: Option<Real>,
     /// The Heckel fit in full.
     pub heckel: HeckelSummary,
-    /// The Kawakita fit again over each window of [`KAWAKITA_WINDOWS`]
+    /// The Kawakita fit again over each window of [`FIT_WINDOWS`]
     /// (C ≥ each; no figures for a window past the strain reached): how
     /// much a and 1/b depend on the window.
     pub kawakita_windows: Vec<KawakitaSummary>,
+    /// The Heckel fit (upper-punch pressure) again over each window of
+    /// [`FIT_WINDOWS`].
+    pub heckel_windows: Vec<HeckelSummary>,
     /// The Heckel fit over the same rows on the mean of the two punches'
     /// pressures ([`mean_punch_pressure`]) instead of the upper one's.
     pub heckel_mean_pressure: HeckelSummary,
@@ -445,10 +449,10 @@ pub fn heckel(run: &BedRun, min_strain: Real, pressure: fn(&BedSample) -> Real) 
 }
 
 /// The starts of the strain windows over which `summary.json`'s
-/// `kawakita_windows` fits the law again: a and 1/b depend on the window
-/// (physics.md's C ≥ 0.25 is the published one), and a reader should see
-/// by how much.
-pub const KAWAKITA_WINDOWS: [Real; 4] = [0.10, 0.15, 0.20, 0.25];
+/// `kawakita_windows` and `heckel_windows` fit the laws again: their
+/// figures depend on the window (physics.md's C ≥ 0.25 is the published
+/// one), and a reader should see by how much.
+pub const FIT_WINDOWS: [Real; 4] = [0.10, 0.15, 0.20, 0.25];
 
 /// Layers of equal height in which `summary.json` averages the granules'
 /// relative density at the end ([`density_by_height`]).
@@ -535,8 +539,9 @@ pub fn summary<'a>(scene: &'a Scene, run: &BedRun) -> Summary<'a> {
     let last = run.samples.last().copied().unwrap_or_default();
     let k = kawakita(&run.samples, scene.kawakita_min_strain);
     let heckel_mean_pressure = heckel(run, scene.heckel_min_strain, mean_punch_pressure);
+    let heckel_windows = FIT_WINDOWS.map(|c| heckel(run, c, upper_pressure)).to_vec();
     let heckel = heckel(run, scene.heckel_min_strain, upper_pressure);
-    let kawakita_windows = KAWAKITA_WINDOWS.map(|c| kawakita(&run.samples, c)).to_vec();
+    let kawakita_windows = FIT_WINDOWS.map(|c| kawakita(&run.samples, c)).to_vec();
     let min_jacobian = run
         .samples
         .iter()
@@ -578,6 +583,7 @@ pub fn summary<'a>(scene: &'a Scene, run: &BedRun) -> Summary<'a> {
         heckel_yield_pressure_pa: heckel.yield_pressure_pa,
         heckel,
         kawakita_windows,
+        heckel_windows,
         heckel_mean_pressure,
         initial_solid_fraction: bed_solid_fraction(run, 0.0),
         final_solid_fraction: bed_solid_fraction(run, last.strain),
@@ -1209,8 +1215,8 @@ mod tests {
             let strains = || (1..=last).map(|i| 0.01 * Real::from(i));
             let run = run_of(strains().map(|c| (c, c * inv_b / (a - c))));
             let s = summary(&scene, &run);
-            assert_eq!(s.kawakita_windows.len(), KAWAKITA_WINDOWS.len());
-            for (k, &from) in s.kawakita_windows.iter().zip(&KAWAKITA_WINDOWS) {
+            assert_eq!(s.kawakita_windows.len(), FIT_WINDOWS.len());
+            for (k, &from) in s.kawakita_windows.iter().zip(&FIT_WINDOWS) {
                 assert_eq!(k.min_strain, from);
                 let rows = strains().filter(|&c| c >= from).count();
                 assert_eq!(k.points, rows, "{k:?}");
@@ -1242,7 +1248,7 @@ mod tests {
     /// The Heckel fit on the mean punch pressure: rows whose mean pressure
     /// follows ln(1/(1 − D)) = P/P_y + A exactly, with the upper punch
     /// carrying a quarter more (the wall's share), give P_y back on the
-    /// mean pressure and 1.25 P_y on the upper one.
+    /// mean pressure and 1.25 P_y on the upper one, in every window.
     #[test]
     fn the_heckel_fit_on_the_mean_punch_pressure() {
         use crate::bed::run::{BedRun, BedSample};
@@ -1275,6 +1281,15 @@ mod tests {
             s.heckel
         );
         assert_eq!((mean.points, mean.min_strain), (6, 0.25));
+        // The upper punch's law again over each window, from its rows.
+        for (w, &from) in s.heckel_windows.iter().zip(&FIT_WINDOWS) {
+            assert_eq!(w.min_strain, from);
+            assert_eq!(
+                w.points,
+                (0..=30).filter(|&i| 0.01 * Real::from(i) >= from).count()
+            );
+            assert!(rel(w.yield_pressure_pa, 1.25 * p_y) < 1e-9, "{w:?}");
+        }
     }
 
     /// Granules go to the layer of their centre's height, a centre at or

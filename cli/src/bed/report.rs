@@ -26,7 +26,7 @@ pub const REPORT_FILE: &str = "report.html";
 /// meaning; any other field follows (nested objects such as `kawakita` and
 /// `heckel` are flattened to `kawakita.<field>`; the scene, `scene` and
 /// `scene_toml`, is shown as TOML instead).
-const FIELDS: [(&str, &str); 89] = [
+const FIELDS: [(&str, &str); 90] = [
     ("kawakita_a", "Kawakita a (limiting strain)"),
     ("kawakita_inv_b_pa", "Kawakita 1/b, Pa"),
     (
@@ -256,8 +256,9 @@ const FIELDS: [(&str, &str); 89] = [
     ("kawakita.inv_b_pa", ""),
     ("heckel.yield_pressure_pa", ""),
     ("warnings", ""),
-    // Its own table, "The Kawakita fit by window".
+    // Their own table, "The fits by window".
     ("kawakita_windows", ""),
+    ("heckel_windows", ""),
     // In the key results and the plot density_height.svg.
     ("final_density_by_height", ""),
 ];
@@ -371,21 +372,23 @@ fn key_results(summary: &Summary<'_>) -> String {
     key_table("Key results", &rows)
 }
 
-/// The Kawakita fit over each window of `summary.kawakita_windows`: its
-/// a, 1/b (kPa), rows and R², a rejected fit marked as in the series'
-/// tables, the run's own window named.
-fn kawakita_by_window(summary: &Summary<'_>) -> String {
+/// The Kawakita and Heckel fits over each window of
+/// `summary.kawakita_windows` and `heckel_windows`: a, 1/b (kPa), P_y
+/// (kPa) and the rows each fit took, a rejected fit marked as in the
+/// series' tables, the run's own window named.
+fn fits_by_window(summary: &Summary<'_>) -> String {
     let mut h = String::from(
-        "<h3>The Kawakita fit by window</h3>\n<p>The law fitted again to the rows from \
-         several strains on: a and 1/b depend on the window, the more the earlier it starts \
-         (rearrangement is not the law's regime). The published scene fits C ≥ 0.25, as the \
-         reference study did; ✗ marks a \
-         fit the summary would reject (its R² on hover); n/a: no fit over the window (the run \
-         did not reach it, or its rows make no line).</p>\n<table>\n<tr><th>rows fitted</th><th>a</th><th>1/b, kPa</th>\
-         <th>rows</th></tr>\n",
+        "<h3>The fits by window</h3>\n<p>The laws fitted again to the rows from several \
+         strains on: their figures depend on the window, the more the earlier it starts \
+         (rearrangement is not the laws' regime). The published scene fits C ≥ 0.25, as the \
+         reference study did; ✗ marks a fit the summary would reject (its R² on hover); n/a: \
+         no fit over the window (the run did not reach it, or its rows make no line).</p>\n\
+         <table>\n<tr><th>rows fitted</th><th>Kawakita a</th><th>Kawakita 1/b, kPa</th>\
+         <th>Heckel P_y, kPa</th><th>rows (Kawakita, Heckel)</th></tr>\n",
     );
-    for k in &summary.kawakita_windows {
+    for (k, hk) in summary.kawakita_windows.iter().zip(&summary.heckel_windows) {
         let ok = super::outputs::kawakita_doubts(k).is_empty();
+        let heckel_ok = hk.r_squared.is_some_and(super::outputs::fit_linear);
         let own = if k.min_strain == summary.kawakita.min_strain {
             " (the run's fit)"
         } else {
@@ -393,11 +396,17 @@ fn kawakita_by_window(summary: &Summary<'_>) -> String {
         };
         let _ = writeln!(
             h,
-            "<tr><td>C ≥ {}{own}</td>{}{}<td class=\"num\">{}</td></tr>",
+            "<tr><td>C ≥ {}{own}</td>{}{}{}<td class=\"num\">{}, {}</td></tr>",
             short(k.min_strain),
             fit_cell(k.a.map(|a| num(Some(a))), k.r_squared, ok),
             fit_cell(k.inv_b_pa.map(|b| kpa(Some(b))), k.r_squared, ok),
-            k.points
+            fit_cell(
+                hk.yield_pressure_pa.map(|p| kpa(Some(p))),
+                hk.r_squared,
+                heckel_ok
+            ),
+            k.points,
+            hk.points
         );
     }
     h.push_str("</table>\n");
@@ -527,7 +536,7 @@ pub fn report_html(
          elements, the fits).",
     ));
     h.push_str(&key_results(summary));
-    h.push_str(&kawakita_by_window(summary));
+    h.push_str(&fits_by_window(summary));
     writeln!(
         h,
         "<p>Files: <a href=\"compression.csv\">compression.csv</a>, \
@@ -723,12 +732,25 @@ mod tests {
         let scene = Scene::published();
         let summary = crate::bed::outputs::summary(&scene, &BedRun::of_samples(samples));
         let html = report_html(&scene, &summary, &[], &[]).unwrap();
-        let table = &html[html.find("The Kawakita fit by window").unwrap()..];
+        let table = &html[html.find("The fits by window").unwrap()..];
         let table = &table[table.find("<table>").unwrap()..table.find("</table>").unwrap()];
-        for (from, rows) in [("0.1", 13), ("0.15", 8), ("0.2", 3)] {
+        for (i, (from, rows)) in [("0.1", 13), ("0.15", 8), ("0.2", 3)]
+            .into_iter()
+            .enumerate()
+        {
+            // The Heckel cell as the window's fit gives it (this run's D
+            // follows no Heckel law).
+            let hk = &summary.heckel_windows[i];
+            assert_eq!(hk.min_strain, crate::bed::outputs::FIT_WINDOWS[i]);
+            let heckel = format!(
+                "<td class=\"num\" title=\"R² = {}\">{}</td>",
+                num(hk.r_squared),
+                kpa(hk.yield_pressure_pa)
+            );
             let row = format!(
                 "<tr><td>C ≥ {from}</td><td class=\"num\" title=\"R² = 1.000\">0.4000</td>\
-                 <td class=\"num\" title=\"R² = 1.000\">50.00</td><td class=\"num\">{rows}</td></tr>"
+                 <td class=\"num\" title=\"R² = 1.000\">50.00</td>{heckel}\
+                 <td class=\"num\">{rows}, {rows}</td></tr>"
             );
             assert!(table.contains(&row), "no row {row} in {table}");
         }
