@@ -27,13 +27,17 @@ fn show(value: &Value) -> String {
 }
 
 /// A JSON value as the table's cell shows it: a float to
-/// [`TABLE_DIGITS`] significant digits ([`significant`]), anything else
-/// as [`show`] gives it.
+/// [`TABLE_DIGITS`] significant digits ([`significant`]), a list element
+/// by element, anything else as [`show`] gives it.
 fn shown_in_cell(value: &Value) -> String {
     match value {
         Value::Number(n) if !(n.is_u64() || n.is_i64()) => n
             .as_f64()
             .map_or_else(|| show(value), |x| significant(x, TABLE_DIGITS)),
+        Value::Array(items) => {
+            let items: Vec<String> = items.iter().map(shown_in_cell).collect();
+            format!("[{}]", items.join(", "))
+        }
         v => show(v),
     }
 }
@@ -265,6 +269,12 @@ mod tests {
         assert_eq!(
             (row.full.as_str(), row.cell.as_str()),
             ("0.123456789", "0.1235")
+        );
+        let list = serde_json::json!([0.150_021_325, 0.300_003_8]);
+        let row = Row::new("x".into(), "", &list);
+        assert_eq!(
+            (row.full.as_str(), row.cell.as_str()),
+            ("[0.150021325,0.3000038]", "[0.1500, 0.3000]")
         );
         for (value, text) in [
             (serde_json::json!(1_234_567_u64), "1234567"),

@@ -832,7 +832,8 @@ impl<'m> Assembly<'m> {
         }
     }
 
-    /// What the last step did.
+    /// What the last step did (the default report before the first step
+    /// and after [`Self::restore`]).
     pub fn last(&self) -> &StepReport {
         &self.last
     }

@@ -60,8 +60,12 @@ Output, in --out DIR (created if missing):
                    ln(1/(1 - D)) = K P + A (yield pressure P_y = 1/K, A,
                    D_A = 1 - exp(-A), R^2, points; C >= heckel_min_strain,
                    0.25), the Kawakita fit again over C >= 0.10, 0.15, 0.20
-                   and 0.25 (kawakita_windows), the Heckel fit on the mean
-                   punch pressure (heckel_mean_pressure), the granules' mean
+                   and 0.25 (kawakita_windows) and the Heckel fit likewise
+                   (heckel_windows), the Heckel fit on the mean punch
+                   pressure (heckel_mean_pressure), the granules' packing
+                   fraction at the start and the end (their envelope volume /
+                   die volume), the strains the certificate judged
+                   (quasi_static_strains), the granules' mean
                    relative density in five layers of the compact at the end
                    (final_density_by_height), the poured bed's solid fraction
                    D0 and the final D in the die, the material (every
@@ -107,7 +111,8 @@ Output, in --out DIR (created if missing):
   plots/*.svg      pressure, coordination number, relative density and Heywood
                    coefficient against strain; Kawakita plot P/C vs P and
                    Heckel plot ln(1/(1 - D)) vs P, each with its fit; the
-                   compaction profile, the bed's solid fraction D vs P; Z vs D;
+                   compaction profile, the bed's solid fraction D vs P; Z vs
+                   the granules' packing fraction;
                    the energy ledger vs strain; each granule's relative
                    density vs its height at the end
   report.html      one page: the warnings (or that there are none), the key

@@ -109,8 +109,9 @@ pub const COMPRESSION_COLUMNS: [(&str, &str); 29] = [
 /// The granules' packing fraction of a row: their envelope volume over
 /// the die volume below the upper punch, D / (Σ solid / Σ V) — the solid
 /// fraction D without the pores inside the granules, the fraction Arzt's
-/// coordination law and the pour's packing fraction are written in. NaN
-/// before the granules' volumes are known.
+/// coordination law and the pour's packing fraction are written in (not
+/// finite if the granules' volumes are not, which `summary.json` writes
+/// as null).
 pub fn packing_fraction(run: &BedRun, s: &BedSample) -> Real {
     bed_solid_fraction(run, s.strain) / s.relative_density_solid
 }
@@ -261,9 +262,10 @@ pub struct Summary<'a> {
     /// The granules' packing fraction at C = 0 ([`packing_fraction`]:
     /// their envelope volume / the die volume below H0).
     pub initial_packing_fraction: Real,
-    /// The granules' packing fraction at the end; 1 − it is the porosity
-    /// between the granules, it × (1 − the granules' Σsolid/ΣV) the
-    /// porosity inside them.
+    /// The granules' packing fraction at the end. As fractions of the die
+    /// volume, 1 − it is the room between the granules and it × (1 − the
+    /// granules' Σsolid/ΣV) the pores inside them; the two add up to
+    /// 1 − D.
     pub final_packing_fraction: Real,
     /// The strains the quasi-static certificate judged: the first and the
     /// last of the second half of the output rows (`None`: no row).

@@ -88,7 +88,7 @@ const FIELDS: [(&str, &str); 90] = [
     ),
     (
         "quasi_static_strains",
-        "the strains the quasi-static certificate judged (the second half of the rows)",
+        "the strains whose kinetic and force figures the certificate judged (the second half of the rows; --rate-check compares the curves from C = 0.02)",
     ),
     (
         "material.youngs_modulus_pa",
@@ -355,8 +355,8 @@ fn key_results(summary: &Summary<'_>) -> String {
         (
             match summary.quasi_static_strains {
                 Some([from, to]) => format!(
-                    "quasi-static certificate, judged over C = {} to {} (the second half of \
-                     the rows)",
+                    "quasi-static certificate (its kinetic and force figures judged over \
+                     C = {} to {}, the second half of the rows)",
                     num(Some(from)),
                     num(Some(to))
                 ),
@@ -389,10 +389,14 @@ fn fits_by_window(summary: &Summary<'_>) -> String {
     for (k, hk) in summary.kawakita_windows.iter().zip(&summary.heckel_windows) {
         let ok = super::outputs::kawakita_doubts(k).is_empty();
         let heckel_ok = hk.r_squared.is_some_and(super::outputs::fit_linear);
-        let own = if k.min_strain == summary.kawakita.min_strain {
-            " (the run's fit)"
-        } else {
-            ""
+        let own = match (
+            k.min_strain == summary.kawakita.min_strain,
+            hk.min_strain == summary.heckel.min_strain,
+        ) {
+            (true, true) => " (the run's fits)",
+            (true, false) => " (the run's Kawakita fit)",
+            (false, true) => " (the run's Heckel fit)",
+            (false, false) => "",
         };
         let _ = writeln!(
             h,
@@ -755,7 +759,7 @@ mod tests {
             assert!(table.contains(&row), "no row {row} in {table}");
         }
         assert!(
-            table.contains("<td>C ≥ 0.25 (the run's fit)</td><td class=\"num\" title=\"no fit")
+            table.contains("<td>C ≥ 0.25 (the run's fits)</td><td class=\"num\" title=\"no fit")
         );
         assert!(!table.contains('✗'));
         let glossary = &html[html.find("<h2>Columns of the tables</h2>").unwrap()..];

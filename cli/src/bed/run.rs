@@ -747,10 +747,13 @@ pub fn run_bed(
     // A run that reached its final strain ends with a snapshot of its
     // final state, listed in `snapshot_strains` or not (a run past the
     // published list's 0.3 had no picture of its end); after its last
-    // checkpoint, which a failure to write the snapshot must not cost.
+    // checkpoint, which a failure to write the snapshot must not cost. A
+    // finished run resumed without a step has its end's snapshot already
+    // (and a lower --strain would mislabel it: the state is at the old end).
     if error.is_none()
         && !stopped
         && !interrupted
+        && !resumed_past_end
         && asm.time() >= end
         && !snapshots.iter().any(|&c| c >= scene.final_strain - 1e-12)
     {

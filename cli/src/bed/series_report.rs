@@ -50,12 +50,16 @@ fn doubts(row: &ComparisonRow) -> Vec<&'static str> {
         out.push("not quasi-static: inertia is in its pressures");
     }
     match (row.kawakita_a, row.kawakita_ok) {
-        (None, _) => out.push("no Kawakita fit (the run ended before its window)"),
+        (None, _) => {
+            out.push("no Kawakita fit (too few rows in its window, or no line through them)")
+        }
         (Some(_), false) => out.push("Kawakita fit rejected"),
         (Some(_), true) => {}
     }
     match (row.heckel_yield_pressure_pa, row.heckel_ok) {
-        (None, _) => out.push("no Heckel fit (the run ended before its window)"),
+        (None, _) => {
+            out.push("no Heckel fit (too few rows in its window, or no line through them)")
+        }
         (Some(_), false) => out.push("Heckel fit rejected"),
         (Some(_), true) => {}
     }
@@ -286,8 +290,8 @@ mod tests {
         // A failed run is not also called not quasi-static, and a fit its
         // run never reached is no rejected fit: n/a without a mark.
         assert!(html.contains(
-            "seed_3</a>: the run failed (see its report); no Kawakita fit (the run ended before \
-             its window)</li>"
+            "seed_3</a>: the run failed (see its report); no Kawakita fit (too few rows in its \
+             window, or no line through them)</li>"
         ));
         assert!(html.contains(&format!("title=\"{}\">n/a</td>", crate::html::NO_FIT)));
         assert!(!html.contains("n/a ✗"));

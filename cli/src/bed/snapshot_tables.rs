@@ -59,9 +59,12 @@ pub const CONTACT_COLUMNS: [(&str, &str); 13] = [
     ),
     (
         "constraints",
-        "node-to-face constraints that carried a force",
+        "node-to-face constraints that carried a force in the step's first contact sweep (0: the pair touched only in a later sweep)",
     ),
-    ("slipping", "of those, the ones at the friction cap μF_n"),
+    (
+        "slipping",
+        "the most constraints at the friction cap μF_n in any one sweep of the step (can exceed constraints)",
+    ),
     (
         "branch_x_m",
         "x of the branch vector: granule_b's centre of mass − granule_a's, m",
@@ -173,7 +176,7 @@ pub const GRANULE_COLUMNS: [(&str, &str); 8] = [
     ("heywood_d", "d S/V with the nominal diameter d"),
     (
         "contacts",
-        "granules it touched in the step (its rows in contacts_<k>.csv)",
+        "granules it carried a contact force with in the step (its rows in contacts_<k>.csv; compression.csv's Z counts only the pairs touching in the step's first sweep)",
     ),
 ];
 
