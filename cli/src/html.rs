@@ -227,6 +227,26 @@ pub fn fit_cell(value: Option<String>, r_squared: Option<f64>, ok: bool) -> Stri
     )
 }
 
+/// A picture as an image (not inline: a section picture holds thousands
+/// of polygons): the file `path` (relative to the page) shown under the
+/// alternative text `what: path`, captioned with links to it and to the
+/// files `beside` it.
+pub fn picture(path: &str, what: &str, beside: &[String]) -> String {
+    let links: Vec<String> = core::iter::once(path)
+        .chain(beside.iter().map(String::as_str))
+        .map(|f| {
+            let f = html_escape(f);
+            format!("<a href=\"{f}\">{f}</a>")
+        })
+        .collect();
+    let (path, what) = (html_escape(path), html_escape(what));
+    format!(
+        "<figure>\n<img src=\"{path}\" alt=\"{what}: {path}\" style=\"max-width: 100%\">\n\
+         <figcaption>{}</figcaption>\n</figure>\n",
+        links.join(", ")
+    )
+}
+
 /// A glossary: the columns (name, meaning with its unit) of the table
 /// `file`, under a heading, after the paragraph `about`.
 pub fn glossary(file: &str, about: &str, columns: &[(&str, &str)]) -> String {

@@ -205,6 +205,14 @@ pub struct HeckelSummary {
     pub min_strain: Real,
 }
 
+impl HeckelSummary {
+    /// Whether its ln(1/(1 − D)) is linear enough in P for P_y to be a
+    /// material figure ([`fit_linear`]; no fit is not).
+    pub fn linear(&self) -> bool {
+        self.r_squared.is_some_and(fit_linear)
+    }
+}
+
 /// The quasi-static certificate of a bed run: the upper punch drives, the
 /// lower punch and the die-wall friction take up.
 pub fn quasi_static(samples: &[BedSample], rate_change_rel: Option<Real>) -> QuasiStatic {
@@ -485,11 +493,10 @@ pub fn density_by_height(granules: &[GranuleAtEnd], height_m: Real) -> Vec<Densi
     let mut sums = vec![(0_usize, 0.0); n];
     for g in granules {
         let at = (g.centre_m[2] / height_m * n as Real).floor();
-        let layer = if at.is_nan() {
+        if at.is_nan() {
             continue;
-        } else {
-            (at.max(0.0) as usize).min(n - 1)
-        };
+        }
+        let layer = (at.max(0.0) as usize).min(n - 1);
         sums[layer].0 += 1;
         sums[layer].1 += g.relative_density;
     }

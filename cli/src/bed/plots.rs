@@ -27,8 +27,8 @@
 use std::path::Path;
 
 use super::outputs::{
-    DENSITY_LAYERS, HeckelSummary, KawakitaSummary, Summary, final_height_m, fit_linear,
-    heckel_rows, kawakita_doubts, packing_fraction, upper_pressure,
+    DENSITY_LAYERS, HeckelSummary, KawakitaSummary, Summary, final_height_m, heckel_rows,
+    kawakita_doubts, packing_fraction, upper_pressure,
 };
 use super::run::{BedRun, BedSample};
 use crate::output::write_text;
@@ -286,7 +286,7 @@ pub fn heckel_svg(
                 fit.a.unwrap_or(f64::NAN),
                 r2_text(fit.r_squared)
             ),
-            fit.r_squared.is_some_and(fit_linear),
+            fit.linear(),
         );
         (label, y as &dyn Fn(f64) -> f64)
     });

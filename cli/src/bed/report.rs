@@ -13,8 +13,8 @@ use super::scene::{DEFAULT_SCENE, Scene};
 use super::snapshot_tables::{CONTACT_COLUMNS, GRANULE_COLUMNS, contacts_file, granules_file};
 use super::snapshots::{PVD_FILE, VTK_DIR};
 use crate::html::{
-    Row, figure, fit_cell, glossary, html_escape, key_table, kpa, num, page_head, summary_rows,
-    summary_table, warnings_section,
+    Row, figure, fit_cell, glossary, html_escape, key_table, kpa, num, page_head, picture,
+    summary_rows, summary_table, warnings_section,
 };
 use crate::numbers::short;
 use crate::output::write_text;
@@ -388,7 +388,7 @@ fn fits_by_window(summary: &Summary<'_>) -> String {
     );
     for (k, hk) in summary.kawakita_windows.iter().zip(&summary.heckel_windows) {
         let ok = super::outputs::kawakita_doubts(k).is_empty();
-        let heckel_ok = hk.r_squared.is_some_and(super::outputs::fit_linear);
+        let heckel_ok = hk.linear();
         let own = match (
             k.min_strain == summary.kawakita.min_strain,
             hk.min_strain == summary.heckel.min_strain,
@@ -581,20 +581,11 @@ pub fn report_html(
              density, contacts), their columns explained at the end of this page.</p>"
         )?;
         for files in sections {
-            let path = html_escape(&files.section);
-            let links: String = core::iter::once(&files.section)
-                .chain(&files.tables)
-                .map(|f| {
-                    let f = html_escape(f);
-                    format!("<a href=\"{f}\">{f}</a>")
-                })
-                .collect::<Vec<_>>()
-                .join(", ");
-            writeln!(
-                h,
-                "<figure>\n<img src=\"{path}\" alt=\"section of the bed: {path}\" \
-                 style=\"max-width: 100%\">\n<figcaption>{links}</figcaption>\n</figure>"
-            )?;
+            h.push_str(&picture(
+                &files.section,
+                "section of the bed",
+                &files.tables,
+            ));
         }
     }
     h.push_str(&summary_table(&rows(summary)?));

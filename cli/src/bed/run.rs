@@ -178,12 +178,12 @@ pub struct GranuleAtEnd {
 /// Every granule of `asm` (meshes `mesh`, nominal diameter `d_m`) as
 /// [`GranuleAtEnd`]: its relative density as the snapshots have it.
 fn granules_at_end(asm: &Assembly<'_>, mesh: &OwnedReference, d_m: Real) -> Vec<GranuleAtEnd> {
-    super::snapshots::granule_fields(asm, mesh, d_m)
-        .relative_density
+    let fields = super::snapshots::granule_fields(asm, mesh, d_m);
+    super::snapshot_tables::centres_of_mass(asm)
         .into_iter()
-        .enumerate()
-        .map(|(g, relative_density)| GranuleAtEnd {
-            centre_m: asm.centre_of_mass(g),
+        .zip(fields.relative_density)
+        .map(|(centre_m, relative_density)| GranuleAtEnd {
+            centre_m,
             relative_density,
         })
         .collect()

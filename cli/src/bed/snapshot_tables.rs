@@ -96,9 +96,10 @@ pub struct ContactRow {
 }
 
 /// The pairs of `asm` that carried a force in its last step, ordered by
-/// (a, b)
-/// (a < b in every candidate pair, [`granbed_kernel::contact::broad::GranulePair`]).
-pub fn contact_rows(asm: &Assembly<'_>) -> Vec<ContactRow> {
+/// (a, b) (a < b in every candidate pair,
+/// [`granbed_kernel::contact::broad::GranulePair`]), with the granules'
+/// `centres` of mass ([`centres_of_mass`]).
+pub fn contact_rows(asm: &Assembly<'_>, centres: &[[Real; 3]]) -> Vec<ContactRow> {
     let contact = asm.contact();
     let mut rows: Vec<ContactRow> = contact
         .pairs()
@@ -108,10 +109,7 @@ pub fn contact_rows(asm: &Assembly<'_>) -> Vec<ContactRow> {
         // constraint but carried a force.
         .filter(|(_, w)| w.touching() || w.step.normal > 0.0)
         .map(|(p, w)| {
-            let (ca, cb) = (
-                asm.centre_of_mass(p.a as usize),
-                asm.centre_of_mass(p.b as usize),
-            );
+            let (ca, cb) = (centres[p.a as usize], centres[p.b as usize]);
             let f = &w.step;
             ContactRow {
                 a: p.a,
@@ -180,14 +178,21 @@ pub const GRANULE_COLUMNS: [(&str, &str); 8] = [
     ),
 ];
 
-/// One row per granule of `asm`: [`GRANULE_COLUMNS`] from its centre of
-/// mass, its `fields` and the number of `contacts` rows it is in.
+/// Every granule's centre of mass, m, in granule order.
+pub fn centres_of_mass(asm: &Assembly<'_>) -> Vec<[Real; 3]> {
+    (0..asm.granules().len())
+        .map(|g| asm.centre_of_mass(g))
+        .collect()
+}
+
+/// One row per granule: [`GRANULE_COLUMNS`] from its centre of mass
+/// (`centres`), its `fields` and the number of `contacts` rows it is in.
 pub fn granule_rows(
-    asm: &Assembly<'_>,
+    centres: &[[Real; 3]],
     fields: &GranuleFields,
     contacts: &[ContactRow],
 ) -> Vec<[Field; 8]> {
-    let mut touching = vec![0_u64; asm.granules().len()];
+    let mut touching = vec![0_u64; centres.len()];
     for c in contacts {
         touching[c.a as usize] += 1;
         touching[c.b as usize] += 1;
@@ -196,7 +201,7 @@ pub fn granule_rows(
         .iter()
         .enumerate()
         .map(|(g, &n)| {
-            let [x, y, z] = asm.centre_of_mass(g);
+            let [x, y, z] = centres[g];
             [
                 Field::Int(g as u64),
                 x.into(),

@@ -29,8 +29,8 @@ use vtkio::model::{
 
 use super::section::{Frame, Quantity, SectionInput, section_svg};
 use super::snapshot_tables::{
-    CONTACT_COLUMNS, ContactRow, GRANULE_COLUMNS, contact_rows, contacts_file, granule_rows,
-    granules_file,
+    CONTACT_COLUMNS, ContactRow, GRANULE_COLUMNS, centres_of_mass, contact_rows, contacts_file,
+    granule_rows, granules_file,
 };
 use crate::assembly::Assembly;
 use crate::csv::write_table;
@@ -448,11 +448,11 @@ impl SnapshotWriter {
             &self.dir.join(section_file(k)),
             &section_svg(&section_input(asm, mesh, &elements, strain)),
         )?;
-        // The tables need a step's contact forces: none at C = 0 (before the
-        // first step), nor at the end of a finished run resumed without a
-        // step (its tables from the run itself stay).
+        // The tables need a step's contact forces: none at C = 0, before
+        // the first step.
         if asm.has_stepped() {
-            let contacts = contact_rows(asm);
+            let centres = centres_of_mass(asm);
+            let contacts = contact_rows(asm, &centres);
             write_table(
                 &self.dir.join(contacts_file(k)),
                 &CONTACT_COLUMNS,
@@ -461,7 +461,7 @@ impl SnapshotWriter {
             write_table(
                 &self.dir.join(granules_file(k)),
                 &GRANULE_COLUMNS,
-                granule_rows(asm, &granules, &contacts).into_iter(),
+                granule_rows(&centres, &granules, &contacts).into_iter(),
             )?;
         }
         let entries: Vec<(Real, String)> = self.strains[..=k]

@@ -10,7 +10,7 @@ use granbed_kernel::material::GranuleType;
 use granbed_kernel::scene::platens::{PlatenSample, SAMPLE_COLUMNS};
 
 use super::summary::Summary;
-use crate::csv::{CsvWriter, Field};
+use crate::csv::{CsvWriter, Field, write_table};
 
 /// File name of the force–displacement table.
 pub const FORCE_CSV: &str = "force_displacement.csv";
@@ -39,6 +39,51 @@ pub const TYPES_COLUMNS: [&str; 12] = [
     "return_map_gap_rel",
 ];
 
+/// The meaning of each column of `force_displacement.csv`, in the order of
+/// [`SAMPLE_COLUMNS`] (a test checks the names): the file's header and
+/// the report's glossary.
+pub const FORCE_COLUMNS: [(&str, &str); 18] = [
+    ("time_s", "simulated time, s"),
+    (
+        "displacement_m",
+        "platen approach x (both platens together), m",
+    ),
+    ("strain", "x/d, d the granule's diameter"),
+    ("force_n", "mean of the upper and lower platen forces, N"),
+    (
+        "force_upper_n",
+        "upper platen force, averaged over the sample interval, N",
+    ),
+    (
+        "force_lower_n",
+        "lower platen force, N (the upper's in an octant run)",
+    ),
+    ("kinetic_j", "kinetic energy, J"),
+    (
+        "internal_work_j",
+        "work of the internal and hourglass forces, J",
+    ),
+    ("elastic_j", "elastic energy Ψ, J"),
+    ("plastic_j", "plastic dissipation, J"),
+    (
+        "hourglass_j",
+        "energy in the one-point element's hourglass modes, J",
+    ),
+    ("damping_j", "energy removed by the damping, J"),
+    (
+        "contact_work_j",
+        "work of the platen contacts on the nodes, J",
+    ),
+    ("gravity_work_j", "work of gravity, J"),
+    ("platen_work_j", "work of the moving platens, J"),
+    (
+        "min_j",
+        "smallest element volume ratio J of the sample's last step",
+    ),
+    ("dt_s", "time step, s"),
+    ("steps", "time steps so far"),
+];
+
 /// The cells of one sample, in the order of [`SAMPLE_COLUMNS`] (the header
 /// of [`FORCE_CSV`]).
 pub fn force_row(s: &PlatenSample) -> [Field; SAMPLE_COLUMNS.len()] {
@@ -48,12 +93,7 @@ pub fn force_row(s: &PlatenSample) -> [Field; SAMPLE_COLUMNS.len()] {
 
 /// Writes `samples` as [`FORCE_CSV`] rows to `path`.
 pub fn write_force_csv(path: &Path, samples: &[PlatenSample]) -> anyhow::Result<()> {
-    let ctx = || format!("cannot write to `{}`", path.display());
-    let mut csv = CsvWriter::new(create_file(path)?, &SAMPLE_COLUMNS).with_context(ctx)?;
-    for s in samples {
-        csv.write_row(&force_row(s)).with_context(ctx)?;
-    }
-    finish_file(csv.into_inner(), path)
+    write_table(path, &FORCE_COLUMNS, samples.iter().map(force_row))
 }
 
 /// Writes `summary` as pretty-printed JSON to `path` (see
@@ -93,4 +133,16 @@ pub fn write_types_csv(path: &Path, runs: &[(GranuleType, &Summary)]) -> anyhow:
         csv.write_row(&types_row(*t, s)).with_context(ctx)?;
     }
     finish_file(csv.into_inner(), path)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The glossary names the CSV's columns, in the kernel's order.
+    #[test]
+    fn the_glossary_follows_the_csv_header() {
+        assert_eq!(FORCE_COLUMNS.map(|c| c.0), SAMPLE_COLUMNS);
+        assert!(FORCE_COLUMNS.iter().all(|c| !c.1.is_empty()));
+    }
 }

@@ -12,11 +12,11 @@ use std::path::Path;
 use granbed_kernel::Real;
 use granbed_kernel::scene::platens::PlatenSample;
 
-use super::outputs::{FORCE_CSV, FORCE_SVG, SUMMARY_JSON, TYPES_CSV, TYPES_SVG};
+use super::outputs::{FORCE_COLUMNS, FORCE_CSV, FORCE_SVG, SUMMARY_JSON, TYPES_CSV, TYPES_SVG};
 use super::section::{DENSITY_SVG, SECTION_SVG};
 use super::summary::Summary;
 use crate::html::{
-    figure, fit_cell, glossary, html_escape, key_table, kpa, num, page_head, summary_rows,
+    figure, fit_cell, glossary, html_escape, key_table, kpa, num, page_head, picture, summary_rows,
     summary_table, warnings_section,
 };
 use crate::output::write_text;
@@ -26,51 +26,6 @@ pub const REPORT_FILE: &str = "report.html";
 
 /// File name of the energy plot beside the force plot.
 pub const ENERGY_SVG: &str = "energy_strain.svg";
-
-/// The meaning of each column of `force_displacement.csv`, in the order of
-/// [`granbed_kernel::scene::platens::SAMPLE_COLUMNS`] (a test checks the
-/// names).
-pub const FORCE_COLUMNS: [(&str, &str); 18] = [
-    ("time_s", "simulated time, s"),
-    (
-        "displacement_m",
-        "platen approach x (both platens together), m",
-    ),
-    ("strain", "x/d, d the granule's diameter"),
-    ("force_n", "mean of the upper and lower platen forces, N"),
-    (
-        "force_upper_n",
-        "upper platen force, averaged over the sample interval, N",
-    ),
-    (
-        "force_lower_n",
-        "lower platen force, N (the upper's in an octant run)",
-    ),
-    ("kinetic_j", "kinetic energy, J"),
-    (
-        "internal_work_j",
-        "work of the internal and hourglass forces, J",
-    ),
-    ("elastic_j", "elastic energy Ψ, J"),
-    ("plastic_j", "plastic dissipation, J"),
-    (
-        "hourglass_j",
-        "energy in the one-point element's hourglass modes, J",
-    ),
-    ("damping_j", "energy removed by the damping, J"),
-    (
-        "contact_work_j",
-        "work of the platen contacts on the nodes, J",
-    ),
-    ("gravity_work_j", "work of gravity, J"),
-    ("platen_work_j", "work of the moving platens, J"),
-    (
-        "min_j",
-        "smallest element volume ratio J of the sample's last step",
-    ),
-    ("dt_s", "time step, s"),
-    ("steps", "time steps so far"),
-];
 
 /// The fields of `summary.json` shown first, with their meaning (any other
 /// follows without one; a test checks that none does).
@@ -312,12 +267,7 @@ pub fn report_html(
              and by its relative density η0/J.</p>"
         )?;
         for path in pictures {
-            let path = html_escape(path);
-            writeln!(
-                h,
-                "<figure>\n<img src=\"{path}\" alt=\"section of the granule: {path}\" \
-                 style=\"max-width: 100%\">\n<figcaption><a href=\"{path}\">{path}</a></figcaption>\n</figure>"
-            )?;
+            h.push_str(&picture(path, "section of the granule", &[]));
         }
     }
     h.push_str(&summary_table(&summary_rows(summary, &FIELDS, skipped)?));
@@ -391,17 +341,4 @@ pub fn types_report_html(overlay: &str, runs: &[(&str, &Summary)]) -> String {
     }
     h.push_str("</table>\n</body>\n</html>\n");
     h
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-    use granbed_kernel::scene::platens::SAMPLE_COLUMNS;
-
-    /// The glossary names the CSV's columns, in the kernel's order.
-    #[test]
-    fn the_glossary_follows_the_csv_header() {
-        assert_eq!(FORCE_COLUMNS.map(|c| c.0), SAMPLE_COLUMNS);
-        assert!(FORCE_COLUMNS.iter().all(|c| !c.1.is_empty()));
-    }
 }
