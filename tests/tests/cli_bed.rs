@@ -63,6 +63,19 @@ fn a_small_bed_runs_end_to_end_and_is_thread_independent() {
     assert_eq!(strain[0], 0.0);
     assert!(*strain.last().unwrap() >= 0.3 - 1e-9);
     assert!(strain.windows(2).all(|w| w[1] > w[0]));
+    // Each row's averages belong to its interval's mean strain: half an
+    // interval back from its end, plus half a step's strain.
+    let (mean, steps) = (table.num("mean_strain"), table.num("steps"));
+    assert_eq!(mean[0], 0.0);
+    for i in 1..strain.len() {
+        let n = steps[i] - steps[i - 1];
+        let want = 0.5 * (strain[i - 1] + strain[i]) + 0.5 * (strain[i] - strain[i - 1]) / n;
+        assert!(
+            (mean[i] - want).abs() < 1e-12 && mean[i] > strain[i - 1] && mean[i] < strain[i],
+            "row {i}: mean strain {} against {want}",
+            mean[i]
+        );
+    }
     // Pressing harder: the pressure, the contacts and the granule density
     // end higher than they start.
     assert!(
@@ -90,10 +103,11 @@ fn a_small_bed_runs_end_to_end_and_is_thread_independent() {
 
     let s = summary(&one);
     // The summary's Kawakita fit is the kernel's fit of the table's rows
-    // with C ≥ 0.25 (a 30-granule bed is far from the law's regime, so its
-    // values are not physical; the kernel test recovers synthetic data).
+    // with C ≥ 0.25, C the mean strain of each row's interval (a 30-granule
+    // bed is far from the law's regime, so its values are not physical;
+    // the kernel test recovers synthetic data).
     let fit = granbed_kernel::analysis::bed::kawakita_fit(
-        pressure.iter().copied().zip(strain.iter().copied()),
+        pressure.iter().copied().zip(mean.iter().copied()),
         0.25,
     )
     .unwrap();
@@ -108,6 +122,7 @@ fn a_small_bed_runs_end_to_end_and_is_thread_independent() {
     // over the rows with C ≥ 0.25 (and D < 1) of the table, checked by its
     // normal equations (the residuals sum to zero and are orthogonal to P)
     // rather than by the kernel's fit again; D0 is the table's first D.
+    // C and D are those of each row's mean strain (D ∝ 1/(1 − C)).
     let solid = table.num("bed_solid_fraction");
     assert_eq!(number(&s, "initial_solid_fraction"), solid[0]);
     let heckel = &s["heckel"];
@@ -115,9 +130,12 @@ fn a_small_bed_runs_end_to_end_and_is_thread_independent() {
     let (k, a) = (number(heckel, "k_per_pa"), number(heckel, "a"));
     assert_eq!(number(&s, "heckel_yield_pressure_pa"), 1.0 / k);
     assert_eq!(number(heckel, "d_a"), -(-a).exp_m1());
+    let solid_mean: Vec<f64> = (0..n)
+        .map(|i| solid[i] * (1.0 - strain[i]) / (1.0 - mean[i]))
+        .collect();
     let rows: Vec<(f64, f64)> = (0..n)
-        .filter(|&i| strain[i] >= 0.25 && solid[i] < 1.0)
-        .map(|i| (pressure[i], -(-solid[i]).ln_1p()))
+        .filter(|&i| mean[i] >= 0.25 && solid_mean[i] < 1.0)
+        .map(|i| (pressure[i], -(-solid_mean[i]).ln_1p()))
         .collect();
     assert_eq!(number(heckel, "points") as usize, rows.len());
     assert!(rows.len() >= 10);
@@ -232,13 +250,17 @@ fn a_small_bed_runs_end_to_end_and_is_thread_independent() {
     assert_eq!(r["steps"], s["steps"]);
     assert_eq!(r["scene"]["kawakita_min_strain"], 0.1);
     let wider = granbed_kernel::analysis::bed::kawakita_fit(
-        pressure.iter().copied().zip(strain.iter().copied()),
+        pressure.iter().copied().zip(mean.iter().copied()),
         0.1,
     )
     .unwrap();
     assert_eq!(number(&r, "kawakita_a"), wider.a);
     assert_eq!(number(&r["kawakita"], "min_strain"), 0.1);
-    let from = |c: f64| (0..n).filter(|&i| strain[i] >= c && solid[i] < 1.0).count();
+    let from = |c: f64| {
+        (0..n)
+            .filter(|&i| mean[i] >= c && solid_mean[i] < 1.0)
+            .count()
+    };
     assert_eq!(number(&r["heckel"], "points") as usize, from(0.15));
     assert!(from(0.15) > from(0.25));
     assert!(two.join("plots/heckel.svg").is_file());

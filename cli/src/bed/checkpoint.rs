@@ -15,7 +15,7 @@ use granbed_kernel::Real;
 use granbed_kernel::contact::broad::{Bound, GranulePair};
 use granbed_kernel::contact::pair::{Constraint, Side};
 
-use super::run::{BedSample, Window};
+use super::run::{BedSample, Window, set_mean_strains};
 use crate::assembly::die::DieScene;
 use crate::assembly::{AssemblyState, Energies, GranuleState, PhaseTimes};
 
@@ -267,7 +267,9 @@ fn energies_from(v: [f64; 10]) -> Energies {
     }
 }
 
-/// Floats per sample: 19 fields, then the 10 energies.
+/// Floats per sample: 19 fields, then the 10 energies. The mean strain is
+/// not among them: it is derived from the rows' strains and steps
+/// ([`set_mean_strains`]), the same in every version.
 const SAMPLE_FLOATS: usize = 29;
 /// Floats per sample before version 5 (without the relative kinetic
 /// energy, the last of the fields).
@@ -311,6 +313,8 @@ fn sample_from(v: [f64; SAMPLE_FLOATS]) -> BedSample {
     BedSample {
         time_s: v[0],
         strain: v[1],
+        // Derived, not stored: set for all rows by `set_mean_strains`.
+        mean_strain: Real::NAN,
         upper_force_n: v[2],
         lower_force_n: v[3],
         die_friction_z_n: v[4],
@@ -424,7 +428,7 @@ impl Checkpoint {
         let snapshots_done = d.u64()? as usize;
         let w = <[f64; WINDOW_FLOATS]>::try_from(d.f64s()?)
             .map_err(|_| anyhow::anyhow!("bad window"))?;
-        let samples = match version {
+        let mut samples: Vec<BedSample> = match version {
             2..=4 => d
                 .vecs::<SAMPLE_FLOATS_V4>()?
                 .into_iter()
@@ -445,6 +449,7 @@ impl Checkpoint {
                 .map(sample_from)
                 .collect(),
         };
+        set_mean_strains(&mut samples);
         let t = <[f64; 4]>::try_from(d.f64s()?).map_err(|_| anyhow::anyhow!("bad time"))?;
         let energies = energies_from(
             <[f64; 10]>::try_from(d.f64s()?).map_err(|_| anyhow::anyhow!("bad energies"))?,

@@ -15,8 +15,8 @@ use serde::Serialize;
 
 use super::outputs::{KawakitaSummary, Summary, fit_linear, kawakita_doubts};
 use super::outputs::{heckel_rows, upper_pressure};
-use super::plots::overlay_svg;
 use super::plots::profile_svg;
+use super::plots::{overlay_svg, strain_of};
 use super::run::{BedRun, BedSample};
 use super::series_report::{SeriesReport, write_series_report};
 use crate::csv::{CsvWriter, Field};
@@ -289,14 +289,14 @@ pub fn write_overlays<'a>(
         &format!("Upper-punch pressure {suffix}"),
         "pressure P, kPa",
         &curves,
-        |s| s.upper_pressure_pa * 1e-3,
+        (strain_of(true), |s| s.upper_pressure_pa * 1e-3),
         true,
     )?;
     let density = overlay_svg(
         &format!("Granule relative density {suffix}"),
         "mean relative density η0 V0/V",
         &curves,
-        |s| s.relative_density_mean,
+        (strain_of(false), |s| s.relative_density_mean),
         false,
     )?;
     let profiles: Vec<(&str, Vec<(f64, f64)>)> = labels

@@ -354,7 +354,9 @@ pub struct BedArgs {
     pub exact_contact_from_strain: Option<f64>,
 
     /// Override: the Kawakita fit of summary.json takes the output rows
-    /// with C ≥ this (0 ≤ C ≤ 0.9; published 0.25, physics.md). Allowed
+    /// with C ≥ this, C the mean strain of the row's output interval, to
+    /// which its averaged pressure belongs (0 ≤ C ≤ 0.9; published 0.25,
+    /// physics.md). Allowed
     /// with --resume: on a finished run it refits without a step.
     #[arg(long, value_name = "C", allow_negative_numbers = true)]
     pub kawakita_min_strain: Option<f64>,
@@ -853,6 +855,10 @@ impl BedArgs {
                 dir.display()
             )));
         }
+        // The two curves at their rows' end strains: both runs have the
+        // same output interval, so their pressures are paired alike, and
+        // the compared window reaches the final strain (the mean strains
+        // stop half an interval short of it).
         let curve = |r: &run::BedRun| -> Vec<(f64, f64)> {
             r.samples
                 .iter()

@@ -20,9 +20,16 @@ use crate::quasi_static::QuasiStatic;
 
 /// Columns of `compression.csv`, in order: (name, meaning with its unit).
 /// The report's glossary ([`super::report`]) shows the meanings.
-pub const COMPRESSION_COLUMNS: [(&str, &str); 29] = [
+pub const COMPRESSION_COLUMNS: [(&str, &str); 30] = [
     ("time_s", "time since the compression began, s"),
-    ("strain", "axial strain C = (H0 − H)/H0"),
+    (
+        "strain",
+        "axial strain C = (H0 − H)/H0 at the row, where the instantaneous columns were taken",
+    ),
+    (
+        "mean_strain",
+        "the output interval's mean axial strain: the strain the averaged columns (forces, pressures, Z) belong to, and the Kawakita and Heckel fits' C",
+    ),
     (
         "upper_pressure_pa",
         "upper-punch pressure F/(π R_d²), Pa (averaged over the output interval, as every force)",
@@ -130,11 +137,12 @@ pub fn bed_solid_fraction(run: &BedRun, strain: Real) -> Real {
     run.solid_volume_m3 / (die_area * run.bed_height_m * (1.0 - strain))
 }
 
-fn row(s: &BedSample, run: &BedRun) -> [Field; 29] {
+fn row(s: &BedSample, run: &BedRun) -> [Field; 30] {
     let e = &s.energies;
     [
         s.time_s.into(),
         s.strain.into(),
+        s.mean_strain.into(),
         s.upper_pressure_pa.into(),
         s.lower_pressure_pa.into(),
         s.upper_force_n.into(),
@@ -174,7 +182,8 @@ pub struct KawakitaSummary {
     pub inv_b_pa: Option<Real>,
     /// R² of the fit.
     pub r_squared: Option<Real>,
-    /// Points used: the output rows with C ≥ `min_strain`.
+    /// Points used: the output rows with C ≥ `min_strain`, C the row's
+    /// mean strain ([`BedSample::mean_strain`]).
     pub points: usize,
     /// The fit's strain window starts here (the run's fit: scene
     /// `kawakita_min_strain`; `kawakita_windows`: each window's start).
@@ -184,7 +193,8 @@ pub struct KawakitaSummary {
 /// A Heckel fit of `summary.json`: ln(1/(1 − D)) = K·P + A over the
 /// output rows with C ≥ `min_strain`, D the bed's solid fraction
 /// ([`bed_solid_fraction`]) and P the upper-punch pressure (`heckel`) or
-/// the mean of the two punches' (`heckel_mean_pressure`).
+/// the mean of the two punches' (`heckel_mean_pressure`), C and D at each
+/// row's mean strain ([`heckel_rows`]).
 #[derive(Clone, Copy, Debug, Serialize)]
 pub struct HeckelSummary {
     /// Mean yield pressure P_y = 1/K, Pa.
@@ -388,9 +398,10 @@ pub fn peak_memory_bytes() -> Option<u64> {
     Some(kb * 1024)
 }
 
-/// The Kawakita fit of the samples with C ≥ `min_strain`.
+/// The Kawakita fit of the samples with C ≥ `min_strain`, each pressure
+/// with its interval's mean strain ([`BedSample::mean_strain`]).
 pub fn kawakita(samples: &[BedSample], min_strain: Real) -> KawakitaSummary {
-    let points = samples.iter().map(|s| (s.upper_pressure_pa, s.strain));
+    let points = samples.iter().map(|s| (s.upper_pressure_pa, s.mean_strain));
     let fit = granbed_kernel::analysis::bed::kawakita_fit(points, min_strain);
     KawakitaSummary {
         a: fit.map(|f| f.a),
@@ -401,7 +412,9 @@ pub fn kawakita(samples: &[BedSample], min_strain: Real) -> KawakitaSummary {
                 samples
                     .iter()
                     .filter(|s| {
-                        s.strain >= min_strain && s.strain > 0.0 && s.upper_pressure_pa.is_finite()
+                        s.mean_strain >= min_strain
+                            && s.mean_strain > 0.0
+                            && s.upper_pressure_pa.is_finite()
                     })
                     .count()
             },
@@ -427,14 +440,20 @@ pub fn mean_punch_pressure(s: &BedSample) -> Real {
 }
 
 /// The rows of a Heckel plot: (P in Pa, D, C) of every output row, with P
-/// the row's `pressure` ([`upper_pressure`] or [`mean_punch_pressure`]).
+/// the row's `pressure` ([`upper_pressure`] or [`mean_punch_pressure`])
+/// and C its interval's mean strain, the strain of the averaged P, at
+/// which D is taken.
 pub fn heckel_rows(
     run: &BedRun,
     pressure: fn(&BedSample) -> Real,
 ) -> impl Iterator<Item = (Real, Real, Real)> + Clone + '_ {
-    run.samples
-        .iter()
-        .map(move |s| (pressure(s), bed_solid_fraction(run, s.strain), s.strain))
+    run.samples.iter().map(move |s| {
+        (
+            pressure(s),
+            bed_solid_fraction(run, s.mean_strain),
+            s.mean_strain,
+        )
+    })
 }
 
 /// The Heckel fit of the run's output rows with C ≥ `min_strain`, on the
@@ -1251,6 +1270,58 @@ mod tests {
                     s.kawakita.r_squared
                 )
             );
+        }
+    }
+
+    /// The fits pair each row's pressure, an average over its output
+    /// interval, with the interval's mean strain: a law that holds there
+    /// is recovered exactly.
+    #[test]
+    fn the_fits_pair_the_averaged_pressure_with_the_mean_strain() {
+        use crate::bed::run::{BedRun, BedSample};
+        // Kawakita's law C = abP/(1 + bP), a = 0.4, 1/b = 20 kPa, holding
+        // at each interval's mean strain: rows every 0.005, 129 equal steps
+        // each, the pressure that of the mean of C over the steps' ends.
+        let (a, inv_b, n) = (0.4, 20e3, 129_u64);
+        let law = |c: Real| inv_b * c / (a - c);
+        let samples: Vec<BedSample> = (0..=60_u32)
+            .map(|i| {
+                let c = 0.005 * Real::from(i);
+                let before = c - 0.005;
+                let mean = (1..=n)
+                    .map(|k| before + 0.005 * k as Real / n as Real)
+                    .sum::<Real>()
+                    / n as Real;
+                BedSample {
+                    strain: c,
+                    steps: n * u64::from(i),
+                    upper_pressure_pa: if i == 0 { 0.0 } else { law(mean) },
+                    min_jacobian: 0.9,
+                    min_gauss_jacobian: 0.9,
+                    ..BedSample::default()
+                }
+            })
+            .collect();
+        let run = BedRun::of_samples(samples);
+        let scene = Scene::published();
+        let s = summary(&scene, &run);
+        let rel = |x: Option<Real>, want: Real| (x.unwrap() - want).abs() / want;
+        assert!(rel(s.kawakita.a, a) < 1e-9, "{:?}", s.kawakita);
+        assert!(rel(s.kawakita.inv_b_pa, inv_b) < 1e-9, "{:?}", s.kawakita);
+        // The rows with a mean strain ≥ 0.25: from C = 0.255 on.
+        assert_eq!(s.kawakita.points, 10);
+        // Paired with the rows' end strains instead, the same data is off
+        // by more than a per cent: the test tells the two apart.
+        let at_end = granbed_kernel::analysis::bed::kawakita_fit(
+            run.samples.iter().map(|s| (s.upper_pressure_pa, s.strain)),
+            0.25,
+        )
+        .unwrap();
+        assert!((at_end.inv_b_pa - inv_b).abs() / inv_b > 0.01, "{at_end:?}");
+        // The Heckel rows take D at the mean strain too.
+        for (s, (_, d, c)) in run.samples.iter().zip(heckel_rows(&run, upper_pressure)) {
+            assert_eq!(c, s.mean_strain);
+            assert_eq!(d, bed_solid_fraction(&run, s.mean_strain));
         }
     }
 

@@ -27,8 +27,8 @@
 use std::path::Path;
 
 use super::outputs::{
-    DENSITY_LAYERS, HeckelSummary, KawakitaSummary, Summary, final_height_m, heckel_rows,
-    kawakita_doubts, packing_fraction, upper_pressure,
+    DENSITY_LAYERS, HeckelSummary, KawakitaSummary, Summary, bed_solid_fraction, final_height_m,
+    heckel_rows, kawakita_doubts, upper_pressure,
 };
 use super::run::{BedRun, BedSample};
 use crate::output::write_text;
@@ -116,19 +116,20 @@ fn density_height_svg(run: &BedRun, summary: &Summary) -> anyhow::Result<String>
 /// The value of a sample a curve shows.
 pub type Quantity = fn(&BedSample) -> Real;
 
-/// One line per (label, samples) of `y` against the strain, overlaid with
-/// a legend (the `--types` comparison plots).
+/// One line per (label, samples) of `y` against the strain `x`
+/// ([`strain_of`]), overlaid with a legend (the `--types` comparison
+/// plots).
 pub fn overlay_svg(
     title: &str,
     y_desc: &str,
     curves: &[(&str, &[BedSample])],
-    y: Quantity,
+    (x, y): (Quantity, Quantity),
     y_from_zero: bool,
 ) -> anyhow::Result<String> {
     let series: Vec<Series> = curves
         .iter()
         .map(|(label, samples)| {
-            Series::new(*label, Mark::Line, samples.iter().map(|s| (s.strain, y(s))))
+            Series::new(*label, Mark::Line, samples.iter().map(|s| (x(s), y(s))))
         })
         .collect();
     xy_svg(
@@ -157,14 +158,29 @@ pub fn profile_svg(title: &str, runs: &[(&str, Vec<(f64, f64)>)]) -> anyhow::Res
     )
 }
 
-/// Two curves (label, value) of the samples against the strain, the
-/// second dashed, so that both show where they lie on each other (the
-/// two relative densities of a bed of one granule size nearly do).
-fn against_strain(samples: &[BedSample], curves: [(&str, Quantity); 2]) -> [Series; 2] {
+/// The strain a quantity of a row belongs to: [`BedSample::mean_strain`]
+/// for the averages over the output interval (forces, pressures, Z),
+/// [`BedSample::strain`] for what was taken at the row.
+pub fn strain_of(averaged: bool) -> Quantity {
+    if averaged {
+        |s| s.mean_strain
+    } else {
+        |s| s.strain
+    }
+}
+
+/// Two curves (label, value) of the samples against the strain `x`
+/// ([`strain_of`]), the second dashed, so that both show where they lie on
+/// each other (the two relative densities of a bed of one granule size
+/// nearly do).
+fn against_strain(
+    samples: &[BedSample],
+    x: Quantity,
+    curves: [(&str, Quantity); 2],
+) -> [Series; 2] {
     let [first, second] = curves;
-    [(first, Mark::Line), (second, Mark::DashedLine)].map(|((label, y), mark)| {
-        Series::new(label, mark, samples.iter().map(|s| (s.strain, y(s))))
-    })
+    [(first, Mark::Line), (second, Mark::DashedLine)]
+        .map(|((label, y), mark)| Series::new(label, mark, samples.iter().map(|s| (x(s), y(s)))))
 }
 
 /// A fit's plot: `rows` (x, y, C) before the strain window `min_strain`
@@ -230,11 +246,11 @@ fn r2_text(r_squared: Option<Real>) -> String {
 /// fitted ones (C ≥ the fit's window) filled, and the line
 /// P/C = P/a + (1/b)/a over the fitted pressures.
 pub fn kawakita_svg(samples: &[BedSample], fit: &KawakitaSummary) -> anyhow::Result<String> {
-    let rows = samples.iter().filter(|s| s.strain > 0.0).map(|s| {
+    let rows = samples.iter().filter(|s| s.mean_strain > 0.0).map(|s| {
         (
             s.upper_pressure_pa * 1e-3,
-            s.upper_pressure_pa / s.strain * 1e-3,
-            s.strain,
+            s.upper_pressure_pa / s.mean_strain * 1e-3,
+            s.mean_strain,
         )
     });
     // In kPa: P/C = P/a + (1/b)/a.
@@ -314,6 +330,7 @@ pub fn plots(
     const C: &str = "axial strain C = (H0 - H)/H0";
     let pressure = against_strain(
         samples,
+        strain_of(true),
         [
             ("upper punch", |s| s.upper_pressure_pa * 1e-3),
             ("lower punch", |s| s.lower_pressure_pa * 1e-3),
@@ -321,6 +338,7 @@ pub fn plots(
     );
     let coordination = against_strain(
         samples,
+        strain_of(true),
         [
             ("granule pairs", |s| s.coordination),
             ("with walls", |s| s.coordination_with_walls),
@@ -328,6 +346,7 @@ pub fn plots(
     );
     let density = against_strain(
         samples,
+        strain_of(false),
         [
             ("mean of η0 V0/V", |s| s.relative_density_mean),
             ("Σ solid / Σ V", |s| s.relative_density_solid),
@@ -335,6 +354,7 @@ pub fn plots(
     );
     let heywood = against_strain(
         samples,
+        strain_of(false),
         [
             ("d_V S/V", |s| s.heywood_dv),
             ("d S/V (nominal d)", |s| s.heywood_d),
@@ -359,7 +379,9 @@ pub fn plots(
             .map(|(p, d, _)| (p * 1e-3, d))
             .collect(),
     )];
-    let packing = |s: &BedSample| packing_fraction(run, s);
+    // Z is an interval average: its packing fraction is the one at the
+    // interval's mean strain.
+    let packing = |s: &BedSample| bed_solid_fraction(run, s.mean_strain) / s.relative_density_solid;
     let coordination_density: [(&str, Mark, Quantity); 2] = [
         ("granule pairs", Mark::Line, |s| s.coordination),
         ("with walls", Mark::DashedLine, |s| {
@@ -480,14 +502,16 @@ mod tests {
         let samples: Vec<BedSample> = (0..40)
             .map(|i| {
                 let p = 5e3 * f64::from(i);
+                let c = 0.5 * p / (1e5 + p);
                 BedSample {
-                    strain: 0.5 * p / (1e5 + p),
+                    strain: c,
+                    mean_strain: c,
                     upper_pressure_pa: p,
                     ..BedSample::default()
                 }
             })
             .collect();
-        let points = samples.iter().map(|s| (s.upper_pressure_pa, s.strain));
+        let points = samples.iter().map(|s| (s.upper_pressure_pa, s.mean_strain));
         let fit = granbed_kernel::analysis::bed::kawakita_fit(points, 0.25).unwrap();
         let summary = KawakitaSummary {
             a: Some(fit.a),

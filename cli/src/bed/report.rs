@@ -423,8 +423,9 @@ fn glossaries() -> String {
     let mut h = String::from("<h2>Columns of the tables</h2>\n");
     h.push_str(&glossary(
         "compression.csv",
-        "One row per output interval; forces and pressures are the interval's averages, \
-         energies the totals so far.",
+        "One row per output interval; forces, pressures and Z are the interval's averages, \
+         which belong to its mean strain (mean_strain, half an interval before the row's \
+         strain); energies are the totals so far.",
         &COMPRESSION_COLUMNS,
     ));
     h.push_str(&glossary(
@@ -449,14 +450,16 @@ fn plot_caption(name: &str, summary: &Summary<'_>) -> Option<String> {
     Some(match name {
         "pressure_strain.svg" => {
             "The punches' pressures against the axial strain C = (H0 − H)/H0: \
-             force over the die's cross-section, averaged over each output interval. Early on \
+             force over the die's cross-section, averaged over each output interval and drawn \
+             at the interval's mean strain. Early on \
              the lower punch carries the bed's weight and takes the impulses of its settling, so \
              its pressure lies above the upper one's; later the die wall's friction keeps it \
              below."
                 .to_owned()
         }
         "kawakita.svg" => format!(
-            "Kawakita's P/C against P (upper-punch pressure); filled: the rows fitted (C ≥ {}), \
+            "Kawakita's P/C against P (upper-punch pressure), C the interval's mean strain that \
+             the averaged P belongs to; filled: the rows fitted (C ≥ {}), \
              rings: the others. The line's slope is 1/a and its intercept 1/(ab); a is the \
              limiting strain, extrapolated beyond the strain reached, and the fit depends on its \
              window (kawakita_min_strain).",
@@ -465,7 +468,8 @@ fn plot_caption(name: &str, summary: &Summary<'_>) -> Option<String> {
         "heckel.svg" => format!(
             "Heckel's ln(1/(1 − D)) against the upper-punch pressure P, with D the bed's solid \
              fraction in the die under load (compression.csv's bed_solid_fraction); filled: the \
-             rows fitted (C ≥ {}). P_y = 1/K, the slope's inverse.",
+             rows fitted (C ≥ {}), D and C taken at each interval's mean strain. P_y = 1/K, the \
+             slope's inverse.",
             window(summary.heckel.min_strain)
         ),
         "coordination_strain.svg" => "The mean coordination number Z against the strain: \

@@ -387,11 +387,13 @@ pub struct Scene {
     /// bits for any value.
     #[serde(default = "default_face_list_skin")]
     pub face_list_skin: f64,
-    /// The Kawakita fit uses the output rows with C ≥ this, 0 ≤ C ≤
+    /// The Kawakita fit uses the output rows with C ≥ this (C the row's
+    /// interval mean strain, the strain of its averaged pressure), 0 ≤ C ≤
     /// [`MAX_FINAL_STRAIN`] (absent: physics.md's 0.25).
     #[serde(default = "default_kawakita_min_strain")]
     pub kawakita_min_strain: f64,
-    /// The Heckel fit uses the output rows with C ≥ this, 0 ≤ C ≤
+    /// The Heckel fit uses the output rows with C ≥ this (the row's mean
+    /// strain, as for Kawakita), 0 ≤ C ≤
     /// [`MAX_FINAL_STRAIN`] (absent: [`HECKEL_MIN_STRAIN`]).
     #[serde(default = "default_heckel_min_strain")]
     pub heckel_min_strain: f64,

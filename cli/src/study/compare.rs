@@ -86,7 +86,11 @@ impl RunRecord {
     }
 }
 
-/// The (strain, upper_pressure_pa) columns of a `compression.csv` text.
+/// The (strain, upper_pressure_pa) columns of a `compression.csv` text:
+/// the averaged pressures at their rows' end strains, not at the
+/// intervals' mean strains (`mean_strain`), so that the compared window
+/// reaches the final strain. Two runs with the same output interval are
+/// paired alike.
 fn pressure_curve(text: &str) -> anyhow::Result<Vec<(Real, Real)>> {
     let mut lines = text.lines();
     let header: Vec<&str> = lines.next().context("empty file")?.split(',').collect();
