@@ -102,6 +102,59 @@ fn a_small_bed_runs_end_to_end_and_is_thread_independent() {
     assert!(su >= sl, "upper {su:e} < lower {sl:e}");
 
     let s = summary(&one);
+    // The die wall. Coulomb's law bounds each contact's friction by μ times
+    // its normal force, so in every interval average the wall's axial
+    // friction is at most μ times its normal force; it carries load at the
+    // end. Its pressure is that force over the wall beside the compact,
+    // 2π R_d H0 (1 − C) at the mean strain, and the summary's end figures
+    // are the last row's.
+    let mu = number(&s["material"], "friction");
+    let (friction, normal) = (
+        table.num("die_friction_z_n"),
+        table.num("die_normal_force_n"),
+    );
+    let wall_pressure = table.num("die_wall_pressure_pa");
+    let wall_area = |i: usize| {
+        core::f64::consts::PI
+            * number(&s["scene"], "die_diameter_mm")
+            * 1e-3
+            * number(&s, "initial_bed_height_m")
+            * (1.0 - mean[i])
+    };
+    for i in 0..n {
+        assert!(
+            friction[i].abs() <= mu * normal[i] * (1.0 + 1e-9),
+            "row {i}: die friction {} against μ F_n = {}",
+            friction[i],
+            mu * normal[i]
+        );
+        let want = normal[i] / wall_area(i);
+        assert!(
+            (wall_pressure[i] - want).abs() <= 1e-12 * want,
+            "row {i}: {}",
+            wall_pressure[i]
+        );
+    }
+    assert!(normal[n - 1] > 0.0 && friction[n - 1] > 0.0, "{normal:?}");
+    // Pressed from above, the granules at the wall slide down along it:
+    // its friction is mobilised (0.6 μ on this bed), and the compact's
+    // radial stress lies below its axial one, as in a plastic powder.
+    let wall = &s["final_die_wall"];
+    assert!(number(wall, "friction_to_normal") > 0.3 * mu, "{wall}");
+    assert!(
+        (0.1..1.0).contains(&number(wall, "radial_to_axial")),
+        "{wall}"
+    );
+    assert_eq!(number(wall, "pressure_pa"), wall_pressure[n - 1]);
+    let axial = 0.5 * (pressure[n - 1] + table.num("lower_pressure_pa")[n - 1]);
+    assert_eq!(
+        number(wall, "radial_to_axial"),
+        wall_pressure[n - 1] / axial
+    );
+    assert_eq!(
+        number(wall, "friction_to_normal"),
+        friction[n - 1].abs() / normal[n - 1]
+    );
     // The summary's Kawakita fit is the kernel's fit of the table's rows
     // with C ≥ 0.25, C the mean strain of each row's interval (a 30-granule
     // bed is far from the law's regime, so its values are not physical;

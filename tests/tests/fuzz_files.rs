@@ -294,8 +294,10 @@ fn older(bytes: &[u8], cut: &[usize], version: u32) -> Vec<u8> {
     b
 }
 
-/// Checkpoints of older formats still read (without the phase times and
-/// counters of version 7: counted from the checkpoint's step): version 4 (before the
+/// Checkpoints of older formats still read: version 8 (before the die
+/// wall's normal forces) with those NaN (not recorded); and without the
+/// phase times and counters of version 7 (counted from the checkpoint's
+/// step) and the die forces: version 4 (before the
 /// samples' kinetic energy relative to the imposed compression) with that
 /// energy NaN (not recorded), version 3 (before the mass factors and the
 /// undeformed step as well) with every factor 1 and no undeformed step
@@ -304,7 +306,7 @@ fn older(bytes: &[u8], cut: &[usize], version: u32) -> Vec<u8> {
 /// are made from this build's own: two checkpoints of one state that
 /// differ only in a field differ only in its words, which are cut out.
 #[test]
-fn versions_2_to_4_checkpoints_read_with_the_fields_they_lack_at_their_defaults() {
+fn versions_2_to_8_checkpoints_read_with_the_fields_they_lack_at_their_defaults() {
     let (dir, _) = base_checkpoint();
     let mut ck = read(dir).unwrap();
     for g in &mut ck.state.granules {
@@ -323,17 +325,26 @@ fn versions_2_to_4_checkpoints_read_with_the_fields_they_lack_at_their_defaults(
     let (step, _) = edited_words(&ck, |c| {
         c.state.undeformed_step = flip(c.state.undeformed_step)
     });
-    let (relative, bytes) = edited_words(&ck, |c| {
+    let (relative, _) = edited_words(&ck, |c| {
         c.progress
             .samples
             .iter_mut()
             .for_each(|s| s.kinetic_relative_j = flip(s.kinetic_relative_j))
+    });
+    // Version 9's die-wall normal forces: the window's, then each row's.
+    let (die, bytes) = edited_words(&ck, |c| {
+        c.progress.window.die_normal = flip(c.progress.window.die_normal);
+        c.progress
+            .samples
+            .iter_mut()
+            .for_each(|s| s.die_normal_force_n = flip(s.die_normal_force_n))
     });
     assert_eq!(
         (flags.len(), factors.len(), step.len(), relative.len()),
         (granules, granules, 1, ck.progress.samples.len())
     );
     assert!(!relative.is_empty(), "the base checkpoint has no samples");
+    assert_eq!(die.len(), 1 + ck.progress.samples.len());
     // Each factor follows its granule's flags word.
     assert!(flags.iter().zip(&factors).all(|(f, k)| *k == f + 8));
     // An older file's state, its relative kinetic energies checked NaN and
@@ -346,12 +357,21 @@ fn versions_2_to_4_checkpoints_read_with_the_fields_they_lack_at_their_defaults(
         assert_eq!(old.progress.counters_from_step, ck.state.steps);
         old.progress.counters = ck.progress.counters;
         old.progress.counters_from_step = ck.progress.counters_from_step;
+        assert!(old.progress.window.die_normal.is_nan());
+        old.progress.window.die_normal = ck.progress.window.die_normal;
         for (o, s) in old.progress.samples.iter_mut().zip(&ck.progress.samples) {
             assert!(
-                o.kinetic_relative_j.is_nan(),
-                "version {version}: not recorded"
+                o.die_normal_force_n.is_nan(),
+                "version {version}: no die-wall force"
             );
-            o.kinetic_relative_j = s.kinetic_relative_j;
+            o.die_normal_force_n = s.die_normal_force_n;
+            if version <= 4 {
+                assert!(
+                    o.kinetic_relative_j.is_nan(),
+                    "version {version}: not recorded"
+                );
+                o.kinetic_relative_j = s.kinetic_relative_j;
+            }
         }
         old
     };
@@ -361,10 +381,34 @@ fn versions_2_to_4_checkpoints_read_with_the_fields_they_lack_at_their_defaults(
             .iter()
             .flat_map(|p| p.iter().copied())
             .chain(counters.iter().copied())
+            .chain(die.iter().copied())
             .collect();
         cut.sort_unstable();
         cut
     };
+
+    // Version 8: all but the die-wall forces (the counters are kept).
+    let mut v8_cut = die.clone();
+    v8_cut.sort_unstable();
+    let v8 = older(&bytes, &v8_cut, 8);
+    let mut v8_read = read(&write_checkpoint("version8", &v8))
+        .unwrap_or_else(|e| panic!("a version 8 checkpoint reads: {e}"));
+    assert_eq!(v8_read.progress.counters, ck.progress.counters);
+    assert!(v8_read.progress.window.die_normal.is_nan());
+    v8_read.progress.window.die_normal = ck.progress.window.die_normal;
+    for (o, s) in v8_read
+        .progress
+        .samples
+        .iter_mut()
+        .zip(&ck.progress.samples)
+    {
+        assert!(
+            o.die_normal_force_n.is_nan(),
+            "version 8: no die-wall force"
+        );
+        o.die_normal_force_n = s.die_normal_force_n;
+    }
+    assert_eq!(v8_read, ck, "version 8 reads as the same state");
 
     let v4 = older(&bytes, &cut_of(&[&relative]), 4);
     assert_eq!(

@@ -59,7 +59,12 @@ pub const FILE_NAME: &str = "checkpoint.bin";
 /// 8: a held constraint's first float may also be 2 or 3: a watch
 /// (`Constraint::watch`) on side A or B. Older builds wrote none; the
 /// reader takes the values in any version (the layout is that of 7).
-pub const VERSION: u32 = 8;
+///
+/// 9: before the phase times, the die wall's normal impulse of the window
+/// in progress (f64), then each sample's die-wall normal force (one f64
+/// per sample, in order; no length: it is the samples'). Older files read
+/// both as NaN (not recorded).
+pub const VERSION: u32 = 9;
 /// The oldest version read.
 const OLDEST_VERSION: u32 = 2;
 /// Floats per held constraint: side (0: A, 1: B; plus 2 for a watch),
@@ -318,6 +323,8 @@ fn sample_from(v: [f64; SAMPLE_FLOATS]) -> BedSample {
         upper_force_n: v[2],
         lower_force_n: v[3],
         die_friction_z_n: v[4],
+        // Stored after the held constraints (version 9 on), set there.
+        die_normal_force_n: Real::NAN,
         upper_pressure_pa: v[5],
         lower_pressure_pa: v[6],
         coordination: v[7],
@@ -396,6 +403,10 @@ impl Checkpoint {
                 }
                 _ => e.u64(0),
             }
+        }
+        e.f64(w.die_normal);
+        for sample in &p.samples {
+            e.f64(sample.die_normal_force_n);
         }
         let c = &p.counters;
         e.f64s(&[c.predict_s, c.contact_s, c.correct_s]);
@@ -528,6 +539,16 @@ impl Checkpoint {
                 })
                 .collect::<anyhow::Result<Vec<_>>>()?,
         };
+        let die_normal = match version {
+            2..=8 => Real::NAN,
+            _ => {
+                let window = d.f64()?;
+                for sample in &mut samples {
+                    sample.die_normal_force_n = d.f64()?;
+                }
+                window
+            }
+        };
         let (counters, counters_from_step) = match version {
             2..=6 => (PhaseTimes::default(), t[1].to_bits()),
             _ => {
@@ -568,6 +589,7 @@ impl Checkpoint {
                 window: Window {
                     time: w[0],
                     impulse: [w[1], w[2], w[3]],
+                    die_normal,
                     pairs: w[4],
                     walls: w[5],
                     min_j: w[6],

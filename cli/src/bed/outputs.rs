@@ -20,7 +20,7 @@ use crate::quasi_static::QuasiStatic;
 
 /// Columns of `compression.csv`, in order: (name, meaning with its unit).
 /// The report's glossary ([`super::report`]) shows the meanings.
-pub const COMPRESSION_COLUMNS: [(&str, &str); 30] = [
+pub const COMPRESSION_COLUMNS: [(&str, &str); 32] = [
     ("time_s", "time since the compression began, s"),
     (
         "strain",
@@ -40,6 +40,14 @@ pub const COMPRESSION_COLUMNS: [(&str, &str); 30] = [
     (
         "die_friction_z_n",
         "axial friction force of the die wall on the granules, N (positive upwards)",
+    ),
+    (
+        "die_normal_force_n",
+        "Σ normal (radial) force of the die wall on the granules, N (NaN: not recorded, rows of a run resumed from a checkpoint older than version 9)",
+    ),
+    (
+        "die_wall_pressure_pa",
+        "radial pressure on the die wall beside the compact, die_normal_force_n/(2π R_d H) with H the compact's height at the mean strain, Pa",
     ),
     (
         "coordination",
@@ -123,6 +131,48 @@ pub fn packing_fraction(run: &BedRun, s: &BedSample) -> Real {
     bed_solid_fraction(run, s.strain) / s.relative_density_solid
 }
 
+/// The radial pressure on the die wall of a row, Pa: its die-wall normal
+/// force (an interval average) over the wall beside the compact, 2π R_d H
+/// with H = H0 (1 − C) at the interval's mean strain. The granules touch
+/// the wall at points, so this is the wall's mean pressure, the radial
+/// stress σ_r of a continuum reading of the compact (NaN where the force
+/// was not recorded).
+pub fn die_wall_pressure(run: &BedRun, s: &BedSample) -> Real {
+    let height = run.bed_height_m * (1.0 - s.mean_strain);
+    s.die_normal_force_n / (2.0 * core::f64::consts::PI * run.die_radius_m * height)
+}
+
+/// The die wall's share of the load at one row ([`DieWallSummary`]).
+pub fn die_wall_summary(run: &BedRun, s: &BedSample) -> DieWallSummary {
+    let pressure_pa = die_wall_pressure(run, s);
+    let ratio = |x: Real, y: Real| (y > 0.0).then(|| x / y).filter(|r| r.is_finite());
+    DieWallSummary {
+        strain: s.mean_strain,
+        pressure_pa: pressure_pa.is_finite().then_some(pressure_pa),
+        radial_to_axial: ratio(pressure_pa, mean_punch_pressure(s)),
+        friction_to_normal: ratio(s.die_friction_z_n.abs(), s.die_normal_force_n),
+    }
+}
+
+/// The die wall's share of the load at an output row (`summary.json`'s
+/// `final_die_wall`: the last row). `None` where a figure is not
+/// recorded or its divisor is not positive.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct DieWallSummary {
+    /// The row's mean strain, to which its averaged forces belong.
+    pub strain: Real,
+    /// Radial pressure on the die wall, Pa ([`die_wall_pressure`]).
+    pub pressure_pa: Option<Real>,
+    /// That pressure over the mean of the two punches' pressures: the
+    /// compact's radial-to-axial stress ratio (the transmission ratio of an
+    /// instrumented die; Janssen's K).
+    pub radial_to_axial: Option<Real>,
+    /// |axial die friction| / die normal force: the wall's mobilised
+    /// friction. Coulomb's law bounds it by the friction coefficient μ,
+    /// which it reaches when every granule at the wall slides axially.
+    pub friction_to_normal: Option<Real>,
+}
+
 /// The compact's height where the run ended, H0 (1 − C), m.
 pub fn final_height_m(run: &BedRun) -> Real {
     run.bed_height_m * (1.0 - run.strain_reached)
@@ -137,7 +187,7 @@ pub fn bed_solid_fraction(run: &BedRun, strain: Real) -> Real {
     run.solid_volume_m3 / (die_area * run.bed_height_m * (1.0 - strain))
 }
 
-fn row(s: &BedSample, run: &BedRun) -> [Field; 30] {
+fn row(s: &BedSample, run: &BedRun) -> [Field; 32] {
     let e = &s.energies;
     [
         s.time_s.into(),
@@ -148,6 +198,8 @@ fn row(s: &BedSample, run: &BedRun) -> [Field; 30] {
         s.upper_force_n.into(),
         s.lower_force_n.into(),
         s.die_friction_z_n.into(),
+        s.die_normal_force_n.into(),
+        die_wall_pressure(run, s).into(),
         s.coordination.into(),
         s.coordination_with_walls.into(),
         s.relative_density_mean.into(),
@@ -292,6 +344,8 @@ pub struct Summary<'a> {
     /// layers of the compact where the run ended, bottom first (empty for a
     /// run stopped by an error).
     pub final_density_by_height: Vec<DensityLayer>,
+    /// The die wall's share of the load at the last row.
+    pub final_die_wall: DieWallSummary,
     /// The granule material, every parameter (`None` if the scene's is
     /// invalid).
     pub material: Option<MaterialSummary>,
@@ -632,6 +686,7 @@ pub fn summary<'a>(scene: &'a Scene, run: &BedRun) -> Summary<'a> {
         } else {
             density_by_height(&run.final_granules, final_height_m(run))
         },
+        final_die_wall: die_wall_summary(run, &last),
         material: material.map(MaterialSummary::from),
         yield_stress_pa: material.map_or(Real::NAN, |m| m.yield_stress_pa),
         eta0: material.map_or(Real::NAN, |m| m.eta0),
@@ -1271,6 +1326,57 @@ mod tests {
                 )
             );
         }
+    }
+
+    /// The die wall's figures of a row: its pressure over the wall beside
+    /// the compact at the mean strain, the two ratios; none where the force
+    /// was not recorded or a divisor is not positive.
+    #[test]
+    fn the_die_wall_figures_of_a_row() {
+        use crate::bed::run::{BedRun, BedSample};
+        // of_samples' bed: R_d = 1 m, H0 = 1 m.
+        let run = BedRun::of_samples(Vec::new());
+        let row = BedSample {
+            mean_strain: 0.2,
+            die_normal_force_n: 2.0 * core::f64::consts::PI * 0.8 * 500.0,
+            die_friction_z_n: -40.0,
+            upper_pressure_pa: 1200.0,
+            lower_pressure_pa: 800.0,
+            ..BedSample::default()
+        };
+        let w = die_wall_summary(&run, &row);
+        assert!((w.pressure_pa.unwrap() - 500.0).abs() < 1e-12);
+        assert!((w.radial_to_axial.unwrap() - 0.5).abs() < 1e-15);
+        assert!((w.friction_to_normal.unwrap() - 40.0 / row.die_normal_force_n).abs() < 1e-15);
+        let unrecorded = die_wall_summary(
+            &run,
+            &BedSample {
+                die_normal_force_n: Real::NAN,
+                ..row
+            },
+        );
+        assert_eq!(
+            (
+                unrecorded.pressure_pa,
+                unrecorded.radial_to_axial,
+                unrecorded.friction_to_normal
+            ),
+            (None, None, None)
+        );
+        let unloaded = die_wall_summary(
+            &run,
+            &BedSample {
+                die_normal_force_n: 0.0,
+                upper_pressure_pa: 0.0,
+                lower_pressure_pa: 0.0,
+                ..row
+            },
+        );
+        assert_eq!(unloaded.pressure_pa, Some(0.0));
+        assert_eq!(
+            (unloaded.radial_to_axial, unloaded.friction_to_normal),
+            (None, None)
+        );
     }
 
     /// The fits pair each row's pressure, an average over its output

@@ -27,8 +27,8 @@
 use std::path::Path;
 
 use super::outputs::{
-    DENSITY_LAYERS, HeckelSummary, KawakitaSummary, Summary, bed_solid_fraction, final_height_m,
-    heckel_rows, kawakita_doubts, upper_pressure,
+    DENSITY_LAYERS, DieWallSummary, HeckelSummary, KawakitaSummary, Summary, bed_solid_fraction,
+    die_wall_summary, final_height_m, heckel_rows, kawakita_doubts, upper_pressure,
 };
 use super::run::{BedRun, BedSample};
 use crate::output::write_text;
@@ -40,7 +40,7 @@ use granbed_kernel::Real;
 pub const PLOTS_DIR: &str = "plots";
 
 /// The plot files, in the order [`write_plots`] writes them.
-pub const PLOT_FILES: [&str; 10] = [
+pub const PLOT_FILES: [&str; 11] = [
     "pressure_strain.svg",
     "kawakita.svg",
     "heckel.svg",
@@ -51,6 +51,7 @@ pub const PLOT_FILES: [&str; 10] = [
     "coordination_density.svg",
     "energy_strain.svg",
     "density_height.svg",
+    "die_wall_strain.svg",
 ];
 
 /// The energy ledger's terms drawn by `energy_strain.svg`, J, with their
@@ -360,6 +361,30 @@ pub fn plots(
             ("d S/V (nominal d)", |s| s.heywood_d),
         ],
     );
+    // The die wall's two ratios at each row's mean strain (rows where one
+    // is not defined, e.g. before the wall carries load, are left out).
+    let walls: Vec<(Real, DieWallSummary)> = samples
+        .iter()
+        .map(|s| (s.mean_strain, die_wall_summary(run, s)))
+        .collect();
+    let wall_ratio = |of: fn(&DieWallSummary) -> Option<Real>| {
+        walls
+            .iter()
+            .filter_map(move |(c, w)| of(w).map(|r| (*c, r)))
+            .collect::<Vec<_>>()
+    };
+    let die_wall = [
+        Series::new(
+            "die-wall pressure / mean punch pressure",
+            Mark::Line,
+            wall_ratio(|w| w.radial_to_axial).into_iter(),
+        ),
+        Series::new(
+            "|die-wall friction| / die-wall normal force",
+            Mark::DashedLine,
+            wall_ratio(|w| w.friction_to_normal).into_iter(),
+        ),
+    ];
     let [
         pressure_f,
         kawakita_f,
@@ -371,6 +396,7 @@ pub fn plots(
         coordination_density_f,
         energy_f,
         density_height_f,
+        die_wall_f,
     ] = PLOT_FILES;
     // Unlabelled: the title and axes say what the one curve is (no legend).
     let profile = [(
@@ -443,6 +469,16 @@ pub fn plots(
         ),
         (energy_f, energy_svg(samples)?),
         (density_height_f, density_height_svg(run, summary)?),
+        (
+            die_wall_f,
+            xy_svg(
+                "The die wall: radial-to-axial stress and mobilised friction",
+                C,
+                "ratio",
+                &die_wall,
+                true,
+            )?,
+        ),
     ])
 }
 

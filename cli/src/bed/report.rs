@@ -26,7 +26,7 @@ pub const REPORT_FILE: &str = "report.html";
 /// meaning; any other field follows (nested objects such as `kawakita` and
 /// `heckel` are flattened to `kawakita.<field>`; the scene, `scene` and
 /// `scene_toml`, is shown as TOML instead).
-const FIELDS: [(&str, &str); 90] = [
+const FIELDS: [(&str, &str); 94] = [
     ("kawakita_a", "Kawakita a (limiting strain)"),
     ("kawakita_inv_b_pa", "Kawakita 1/b, Pa"),
     (
@@ -121,6 +121,22 @@ const FIELDS: [(&str, &str); 90] = [
     (
         "final_coordination",
         "coordination number Z at the end (granule contacts only)",
+    ),
+    (
+        "final_die_wall.strain",
+        "mean strain of the last output interval, to which the die-wall figures belong",
+    ),
+    (
+        "final_die_wall.pressure_pa",
+        "radial pressure on the die wall beside the compact at the end, Pa",
+    ),
+    (
+        "final_die_wall.radial_to_axial",
+        "die-wall pressure / mean punch pressure at the end: the radial-to-axial stress ratio",
+    ),
+    (
+        "final_die_wall.friction_to_normal",
+        "|die-wall friction| / die-wall normal force at the end (Coulomb: at most μ)",
     ),
     (
         "quasi_static.passed",
@@ -345,6 +361,20 @@ fn key_results(summary: &Summary<'_>) -> String {
             kpa(Some(summary.final_pressure_pa)),
         ),
         (
+            "die wall at the end: radial pressure, kPa; over the mean punch pressure; its \
+             mobilised friction |F_z|/F_n"
+                .to_owned(),
+            {
+                let w = &summary.final_die_wall;
+                format!(
+                    "{}; {}; {}",
+                    kpa(w.pressure_pa),
+                    num(w.radial_to_axial),
+                    num(w.friction_to_normal)
+                )
+            },
+        ),
+        (
             "coordination number Z at the end (averaged over the last output interval)".to_owned(),
             num(Some(summary.final_coordination)),
         ),
@@ -504,6 +534,17 @@ fn plot_caption(name: &str, summary: &Summary<'_>) -> Option<String> {
              pressed from above the granules at the bottom usually end less dense than those at \
              the top.",
             num(Some(summary.final_strain))
+        ),
+        "die_wall_strain.svg" => format!(
+            "The die wall against the strain, at each output interval's mean strain: its radial \
+             pressure (the normal force over the wall beside the compact, 2π R_d H) over the \
+             mean of the two punches' pressures, the compact's radial-to-axial stress ratio that \
+             an instrumented die measures; and the axial friction the wall holds over its normal \
+             force, which Coulomb's law keeps at or below the friction coefficient μ = {} and \
+             which reaches μ where every granule at the wall slides.",
+            summary
+                .material
+                .map_or("n/a".to_owned(), |m| num(Some(m.friction)))
         ),
         "energy_strain.svg" => "Where the punch's work went, totals so far against the strain \
              (compression.csv's energy columns): the elastic energy stored in the \

@@ -63,6 +63,10 @@ pub struct BedSample {
     /// Axial (z) friction force of the die wall on the granules, N
     /// (interval average; positive upwards).
     pub die_friction_z_n: Real,
+    /// Σ normal (radial) force of the die wall on the granules, N
+    /// (interval average): the die-wall pressure's resultant. NaN where
+    /// not recorded (checkpoints before version 9).
+    pub die_normal_force_n: Real,
     /// Upper-punch pressure F/(π R_d²), Pa.
     pub upper_pressure_pa: Real,
     /// Lower-punch pressure, Pa.
@@ -318,6 +322,9 @@ pub struct Window {
     pub time: Real,
     /// ∫ upper, lower punch force and die friction z dt, N s.
     pub impulse: [Real; 3],
+    /// ∫ Σ die-wall normal force dt, N s (NaN: the window of a checkpoint
+    /// before version 9, which did not record it).
+    pub die_normal: Real,
     /// ∫ pairs in contact dt, s.
     pub pairs: Real,
     /// ∫ (granule, wall) contacts dt, s.
@@ -616,6 +623,7 @@ pub fn run_bed(
             upper_force_n: avg(w.impulse[0]),
             lower_force_n: avg(w.impulse[1]),
             die_friction_z_n: avg(w.impulse[2]),
+            die_normal_force_n: avg(w.die_normal),
             upper_pressure_pa: avg(w.impulse[0]) / area,
             lower_pressure_pa: avg(w.impulse[1]) / area,
             coordination: coordination_number(avg(w.pairs), granules).unwrap_or(Real::NAN),
@@ -710,6 +718,7 @@ pub fn run_bed(
         window.impulse[0] += last.walls[wall_index::UPPER].normal * dt;
         window.impulse[1] += last.walls[wall_index::LOWER].normal * dt;
         window.impulse[2] += last.walls[wall_index::DIE].tangential[2] * dt;
+        window.die_normal += last.walls[wall_index::DIE].normal * dt;
         window.pairs += asm.contact().pairs_in_contact() as Real * dt;
         window.walls += last.wall_contacts as Real * dt;
         window.min_j = window.min_j.min(last.min_j);
