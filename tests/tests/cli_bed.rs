@@ -71,7 +71,7 @@ fn a_small_bed_runs_end_to_end_and_is_thread_independent() {
         let n = steps[i] - steps[i - 1];
         let want = 0.5 * (strain[i - 1] + strain[i]) + 0.5 * (strain[i] - strain[i - 1]) / n;
         assert!(
-            (mean[i] - want).abs() < 1e-12 && mean[i] > strain[i - 1] && mean[i] < strain[i],
+            (mean[i] - want).abs() < 1e-12 && mean[i] > strain[i - 1] && mean[i] <= strain[i],
             "row {i}: mean strain {} against {want}",
             mean[i]
         );
@@ -137,8 +137,9 @@ fn a_small_bed_runs_end_to_end_and_is_thread_independent() {
     }
     assert!(normal[n - 1] > 0.0 && friction[n - 1] > 0.0, "{normal:?}");
     // Pressed from above, the granules at the wall slide down along it:
-    // its friction is mobilised (0.6 μ on this bed), and the compact's
-    // radial stress lies below its axial one, as in a plastic powder.
+    // its friction is mobilised (0.6 μ on this bed); and the die wall
+    // carries less than the punches, the radial stress below the axial
+    // one (0.44 on this bed; a fully plastic compact would approach 1).
     let wall = &s["final_die_wall"];
     assert!(number(wall, "friction_to_normal") > 0.3 * mu, "{wall}");
     assert!(

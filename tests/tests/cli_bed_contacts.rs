@@ -5,7 +5,10 @@
 //! inside the bed, away from the die and the punches, is held by its
 //! granule contacts alone, so their forces nearly cancel on it, while a
 //! granule at a wall is not balanced by them. The summary's density by
-//! height is the table's granules averaged by layer.
+//! height is the table's granules averaged by layer, and the network's
+//! figures (`vtk/network_<k>.csv`, the summary's `contact_network`) are
+//! the contacts table's: a broad force distribution whose strong pairs
+//! align with the die axis.
 
 mod common;
 
@@ -32,10 +35,19 @@ fn the_contact_network_balances_the_inner_granules() {
     // and of the final state at 0.15: k = 0, 1, 2. The one at C = 0 comes
     // before the first step, which detects the contacts: it has no tables.
     let last = 2;
-    for table in ["contacts", "granules"] {
+    for table in ["contacts", "granules", "network"] {
         let path = dir.join(format!("vtk/{table}_0.csv"));
         assert!(!path.exists(), "{}", path.display());
     }
+    // The report shows the network's table: a row per snapshot with one.
+    let html = std::fs::read_to_string(dir.join("report.html")).unwrap();
+    let table = &html[html
+        .find("<h3>The contact network</h3>")
+        .expect("no network table")..];
+    let table = &table[..table.find("</table>").unwrap()];
+    assert_eq!(table.matches("<tr>").count(), 1 + last, "{table}");
+    assert!(table.contains("<th>force_fabric_zz</th>"), "{table}");
+    assert!(html.contains(&format!("href=\"vtk/network_{last}.csv\"")));
     for k in 1..=last {
         let contacts = Table::read(&dir.join(format!("vtk/contacts_{k}.csv")));
         let granules = Table::read(&dir.join(format!("vtk/granules_{k}.csv")));
@@ -85,6 +97,74 @@ fn the_contact_network_balances_the_inner_granules() {
             .collect();
         assert_eq!(counted, touching, "granules_{k}'s contacts");
         assert!(!rows.is_empty());
+        // The network's figures are the contacts table's, recomputed here,
+        // and the summary's entry k − 1 (none at C = 0).
+        let network = Table::read(&dir.join(format!("vtk/network_{k}.csv")));
+        let figure = |n: &str| network.num(n)[0];
+        let entry = &s["contact_network"][k - 1];
+        assert_eq!(entry["pairs"], rows.len());
+        assert_eq!(figure("pairs"), rows.len() as f64);
+        assert_eq!(number(entry, "strain"), [0.1, 0.15][k - 1]);
+        let forces = contacts.num("normal_force_n");
+        let total: f64 = forces.iter().sum();
+        let mean = total / forces.len() as f64;
+        let mut sorted: Vec<f64> = forces.iter().map(|f| f / mean).collect();
+        sorted.sort_by(f64::total_cmp);
+        let half = sorted.len() / 2;
+        let median = if sorted.len() % 2 == 1 {
+            sorted[half]
+        } else {
+            0.5 * (sorted[half - 1] + sorted[half])
+        };
+        let nz2: Vec<f64> = rows
+            .iter()
+            .map(|(_, _, _, l)| l[2] * l[2] / (l[0] * l[0] + l[1] * l[1] + l[2] * l[2]))
+            .collect();
+        let fabric = nz2.iter().sum::<f64>() / nz2.len() as f64;
+        let by_force = forces.iter().zip(&nz2).map(|(f, n)| f * n).sum::<f64>() / total;
+        let strong: Vec<f64> = forces.iter().copied().filter(|&f| f > mean).collect();
+        // numpy's quantile: linear between the ranks, at rank 0.9 (n − 1).
+        let rank = 0.9 * (sorted.len() - 1) as f64;
+        let (below, t) = (rank.floor() as usize, rank - rank.floor());
+        let p90 = sorted[below] + t * (sorted[(below + 1).min(sorted.len() - 1)] - sorted[below]);
+        let sliding = contacts
+            .num("slipping")
+            .iter()
+            .filter(|&&n| n > 0.0)
+            .count();
+        for (name, want) in [
+            ("mean_normal_force_n", mean),
+            ("median_to_mean", median),
+            ("max_to_mean", sorted[sorted.len() - 1]),
+            ("fabric_zz", fabric),
+            ("force_fabric_zz", by_force),
+            ("strong_share", strong.len() as f64 / forces.len() as f64),
+            ("strong_force_share", strong.iter().sum::<f64>() / total),
+            ("p90_to_mean", p90),
+            ("sliding_share", sliding as f64 / forces.len() as f64),
+        ] {
+            let got = figure(name);
+            assert!(
+                (got - want).abs() <= 1e-12 * want.abs() || got == want,
+                "network_{k} {name}: {got} against {want}"
+            );
+            assert_eq!(number(entry, name), got, "summary's {name}");
+        }
+        // A compressed packing: most pairs carry less than the mean force,
+        // a minority of strong pairs carries most of it, and the
+        // load-carrying pairs align with the die axis more than the pairs
+        // do by number.
+        assert!(median < 1.0, "median f/<f> {median}");
+        assert!(
+            strong.iter().sum::<f64>() / total > 0.5 && strong.len() * 2 < forces.len(),
+            "{} strong pairs of {}",
+            strong.len(),
+            forces.len()
+        );
+        assert!(
+            by_force > fabric && by_force > 1.0 / 3.0,
+            "fabric {fabric}, by force {by_force}"
+        );
         if k < last {
             continue;
         }
@@ -166,7 +246,7 @@ fn the_contact_network_balances_the_inner_granules() {
     // again: the tables of its end, which need a step's forces, stay as
     // the run left them.
     let tables = |k: usize| {
-        ["contacts", "granules"]
+        ["contacts", "granules", "network"]
             .map(|t| std::fs::read(dir.join(format!("vtk/{t}_{k}.csv"))).unwrap())
     };
     let before = tables(last);
@@ -176,13 +256,18 @@ fn the_contact_network_balances_the_inner_granules() {
         tables(last) == before,
         "the resumed run changed the end's tables"
     );
+    assert_eq!(
+        summary(&dir)["contact_network"],
+        s["contact_network"],
+        "the resumed run's summary lost the network"
+    );
     // A fresh run into the same directory removes the tables of snapshots
     // it does not reach.
     let mut argv = vec!["bed", "--quiet", "--out", dir.to_str().unwrap()];
     argv.extend_from_slice(&small_bed("100", "0.05"));
     assert_eq!(cli(&argv).code, 0);
     for k in 1..=last {
-        for table in ["contacts", "granules"] {
+        for table in ["contacts", "granules", "network"] {
             let path = dir.join(format!("vtk/{table}_{k}.csv"));
             // k = 1 is now the final state at 0.05; k = 2 is gone.
             assert_eq!(path.is_file(), k == 1, "{}", path.display());

@@ -345,6 +345,10 @@ fn versions_2_to_8_checkpoints_read_with_the_fields_they_lack_at_their_defaults(
     );
     assert!(!relative.is_empty(), "the base checkpoint has no samples");
     assert_eq!(die.len(), 1 + ck.progress.samples.len());
+    // An older file's window holds no die force: NaN, or 0 if the window
+    // is empty (a checkpoint taken at an output row's step, as this one).
+    let empty = ck.progress.window.time == 0.0;
+    let unrecorded_window = |x: f64| if empty { x == 0.0 } else { x.is_nan() };
     // Each factor follows its granule's flags word.
     assert!(flags.iter().zip(&factors).all(|(f, k)| *k == f + 8));
     // An older file's state, its relative kinetic energies checked NaN and
@@ -357,7 +361,7 @@ fn versions_2_to_8_checkpoints_read_with_the_fields_they_lack_at_their_defaults(
         assert_eq!(old.progress.counters_from_step, ck.state.steps);
         old.progress.counters = ck.progress.counters;
         old.progress.counters_from_step = ck.progress.counters_from_step;
-        assert!(old.progress.window.die_normal.is_nan());
+        assert!(unrecorded_window(old.progress.window.die_normal));
         old.progress.window.die_normal = ck.progress.window.die_normal;
         for (o, s) in old.progress.samples.iter_mut().zip(&ck.progress.samples) {
             assert!(
@@ -394,7 +398,7 @@ fn versions_2_to_8_checkpoints_read_with_the_fields_they_lack_at_their_defaults(
     let mut v8_read = read(&write_checkpoint("version8", &v8))
         .unwrap_or_else(|e| panic!("a version 8 checkpoint reads: {e}"));
     assert_eq!(v8_read.progress.counters, ck.progress.counters);
-    assert!(v8_read.progress.window.die_normal.is_nan());
+    assert!(unrecorded_window(v8_read.progress.window.die_normal));
     v8_read.progress.window.die_normal = ck.progress.window.die_normal;
     for (o, s) in v8_read
         .progress
@@ -409,6 +413,21 @@ fn versions_2_to_8_checkpoints_read_with_the_fields_they_lack_at_their_defaults(
         o.die_normal_force_n = s.die_normal_force_n;
     }
     assert_eq!(v8_read, ck, "version 8 reads as the same state");
+    // A version 8 file whose window had begun: its die force is unknown.
+    let mut begun = ck.clone();
+    begun.progress.window.time = 1e-4;
+    begun.progress.window.die_normal = 0.5;
+    let (die_begun, begun_bytes) = edited_words(&begun, |c| {
+        c.progress.window.die_normal = flip(c.progress.window.die_normal);
+        c.progress
+            .samples
+            .iter_mut()
+            .for_each(|s| s.die_normal_force_n = flip(s.die_normal_force_n))
+    });
+    let v8_begun = older(&begun_bytes, &die_begun, 8);
+    let read_begun = read(&write_checkpoint("version8_begun", &v8_begun)).unwrap();
+    assert_eq!(read_begun.progress.window.time, 1e-4);
+    assert!(read_begun.progress.window.die_normal.is_nan());
 
     let v4 = older(&bytes, &cut_of(&[&relative]), 4);
     assert_eq!(

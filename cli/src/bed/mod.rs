@@ -29,6 +29,7 @@ pub const HALF_SPEED_DIR: &str = "half_speed";
 
 pub mod checkpoint;
 pub mod compare;
+pub mod network;
 pub mod outputs;
 pub mod plots;
 pub mod report;
@@ -46,17 +47,20 @@ pub use scene::{DEFAULT_SCENE, Scene};
 /// The output description shown at the end of `bed --help`.
 const OUTPUT_HELP: &str = "\
 Output, in --out DIR (created if missing):
-  compression.csv  one row per output interval (time averages over it): time_s,
-                   strain (C = (H0 - H)/H0), upper/lower punch force and pressure,
-                   die-wall axial friction, coordination number (granule pairs,
-                   and with walls), mean granule relative density (arithmetic
+  compression.csv  one row per output interval: time_s, strain (C = (H0 - H)/H0
+                   at the row), mean_strain (the interval's mean C, to which
+                   its averages belong); averaged over the interval: upper/lower
+                   punch force and pressure, die-wall axial friction, die-wall
+                   normal force and pressure, coordination number (granule
+                   pairs, and with walls); at the row: mean granule relative density (arithmetic
                    mean of eta0 V0/V, and solid/total), bed_solid_fraction D
                    (granule solid volume / (die area x H0 (1 - C)); Heckel:
                    ln(1/(1 - D)) against the pressure), mean Heywood coefficient
                    (d_V and nominal d), min Jacobian, steps, energies
   summary.json     the scene (and scene_toml, exact: --scene reads it),
                    Kawakita fit (a, 1/b, R^2, points; over the rows
-                   with C >= kawakita_min_strain, 0.25), Heckel fit of
+                   with mean_strain >= kawakita_min_strain, 0.25, each
+                   pressure at its interval's mean strain), Heckel fit of
                    ln(1/(1 - D)) = K P + A (yield pressure P_y = 1/K, A,
                    D_A = 1 - exp(-A), R^2, points; C >= heckel_min_strain,
                    0.25), the Kawakita fit again over C >= 0.10, 0.15, 0.20
@@ -68,7 +72,11 @@ Output, in --out DIR (created if missing):
                    (quasi_static_strains), the granules' mean
                    relative density in five layers of the compact at the end
                    (final_density_by_height), the poured bed's solid fraction
-                   D0 and the final D in the die, the material (every
+                   D0 and the final D in the die, the die wall at the end
+                   (final_die_wall: radial pressure, radial-to-axial stress
+                   ratio, mobilised friction |F_z|/F_n), the contact network
+                   at each snapshot (contact_network, from vtk/network_<k>.csv),
+                   the material (every
                    parameter), final strain,
                    max pressure, initial bed height, counts, wall time, ns per
                    element-step, cost figures (over the whole run,
@@ -108,15 +116,21 @@ Output, in --out DIR (created if missing):
   vtk/granules_<k>.csv
                    per granule: centre of mass, relative density, Heywood
                    coefficients and contacts (none at C = 0)
+  vtk/network_<k>.csv
+                   the contact network in figures: quantiles of f/<f>, the
+                   strong pairs' shares, the fabric <n_z^2> by number and by
+                   force, the pairs sliding (none at C = 0)
   plots/*.svg      pressure, coordination number, relative density and Heywood
                    coefficient against strain; Kawakita plot P/C vs P and
                    Heckel plot ln(1/(1 - D)) vs P, each with its fit; the
                    compaction profile, the bed's solid fraction D vs P; Z vs
                    the granules' packing fraction;
                    the energy ledger vs strain; each granule's relative
-                   density vs its height at the end
+                   density vs its height at the end; the die wall's
+                   radial-to-axial stress ratio and mobilised friction vs
+                   strain
   report.html      one page: the warnings (or that there are none), the key
-                   results, the fits by window, the plots with
+                   results, the fits by window, the contact network, the plots with
                    captions, the sections with their tables linked, the
                    summary table (rounded; hover a value for all its digits),
                    the tables' columns explained, and the scene
@@ -362,7 +376,8 @@ pub struct BedArgs {
     pub kawakita_min_strain: Option<f64>,
 
     /// Override: the Heckel fit of summary.json (ln(1/(1 - D)) against P)
-    /// takes the output rows with C ≥ this (0 ≤ C ≤ 0.9; published 0.25).
+    /// takes the output rows with C ≥ this, C the row's interval mean
+    /// strain, as for --kawakita-min-strain (0 ≤ C ≤ 0.9; published 0.25).
     /// Allowed with --resume: on a finished run it refits without a step.
     #[arg(long, value_name = "C", allow_negative_numbers = true)]
     pub heckel_min_strain: Option<f64>,

@@ -11,6 +11,7 @@ use granbed_kernel::analysis::quasi_static::LoadSample;
 use indicatif::ProgressBar;
 use serde::Serialize;
 
+use super::network::NetworkStats;
 use super::run::{BedRun, BedSample, GranuleAtEnd};
 use super::scene::Scene;
 use crate::csv::{Field, write_table};
@@ -43,11 +44,11 @@ pub const COMPRESSION_COLUMNS: [(&str, &str); 32] = [
     ),
     (
         "die_normal_force_n",
-        "Σ normal (radial) force of the die wall on the granules, N (NaN: not recorded, rows of a run resumed from a checkpoint older than version 9)",
+        "Σ normal (radial) force of the die wall on the granules, N (NaN: not recorded: the rows a checkpoint older than version 9 held, and the one in progress then)",
     ),
     (
         "die_wall_pressure_pa",
-        "radial pressure on the die wall beside the compact, die_normal_force_n/(2π R_d H) with H the compact's height at the mean strain, Pa",
+        "radial pressure on the die wall beside the compact, die_normal_force_n/(2π R_d H) with H the compact's height at the mean strain, Pa (NaN where the force is)",
     ),
     (
         "coordination",
@@ -147,7 +148,7 @@ pub fn die_wall_summary(run: &BedRun, s: &BedSample) -> DieWallSummary {
     let pressure_pa = die_wall_pressure(run, s);
     let ratio = |x: Real, y: Real| (y > 0.0).then(|| x / y).filter(|r| r.is_finite());
     DieWallSummary {
-        strain: s.mean_strain,
+        mean_strain: s.mean_strain,
         pressure_pa: pressure_pa.is_finite().then_some(pressure_pa),
         radial_to_axial: ratio(pressure_pa, mean_punch_pressure(s)),
         friction_to_normal: ratio(s.die_friction_z_n.abs(), s.die_normal_force_n),
@@ -160,12 +161,12 @@ pub fn die_wall_summary(run: &BedRun, s: &BedSample) -> DieWallSummary {
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]
 pub struct DieWallSummary {
     /// The row's mean strain, to which its averaged forces belong.
-    pub strain: Real,
+    pub mean_strain: Real,
     /// Radial pressure on the die wall, Pa ([`die_wall_pressure`]).
     pub pressure_pa: Option<Real>,
     /// That pressure over the mean of the two punches' pressures: the
-    /// compact's radial-to-axial stress ratio (the transmission ratio of an
-    /// instrumented die; Janssen's K).
+    /// compact's radial-to-axial stress ratio, as an instrumented die
+    /// measures it (Janssen's K).
     pub radial_to_axial: Option<Real>,
     /// |axial die friction| / die normal force: the wall's mobilised
     /// friction. Coulomb's law bounds it by the friction coefficient μ,
@@ -346,6 +347,11 @@ pub struct Summary<'a> {
     pub final_density_by_height: Vec<DensityLayer>,
     /// The die wall's share of the load at the last row.
     pub final_die_wall: DieWallSummary,
+    /// The contact network at each snapshot after a step, in strain order
+    /// (`vtk/network_<k>.csv`, [`super::network`]): read from those files
+    /// by [`write_all`], so a finished run resumed without a step keeps
+    /// them; empty in a summary made without the files.
+    pub contact_network: Vec<NetworkStats>,
     /// The granule material, every parameter (`None` if the scene's is
     /// invalid).
     pub material: Option<MaterialSummary>,
@@ -687,6 +693,7 @@ pub fn summary<'a>(scene: &'a Scene, run: &BedRun) -> Summary<'a> {
             density_by_height(&run.final_granules, final_height_m(run))
         },
         final_die_wall: die_wall_summary(run, &last),
+        contact_network: Vec::new(),
         material: material.map(MaterialSummary::from),
         yield_stress_pa: material.map_or(Real::NAN, |m| m.yield_stress_pa),
         eta0: material.map_or(Real::NAN, |m| m.eta0),
@@ -1028,7 +1035,10 @@ pub fn write_all(dir: &Path, scene: &Scene, run: &BedRun) -> anyhow::Result<()> 
         &COMPRESSION_COLUMNS,
         run.samples.iter().map(|s| row(s, run)),
     )?;
-    let summary = summary(scene, run);
+    let mut summary = summary(scene, run);
+    let (network, left_out) = super::network::read_all(&dir.join(super::snapshots::VTK_DIR));
+    summary.contact_network = network;
+    summary.warnings.extend(left_out);
     write_json(&dir.join(SUMMARY_JSON), &summary)?;
     let svgs = super::plots::write_plots(dir, run, &summary)?;
     super::report::write_report(dir, scene, &summary, &svgs)

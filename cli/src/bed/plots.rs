@@ -22,7 +22,14 @@
 //!   (elastic, plastic, hourglass, contact losses, damping, kinetic)
 //!   against C, in J, mJ or µJ (as the largest needs);
 //! * `density_height.svg`: each granule's relative density where the run
-//!   ended against its height in the compact, with the layer means.
+//!   ended against its height in the compact, with the layer means;
+//! * `die_wall_strain.svg`: the die wall's radial-to-axial stress ratio and
+//!   its mobilised friction |F_z|/F_n against C, from where the punches
+//!   carry load.
+//!
+//! The averaged quantities (pressures, Z, the die wall's forces) are drawn
+//! at each output interval's mean strain, those taken at the rows
+//! (densities, Heywood, energies) at the rows' strains ([`strain_of`]).
 
 use std::path::Path;
 
@@ -361,10 +368,18 @@ pub fn plots(
             ("d S/V (nominal d)", |s| s.heywood_d),
         ],
     );
-    // The die wall's two ratios at each row's mean strain (rows where one
-    // is not defined, e.g. before the wall carries load, are left out).
+    // The die wall's two ratios at each row's mean strain, from the first
+    // row whose upper-punch pressure reaches 1 % of its largest: before,
+    // both are ratios of the settling's noise (rows where one is not
+    // defined are left out too).
+    let loaded = 0.01
+        * samples
+            .iter()
+            .map(|s| s.upper_pressure_pa)
+            .fold(0.0, Real::max);
     let walls: Vec<(Real, DieWallSummary)> = samples
         .iter()
+        .skip_while(|s| !(s.upper_pressure_pa >= loaded && loaded > 0.0))
         .map(|s| (s.mean_strain, die_wall_summary(run, s)))
         .collect();
     let wall_ratio = |of: fn(&DieWallSummary) -> Option<Real>| {

@@ -8,10 +8,12 @@
 use core::fmt::Write as _;
 use std::path::Path;
 
+use super::network::{NETWORK_COLUMNS, network_file};
 use super::outputs::{COMPRESSION_COLUMNS, Summary};
 use super::scene::{DEFAULT_SCENE, Scene};
 use super::snapshot_tables::{CONTACT_COLUMNS, GRANULE_COLUMNS, contacts_file, granules_file};
 use super::snapshots::{PVD_FILE, VTK_DIR};
+use crate::csv::Field;
 use crate::html::{
     Row, figure, fit_cell, glossary, html_escape, key_table, kpa, num, page_head, picture,
     summary_rows, summary_table, warnings_section,
@@ -26,7 +28,7 @@ pub const REPORT_FILE: &str = "report.html";
 /// meaning; any other field follows (nested objects such as `kawakita` and
 /// `heckel` are flattened to `kawakita.<field>`; the scene, `scene` and
 /// `scene_toml`, is shown as TOML instead).
-const FIELDS: [(&str, &str); 94] = [
+const FIELDS: [(&str, &str); 95] = [
     ("kawakita_a", "Kawakita a (limiting strain)"),
     ("kawakita_inv_b_pa", "Kawakita 1/b, Pa"),
     (
@@ -113,17 +115,20 @@ const FIELDS: [(&str, &str); 94] = [
         "granule initial relative density η0 (as material.eta0)",
     ),
     ("final_strain", "axial strain reached"),
-    ("final_pressure_pa", "upper-punch pressure at the end, Pa"),
+    (
+        "final_pressure_pa",
+        "upper-punch pressure at the end, Pa (averaged over the last output interval, at its mean strain final_die_wall.mean_strain)",
+    ),
     (
         "final_relative_density",
         "mean granule relative density at the end",
     ),
     (
         "final_coordination",
-        "coordination number Z at the end (granule contacts only)",
+        "coordination number Z at the end (granule contacts only; averaged over the last output interval)",
     ),
     (
-        "final_die_wall.strain",
+        "final_die_wall.mean_strain",
         "mean strain of the last output interval, to which the die-wall figures belong",
     ),
     (
@@ -277,6 +282,8 @@ const FIELDS: [(&str, &str); 94] = [
     ("heckel_windows", ""),
     // In the key results and the plot density_height.svg.
     ("final_density_by_height", ""),
+    // Its own table, "The contact network".
+    ("contact_network", ""),
 ];
 
 /// The summary's fields as rows, in [`FIELDS`]' order, then the others;
@@ -447,6 +454,49 @@ fn fits_by_window(summary: &Summary<'_>) -> String {
     h
 }
 
+/// The contact network at each snapshot (`summary.contact_network`):
+/// one row per snapshot, the figures of [`NETWORK_COLUMNS`]. Nothing if
+/// the run has none.
+fn contact_network(summary: &Summary<'_>) -> String {
+    if summary.contact_network.is_empty() {
+        return String::new();
+    }
+    let mut h = String::from(
+        "<h3>The contact network</h3>\n<p>At each snapshot after a step (its nominal strain), \
+         from its contacts table: granule–granule pairs only, the die and the punches left out \
+         (vtk/network_&lt;k&gt;.csv; each column explained at the end of this page). f is a \
+         pair's normal force and ⟨f⟩ their mean; a pair is strong if f &gt; ⟨f⟩ (the strong \
+         network of granular mechanics). n is the direction of the pair's branch vector \
+         between the granules' centres of mass, z the die axis: ⟨n_z²⟩ is 1/3 if the pairs \
+         point in all directions alike. In compressed packings of rigid grains most pairs \
+         carry less than ⟨f⟩ and the strong pairs align with the compression; deformable \
+         granules pressed dense spread the load more evenly.</p>\n<table>\n<tr>",
+    );
+    for (name, _) in NETWORK_COLUMNS {
+        let _ = write!(h, "<th>{name}</th>");
+    }
+    h.push_str("</tr>\n");
+    for s in &summary.contact_network {
+        h.push_str("<tr>");
+        for cell in s.fields() {
+            let _ = write!(h, "<td class=\"num\">{}</td>", field_text(cell));
+        }
+        h.push_str("</tr>\n");
+    }
+    h.push_str("</table>\n");
+    h
+}
+
+/// A table cell's text: an integer as is, a float rounded as the report's
+/// other figures ([`num`]).
+fn field_text(cell: Field) -> String {
+    match cell {
+        Field::Int(n) => n.to_string(),
+        Field::Real(x) => num(Some(x)),
+        Field::Text(t) => t.to_owned(),
+    }
+}
+
 /// The glossaries of the run's tables: `compression.csv` and the
 /// snapshots' [`CONTACT_COLUMNS`] and [`GRANULE_COLUMNS`].
 fn glossaries() -> String {
@@ -469,6 +519,12 @@ fn glossaries() -> String {
         "vtk/granules_<k>.csv",
         "Beside snapshot k: one row per granule.",
         &GRANULE_COLUMNS,
+    ));
+    h.push_str(&glossary(
+        "vtk/network_<k>.csv",
+        "Beside snapshot k: its contact network in figures, one row from contacts_<k>.csv \
+         (the report's table \"The contact network\").",
+        &NETWORK_COLUMNS,
     ));
     h
 }
@@ -497,9 +553,10 @@ fn plot_caption(name: &str, summary: &Summary<'_>) -> Option<String> {
         ),
         "heckel.svg" => format!(
             "Heckel's ln(1/(1 − D)) against the upper-punch pressure P, with D the bed's solid \
-             fraction in the die under load (compression.csv's bed_solid_fraction); filled: the \
-             rows fitted (C ≥ {}), D and C taken at each interval's mean strain. P_y = 1/K, the \
-             slope's inverse.",
+             fraction in the die under load (the granules' solid over the die volume below the \
+             upper punch) at each interval's mean strain, to which the averaged P belongs \
+             (compression.csv's bed_solid_fraction is D at the row's end strain); filled: the rows \
+             fitted (C ≥ {}). P_y = 1/K, the slope's inverse.",
             window(summary.heckel.min_strain)
         ),
         "coordination_strain.svg" => "The mean coordination number Z against the strain: \
@@ -517,14 +574,15 @@ fn plot_caption(name: &str, summary: &Summary<'_>) -> Option<String> {
             .to_owned(),
         "solid_fraction_pressure.svg" => "The compaction profile: the bed's solid fraction D \
              (the granules' solid over the die volume below the upper punch) against the \
-             upper-punch pressure P."
+             upper-punch pressure P, D at each interval's mean strain, as in the Heckel plot."
             .to_owned(),
         "coordination_density.svg" => "The coordination number Z against the granules' \
              packing fraction (their envelope volume over the die volume below the upper punch: \
-             bed_solid_fraction / relative_density_solid, the pores inside the granules left \
-             out), granule contacts only and with the wall contacts: how the contact network \
-             grows as the bed densifies, in the packing fraction Arzt's Z law for spheres is \
-             written in. Z is averaged over each output interval."
+             D / relative_density_solid, the pores inside the granules left out), granule \
+             contacts only and with the wall contacts: how the contact network grows as the bed \
+             densifies, in the packing fraction Arzt's Z law for spheres is written in. Z is \
+             averaged over each output interval, so D is taken at the interval's mean strain \
+             (the granules' own density, which changes far more slowly, at the row)."
             .to_owned(),
         "density_height.svg" => format!(
             "Each granule's relative density where the run ended against the height of its \
@@ -536,12 +594,13 @@ fn plot_caption(name: &str, summary: &Summary<'_>) -> Option<String> {
             num(Some(summary.final_strain))
         ),
         "die_wall_strain.svg" => format!(
-            "The die wall against the strain, at each output interval's mean strain: its radial \
+            "The die wall against the strain, at each output interval's mean strain from where \
+             the upper punch carries 1 % of its largest load: its radial \
              pressure (the normal force over the wall beside the compact, 2π R_d H) over the \
              mean of the two punches' pressures, the compact's radial-to-axial stress ratio that \
              an instrumented die measures; and the axial friction the wall holds over its normal \
              force, which Coulomb's law keeps at or below the friction coefficient μ = {} and \
-             which reaches μ where every granule at the wall slides.",
+             which reaches μ where every granule at the wall slides axially.",
             summary
                 .material
                 .map_or("n/a".to_owned(), |m| num(Some(m.friction)))
@@ -586,6 +645,7 @@ pub fn report_html(
     ));
     h.push_str(&key_results(summary));
     h.push_str(&fits_by_window(summary));
+    h.push_str(&contact_network(summary));
     writeln!(
         h,
         "<p>Files: <a href=\"compression.csv\">compression.csv</a>, \
@@ -622,8 +682,10 @@ pub fn report_html(
              picture has its own colour scale, up to the 99th percentile of its stresses. The \
              VTU snapshots beside them hold the whole bed; the tables beside each picture (none at \
              C = 0, before the first step) hold its contact network (contacts_&lt;k&gt;.csv: every pair of granules in contact, with its \
-             forces and branch vector) and its granules (granules_&lt;k&gt;.csv: centre, relative \
-             density, contacts), their columns explained at the end of this page.</p>"
+             forces and branch vector), its granules (granules_&lt;k&gt;.csv: centre, relative \
+             density, contacts) and the network's figures (network_&lt;k&gt;.csv, the table \
+             \"The contact network\" above), their columns explained at the end of this \
+             page.</p>"
         )?;
         for files in sections {
             h.push_str(&picture(
@@ -671,7 +733,7 @@ fn snapshot_files(dir: &Path) -> Vec<SnapshotFiles> {
     ks.into_iter()
         .map(|k| SnapshotFiles {
             section: format!("{VTK_DIR}/{}", super::snapshots::section_file(k)),
-            tables: [contacts_file(k), granules_file(k)]
+            tables: [contacts_file(k), granules_file(k), network_file(k)]
                 .into_iter()
                 .filter(|name| dir.join(VTK_DIR).join(name).is_file())
                 .map(|name| format!("{VTK_DIR}/{name}"))
@@ -803,6 +865,7 @@ mod tests {
             ("compression.csv", &COMPRESSION_COLUMNS[..]),
             ("vtk/contacts_&lt;k&gt;.csv", &CONTACT_COLUMNS[..]),
             ("vtk/granules_&lt;k&gt;.csv", &GRANULE_COLUMNS[..]),
+            ("vtk/network_&lt;k&gt;.csv", &NETWORK_COLUMNS[..]),
         ] {
             let table = &glossary[glossary.find(&format!("<h3>{file}</h3>")).unwrap()..];
             let table = &table[..table.find("</table>").unwrap()];

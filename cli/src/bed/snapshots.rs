@@ -27,6 +27,7 @@ use vtkio::model::{
     Version, VertexNumbers, Vtk,
 };
 
+use super::network::{network_stats, write_network};
 use super::section::{Frame, Quantity, SectionInput, section_svg};
 use super::snapshot_tables::{
     CONTACT_COLUMNS, ContactRow, GRANULE_COLUMNS, centres_of_mass, contact_rows, contacts_file,
@@ -353,7 +354,8 @@ fn section_input<'a>(
 }
 
 /// Removes the snapshots an earlier run left in `out`/[`VTK_DIR`]
-/// (`bed_<k>.vtu`, `section_<k>.svg`, `contacts_<k>.csv`, `granules_<k>.csv` and
+/// (`bed_<k>.vtu`, `section_<k>.svg`, `contacts_<k>.csv`, `granules_<k>.csv`,
+/// `network_<k>.csv` and
 /// [`PVD_FILE`]; nothing else), so that a fresh run
 /// into the same directory does not leave stale snapshots beside its own
 /// (e.g. of strains it does not reach). Returns how many files went.
@@ -370,7 +372,8 @@ pub fn remove_old(out: &Path) -> anyhow::Result<usize> {
         let snapshot = numbered(name, "bed_", ".vtu").is_some()
             || numbered(name, "section_", ".svg").is_some()
             || numbered(name, "contacts_", ".csv").is_some()
-            || numbered(name, "granules_", ".csv").is_some();
+            || numbered(name, "granules_", ".csv").is_some()
+            || numbered(name, "network_", ".csv").is_some();
         if (snapshot || name == PVD_FILE) && entry.path().is_file() {
             std::fs::remove_file(entry.path())
                 .with_context(|| format!("cannot remove `{}`", entry.path().display()))?;
@@ -463,6 +466,7 @@ impl SnapshotWriter {
                 &GRANULE_COLUMNS,
                 granule_rows(&centres, &granules, &contacts).into_iter(),
             )?;
+            write_network(&self.dir, k, &network_stats(k, strain, &contacts))?;
         }
         let entries: Vec<(Real, String)> = self.strains[..=k]
             .iter()

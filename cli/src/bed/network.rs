@@ -1,0 +1,339 @@
+//! The contact network of a bed snapshot in figures: how the contact
+//! forces are distributed over the granule pairs and how the pairs are
+//! oriented (the fabric). Written beside each snapshot's tables as
+//! `vtk/network_<k>.csv` (one row, [`NETWORK_COLUMNS`]) from the rows of
+//! `contacts_<k>.csv` ([`super::snapshot_tables`]), and gathered from
+//! there into `summary.json`'s `contact_network` and the report, so that a
+//! finished run resumed without a step keeps them.
+//!
+//! The forces of a compressed granular packing are broadly distributed:
+//! most pairs carry less than the mean force, and a minority of strong
+//! pairs, the force chains, carries most of the load along the direction
+//! of compression. The figures here say how much: quantiles of f/⟨f⟩,
+//! the share of pairs above the mean and the share of the force they
+//! carry, and the axial component of the fabric tensor ⟨n ⊗ n⟩ of the
+//! branch directions n, by number and weighted by the force.
+
+use std::path::{Path, PathBuf};
+
+use anyhow::Context as _;
+use granbed_kernel::Real;
+use serde::Serialize;
+
+use super::snapshot_tables::ContactRow;
+use crate::csv::{Field, write_table};
+
+/// Columns of a network file, in order: (name, meaning with its unit).
+pub const NETWORK_COLUMNS: [(&str, &str); 11] = [
+    (
+        "strain",
+        "the snapshot's nominal axial strain C (the state is that of the step that first reached it)",
+    ),
+    (
+        "pairs",
+        "granule pairs in the snapshot's contacts table (in contact in its step)",
+    ),
+    (
+        "mean_normal_force_n",
+        "mean normal force ⟨f⟩ of a pair (its constraints' Σ F_n), N",
+    ),
+    (
+        "median_to_mean",
+        "median f/⟨f⟩: 1 if every pair carried the same force, below 1 for the broad force distributions of granular packings",
+    ),
+    (
+        "p90_to_mean",
+        "90th percentile of f/⟨f⟩ (linear between ranks)",
+    ),
+    ("max_to_mean", "largest f/⟨f⟩"),
+    (
+        "strong_share",
+        "share of the pairs with f > ⟨f⟩: the strong network, the force chains",
+    ),
+    (
+        "strong_force_share",
+        "share of Σ f that the strong pairs carry",
+    ),
+    (
+        "fabric_zz",
+        "⟨n_z²⟩ over the pairs, n the branch direction (z the die axis): 1/3 if the pairs point in all directions alike, more if they align with the axis",
+    ),
+    (
+        "force_fabric_zz",
+        "Σ f n_z² / Σ f: the same weighted by the normal force, the alignment of the load-carrying pairs",
+    ),
+    (
+        "sliding_share",
+        "share of the pairs with a constraint at the friction cap μF_n in the step: the pairs sliding",
+    ),
+];
+
+/// One snapshot's network in figures ([`NETWORK_COLUMNS`]). A snapshot
+/// without pairs has `pairs` 0 and every ratio NaN (`null` in JSON).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct NetworkStats {
+    /// The snapshot's index k (its files' number), which the file's name
+    /// holds, not its row.
+    pub snapshot: usize,
+    /// Nominal axial strain C of the snapshot.
+    pub strain: Real,
+    /// Granule pairs in contact.
+    pub pairs: usize,
+    /// ⟨f⟩, N.
+    pub mean_normal_force_n: Real,
+    /// Median f/⟨f⟩.
+    pub median_to_mean: Real,
+    /// 90th percentile of f/⟨f⟩.
+    pub p90_to_mean: Real,
+    /// Largest f/⟨f⟩.
+    pub max_to_mean: Real,
+    /// Share of pairs with f > ⟨f⟩.
+    pub strong_share: Real,
+    /// Share of Σ f those pairs carry.
+    pub strong_force_share: Real,
+    /// ⟨n_z²⟩ (1/3: isotropic).
+    pub fabric_zz: Real,
+    /// Σ f n_z² / Σ f.
+    pub force_fabric_zz: Real,
+    /// Share of pairs with a constraint sliding.
+    pub sliding_share: Real,
+}
+
+/// The `q` quantile (0 ≤ q ≤ 1) of the ascending `sorted`, linear between
+/// the ranks (rank q (n − 1), the default of numpy's `quantile`); NaN if
+/// empty.
+fn quantile(sorted: &[Real], q: Real) -> Real {
+    let Some(last) = sorted.len().checked_sub(1) else {
+        return Real::NAN;
+    };
+    let rank = q * last as Real;
+    let below = rank.floor() as usize;
+    let above = (below + 1).min(last);
+    let t = rank - below as Real;
+    sorted[below] + t * (sorted[above] - sorted[below])
+}
+
+/// The figures of the contact `rows` of snapshot `snapshot` at `strain`.
+pub fn network_stats(snapshot: usize, strain: Real, rows: &[ContactRow]) -> NetworkStats {
+    let n = rows.len() as Real;
+    let total: Real = rows.iter().map(|r| r.normal_n).sum();
+    let mean = total / n;
+    let mut ratios: Vec<Real> = rows.iter().map(|r| r.normal_n / mean).collect();
+    ratios.sort_by(Real::total_cmp);
+    let strong = rows.iter().filter(|r| r.normal_n > mean);
+    let strong_force: Real = strong.clone().map(|r| r.normal_n).sum();
+    // n_z² of each pair's branch direction.
+    let nz2 = |r: &ContactRow| {
+        let l2: Real = r.branch.iter().map(|x| x * x).sum();
+        r.branch[2] * r.branch[2] / l2
+    };
+    NetworkStats {
+        snapshot,
+        strain,
+        pairs: rows.len(),
+        mean_normal_force_n: mean,
+        median_to_mean: quantile(&ratios, 0.5),
+        p90_to_mean: quantile(&ratios, 0.9),
+        max_to_mean: ratios.last().copied().unwrap_or(Real::NAN),
+        strong_share: strong.count() as Real / n,
+        strong_force_share: strong_force / total,
+        fabric_zz: rows.iter().map(nz2).sum::<Real>() / n,
+        force_fabric_zz: rows.iter().map(|r| r.normal_n * nz2(r)).sum::<Real>() / total,
+        sliding_share: rows.iter().filter(|r| r.slipping > 0).count() as Real / n,
+    }
+}
+
+impl NetworkStats {
+    /// The row's cells, as [`NETWORK_COLUMNS`] lists them.
+    pub fn fields(&self) -> [Field; 11] {
+        [
+            self.strain.into(),
+            Field::Int(self.pairs as u64),
+            self.mean_normal_force_n.into(),
+            self.median_to_mean.into(),
+            self.p90_to_mean.into(),
+            self.max_to_mean.into(),
+            self.strong_share.into(),
+            self.strong_force_share.into(),
+            self.fabric_zz.into(),
+            self.force_fabric_zz.into(),
+            self.sliding_share.into(),
+        ]
+    }
+
+    /// The figures of snapshot `snapshot` from the cells of its network
+    /// file's row, in [`NETWORK_COLUMNS`]' order.
+    fn from_cells(snapshot: usize, cells: &[Real; 11]) -> Self {
+        let [
+            strain,
+            pairs,
+            mean_normal_force_n,
+            median_to_mean,
+            p90_to_mean,
+            max_to_mean,
+            strong_share,
+            strong_force_share,
+            fabric_zz,
+            force_fabric_zz,
+            sliding_share,
+        ] = *cells;
+        Self {
+            snapshot,
+            strain,
+            pairs: pairs as usize,
+            mean_normal_force_n,
+            median_to_mean,
+            p90_to_mean,
+            max_to_mean,
+            strong_share,
+            strong_force_share,
+            fabric_zz,
+            force_fabric_zz,
+            sliding_share,
+        }
+    }
+}
+
+/// File name of the network figures of snapshot `k`.
+pub fn network_file(k: usize) -> String {
+    format!("network_{k}.csv")
+}
+
+/// Writes `stats` as `vtk_dir`/[`network_file`]`(k)`.
+pub fn write_network(vtk_dir: &Path, k: usize, stats: &NetworkStats) -> anyhow::Result<()> {
+    write_table(
+        &vtk_dir.join(network_file(k)),
+        &NETWORK_COLUMNS,
+        core::iter::once(stats.fields()),
+    )
+}
+
+/// Reads the network file of snapshot `snapshot`: its header must be
+/// [`NETWORK_COLUMNS`]' names and its one row numbers.
+fn read_network(snapshot: usize, path: &Path) -> anyhow::Result<NetworkStats> {
+    let text = std::fs::read_to_string(path)
+        .with_context(|| format!("cannot read `{}`", path.display()))?;
+    let mut lines = text.lines();
+    let header: Vec<&str> = lines.next().unwrap_or_default().split(',').collect();
+    let names = NETWORK_COLUMNS.map(|c| c.0);
+    anyhow::ensure!(
+        header == names,
+        "`{}`: the header is not {}",
+        path.display(),
+        names.join(",")
+    );
+    let cells: Vec<Real> = lines
+        .next()
+        .unwrap_or_default()
+        .split(',')
+        .map(str::parse)
+        .collect::<Result<_, _>>()
+        .with_context(|| format!("`{}`: a cell is not a number", path.display()))?;
+    let cells: [Real; 11] = cells
+        .try_into()
+        .map_err(|_| anyhow::anyhow!("`{}`: not one row of 11 cells", path.display()))?;
+    Ok(NetworkStats::from_cells(snapshot, &cells))
+}
+
+/// The network files in `vtk_dir`, in the order of k (the snapshots'
+/// strain order), each read (header and one row checked), and why each file that
+/// could not be read was left out (a damaged file must not cost the run's
+/// other outputs). None if the folder is not there.
+pub fn read_all(vtk_dir: &Path) -> (Vec<NetworkStats>, Vec<String>) {
+    let Ok(entries) = std::fs::read_dir(vtk_dir) else {
+        return (Vec::new(), Vec::new());
+    };
+    let mut found: Vec<(usize, PathBuf)> = entries
+        .filter_map(Result::ok)
+        .filter_map(|e| {
+            let name = e.file_name().into_string().ok()?;
+            let k = super::snapshots::numbered(&name, "network_", ".csv")?;
+            Some((k, e.path()))
+        })
+        .collect();
+    found.sort_unstable();
+    let (mut stats, mut left_out) = (Vec::new(), Vec::new());
+    for (k, path) in &found {
+        match read_network(*k, path) {
+            Ok(s) => stats.push(s),
+            Err(e) => left_out.push(format!("{e:#}; left out of contact_network")),
+        }
+    }
+    (stats, left_out)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn pair(normal_n: Real, branch: [Real; 3], slipping: usize) -> ContactRow {
+        ContactRow {
+            a: 0,
+            b: 1,
+            normal_n,
+            friction_n: 0.0,
+            force_on_a: [0.0; 3],
+            constraints: 1,
+            slipping,
+            branch,
+        }
+    }
+
+    /// Four pairs of forces 1, 2, 3, 6 (mean 3): the quantiles, the strong
+    /// pair (one, 6/12 of the force) and the fabric of two axial and two
+    /// horizontal branches, by number 1/2 and by force (2·0 + 3 + 6)/12.
+    #[test]
+    fn the_figures_of_four_pairs() {
+        let rows = [
+            pair(1.0, [2e-3, 0.0, 0.0], 0),
+            pair(2.0, [0.0, -1e-3, 0.0], 1),
+            pair(3.0, [0.0, 0.0, 1e-3], 0),
+            pair(6.0, [0.0, 0.0, -3e-3], 2),
+        ];
+        let s = network_stats(7, 0.2, &rows);
+        assert_eq!((s.snapshot, s.strain, s.pairs), (7, 0.2, 4));
+        assert_eq!(s.mean_normal_force_n, 3.0);
+        assert!((s.median_to_mean - 2.5 / 3.0).abs() < 1e-15);
+        // Rank 0.9 · 3 = 2.7: 1 + 0.7 (2 − 1).
+        assert!((s.p90_to_mean - 1.7).abs() < 1e-15);
+        assert_eq!(s.max_to_mean, 2.0);
+        assert_eq!((s.strong_share, s.strong_force_share), (0.25, 0.5));
+        assert_eq!(s.fabric_zz, 0.5);
+        assert_eq!(s.force_fabric_zz, 0.75);
+        assert_eq!(s.sliding_share, 0.5);
+    }
+
+    /// A file written reads back to the same figures, to the bit; a
+    /// snapshot without pairs has NaN ratios, which read back too.
+    #[test]
+    fn a_network_file_round_trips() {
+        let dir = std::env::temp_dir().join(format!("granbed-network-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let rows = [
+            pair(0.1, [1e-3, 2e-3, 3e-3], 0),
+            pair(0.7, [-1e-3, 0.5e-3, 2e-3], 1),
+        ];
+        let full = network_stats(2, 0.1 + 0.2, &rows);
+        let empty = network_stats(10, 0.3, &[]);
+        assert_eq!(empty.pairs, 0);
+        assert!(empty.median_to_mean.is_nan() && empty.fabric_zz.is_nan());
+        write_network(&dir, 2, &full).unwrap();
+        write_network(&dir, 10, &empty).unwrap();
+        let (back, left_out) = read_all(&dir);
+        assert!(left_out.is_empty());
+        assert_eq!(back[0], full);
+        assert_eq!((back[1].snapshot, back[1].pairs), (10, 0));
+        assert!(back[1].median_to_mean.is_nan());
+        // A damaged file is left out, and said so; the others are read.
+        std::fs::write(dir.join(network_file(3)), "strain\n0.1\n").unwrap();
+        let (back, left_out) = read_all(&dir);
+        assert_eq!(back.iter().map(|s| s.snapshot).collect::<Vec<_>>(), [2, 10]);
+        assert!(
+            left_out.len() == 1
+                && left_out[0].contains("network_3.csv")
+                && left_out[0].contains("header"),
+            "{left_out:?}"
+        );
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+}
