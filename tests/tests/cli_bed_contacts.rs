@@ -127,11 +127,15 @@ fn the_contact_network_balances_the_inner_granules() {
         let rank = 0.9 * (sorted.len() - 1) as f64;
         let (below, t) = (rank.floor() as usize, rank - rank.floor());
         let p90 = sorted[below] + t * (sorted[(below + 1).min(sorted.len() - 1)] - sorted[below]);
-        let sliding = contacts
-            .num("slipping")
-            .iter()
-            .filter(|&&n| n > 0.0)
-            .count();
+        // Coulomb: each pair's friction at most μ times its normal force.
+        let mu = number(&s["material"], "friction");
+        let friction = contacts.num("friction_force_n");
+        for (i, (ft, f)) in friction.iter().zip(&forces).enumerate() {
+            assert!(
+                *ft <= mu * f * (1.0 + 1e-9),
+                "row {i}: friction {ft} of F_n {f}"
+            );
+        }
         for (name, want) in [
             ("mean_normal_force_n", mean),
             ("median_to_mean", median),
@@ -141,7 +145,7 @@ fn the_contact_network_balances_the_inner_granules() {
             ("strong_share", strong.len() as f64 / forces.len() as f64),
             ("strong_force_share", strong.iter().sum::<f64>() / total),
             ("p90_to_mean", p90),
-            ("sliding_share", sliding as f64 / forces.len() as f64),
+            ("friction_to_normal", friction.iter().sum::<f64>() / total),
         ] {
             let got = figure(name);
             assert!(

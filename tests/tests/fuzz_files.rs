@@ -332,13 +332,14 @@ fn versions_2_to_8_checkpoints_read_with_the_fields_they_lack_at_their_defaults(
             .for_each(|s| s.kinetic_relative_j = flip(s.kinetic_relative_j))
     });
     // Version 9's die-wall normal forces: the window's, then each row's.
-    let (die, bytes) = edited_words(&ck, |c| {
+    let flip_die = |c: &mut Checkpoint| {
         c.progress.window.die_normal = flip(c.progress.window.die_normal);
         c.progress
             .samples
             .iter_mut()
             .for_each(|s| s.die_normal_force_n = flip(s.die_normal_force_n))
-    });
+    };
+    let (die, bytes) = edited_words(&ck, flip_die);
     assert_eq!(
         (flags.len(), factors.len(), step.len(), relative.len()),
         (granules, granules, 1, ck.progress.samples.len())
@@ -417,13 +418,7 @@ fn versions_2_to_8_checkpoints_read_with_the_fields_they_lack_at_their_defaults(
     let mut begun = ck.clone();
     begun.progress.window.time = 1e-4;
     begun.progress.window.die_normal = 0.5;
-    let (die_begun, begun_bytes) = edited_words(&begun, |c| {
-        c.progress.window.die_normal = flip(c.progress.window.die_normal);
-        c.progress
-            .samples
-            .iter_mut()
-            .for_each(|s| s.die_normal_force_n = flip(s.die_normal_force_n))
-    });
+    let (die_begun, begun_bytes) = edited_words(&begun, flip_die);
     let v8_begun = older(&begun_bytes, &die_begun, 8);
     let read_begun = read(&write_checkpoint("version8_begun", &v8_begun)).unwrap();
     assert_eq!(read_begun.progress.window.time, 1e-4);

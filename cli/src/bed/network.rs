@@ -63,8 +63,8 @@ pub const NETWORK_COLUMNS: [(&str, &str); 11] = [
         "Σ f n_z² / Σ f: the same weighted by the normal force, the alignment of the load-carrying pairs",
     ),
     (
-        "sliding_share",
-        "share of the pairs with a constraint at the friction cap μF_n in the step: the pairs sliding",
+        "friction_to_normal",
+        "Σ |friction| / Σ f over the pairs: their mobilised friction, force-weighted (Coulomb's law keeps each pair's at or below μ)",
     ),
 ];
 
@@ -95,8 +95,8 @@ pub struct NetworkStats {
     pub fabric_zz: Real,
     /// Σ f n_z² / Σ f.
     pub force_fabric_zz: Real,
-    /// Share of pairs with a constraint sliding.
-    pub sliding_share: Real,
+    /// Σ |friction| / Σ f.
+    pub friction_to_normal: Real,
 }
 
 /// The `q` quantile (0 ≤ q ≤ 1) of the ascending `sorted`, linear between
@@ -139,7 +139,7 @@ pub fn network_stats(snapshot: usize, strain: Real, rows: &[ContactRow]) -> Netw
         strong_force_share: strong_force / total,
         fabric_zz: rows.iter().map(nz2).sum::<Real>() / n,
         force_fabric_zz: rows.iter().map(|r| r.normal_n * nz2(r)).sum::<Real>() / total,
-        sliding_share: rows.iter().filter(|r| r.slipping > 0).count() as Real / n,
+        friction_to_normal: rows.iter().map(|r| r.friction_n).sum::<Real>() / total,
     }
 }
 
@@ -157,39 +157,26 @@ impl NetworkStats {
             self.strong_force_share.into(),
             self.fabric_zz.into(),
             self.force_fabric_zz.into(),
-            self.sliding_share.into(),
+            self.friction_to_normal.into(),
         ]
     }
 
     /// The figures of snapshot `snapshot` from the cells of its network
     /// file's row, in [`NETWORK_COLUMNS`]' order.
-    fn from_cells(snapshot: usize, cells: &[Real; 11]) -> Self {
-        let [
-            strain,
-            pairs,
-            mean_normal_force_n,
-            median_to_mean,
-            p90_to_mean,
-            max_to_mean,
-            strong_share,
-            strong_force_share,
-            fabric_zz,
-            force_fabric_zz,
-            sliding_share,
-        ] = *cells;
+    fn from_cells(snapshot: usize, c: &[Real; 11]) -> Self {
         Self {
             snapshot,
-            strain,
-            pairs: pairs as usize,
-            mean_normal_force_n,
-            median_to_mean,
-            p90_to_mean,
-            max_to_mean,
-            strong_share,
-            strong_force_share,
-            fabric_zz,
-            force_fabric_zz,
-            sliding_share,
+            strain: c[0],
+            pairs: c[1] as usize,
+            mean_normal_force_n: c[2],
+            median_to_mean: c[3],
+            p90_to_mean: c[4],
+            max_to_mean: c[5],
+            strong_share: c[6],
+            strong_force_share: c[7],
+            fabric_zz: c[8],
+            force_fabric_zz: c[9],
+            friction_to_normal: c[10],
         }
     }
 }
@@ -266,29 +253,30 @@ pub fn read_all(vtk_dir: &Path) -> (Vec<NetworkStats>, Vec<String>) {
 mod tests {
     use super::*;
 
-    fn pair(normal_n: Real, branch: [Real; 3], slipping: usize) -> ContactRow {
+    fn pair(normal_n: Real, branch: [Real; 3], friction_n: Real) -> ContactRow {
         ContactRow {
             a: 0,
             b: 1,
             normal_n,
-            friction_n: 0.0,
+            friction_n,
             force_on_a: [0.0; 3],
             constraints: 1,
-            slipping,
+            slipping: 0,
             branch,
         }
     }
 
     /// Four pairs of forces 1, 2, 3, 6 (mean 3): the quantiles, the strong
     /// pair (one, 6/12 of the force) and the fabric of two axial and two
-    /// horizontal branches, by number 1/2 and by force (2·0 + 3 + 6)/12.
+    /// horizontal branches, by number 1/2 and by force (2·0 + 3 + 6)/12;
+    /// frictions 0.5 + 1 + 0 + 1.5 over Σ f = 12.
     #[test]
     fn the_figures_of_four_pairs() {
         let rows = [
-            pair(1.0, [2e-3, 0.0, 0.0], 0),
-            pair(2.0, [0.0, -1e-3, 0.0], 1),
-            pair(3.0, [0.0, 0.0, 1e-3], 0),
-            pair(6.0, [0.0, 0.0, -3e-3], 2),
+            pair(1.0, [2e-3, 0.0, 0.0], 0.5),
+            pair(2.0, [0.0, -1e-3, 0.0], 1.0),
+            pair(3.0, [0.0, 0.0, 1e-3], 0.0),
+            pair(6.0, [0.0, 0.0, -3e-3], 1.5),
         ];
         let s = network_stats(7, 0.2, &rows);
         assert_eq!((s.snapshot, s.strain, s.pairs), (7, 0.2, 4));
@@ -300,7 +288,7 @@ mod tests {
         assert_eq!((s.strong_share, s.strong_force_share), (0.25, 0.5));
         assert_eq!(s.fabric_zz, 0.5);
         assert_eq!(s.force_fabric_zz, 0.75);
-        assert_eq!(s.sliding_share, 0.5);
+        assert_eq!(s.friction_to_normal, 0.25);
     }
 
     /// A file written reads back to the same figures, to the bit; a
@@ -310,8 +298,8 @@ mod tests {
         let dir = std::env::temp_dir().join(format!("granbed-network-{}", std::process::id()));
         std::fs::create_dir_all(&dir).unwrap();
         let rows = [
-            pair(0.1, [1e-3, 2e-3, 3e-3], 0),
-            pair(0.7, [-1e-3, 0.5e-3, 2e-3], 1),
+            pair(0.1, [1e-3, 2e-3, 3e-3], 0.01),
+            pair(0.7, [-1e-3, 0.5e-3, 2e-3], 0.05),
         ];
         let full = network_stats(2, 0.1 + 0.2, &rows);
         let empty = network_stats(10, 0.3, &[]);

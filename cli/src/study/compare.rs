@@ -197,8 +197,33 @@ impl CompareArgs {
             "pair searches per step, run / reference: {:.4}",
             c.pair_searches
         )?;
+        if let Some(note) = interval_note(&reference, &run) {
+            writeln!(streams.stderr, "note: {note}")?;
+        }
         Ok(())
     }
+}
+
+/// What to say when the two runs' output intervals differ: the curves
+/// pair each interval-averaged pressure with the row's end strain, which
+/// then lies half an interval further on in one run than in the other,
+/// and the curve distance includes that offset.
+fn interval_note(reference: &RunRecord, run: &RunRecord) -> Option<String> {
+    let interval = |r: &RunRecord| {
+        r.summary
+            .get("scene")
+            .and_then(|s| s.get("output_strain_interval"))
+            .and_then(Value::as_f64)
+    };
+    let (a, b) = (interval(reference)?, interval(run)?);
+    (a != b).then(|| {
+        format!(
+            "the runs' output intervals differ ({a} and {b}): each pressure, an average over its \
+             interval, is read at the interval's end, so the curves are offset by {} in strain, \
+             which the P(C) distance includes",
+            0.5 * (a - b).abs()
+        )
+    })
 }
 
 #[cfg(test)]
@@ -249,5 +274,26 @@ mod tests {
             let e = parse_window(bad).unwrap_err();
             assert!(e.contains("--window"), "{bad}: {e}");
         }
+    }
+
+    /// Runs of one output interval compare without a note; runs of two
+    /// get one, with the curves' offset, half the difference.
+    #[test]
+    fn different_output_intervals_are_noted() {
+        let of = |interval: f64| {
+            record(
+                vec![(0.0, 0.0), (interval, 1.0)],
+                serde_json::json!({"scene": {"output_strain_interval": interval}}),
+            )
+        };
+        assert_eq!(interval_note(&of(0.005), &of(0.005)), None);
+        let note = interval_note(&of(0.005), &of(0.01)).unwrap();
+        assert!(
+            note.contains("0.005 and 0.01") && note.contains("offset by 0.0025"),
+            "{note}"
+        );
+        // A summary without the field (not a bed scene's): nothing to say.
+        let bare = record(vec![(0.0, 0.0)], serde_json::json!({}));
+        assert_eq!(interval_note(&bare, &of(0.01)), None);
     }
 }
