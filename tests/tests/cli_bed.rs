@@ -148,6 +148,11 @@ fn a_small_bed_runs_end_to_end_and_is_thread_independent() {
     );
     assert_eq!(number(wall, "pressure_pa"), wall_pressure[n - 1]);
     let axial = 0.5 * (pressure[n - 1] + table.num("lower_pressure_pa")[n - 1]);
+    assert_eq!(number(wall, "mean_punch_pressure_pa"), axial);
+    assert_eq!(
+        number(wall, "radial_to_upper"),
+        wall_pressure[n - 1] / pressure[n - 1]
+    );
     assert_eq!(
         number(wall, "radial_to_axial"),
         wall_pressure[n - 1] / axial

@@ -123,6 +123,16 @@ fn the_contact_network_balances_the_inner_granules() {
         let fabric = nz2.iter().sum::<f64>() / nz2.len() as f64;
         let by_force = forces.iter().zip(&nz2).map(|(f, n)| f * n).sum::<f64>() / total;
         let strong: Vec<f64> = forces.iter().copied().filter(|&f| f > mean).collect();
+        let nz2_of = |strong_ones: bool| {
+            let v: Vec<f64> = (0..forces.len())
+                .filter(|&i| (forces[i] > mean) == strong_ones)
+                .map(|i| {
+                    let l = rows[i].3;
+                    l[2] * l[2] / (l[0] * l[0] + l[1] * l[1] + l[2] * l[2])
+                })
+                .collect();
+            v.iter().sum::<f64>() / v.len() as f64
+        };
         // numpy's quantile: linear between the ranks, at rank 0.9 (n − 1).
         let rank = 0.9 * (sorted.len() - 1) as f64;
         let (below, t) = (rank.floor() as usize, rank - rank.floor());
@@ -146,6 +156,15 @@ fn the_contact_network_balances_the_inner_granules() {
             ("strong_force_share", strong.iter().sum::<f64>() / total),
             ("p90_to_mean", p90),
             ("friction_to_normal", friction.iter().sum::<f64>() / total),
+            ("strong_fabric_zz", nz2_of(true)),
+            ("weak_fabric_zz", nz2_of(false)),
+            (
+                "sliding_share",
+                (0..forces.len())
+                    .filter(|&i| friction[i] >= 0.99 * mu * forces[i])
+                    .count() as f64
+                    / forces.len() as f64,
+            ),
         ] {
             let got = figure(name);
             assert!(
@@ -168,6 +187,13 @@ fn the_contact_network_balances_the_inner_granules() {
         assert!(
             by_force > fabric && by_force > 1.0 / 3.0,
             "fabric {fabric}, by force {by_force}"
+        );
+        // The strong pairs align with the axis, the weak ones across it.
+        assert!(
+            nz2_of(true) > 1.0 / 3.0 && nz2_of(false) < nz2_of(true),
+            "strong {}, weak {}",
+            nz2_of(true),
+            nz2_of(false)
         );
         if k < last {
             continue;

@@ -118,8 +118,9 @@ Output, in --out DIR (created if missing):
                    coefficients and contacts (none at C = 0)
   vtk/network_<k>.csv
                    the contact network in figures: quantiles of f/<f>, the
-                   strong pairs' shares, the fabric <n_z^2> by number and by
-                   force, the pairs' mobilised friction (none at C = 0)
+                   strong pairs' shares, the fabric <n_z^2> by number, by
+                   force, over the strong and the weak pairs, the pairs'
+                   mobilised friction and those sliding (none at C = 0)
   plots/*.svg      pressure, coordination number, relative density and Heywood
                    coefficient against strain; Kawakita plot P/C vs P and
                    Heckel plot ln(1/(1 - D)) vs P, each with its fit; the

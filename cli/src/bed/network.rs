@@ -24,7 +24,7 @@ use super::snapshot_tables::ContactRow;
 use crate::csv::{Field, write_table};
 
 /// Columns of a network file, in order: (name, meaning with its unit).
-pub const NETWORK_COLUMNS: [(&str, &str); 11] = [
+pub const NETWORK_COLUMNS: [(&str, &str); 14] = [
     (
         "strain",
         "the snapshot's nominal axial strain C (the state is that of the step that first reached it)",
@@ -48,7 +48,7 @@ pub const NETWORK_COLUMNS: [(&str, &str); 11] = [
     ("max_to_mean", "largest f/⟨f⟩"),
     (
         "strong_share",
-        "share of the pairs with f > ⟨f⟩: the strong network, the force chains",
+        "share of the pairs with f > ⟨f⟩: the strong network (Radjai's), which holds the force chains",
     ),
     (
         "strong_force_share",
@@ -63,8 +63,20 @@ pub const NETWORK_COLUMNS: [(&str, &str); 11] = [
         "Σ f n_z² / Σ f: the same weighted by the normal force, the alignment of the load-carrying pairs",
     ),
     (
+        "strong_fabric_zz",
+        "⟨n_z²⟩ over the strong pairs alone (f > ⟨f⟩)",
+    ),
+    (
+        "weak_fabric_zz",
+        "⟨n_z²⟩ over the weak pairs (f ≤ ⟨f⟩): in granular packings these tend to lie across the load",
+    ),
+    (
         "friction_to_normal",
         "Σ |friction| / Σ f over the pairs: their mobilised friction, force-weighted (Coulomb's law keeps each pair's at or below μ)",
+    ),
+    (
+        "sliding_share",
+        "share of the pairs whose friction is at Coulomb's limit, |friction| ≥ 0.99 μ f: the pairs sliding as a whole",
     ),
 ];
 
@@ -95,8 +107,14 @@ pub struct NetworkStats {
     pub fabric_zz: Real,
     /// Σ f n_z² / Σ f.
     pub force_fabric_zz: Real,
+    /// ⟨n_z²⟩ over the strong pairs.
+    pub strong_fabric_zz: Real,
+    /// ⟨n_z²⟩ over the weak pairs.
+    pub weak_fabric_zz: Real,
     /// Σ |friction| / Σ f.
     pub friction_to_normal: Real,
+    /// Share of the pairs at Coulomb's limit ([`SLIDING_AT`]).
+    pub sliding_share: Real,
 }
 
 /// The `q` quantile (0 ≤ q ≤ 1) of the ascending `sorted`, linear between
@@ -113,8 +131,15 @@ fn quantile(sorted: &[Real], q: Real) -> Real {
     sorted[below] + t * (sorted[above] - sorted[below])
 }
 
-/// The figures of the contact `rows` of snapshot `snapshot` at `strain`.
-pub fn network_stats(snapshot: usize, strain: Real, rows: &[ContactRow]) -> NetworkStats {
+/// A pair slides as a whole when its friction is within this share of
+/// Coulomb's limit μ f ([`NetworkStats::sliding_share`]): its constraints'
+/// frictions add as vectors, so the pair's reaches μ f only when they all
+/// slide the same way.
+pub const SLIDING_AT: Real = 0.99;
+
+/// The figures of the contact `rows` of snapshot `snapshot` at `strain`,
+/// the pairs' friction coefficient `mu`.
+pub fn network_stats(snapshot: usize, strain: Real, mu: Real, rows: &[ContactRow]) -> NetworkStats {
     let n = rows.len() as Real;
     let total: Real = rows.iter().map(|r| r.normal_n).sum();
     let mean = total / n;
@@ -126,6 +151,13 @@ pub fn network_stats(snapshot: usize, strain: Real, rows: &[ContactRow]) -> Netw
     let nz2 = |r: &ContactRow| {
         let l2: Real = r.branch.iter().map(|x| x * x).sum();
         r.branch[2] * r.branch[2] / l2
+    };
+    let mean_nz2 = |strong_ones: bool| {
+        let (count, sum) = rows
+            .iter()
+            .filter(|r| (r.normal_n > mean) == strong_ones)
+            .fold((0_usize, 0.0), |(c, s), r| (c + 1, s + nz2(r)));
+        sum / count as Real
     };
     NetworkStats {
         snapshot,
@@ -139,13 +171,20 @@ pub fn network_stats(snapshot: usize, strain: Real, rows: &[ContactRow]) -> Netw
         strong_force_share: strong_force / total,
         fabric_zz: rows.iter().map(nz2).sum::<Real>() / n,
         force_fabric_zz: rows.iter().map(|r| r.normal_n * nz2(r)).sum::<Real>() / total,
+        strong_fabric_zz: mean_nz2(true),
+        weak_fabric_zz: mean_nz2(false),
         friction_to_normal: rows.iter().map(|r| r.friction_n).sum::<Real>() / total,
+        sliding_share: rows
+            .iter()
+            .filter(|r| r.friction_n >= SLIDING_AT * mu * r.normal_n && r.normal_n > 0.0)
+            .count() as Real
+            / n,
     }
 }
 
 impl NetworkStats {
     /// The row's cells, as [`NETWORK_COLUMNS`] lists them.
-    pub fn fields(&self) -> [Field; 11] {
+    pub fn fields(&self) -> [Field; 14] {
         [
             self.strain.into(),
             Field::Int(self.pairs as u64),
@@ -157,13 +196,16 @@ impl NetworkStats {
             self.strong_force_share.into(),
             self.fabric_zz.into(),
             self.force_fabric_zz.into(),
+            self.strong_fabric_zz.into(),
+            self.weak_fabric_zz.into(),
             self.friction_to_normal.into(),
+            self.sliding_share.into(),
         ]
     }
 
     /// The figures of snapshot `snapshot` from the cells of its network
     /// file's row, in [`NETWORK_COLUMNS`]' order.
-    fn from_cells(snapshot: usize, c: &[Real; 11]) -> Self {
+    fn from_cells(snapshot: usize, c: &[Real; 14]) -> Self {
         Self {
             snapshot,
             strain: c[0],
@@ -176,7 +218,10 @@ impl NetworkStats {
             strong_force_share: c[7],
             fabric_zz: c[8],
             force_fabric_zz: c[9],
-            friction_to_normal: c[10],
+            strong_fabric_zz: c[10],
+            weak_fabric_zz: c[11],
+            friction_to_normal: c[12],
+            sliding_share: c[13],
         }
     }
 }
@@ -216,9 +261,13 @@ fn read_network(snapshot: usize, path: &Path) -> anyhow::Result<NetworkStats> {
         .map(str::parse)
         .collect::<Result<_, _>>()
         .with_context(|| format!("`{}`: a cell is not a number", path.display()))?;
-    let cells: [Real; 11] = cells
-        .try_into()
-        .map_err(|_| anyhow::anyhow!("`{}`: not one row of 11 cells", path.display()))?;
+    let cells: [Real; 14] = cells.try_into().map_err(|_| {
+        anyhow::anyhow!(
+            "`{}`: not one row of {} cells",
+            path.display(),
+            NETWORK_COLUMNS.len()
+        )
+    })?;
     Ok(NetworkStats::from_cells(snapshot, &cells))
 }
 
@@ -278,7 +327,7 @@ mod tests {
             pair(3.0, [0.0, 0.0, 1e-3], 0.0),
             pair(6.0, [0.0, 0.0, -3e-3], 1.5),
         ];
-        let s = network_stats(7, 0.2, &rows);
+        let s = network_stats(7, 0.2, 0.5, &rows);
         assert_eq!((s.snapshot, s.strain, s.pairs), (7, 0.2, 4));
         assert_eq!(s.mean_normal_force_n, 3.0);
         assert!((s.median_to_mean - 2.5 / 3.0).abs() < 1e-15);
@@ -289,6 +338,11 @@ mod tests {
         assert_eq!(s.fabric_zz, 0.5);
         assert_eq!(s.force_fabric_zz, 0.75);
         assert_eq!(s.friction_to_normal, 0.25);
+        // Strong: the pair of 6 (axial); weak: 1, 2 (across) and 3 (axial).
+        assert_eq!((s.strong_fabric_zz, s.weak_fabric_zz), (1.0, 1.0 / 3.0));
+        // At μ = 0.5 the pairs of 1 and 2 are at the limit (0.5 = 0.5 · 1,
+        // 1 = 0.5 · 2); those of 3 (no friction) and 6 (1.5 < 3) are not.
+        assert_eq!(s.sliding_share, 0.5);
     }
 
     /// A file written reads back to the same figures, to the bit; a
@@ -301,8 +355,8 @@ mod tests {
             pair(0.1, [1e-3, 2e-3, 3e-3], 0.01),
             pair(0.7, [-1e-3, 0.5e-3, 2e-3], 0.05),
         ];
-        let full = network_stats(2, 0.1 + 0.2, &rows);
-        let empty = network_stats(10, 0.3, &[]);
+        let full = network_stats(2, 0.1 + 0.2, 0.1, &rows);
+        let empty = network_stats(10, 0.3, 0.1, &[]);
         assert_eq!(empty.pairs, 0);
         assert!(empty.median_to_mean.is_nan() && empty.fabric_zz.is_nan());
         write_network(&dir, 2, &full).unwrap();

@@ -150,7 +150,9 @@ pub fn die_wall_summary(run: &BedRun, s: &BedSample) -> DieWallSummary {
     DieWallSummary {
         mean_strain: s.mean_strain,
         pressure_pa: pressure_pa.is_finite().then_some(pressure_pa),
+        mean_punch_pressure_pa: mean_punch_pressure(s),
         radial_to_axial: ratio(pressure_pa, mean_punch_pressure(s)),
+        radial_to_upper: ratio(pressure_pa, s.upper_pressure_pa),
         friction_to_normal: ratio(s.die_friction_z_n.abs(), s.die_normal_force_n),
     }
 }
@@ -164,10 +166,17 @@ pub struct DieWallSummary {
     pub mean_strain: Real,
     /// Radial pressure on the die wall, Pa ([`die_wall_pressure`]).
     pub pressure_pa: Option<Real>,
+    /// The mean of the two punches' pressures, Pa ([`mean_punch_pressure`]):
+    /// the compact's axial stress averaged over its height, the divisor of
+    /// `radial_to_axial`.
+    pub mean_punch_pressure_pa: Real,
     /// That pressure over the mean of the two punches' pressures: the
     /// compact's radial-to-axial stress ratio, as an instrumented die
     /// measures it (Janssen's K).
     pub radial_to_axial: Option<Real>,
+    /// The die-wall pressure over the upper punch's alone, the divisor
+    /// instrumented-die studies often use (their σ_r read at one sensor).
+    pub radial_to_upper: Option<Real>,
     /// |axial die friction| / die normal force: the wall's mobilised
     /// friction. Coulomb's law bounds it by the friction coefficient μ,
     /// which it reaches when every granule at the wall slides axially.
@@ -1356,7 +1365,9 @@ mod tests {
         };
         let w = die_wall_summary(&run, &row);
         assert!((w.pressure_pa.unwrap() - 500.0).abs() < 1e-12);
+        assert_eq!(w.mean_punch_pressure_pa, 1000.0);
         assert!((w.radial_to_axial.unwrap() - 0.5).abs() < 1e-15);
+        assert!((w.radial_to_upper.unwrap() - 500.0 / 1200.0).abs() < 1e-15);
         assert!((w.friction_to_normal.unwrap() - 40.0 / row.die_normal_force_n).abs() < 1e-15);
         let unrecorded = die_wall_summary(
             &run,
@@ -1384,8 +1395,12 @@ mod tests {
         );
         assert_eq!(unloaded.pressure_pa, Some(0.0));
         assert_eq!(
-            (unloaded.radial_to_axial, unloaded.friction_to_normal),
-            (None, None)
+            (
+                unloaded.radial_to_axial,
+                unloaded.radial_to_upper,
+                unloaded.friction_to_normal
+            ),
+            (None, None, None)
         );
     }
 

@@ -369,10 +369,10 @@ pub fn plots(
         ],
     );
     // The die wall's two ratios at each row's mean strain, from the first
-    // row whose upper-punch pressure reaches 1 % of its largest: before,
-    // both are ratios of the settling's noise (rows where one is not
-    // defined are left out too).
-    let loaded = 0.01
+    // row whose upper-punch pressure reaches 5 % of its largest: before,
+    // the bed's own weight and the settling's impulses are a large part of
+    // the stresses (rows where a ratio is not defined are left out too).
+    let loaded = 0.05
         * samples
             .iter()
             .map(|s| s.upper_pressure_pa)
@@ -388,16 +388,28 @@ pub fn plots(
             .filter_map(move |(c, w)| of(w).map(|r| (*c, r)))
             .collect::<Vec<_>>()
     };
+    let friction = wall_ratio(|w| w.friction_to_normal);
+    // Coulomb's limit of the second ratio, over the same strains.
+    let mu = summary.material.map_or(Real::NAN, |m| m.friction);
+    let limit = friction
+        .first()
+        .zip(friction.last())
+        .map(|(a, b)| [(a.0, mu), (b.0, mu)]);
     let die_wall = [
         Series::new(
-            "die-wall pressure / mean punch pressure",
+            "K: die-wall pressure / mean punch pressure",
             Mark::Line,
             wall_ratio(|w| w.radial_to_axial).into_iter(),
         ),
         Series::new(
             "|die-wall friction| / die-wall normal force",
             Mark::DashedLine,
-            wall_ratio(|w| w.friction_to_normal).into_iter(),
+            friction.into_iter(),
+        ),
+        Series::new(
+            "friction coefficient μ",
+            Mark::Dashed,
+            limit.into_iter().flatten(),
         ),
     ];
     let [

@@ -28,7 +28,7 @@ pub const REPORT_FILE: &str = "report.html";
 /// meaning; any other field follows (nested objects such as `kawakita` and
 /// `heckel` are flattened to `kawakita.<field>`; the scene, `scene` and
 /// `scene_toml`, is shown as TOML instead).
-const FIELDS: [(&str, &str); 95] = [
+const FIELDS: [(&str, &str); 97] = [
     ("kawakita_a", "Kawakita a (limiting strain)"),
     ("kawakita_inv_b_pa", "Kawakita 1/b, Pa"),
     (
@@ -136,8 +136,16 @@ const FIELDS: [(&str, &str); 95] = [
         "radial pressure on the die wall beside the compact at the end, Pa",
     ),
     (
+        "final_die_wall.mean_punch_pressure_pa",
+        "mean of the two punches' pressures at the end, Pa: the compact's axial stress averaged over its height",
+    ),
+    (
         "final_die_wall.radial_to_axial",
-        "die-wall pressure / mean punch pressure at the end: the radial-to-axial stress ratio",
+        "die-wall pressure / mean punch pressure at the end: the radial-to-axial stress ratio K",
+    ),
+    (
+        "final_die_wall.radial_to_upper",
+        "die-wall pressure / upper-punch pressure at the end (the divisor of many instrumented-die studies)",
     ),
     (
         "final_die_wall.friction_to_normal",
@@ -368,15 +376,17 @@ fn key_results(summary: &Summary<'_>) -> String {
             kpa(Some(summary.final_pressure_pa)),
         ),
         (
-            "die wall at the end: radial pressure, kPa; over the mean punch pressure; its \
-             mobilised friction |F_z|/F_n"
+            "die wall at the end: radial pressure σ_r, kPa; K = σ_r over the mean punch pressure \
+             (kPa); σ_r over the upper punch's; the wall's mobilised friction |F_z|/F_n"
                 .to_owned(),
             {
                 let w = &summary.final_die_wall;
                 format!(
-                    "{}; {}; {}",
+                    "{}; {} (of {}); {}; {}",
                     kpa(w.pressure_pa),
                     num(w.radial_to_axial),
+                    kpa(Some(w.mean_punch_pressure_pa)),
+                    num(w.radial_to_upper),
                     num(w.friction_to_normal)
                 )
             },
@@ -468,9 +478,11 @@ fn contact_network(summary: &Summary<'_>) -> String {
          pair's normal force and ⟨f⟩ their mean; a pair is strong if f &gt; ⟨f⟩ (the strong \
          network of granular mechanics). n is the direction of the pair's branch vector \
          between the granules' centres of mass, z the die axis: ⟨n_z²⟩ is 1/3 if the pairs \
-         point in all directions alike. In compressed packings of rigid grains most pairs \
-         carry less than ⟨f⟩ and the strong pairs align with the compression; deformable \
-         granules pressed dense spread the load more evenly.</p>\n<table>\n<tr>",
+         point in all directions alike (necessary for isotropy, not sufficient). In compressed \
+         packings of rigid grains most pairs carry less than ⟨f⟩, the strong pairs align with \
+         the compression and the weak ones lie across it (Radjai et al. 1998); the table shows \
+         how far this bed follows. A pair slides as a whole when its friction reaches μ f.</p>\n\
+         <table>\n<tr>",
     );
     for (name, _) in NETWORK_COLUMNS {
         let _ = write!(h, "<th>{name}</th>");
@@ -594,13 +606,18 @@ fn plot_caption(name: &str, summary: &Summary<'_>) -> Option<String> {
             num(Some(summary.final_strain))
         ),
         "die_wall_strain.svg" => format!(
-            "The die wall against the strain, at each output interval's mean strain from where \
-             the upper punch carries 1 % of its largest load: its radial \
-             pressure (the normal force over the wall beside the compact, 2π R_d H) over the \
-             mean of the two punches' pressures, the compact's radial-to-axial stress ratio that \
-             an instrumented die measures; and the axial friction the wall holds over its normal \
-             force, which Coulomb's law keeps at or below the friction coefficient μ = {} and \
-             which reaches μ where every granule at the wall slides axially.",
+            "The die wall against the strain, at each output interval's mean strain, from where \
+             the upper punch carries 5 % of its largest load (before, the bed's own weight is a \
+             large part of the stresses): K = σ_r / ((P_upper + P_lower)/2), the radial stress \
+             σ_r = F_n/(2π R_d H) (the wall's normal force over its area beside the compact of \
+             height H) over the mean punch pressure, the compact's radial-to-axial stress ratio \
+             averaged over its height (an instrumented die reads σ_r at one sensor and often \
+             divides it by P_upper: summary.json's final_die_wall.radial_to_upper); and \
+             |F_z|/F_n, the axial friction the wall holds over its normal force, which Coulomb's \
+             law keeps at or below the friction coefficient μ = {} (the black dashed line) and which \
+             reaches μ where every granule at the wall slides axially. The punches' forces \
+             balance as F_upper + W = F_lower + F_z, W the bed's weight, so (F_upper − \
+             F_lower)/F_n, the usual estimate from the punches, falls short of |F_z|/F_n by W/F_n.",
             summary
                 .material
                 .map_or("n/a".to_owned(), |m| num(Some(m.friction)))

@@ -466,7 +466,8 @@ impl SnapshotWriter {
                 &GRANULE_COLUMNS,
                 granule_rows(&centres, &granules, &contacts).into_iter(),
             )?;
-            write_network(&self.dir, k, &network_stats(k, strain, &contacts))?;
+            let mu = asm.params().contact.friction;
+            write_network(&self.dir, k, &network_stats(k, strain, mu, &contacts))?;
         }
         let entries: Vec<(Real, String)> = self.strains[..=k]
             .iter()
