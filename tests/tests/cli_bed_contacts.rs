@@ -188,7 +188,8 @@ fn the_contact_network_balances_the_inner_granules() {
             by_force > fabric && by_force > 1.0 / 3.0,
             "fabric {fabric}, by force {by_force}"
         );
-        // The strong pairs align with the axis, the weak ones across it.
+        // The strong pairs align with the axis more than 1/3 and more than
+        // the weak ones do.
         assert!(
             nz2_of(true) > 1.0 / 3.0 && nz2_of(false) < nz2_of(true),
             "strong {}, weak {}",

@@ -150,7 +150,7 @@ pub fn die_wall_summary(run: &BedRun, s: &BedSample) -> DieWallSummary {
     DieWallSummary {
         mean_strain: s.mean_strain,
         pressure_pa: pressure_pa.is_finite().then_some(pressure_pa),
-        mean_punch_pressure_pa: mean_punch_pressure(s),
+        mean_punch_pressure_pa: Some(mean_punch_pressure(s)).filter(|p| p.is_finite()),
         radial_to_axial: ratio(pressure_pa, mean_punch_pressure(s)),
         radial_to_upper: ratio(pressure_pa, s.upper_pressure_pa),
         friction_to_normal: ratio(s.die_friction_z_n.abs(), s.die_normal_force_n),
@@ -169,7 +169,7 @@ pub struct DieWallSummary {
     /// The mean of the two punches' pressures, Pa ([`mean_punch_pressure`]):
     /// the compact's axial stress averaged over its height, the divisor of
     /// `radial_to_axial`.
-    pub mean_punch_pressure_pa: Real,
+    pub mean_punch_pressure_pa: Option<Real>,
     /// That pressure over the mean of the two punches' pressures: the
     /// compact's radial-to-axial stress ratio, as an instrumented die
     /// measures it (Janssen's K).
@@ -1365,7 +1365,7 @@ mod tests {
         };
         let w = die_wall_summary(&run, &row);
         assert!((w.pressure_pa.unwrap() - 500.0).abs() < 1e-12);
-        assert_eq!(w.mean_punch_pressure_pa, 1000.0);
+        assert_eq!(w.mean_punch_pressure_pa, Some(1000.0));
         assert!((w.radial_to_axial.unwrap() - 0.5).abs() < 1e-15);
         assert!((w.radial_to_upper.unwrap() - 500.0 / 1200.0).abs() < 1e-15);
         assert!((w.friction_to_normal.unwrap() - 40.0 / row.die_normal_force_n).abs() < 1e-15);
@@ -1380,10 +1380,21 @@ mod tests {
             (
                 unrecorded.pressure_pa,
                 unrecorded.radial_to_axial,
+                unrecorded.radial_to_upper,
                 unrecorded.friction_to_normal
             ),
-            (None, None, None)
+            (None, None, None, None)
         );
+        // The upper punch unloaded, the lower one not: no ratio to it.
+        let upper_free = die_wall_summary(
+            &run,
+            &BedSample {
+                upper_pressure_pa: 0.0,
+                ..row
+            },
+        );
+        assert_eq!(upper_free.radial_to_upper, None);
+        assert!((upper_free.radial_to_axial.unwrap() - 500.0 / 400.0).abs() < 1e-15);
         let unloaded = die_wall_summary(
             &run,
             &BedSample {

@@ -395,7 +395,7 @@ pub fn plots(
         .first()
         .zip(friction.last())
         .map(|(a, b)| [(a.0, mu), (b.0, mu)]);
-    let die_wall = [
+    let mut die_wall = vec![
         Series::new(
             "K: die-wall pressure / mean punch pressure",
             Mark::Line,
@@ -406,12 +406,15 @@ pub fn plots(
             Mark::DashedLine,
             friction.into_iter(),
         ),
-        Series::new(
+    ];
+    // No line (nor legend) without a known μ.
+    if let Some(limit) = limit.filter(|_| mu.is_finite()) {
+        die_wall.push(Series::new(
             "friction coefficient μ",
             Mark::Dashed,
-            limit.into_iter().flatten(),
-        ),
-    ];
+            limit.into_iter(),
+        ));
+    }
     let [
         pressure_f,
         kawakita_f,

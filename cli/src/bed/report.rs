@@ -377,7 +377,8 @@ fn key_results(summary: &Summary<'_>) -> String {
         ),
         (
             "die wall at the end: radial pressure σ_r, kPa; K = σ_r over the mean punch pressure \
-             (kPa); σ_r over the upper punch's; the wall's mobilised friction |F_z|/F_n"
+             (that pressure in kPa); σ_r over the upper punch's; the wall's mobilised friction \
+             |F_z|/F_n"
                 .to_owned(),
             {
                 let w = &summary.final_die_wall;
@@ -385,7 +386,7 @@ fn key_results(summary: &Summary<'_>) -> String {
                     "{}; {} (of {}); {}; {}",
                     kpa(w.pressure_pa),
                     num(w.radial_to_axial),
-                    kpa(Some(w.mean_punch_pressure_pa)),
+                    kpa(w.mean_punch_pressure_pa),
                     num(w.radial_to_upper),
                     num(w.friction_to_normal)
                 )

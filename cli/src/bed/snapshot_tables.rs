@@ -63,7 +63,7 @@ pub const CONTACT_COLUMNS: [(&str, &str); 13] = [
     ),
     (
         "slipping",
-        "the most node constraints at their friction cap μF_n in any one sweep of the step (a count of nodes, which can exceed constraints; a pair slides as a whole only when its friction_force_n reaches μ normal_force_n)",
+        "the most node constraints at their friction cap μF_n in any one sweep of the step (can exceed constraints, which counts the first sweep only; a pair slides as a whole only when its friction_force_n reaches μ normal_force_n)",
     ),
     (
         "branch_x_m",
