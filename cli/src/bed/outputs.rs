@@ -122,14 +122,16 @@ pub const COMPRESSION_COLUMNS: [(&str, &str); 32] = [
     ),
 ];
 
-/// The granules' packing fraction of a row: their envelope volume over
-/// the die volume below the upper punch, D / (Σ solid / Σ V) — the solid
-/// fraction D without the pores inside the granules, the fraction Arzt's
-/// coordination law and the pour's packing fraction are written in (not
-/// finite if the granules' volumes are not, which `summary.json` writes
-/// as null).
-pub fn packing_fraction(run: &BedRun, s: &BedSample) -> Real {
-    bed_solid_fraction(run, s.strain) / s.relative_density_solid
+/// The granules' packing fraction of a row at `strain` (its own, or its
+/// interval's mean strain for an averaged quantity): their envelope volume
+/// over the die volume below the upper punch, D / (Σ solid / Σ V) — the
+/// solid fraction D without the pores inside the granules, the fraction
+/// Arzt's coordination law and the pour's packing fraction are written in
+/// (not finite if the granules' volumes are not, which `summary.json`
+/// writes as null). The granules' own density is the row's: it changes far
+/// more slowly than D.
+pub fn packing_fraction(run: &BedRun, s: &BedSample, strain: Real) -> Real {
+    bed_solid_fraction(run, strain) / s.relative_density_solid
 }
 
 /// The radial pressure on the die wall of a row, Pa: its die-wall normal
@@ -687,8 +689,8 @@ pub fn summary<'a>(scene: &'a Scene, run: &BedRun) -> Summary<'a> {
         initial_packing_fraction: run
             .samples
             .first()
-            .map_or(Real::NAN, |s| packing_fraction(run, s)),
-        final_packing_fraction: packing_fraction(run, &last),
+            .map_or(Real::NAN, |s| packing_fraction(run, s, s.strain)),
+        final_packing_fraction: packing_fraction(run, &last, last.strain),
         quasi_static_strains: {
             let judged = granbed_kernel::analysis::quasi_static::judged(&run.samples);
             judged

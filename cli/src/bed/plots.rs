@@ -34,8 +34,8 @@
 use std::path::Path;
 
 use super::outputs::{
-    DENSITY_LAYERS, DieWallSummary, HeckelSummary, KawakitaSummary, Summary, bed_solid_fraction,
-    die_wall_summary, final_height_m, heckel_rows, kawakita_doubts, upper_pressure,
+    DENSITY_LAYERS, DieWallSummary, HeckelSummary, KawakitaSummary, Summary, die_wall_summary,
+    final_height_m, heckel_rows, kawakita_doubts, packing_fraction, upper_pressure,
 };
 use super::run::{BedRun, BedSample};
 use crate::output::write_text;
@@ -372,11 +372,7 @@ pub fn plots(
     // row whose upper-punch pressure reaches 5 % of its largest: before,
     // the bed's own weight and the settling's impulses are a large part of
     // the stresses (rows where a ratio is not defined are left out too).
-    let loaded = 0.05
-        * samples
-            .iter()
-            .map(|s| s.upper_pressure_pa)
-            .fold(0.0, Real::max);
+    let loaded = 0.05 * summary.max_pressure_pa;
     let walls: Vec<(Real, DieWallSummary)> = samples
         .iter()
         .skip_while(|s| !(s.upper_pressure_pa >= loaded && loaded > 0.0))
@@ -437,7 +433,7 @@ pub fn plots(
     )];
     // Z is an interval average: its packing fraction is the one at the
     // interval's mean strain.
-    let packing = |s: &BedSample| bed_solid_fraction(run, s.mean_strain) / s.relative_density_solid;
+    let packing = |s: &BedSample| packing_fraction(run, s, s.mean_strain);
     let coordination_density: [(&str, Mark, Quantity); 2] = [
         ("granule pairs", Mark::Line, |s| s.coordination),
         ("with walls", Mark::DashedLine, |s| {
