@@ -63,7 +63,7 @@ pub const FILE_NAME: &str = "checkpoint.bin";
 /// 9: before the phase times, the die wall's normal impulse of the window
 /// in progress (f64), then each sample's die-wall normal force (one f64
 /// per sample, in order; no length: it is the samples'). Older files read
-/// both as NaN (not recorded).
+/// both as NaN (not recorded), the window's as 0 when it is empty.
 pub const VERSION: u32 = 9;
 /// The oldest version read.
 const OLDEST_VERSION: u32 = 2;
