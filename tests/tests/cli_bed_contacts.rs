@@ -8,7 +8,9 @@
 //! height is the table's granules averaged by layer, and the network's
 //! figures (`vtk/network_<k>.csv`, the summary's `contact_network`) are
 //! the contacts table's: a broad force distribution whose strong pairs
-//! align with the die axis.
+//! align with the die axis. The stress through the compact
+//! (`vtk/stress_<k>.csv`, the summary's `stress_by_height`) is what the
+//! walls read in the same step.
 
 mod common;
 
@@ -35,7 +37,7 @@ fn the_contact_network_balances_the_inner_granules() {
     // and of the final state at 0.15: k = 0, 1, 2. The one at C = 0 comes
     // before the first step, which detects the contacts: it has no tables.
     let last = 2;
-    for table in ["contacts", "granules", "network"] {
+    for table in ["contacts", "granules", "network", "stress"] {
         let path = dir.join(format!("vtk/{table}_0.csv"));
         assert!(!path.exists(), "{}", path.display());
     }
@@ -196,6 +198,7 @@ fn the_contact_network_balances_the_inner_granules() {
             nz2_of(true),
             nz2_of(false)
         );
+        stress_through_the_compact(&dir, &s, k);
         if k < last {
             continue;
         }
@@ -277,7 +280,7 @@ fn the_contact_network_balances_the_inner_granules() {
     // again: the tables of its end, which need a step's forces, stay as
     // the run left them.
     let tables = |k: usize| {
-        ["contacts", "granules", "network"]
+        ["contacts", "granules", "network", "stress"]
             .map(|t| std::fs::read(dir.join(format!("vtk/{t}_{k}.csv"))).unwrap())
     };
     let before = tables(last);
@@ -287,21 +290,94 @@ fn the_contact_network_balances_the_inner_granules() {
         tables(last) == before,
         "the resumed run changed the end's tables"
     );
-    assert_eq!(
-        summary(&dir)["contact_network"],
-        s["contact_network"],
-        "the resumed run's summary lost the network"
-    );
+    for field in ["contact_network", "stress_by_height"] {
+        assert_eq!(
+            summary(&dir)[field],
+            s[field],
+            "the resumed run's summary lost {field}"
+        );
+    }
     // A fresh run into the same directory removes the tables of snapshots
     // it does not reach.
     let mut argv = vec!["bed", "--quiet", "--out", dir.to_str().unwrap()];
     argv.extend_from_slice(&small_bed("100", "0.05"));
     assert_eq!(cli(&argv).code, 0);
     for k in 1..=last {
-        for table in ["contacts", "granules", "network"] {
+        for table in ["contacts", "granules", "network", "stress"] {
             let path = dir.join(format!("vtk/{table}_{k}.csv"));
             // k = 1 is now the final state at 0.05; k = 2 is gone.
             assert_eq!(path.is_file(), k == 1, "{}", path.display());
         }
     }
+}
+
+/// The stress profile of snapshot k (`vtk/stress_<k>.csv`, the summary's
+/// `stress_by_height[k − 1]`) against what the walls read in the same
+/// step: the elements' mean lateral stress is the die wall's pressure
+/// (the virial theorem; 1.5 % apart in this bed at C = 0.1 and 0.15), each
+/// layer's mean axial stress lies between the punches' pressures (the
+/// layers scatter by about 2 % of P_upper about the line between them;
+/// the bed's weight is allowed for), the die wall's friction leaves the
+/// upper half of the compact more loaded than the lower half, and the
+/// layers' solid fractions add up to the bed's, D0/(1 − C).
+fn stress_through_the_compact(dir: &std::path::Path, s: &serde_json::Value, k: usize) {
+    let t = Table::read(&dir.join(format!("vtk/stress_{k}.csv")));
+    assert_eq!(t.cells.len(), 10, "stress_{k}");
+    let (bottom, top) = (t.num("bottom"), t.num("top"));
+    for l in 0..10 {
+        assert_eq!(
+            (bottom[l], top[l]),
+            (l as f64 / 10.0, (l + 1) as f64 / 10.0)
+        );
+    }
+    let one = |n: &str| {
+        let v = t.num(n);
+        assert!(v.iter().all(|&x| x == v[0]), "{n} differs between rows");
+        v[0]
+    };
+    let strain = one("strain");
+    let height = number(s, "initial_bed_height_m") * (1.0 - strain);
+    assert!(
+        (one("height_m") / height - 1.0).abs() < 1e-3,
+        "H {}",
+        one("height_m")
+    );
+    let mean = |n: &str| t.num(n).iter().sum::<f64>() / 10.0;
+    let d = number(s, "initial_solid_fraction") / (1.0 - strain);
+    assert!(
+        (mean("solid_fraction") / d - 1.0).abs() < 2e-3,
+        "solid fraction {} against D {d}",
+        mean("solid_fraction")
+    );
+    let (up, low, wall, weight) = (
+        one("upper_punch_pa"),
+        one("lower_punch_pa"),
+        one("die_wall_pa"),
+        one("weight_pa"),
+    );
+    assert!(
+        weight > 0.0 && weight < 0.1 * up,
+        "weight {weight} Pa, P_upper {up}"
+    );
+    let lateral = mean("lateral_stress_pa");
+    assert!(
+        (lateral / wall - 1.0).abs() < 0.03,
+        "C = {strain}: mean lateral stress {lateral} Pa, die wall {wall} Pa"
+    );
+    let axial = t.num("axial_stress_pa");
+    let slack = weight + 0.05 * up;
+    for (l, a) in axial.iter().enumerate() {
+        assert!(
+            *a > low - slack && *a < up + slack,
+            "C = {strain} layer {l}: axial {a} Pa, punches {low} and {up} Pa"
+        );
+    }
+    let half = |r: core::ops::Range<usize>| axial[r].iter().sum::<f64>() / 5.0;
+    assert!(half(5..10) > half(0..5), "axial by layer {axial:?}");
+    let entry = &s["stress_by_height"][k - 1];
+    assert_eq!(number(entry, "strain"), strain);
+    assert_eq!(number(&entry["walls"], "die_wall_pa"), wall);
+    assert_eq!(number(entry, "mean_lateral_stress_pa"), lateral);
+    assert_eq!(number(entry, "lower_to_upper"), low / up);
+    assert_eq!(entry["layers"].as_array().unwrap().len(), 10);
 }

@@ -41,6 +41,7 @@ pub mod series;
 pub mod series_report;
 pub mod snapshot_tables;
 pub mod snapshots;
+pub mod stress_profile;
 
 pub use scene::{DEFAULT_SCENE, Scene};
 
@@ -76,6 +77,10 @@ Output, in --out DIR (created if missing):
                    (final_die_wall: radial pressure, radial-to-axial stress
                    ratio, mobilised friction |F_z|/F_n), the contact network
                    at each snapshot (contact_network, from vtk/network_<k>.csv),
+                   the stress through the compact at each snapshot: the
+                   elements' mean axial and lateral stress in ten layers
+                   beside the walls' pressures and Janssen's share
+                   (stress_by_height, from vtk/stress_<k>.csv),
                    the material (every
                    parameter), final strain,
                    max pressure, initial bed height, counts, wall time, ns per

@@ -14,9 +14,8 @@
 //! carry, and the axial component of the fabric tensor ⟨n ⊗ n⟩ of the
 //! branch directions n, by number and weighted by the force.
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
-use anyhow::Context as _;
 use granbed_kernel::Real;
 use serde::Serialize;
 
@@ -246,34 +245,12 @@ pub fn write_network(vtk_dir: &Path, k: usize, stats: &NetworkStats) -> anyhow::
 }
 
 /// Reads the network file of snapshot `snapshot`: its header must be
-/// [`NETWORK_COLUMNS`]' names and its one row numbers.
+/// [`NETWORK_COLUMNS`]' names and it must hold one row of numbers.
 fn read_network(snapshot: usize, path: &Path) -> anyhow::Result<NetworkStats> {
-    let text = std::fs::read_to_string(path)
-        .with_context(|| format!("cannot read `{}`", path.display()))?;
-    let mut lines = text.lines();
-    let header: Vec<&str> = lines.next().unwrap_or_default().split(',').collect();
-    let names = NETWORK_COLUMNS.map(|c| c.0);
-    anyhow::ensure!(
-        header == names,
-        "`{}`: the header is not {}",
-        path.display(),
-        names.join(",")
-    );
-    let cells: Vec<Real> = lines
-        .next()
-        .unwrap_or_default()
-        .split(',')
-        .map(str::parse)
-        .collect::<Result<_, _>>()
-        .with_context(|| format!("`{}`: a cell is not a number", path.display()))?;
-    let cells: [Real; 14] = cells.try_into().map_err(|_| {
-        anyhow::anyhow!(
-            "`{}`: not one row of {} cells",
-            path.display(),
-            NETWORK_COLUMNS.len()
-        )
-    })?;
-    Ok(NetworkStats::from_cells(snapshot, &cells))
+    match crate::csv::read_table(path, &NETWORK_COLUMNS)?[..] {
+        [cells] => Ok(NetworkStats::from_cells(snapshot, &cells)),
+        _ => anyhow::bail!("`{}`: not one row", path.display()),
+    }
 }
 
 /// The network files in `vtk_dir`, in the order of k (the snapshots'
@@ -281,20 +258,8 @@ fn read_network(snapshot: usize, path: &Path) -> anyhow::Result<NetworkStats> {
 /// could not be read was left out (a damaged file must not cost the run's
 /// other outputs). None if the folder is not there.
 pub fn read_all(vtk_dir: &Path) -> (Vec<NetworkStats>, Vec<String>) {
-    let Ok(entries) = std::fs::read_dir(vtk_dir) else {
-        return (Vec::new(), Vec::new());
-    };
-    let mut found: Vec<(usize, PathBuf)> = entries
-        .filter_map(Result::ok)
-        .filter_map(|e| {
-            let name = e.file_name().into_string().ok()?;
-            let k = super::snapshots::numbered(&name, "network_", ".csv")?;
-            Some((k, e.path()))
-        })
-        .collect();
-    found.sort_unstable();
     let (mut stats, mut left_out) = (Vec::new(), Vec::new());
-    for (k, path) in &found {
+    for (k, path) in &super::snapshots::numbered_files(vtk_dir, "network_", ".csv") {
         match read_network(*k, path) {
             Ok(s) => stats.push(s),
             Err(e) => left_out.push(format!("{e:#}; left out of contact_network")),

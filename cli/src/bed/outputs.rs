@@ -14,6 +14,7 @@ use serde::Serialize;
 use super::network::NetworkStats;
 use super::run::{BedRun, BedSample, GranuleAtEnd};
 use super::scene::Scene;
+use super::stress_profile::StressSummary;
 use crate::csv::{Field, write_table};
 use crate::output::{finite_ratio, write_json};
 use crate::progress::{StrainBar, draw_target, steps_per_second};
@@ -363,6 +364,10 @@ pub struct Summary<'a> {
     /// by [`write_all`], so a finished run resumed without a step keeps
     /// them; empty in a summary made without the files.
     pub contact_network: Vec<NetworkStats>,
+    /// The stress through the compact at each snapshot after a step, in
+    /// strain order (`vtk/stress_<k>.csv`, [`super::stress_profile`]):
+    /// read from those files by [`write_all`], like `contact_network`.
+    pub stress_by_height: Vec<StressSummary>,
     /// The granule material, every parameter (`None` if the scene's is
     /// invalid).
     pub material: Option<MaterialSummary>,
@@ -705,6 +710,7 @@ pub fn summary<'a>(scene: &'a Scene, run: &BedRun) -> Summary<'a> {
         },
         final_die_wall: die_wall_summary(run, &last),
         contact_network: Vec::new(),
+        stress_by_height: Vec::new(),
         material: material.map(MaterialSummary::from),
         yield_stress_pa: material.map_or(Real::NAN, |m| m.yield_stress_pa),
         eta0: material.map_or(Real::NAN, |m| m.eta0),
@@ -1049,6 +1055,14 @@ pub fn write_all(dir: &Path, scene: &Scene, run: &BedRun) -> anyhow::Result<()> 
     let mut summary = summary(scene, run);
     let (network, left_out) = super::network::read_all(&dir.join(super::snapshots::VTK_DIR));
     summary.contact_network = network;
+    summary.warnings.extend(left_out);
+    let (profiles, left_out) =
+        super::stress_profile::read_all(&dir.join(super::snapshots::VTK_DIR));
+    let mu = summary.material.as_ref().map(|m| m.friction);
+    summary.stress_by_height = profiles
+        .iter()
+        .map(|p| StressSummary::of(p, 0.5e-3 * scene.die_diameter_mm, mu))
+        .collect();
     summary.warnings.extend(left_out);
     write_json(&dir.join(SUMMARY_JSON), &summary)?;
     let svgs = super::plots::write_plots(dir, run, &summary)?;

@@ -47,7 +47,7 @@ use granbed_kernel::Real;
 pub const PLOTS_DIR: &str = "plots";
 
 /// The plot files, in the order [`write_plots`] writes them.
-pub const PLOT_FILES: [&str; 11] = [
+pub const PLOT_FILES: [&str; 12] = [
     "pressure_strain.svg",
     "kawakita.svg",
     "heckel.svg",
@@ -59,6 +59,7 @@ pub const PLOT_FILES: [&str; 11] = [
     "energy_strain.svg",
     "density_height.svg",
     "die_wall_strain.svg",
+    "stress_height.svg",
 ];
 
 /// The energy ledger's terms drawn by `energy_strain.svg`, J, with their
@@ -114,6 +115,57 @@ fn density_height_svg(run: &BedRun, summary: &Summary) -> anyhow::Result<String>
         "Granule density by height where the run ended",
         (
             "granule relative density η0 V0/V",
+            "height in the compact z/H",
+        ),
+        &series,
+        (false, true),
+    )
+}
+
+/// Points of Janssen's curve drawn for a profile: every twentieth of the
+/// height.
+const JANSSEN_POINTS: usize = 21;
+
+/// The axial stress by height at each snapshot with a stress profile
+/// (summary.json's `stress_by_height`), over the upper punch's pressure
+/// in the same step, at the layers' mid-heights; and Janssen's curve
+/// exp(−4μK (H − z)/D) for the last profile, from its own K and the
+/// wall's μ (none without a material or a finite ratio).
+fn stress_height_svg(summary: &Summary, die_radius_m: Real) -> anyhow::Result<String> {
+    let profiles = &summary.stress_by_height;
+    let mut series: Vec<Series> = profiles
+        .iter()
+        .map(|p| {
+            let up = p.walls.upper_punch_pa;
+            Series::new(
+                format!("C = {:.3}", p.strain),
+                Mark::Line,
+                p.layers
+                    .iter()
+                    .map(move |l| (l.axial_stress_pa / up, 0.5 * (l.bottom + l.top))),
+            )
+        })
+        .collect();
+    let mu = summary.material.map(|m| m.friction);
+    if let (Some(last), Some(mu)) = (profiles.last(), mu) {
+        let (k, h) = (last.lateral_to_axial, last.walls.height_m);
+        let janssen = (0..JANSSEN_POINTS).map(move |i| {
+            let z = i as Real / (JANSSEN_POINTS - 1) as Real;
+            let depth = (1.0 - z) * h;
+            ((-4.0 * mu * k * depth / (2.0 * die_radius_m)).exp(), z)
+        });
+        if janssen.clone().all(|(x, _)| x.is_finite()) {
+            series.push(Series::new(
+                format!("Janssen at C = {:.3} (its K, μ)", last.strain),
+                Mark::Dashed,
+                janssen,
+            ));
+        }
+    }
+    xy_svg_from(
+        "Axial stress through the compact",
+        (
+            "layer's mean axial stress −σzz / upper-punch pressure",
             "height in the compact z/H",
         ),
         &series,
@@ -423,6 +475,7 @@ pub fn plots(
         energy_f,
         density_height_f,
         die_wall_f,
+        stress_height_f,
     ] = PLOT_FILES;
     // Unlabelled: the title and axes say what the one curve is (no legend).
     let profile = [(
@@ -504,6 +557,10 @@ pub fn plots(
                 &die_wall,
                 true,
             )?,
+        ),
+        (
+            stress_height_f,
+            stress_height_svg(summary, 0.5e-3 * summary.scene.die_diameter_mm)?,
         ),
     ])
 }

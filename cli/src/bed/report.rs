@@ -13,6 +13,7 @@ use super::outputs::{COMPRESSION_COLUMNS, Summary};
 use super::scene::{DEFAULT_SCENE, Scene};
 use super::snapshot_tables::{CONTACT_COLUMNS, GRANULE_COLUMNS, contacts_file, granules_file};
 use super::snapshots::{PVD_FILE, VTK_DIR};
+use super::stress_profile::{STRESS_COLUMNS, stress_file};
 use crate::csv::Field;
 use crate::html::{
     Row, figure, fit_cell, glossary, html_escape, key_table, kpa, num, page_head, picture,
@@ -28,7 +29,7 @@ pub const REPORT_FILE: &str = "report.html";
 /// meaning; any other field follows (nested objects such as `kawakita` and
 /// `heckel` are flattened to `kawakita.<field>`; the scene, `scene` and
 /// `scene_toml`, is shown as TOML instead).
-const FIELDS: [(&str, &str); 97] = [
+const FIELDS: [(&str, &str); 98] = [
     ("kawakita_a", "Kawakita a (limiting strain)"),
     ("kawakita_inv_b_pa", "Kawakita 1/b, Pa"),
     (
@@ -292,6 +293,8 @@ const FIELDS: [(&str, &str); 97] = [
     ("final_density_by_height", ""),
     // Its own table, "The contact network".
     ("contact_network", ""),
+    // Its own table, "The stress through the compact".
+    ("stress_by_height", ""),
 ];
 
 /// The summary's fields as rows, in [`FIELDS`]' order, then the others;
@@ -500,6 +503,62 @@ fn contact_network(summary: &Summary<'_>) -> String {
     h
 }
 
+/// The stress through the compact at each snapshot
+/// (`summary.stress_by_height`): per snapshot the walls' pressures and
+/// the elements' mean stresses they must match, and Janssen's share of
+/// the load beside the punches' (the layers themselves are in the files
+/// and the plot). Nothing if the run has none.
+fn stress_by_height(summary: &Summary<'_>) -> String {
+    if summary.stress_by_height.is_empty() {
+        return String::new();
+    }
+    let mut h = String::from(
+        "<h3>The stress through the compact</h3>\n<p>At each snapshot after a step, from \
+         its elements' stresses averaged over the compact between the punches (the room \
+         between the granules counting unstressed: the powder's stress as a load cell reads \
+         it; vtk/stress_&lt;k&gt;.csv has it in ten layers, plotted in stress_height.svg), \
+         beside what the walls read in the same step. At rest the two must agree (the virial \
+         theorem: ∫σ dV is the sum of x ⊗ f over the forces on the compact's boundary): the \
+         mean lateral stress −(σ<sub>xx</sub> + σ<sub>yy</sub>)/2 is the die wall's pressure \
+         F<sub>n</sub>/(2π R<sub>d</sub> H), and the mean axial stress lies between the \
+         punches' pressures (the die wall's friction takes the load down from the upper \
+         punch to the lower; the bed's weight adds its share downwards). K is the elements' \
+         lateral over axial mean stress; Janssen's share exp(−4μK H/D) is what would reach \
+         the lower punch if K were the same at every height and the wall's friction μ fully \
+         mobilised.</p>\n<table>\n<tr><th>C</th><th>H, mm</th><th>P_upper, kPa</th>\
+         <th>P_lower, kPa</th><th>mean axial stress, kPa</th><th>die-wall pressure (wall \
+         forces), kPa</th><th>mean lateral stress (elements), kPa</th><th>K</th>\
+         <th>P_lower / P_upper</th><th>Janssen's share</th><th>weight / die area, kPa</th>\
+         </tr>\n",
+    );
+    for s in &summary.stress_by_height {
+        let w = s.walls;
+        let _ = writeln!(
+            h,
+            "<tr><td class=\"num\">{}</td><td class=\"num\">{}</td>{}<td class=\"num\">{}</td>\
+             <td class=\"num\">{}</td><td class=\"num\">{}</td>\
+             <td class=\"num\">{}</td></tr>",
+            num(Some(s.strain)),
+            num(Some(w.height_m * 1e3)),
+            [
+                w.upper_punch_pa,
+                w.lower_punch_pa,
+                s.mean_axial_stress_pa,
+                w.die_wall_pa,
+                s.mean_lateral_stress_pa,
+            ]
+            .map(|p| format!("<td class=\"num\">{}</td>", kpa(Some(p))))
+            .concat(),
+            num(Some(s.lateral_to_axial)),
+            num(Some(s.lower_to_upper)),
+            num(s.janssen_lower_to_upper),
+            kpa(Some(w.weight_pa)),
+        );
+    }
+    h.push_str("</table>\n");
+    h
+}
+
 /// A table cell's text: an integer as is, a float rounded as the report's
 /// other figures ([`num`]).
 fn field_text(cell: Field) -> String {
@@ -538,6 +597,13 @@ fn glossaries() -> String {
         "Beside snapshot k: its contact network in figures, one row from contacts_<k>.csv \
          (the report's table \"The contact network\").",
         &NETWORK_COLUMNS,
+    ));
+    h.push_str(&glossary(
+        "vtk/stress_<k>.csv",
+        "Beside snapshot k: the stress through the compact, one row per layer of a tenth of \
+         its height, bottom first, with the walls' readings in the snapshot's step repeated \
+         on every row (the report's table \"The stress through the compact\").",
+        &STRESS_COLUMNS,
     ));
     h
 }
@@ -623,6 +689,18 @@ fn plot_caption(name: &str, summary: &Summary<'_>) -> Option<String> {
                 .material
                 .map_or("n/a".to_owned(), |m| num(Some(m.friction)))
         ),
+        "stress_height.svg" => "The axial stress through the compact at each snapshot after a \
+             step: each tenth of the compact's height, its elements' mean axial stress −σ_zz \
+             over the whole layer (vtk/stress_<k>.csv) divided by the upper punch's pressure in \
+             the same step, at the layer's mid-height (0: the lower punch, 1: the upper one). \
+             The die wall's friction takes the load down on its way to the lower punch, so the \
+             curves lean towards smaller stresses at the bottom; the layers at the punches hold \
+             fewer granules (a flat punch leaves gaps between spheres). The dashed line is \
+             Janssen's exp(−4μK (H − z)/D) for the last snapshot, from its K (the elements' \
+             lateral over axial mean stress, table \"The stress through the compact\") and the \
+             wall's friction coefficient μ: the fall if K were the same at every height and \
+             every granule at the wall slid."
+            .to_owned(),
         "energy_strain.svg" => "Where the punch's work went, totals so far against the strain \
              (compression.csv's energy columns): the elastic energy stored in the \
              granules, the plastic dissipation, the contact losses (friction and the \
@@ -664,6 +742,7 @@ pub fn report_html(
     h.push_str(&key_results(summary));
     h.push_str(&fits_by_window(summary));
     h.push_str(&contact_network(summary));
+    h.push_str(&stress_by_height(summary));
     writeln!(
         h,
         "<p>Files: <a href=\"compression.csv\">compression.csv</a>, \
@@ -737,25 +816,20 @@ pub struct SnapshotFiles {
 /// The snapshots' files in `dir`/[`VTK_DIR`] (`section_<k>.svg` and the
 /// tables of the same k), in the order of k (the snapshots' strain order).
 fn snapshot_files(dir: &Path) -> Vec<SnapshotFiles> {
-    let Ok(entries) = std::fs::read_dir(dir.join(VTK_DIR)) else {
-        return Vec::new();
-    };
-    let mut ks: Vec<usize> = entries
-        .filter_map(Result::ok)
-        .filter_map(|e| {
-            let name = e.file_name().into_string().ok()?;
-            super::snapshots::numbered(&name, "section_", ".svg")
-        })
-        .collect();
-    ks.sort_unstable();
-    ks.into_iter()
-        .map(|k| SnapshotFiles {
+    super::snapshots::numbered_files(&dir.join(VTK_DIR), "section_", ".svg")
+        .into_iter()
+        .map(|(k, _)| SnapshotFiles {
             section: format!("{VTK_DIR}/{}", super::snapshots::section_file(k)),
-            tables: [contacts_file(k), granules_file(k), network_file(k)]
-                .into_iter()
-                .filter(|name| dir.join(VTK_DIR).join(name).is_file())
-                .map(|name| format!("{VTK_DIR}/{name}"))
-                .collect(),
+            tables: [
+                contacts_file(k),
+                granules_file(k),
+                network_file(k),
+                stress_file(k),
+            ]
+            .into_iter()
+            .filter(|name| dir.join(VTK_DIR).join(name).is_file())
+            .map(|name| format!("{VTK_DIR}/{name}"))
+            .collect(),
         })
         .collect()
 }

@@ -33,6 +33,7 @@ use super::snapshot_tables::{
     CONTACT_COLUMNS, ContactRow, GRANULE_COLUMNS, centres_of_mass, contact_rows, contacts_file,
     granule_rows, granules_file,
 };
+use super::stress_profile::{WallReadings, stress_profile, write_profile};
 use crate::assembly::Assembly;
 use crate::csv::write_table;
 use crate::model::OwnedReference;
@@ -98,6 +99,13 @@ pub struct ElementFields {
     /// The element's relative density η0/J (J its current / reference
     /// volume).
     pub relative_density: Vec<Real>,
+    /// Lateral stress −(σ_xx + σ_yy)/2 across the punches' axis, Pa,
+    /// positive in compression: the mean of the radial and hoop stresses.
+    pub lateral_stress_pa: Vec<Real>,
+    /// The element's current volume J V0, m³.
+    pub volume_m3: Vec<Real>,
+    /// Height of the element's centre (the mean of its nodes' z), m.
+    pub height_m: Vec<Real>,
 }
 
 /// The pressure −tr σ/3 and von Mises stress √(3/2)‖dev σ‖ of a Cauchy
@@ -143,12 +151,18 @@ pub fn element_fields(asm: &Assembly<'_>, mesh: &OwnedReference) -> ElementField
         })
         .collect();
     let mut f = ElementFields::default();
-    for o in per_granule.iter().flatten() {
-        let (p, q) = pressure_and_von_mises(&o.sigma);
-        f.pressure_pa.push(p);
-        f.von_mises_pa.push(q);
-        f.axial_stress_pa.push(-o.sigma[2]);
-        f.relative_density.push(eta0 / o.j);
+    for (g, out) in asm.granules().iter().zip(&per_granule) {
+        for ((o, hex), reference) in out.iter().zip(&mesh.hexes).zip(&mesh.elements) {
+            let (p, q) = pressure_and_von_mises(&o.sigma);
+            f.pressure_pa.push(p);
+            f.von_mises_pa.push(q);
+            f.axial_stress_pa.push(-o.sigma[2]);
+            f.relative_density.push(eta0 / o.j);
+            f.lateral_stress_pa.push(-0.5 * (o.sigma[0] + o.sigma[1]));
+            f.volume_m3.push(o.j * reference.volume);
+            f.height_m
+                .push(hex.iter().map(|&n| g.x[n as usize][2]).sum::<Real>() / 8.0);
+        }
     }
     f
 }
@@ -320,15 +334,26 @@ pub fn numbered(name: &str, prefix: &str, suffix: &str) -> Option<usize> {
     k.parse().ok()
 }
 
-/// What the section picture of `asm` at `strain` shows: the granules'
-/// positions, the mesh, the axial stress of `elements`, the die's radius
-/// and the upper punch's height (from the walls).
-fn section_input<'a>(
-    asm: &'a Assembly<'_>,
-    mesh: &'a OwnedReference,
-    elements: &'a ElementFields,
-    strain: Real,
-) -> SectionInput<'a> {
+/// The files `<prefix><k><suffix>` in `dir` ([`numbered`]), in the order
+/// of k; none if the folder is not there.
+pub fn numbered_files(dir: &Path, prefix: &str, suffix: &str) -> Vec<(usize, PathBuf)> {
+    let Ok(entries) = std::fs::read_dir(dir) else {
+        return Vec::new();
+    };
+    let mut found: Vec<(usize, PathBuf)> = entries
+        .filter_map(Result::ok)
+        .filter_map(|e| {
+            let name = e.file_name().into_string().ok()?;
+            Some((numbered(&name, prefix, suffix)?, e.path()))
+        })
+        .collect();
+    found.sort_unstable();
+    found
+}
+
+/// The die's radius and the upper punch's height of `asm`, m (from its
+/// walls; NaN and 0 for a scene without them).
+pub fn die_geometry(asm: &Assembly<'_>) -> (Real, Real) {
     use granbed_kernel::contact::wall::Wall;
     let (mut die_radius_m, mut upper_z_m) = (Real::NAN, 0.0);
     for wall in asm.walls() {
@@ -339,6 +364,38 @@ fn section_input<'a>(
             Wall::Plane(_) => {}
         }
     }
+    (die_radius_m, upper_z_m)
+}
+
+/// What the walls of `asm` (granules meshed as `mesh`) read in its last
+/// step, as pressures on the compact between its punches.
+pub fn wall_readings(asm: &Assembly<'_>, mesh: &OwnedReference) -> WallReadings {
+    use crate::assembly::die::wall_index::{DIE, LOWER, UPPER};
+    let (die_radius_m, height_m) = die_geometry(asm);
+    let area = core::f64::consts::PI * die_radius_m * die_radius_m;
+    let walls = &asm.last().walls;
+    let params = asm.params();
+    let granule_volume: Real = mesh.elements.iter().map(|e| e.volume).sum();
+    let mass = asm.granules().len() as Real * params.material.density0 * granule_volume;
+    WallReadings {
+        height_m,
+        upper_punch_pa: walls[UPPER].normal / area,
+        lower_punch_pa: walls[LOWER].normal / area,
+        die_wall_pa: walls[DIE].normal / (2.0 * core::f64::consts::PI * die_radius_m * height_m),
+        weight_pa: mass * params.gravity_m_s2 / area,
+    }
+}
+
+/// What the section picture of `asm` at `strain` shows: the granules'
+/// positions, the mesh, the axial stress of `elements`, the die's radius
+/// and the upper punch's height (from the walls).
+fn section_input<'a>(
+    asm: &'a Assembly<'_>,
+    mesh: &'a OwnedReference,
+    elements: &'a ElementFields,
+    strain: Real,
+) -> SectionInput<'a> {
+    let (die_radius_m, upper_z_m) = die_geometry(asm);
     SectionInput {
         granules: asm.granules().iter().map(|g| g.x.as_slice()).collect(),
         hexes: &mesh.hexes,
@@ -355,8 +412,7 @@ fn section_input<'a>(
 
 /// Removes the snapshots an earlier run left in `out`/[`VTK_DIR`]
 /// (`bed_<k>.vtu`, `section_<k>.svg`, `contacts_<k>.csv`, `granules_<k>.csv`,
-/// `network_<k>.csv` and
-/// [`PVD_FILE`]; nothing else), so that a fresh run
+/// `network_<k>.csv`, `stress_<k>.csv` and [`PVD_FILE`]; nothing else), so that a fresh run
 /// into the same directory does not leave stale snapshots beside its own
 /// (e.g. of strains it does not reach). Returns how many files went.
 pub fn remove_old(out: &Path) -> anyhow::Result<usize> {
@@ -373,7 +429,8 @@ pub fn remove_old(out: &Path) -> anyhow::Result<usize> {
             || numbered(name, "section_", ".svg").is_some()
             || numbered(name, "contacts_", ".csv").is_some()
             || numbered(name, "granules_", ".csv").is_some()
-            || numbered(name, "network_", ".csv").is_some();
+            || numbered(name, "network_", ".csv").is_some()
+            || numbered(name, "stress_", ".csv").is_some();
         if (snapshot || name == PVD_FILE) && entry.path().is_file() {
             std::fs::remove_file(entry.path())
                 .with_context(|| format!("cannot remove `{}`", entry.path().display()))?;
@@ -468,6 +525,10 @@ impl SnapshotWriter {
             )?;
             let mu = asm.params().contact.friction;
             write_network(&self.dir, k, &network_stats(k, strain, mu, &contacts))?;
+            let (die_radius_m, _) = die_geometry(asm);
+            let profile =
+                stress_profile(k, strain, &elements, die_radius_m, wall_readings(asm, mesh));
+            write_profile(&self.dir, &profile)?;
         }
         let entries: Vec<(Real, String)> = self.strains[..=k]
             .iter()
