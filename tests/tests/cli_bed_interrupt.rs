@@ -66,17 +66,23 @@ fn fnv1a(bytes: &[u8]) -> u64 {
     })
 }
 
-/// Rewrites the format-9 checkpoint of `samples` output rows in `dir` as
-/// format 6: without the die wall's normal forces of format 9 (one float
-/// for the window, one per row) and the trailing phase times and counters
-/// of format 7 (a length-prefixed list of 3 floats, then 7 u64s), version
-/// 6, the checksum of the shorter payload. (Format 8 differs from 7 only in
+/// Rewrites the format-10 checkpoint of `samples` output rows in `dir`,
+/// which holds no withdrawal, as format 6: without format 10's unloading
+/// flag (the last u64, 0), the die wall's normal forces of format 9 (one
+/// float for the window, one per row) and the phase times and counters of
+/// format 7 (a length-prefixed list of 3 floats, then 7 u64s), version 6,
+/// the checksum of the shorter payload. (Format 8 differs from 7 only in
 /// the side values of watches, which the reader takes in any version.)
 fn downgrade_to_format_6(dir: &Path, samples: usize) {
     let path = dir.join(FILE_NAME);
     let bytes = std::fs::read(&path).unwrap();
-    assert_eq!(u32::from_le_bytes(bytes[16..20].try_into().unwrap()), 9);
-    let payload = &bytes[36..bytes.len() - (8 + 3 * 8 + 7 * 8) - 8 * (1 + samples)];
+    assert_eq!(u32::from_le_bytes(bytes[16..20].try_into().unwrap()), 10);
+    assert_eq!(
+        bytes[bytes.len() - 8..],
+        [0; 8],
+        "a checkpoint without a withdrawal"
+    );
+    let payload = &bytes[36..bytes.len() - 8 - (8 + 3 * 8 + 7 * 8) - 8 * (1 + samples)];
     let mut out = bytes[..16].to_vec();
     out.extend_from_slice(&6u32.to_le_bytes());
     out.extend_from_slice(&(payload.len() as u64).to_le_bytes());
@@ -245,7 +251,11 @@ fn an_interrupted_run_keeps_its_work_and_resumes_to_the_same_bits() {
     // cost figures; a --strain below the strain reached says so too.
     let r = bed(&["--resume", whole_s]);
     assert_eq!(r.code, 0, "{}", r.stderr);
-    assert!(r.stderr.contains("no step to take"), "{}", r.stderr);
+    assert!(
+        r.stderr.contains("no step of the loading to take"),
+        "{}",
+        r.stderr
+    );
     let again = summary(&whole);
     for key in COUNTED {
         assert_eq!(again[key], whole_summary[key], "{key}");

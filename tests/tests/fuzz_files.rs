@@ -258,16 +258,22 @@ fn edited_words(ck: &Checkpoint, edit: impl Fn(&mut Checkpoint)) -> (Vec<usize>,
     (words, before)
 }
 
-/// Bytes at the end of a format-7 payload that older formats lack: the
+/// Bytes near the end of a format-7 payload that older formats lack: the
 /// phase times (a length-prefixed list of 3 floats) and 7 counters.
 const COUNTER_BYTES: usize = 8 + 3 * 8 + 7 * 8;
 
-/// The offsets of the 8-byte words of the counters at the end of the
-/// checkpoint file `bytes` (cut from every older format).
+/// The offset of format 10's last word in the checkpoint file `bytes` of
+/// a run without a withdrawal: its unloading flag, 0 (cut from every older
+/// format).
+fn unloading_word(bytes: &[u8]) -> usize {
+    bytes.len() - 8
+}
+
+/// The offsets of the 8-byte words of the counters before the unloading
+/// flag of the checkpoint file `bytes` (cut from formats before 7).
 fn counter_words(bytes: &[u8]) -> Vec<usize> {
-    (bytes.len() - COUNTER_BYTES..bytes.len())
-        .step_by(8)
-        .collect()
+    let end = unloading_word(bytes);
+    (end - COUNTER_BYTES..end).step_by(8).collect()
 }
 
 /// `x` with its sign and lowest mantissa bit flipped: it differs from `x`
@@ -294,7 +300,8 @@ fn older(bytes: &[u8], cut: &[usize], version: u32) -> Vec<u8> {
     b
 }
 
-/// Checkpoints of older formats still read: version 8 (before the die
+/// Checkpoints of older formats still read: version 9 (before the
+/// upper punch's withdrawal) with none; version 8 (before the die
 /// wall's normal forces) with those NaN (not recorded); and without the
 /// phase times and counters of version 7 (counted from the checkpoint's
 /// step) and the die forces: version 4 (before the
@@ -306,7 +313,7 @@ fn older(bytes: &[u8], cut: &[usize], version: u32) -> Vec<u8> {
 /// are made from this build's own: two checkpoints of one state that
 /// differ only in a field differ only in its words, which are cut out.
 #[test]
-fn versions_2_to_8_checkpoints_read_with_the_fields_they_lack_at_their_defaults() {
+fn versions_2_to_9_checkpoints_read_with_the_fields_they_lack_at_their_defaults() {
     let (dir, _) = base_checkpoint();
     let mut ck = read(dir).unwrap();
     for g in &mut ck.state.granules {
@@ -381,19 +388,29 @@ fn versions_2_to_8_checkpoints_read_with_the_fields_they_lack_at_their_defaults(
         old
     };
     let counters = counter_words(&bytes);
+    let unloading = unloading_word(&bytes);
+    assert_eq!(bytes[unloading..], [0; 8], "no withdrawal: flag 0");
     let cut_of = |parts: &[&Vec<usize>]| {
         let mut cut: Vec<usize> = parts
             .iter()
             .flat_map(|p| p.iter().copied())
             .chain(counters.iter().copied())
             .chain(die.iter().copied())
+            .chain([unloading])
             .collect();
         cut.sort_unstable();
         cut
     };
 
+    // Version 9: all but the unloading flag.
+    let v9 = older(&bytes, &[unloading], 9);
+    let v9_read = read(&write_checkpoint("version9", &v9))
+        .unwrap_or_else(|e| panic!("a version 9 checkpoint reads: {e}"));
+    assert_eq!(v9_read, ck, "version 9 reads as the same state");
+
     // Version 8: all but the die-wall forces (the counters are kept).
     let mut v8_cut = die.clone();
+    v8_cut.push(unloading);
     v8_cut.sort_unstable();
     let v8 = older(&bytes, &v8_cut, 8);
     let mut v8_read = read(&write_checkpoint("version8", &v8))
@@ -418,7 +435,8 @@ fn versions_2_to_8_checkpoints_read_with_the_fields_they_lack_at_their_defaults(
     let mut begun = ck.clone();
     begun.progress.window.time = 1e-4;
     begun.progress.window.die_normal = 0.5;
-    let (die_begun, begun_bytes) = edited_words(&begun, flip_die);
+    let (mut die_begun, begun_bytes) = edited_words(&begun, flip_die);
+    die_begun.push(unloading_word(&begun_bytes));
     let v8_begun = older(&begun_bytes, &die_begun, 8);
     let read_begun = read(&write_checkpoint("version8_begun", &v8_begun)).unwrap();
     assert_eq!(read_begun.progress.window.time, 1e-4);
@@ -449,6 +467,49 @@ fn versions_2_to_8_checkpoints_read_with_the_fields_they_lack_at_their_defaults(
     // The same bytes labelled version 3 lack the flags: refused.
     v2[16..20].copy_from_slice(&3u32.to_le_bytes());
     read(&write_checkpoint("version2as3", &v2)).expect_err("flags missing");
+}
+
+/// A checkpoint with a withdrawal (format 10) reads back to the same
+/// rows, lift-off and wall time, the rows' mean strains continuing from
+/// the loading's last row; a flag other than 0 or 1 is refused by name.
+#[test]
+fn a_withdrawal_in_a_checkpoint_reads_back() {
+    use granbed_cli::bed::run::{Unloading, set_mean_strains_after};
+    let (dir, _) = base_checkpoint();
+    let mut ck = read(dir).unwrap();
+    let last = *ck.progress.samples.last().unwrap();
+    let mut rows: Vec<_> = [1, 2]
+        .map(|k| granbed_cli::bed::run::BedSample {
+            strain: last.strain - 1e-4 * f64::from(k),
+            steps: last.steps + 10 * u64::from(k as u8),
+            upper_force_n: 1.0 / f64::from(k),
+            die_normal_force_n: 0.25 * f64::from(k),
+            ..last
+        })
+        .to_vec();
+    set_mean_strains_after(Some(&last), &mut rows);
+    assert!(rows[0].mean_strain < last.strain && rows[0].mean_strain > rows[0].strain);
+    ck.progress.unloading = Some(Unloading {
+        samples: rows,
+        lift_off_strain: last.strain - 1.5e-4,
+        wall_time_s: 0.25,
+        cut_short: None,
+    });
+    let d = common::fresh_dir("fuzz_files", "withdrawal");
+    std::fs::create_dir_all(&d).unwrap();
+    ck.write(&d).unwrap();
+    assert_eq!(read(&d).unwrap(), ck);
+    // The flag is the word after the counters, where a file without a
+    // withdrawal ends; 1 here: make it 2.
+    let (_, without) = base_checkpoint();
+    let flag = without.len() - 8;
+    let mut bytes = std::fs::read(d.join(FILE_NAME)).unwrap();
+    assert_eq!(bytes[flag..flag + 8], 1u64.to_le_bytes());
+    bytes[flag] = 2;
+    let sum = fnv1a(&bytes[36..]);
+    bytes[28..36].copy_from_slice(&sum.to_le_bytes());
+    let e = read(&write_checkpoint("withdrawal_flag", &bytes)).unwrap_err();
+    assert!(e.contains("unknown unloading flag 2"), "{e}");
 }
 
 /// The payload property below only resumes the mutants that decode; this

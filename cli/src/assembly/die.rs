@@ -86,6 +86,12 @@ impl DieScene {
         self.punch_speed_m_s * t / self.bed_height_m
     }
 
+    /// The nominal axial strain (H0 − H)/H0 with the upper punch at height
+    /// `upper_z_m` (the lower one at 0): the strain of a punch withdrawing.
+    pub fn strain_at_height(&self, upper_z_m: Real) -> Real {
+        (self.bed_height_m - upper_z_m) / self.bed_height_m
+    }
+
     /// Time at which the axial strain reaches `strain`, s.
     pub fn time_of_strain(&self, strain: Real) -> Real {
         strain * self.bed_height_m / self.punch_speed_m_s

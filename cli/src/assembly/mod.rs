@@ -1005,6 +1005,33 @@ impl<'m> Assembly<'m> {
     pub fn undeformed_step(&self) -> Real {
         self.undeformed_step
     }
+
+    /// Sets [`AssemblyParams::exact_contact_from_s`] to `time_s` (∞: the
+    /// held constraints and the search interval apply from the next step
+    /// on; a search renews what is held, so the steps after an exact one
+    /// hold what it found).
+    pub fn set_exact_contact_from(&mut self, time_s: Real) {
+        self.params.exact_contact_from_s = time_s;
+    }
+
+    /// From now on, the plane wall `index` moves back against its inward
+    /// normal at `speed_m_s` (> 0) from where it is, and never stops: a
+    /// punch withdrawing. The walls' work then falls by what the bed pushes
+    /// it back with (`Energies::punch_work`). False (nothing changed) if
+    /// `index` is not a plane wall.
+    pub fn withdraw_wall(&mut self, index: usize, speed_m_s: Real) -> bool {
+        let time = self.time;
+        let Some(spec) = self.walls.get_mut(index) else {
+            return false;
+        };
+        let Wall::Plane(mut plane) = spec.at(time) else {
+            return false;
+        };
+        // at(t) = offset + (−speed) t: the offset now at t = time.
+        plane.offset += speed_m_s * time;
+        *spec = WallSpec::moving(Wall::Plane(plane), -speed_m_s, Real::INFINITY);
+        true
+    }
 }
 
 /// Sets a granule's masses to `base` × `factor` (for `factor` = 1 exactly

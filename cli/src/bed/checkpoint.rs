@@ -15,7 +15,7 @@ use granbed_kernel::Real;
 use granbed_kernel::contact::broad::{Bound, GranulePair};
 use granbed_kernel::contact::pair::{Constraint, Side};
 
-use super::run::{BedSample, Window, set_mean_strains};
+use super::run::{BedSample, Unloading, Window, set_mean_strains, set_mean_strains_after};
 use crate::assembly::die::DieScene;
 use crate::assembly::{AssemblyState, Energies, GranuleState, PhaseTimes};
 
@@ -64,7 +64,13 @@ pub const FILE_NAME: &str = "checkpoint.bin";
 /// in progress (f64), then each sample's die-wall normal force (one f64
 /// per sample, in order; no length: it is the samples'). Older files read
 /// both as NaN (not recorded), the window's as 0 when it is empty.
-pub const VERSION: u32 = 9;
+///
+/// 10: the payload ends with the upper punch's withdrawal after the final
+/// strain (scene `unload`): a flag (u64, 0: none), then with 1 its rows
+/// (as the samples, then each one's die-wall normal force, one f64 per
+/// row), its lift-off strain (f64, NaN: none) and its wall time (f64).
+/// Older files hold none: a finished run resumed with `unload` runs it.
+pub const VERSION: u32 = 10;
 /// The oldest version read.
 const OLDEST_VERSION: u32 = 2;
 /// Floats per held constraint: side (0: A, 1: B; plus 2 for a watch),
@@ -101,6 +107,9 @@ pub struct Progress {
     /// The step the counters count from: 0 unless the run went through a
     /// checkpoint older than format 7 (then that checkpoint's step).
     pub counters_from_step: u64,
+    /// The withdrawal of a finished run (format 10; the state is still
+    /// that of the loading's end).
+    pub unloading: Option<Unloading>,
 }
 
 /// A checkpoint: progress and assembly state.
@@ -421,6 +430,18 @@ impl Checkpoint {
         ] {
             e.u64(n);
         }
+        match &p.unloading {
+            None => e.u64(0),
+            Some(u) => {
+                e.u64(1);
+                e.vecs(&u.samples.iter().map(sample_to).collect::<Vec<_>>());
+                for sample in &u.samples {
+                    e.f64(sample.die_normal_force_n);
+                }
+                e.f64(u.lift_off_strain);
+                e.f64(u.wall_time_s);
+            }
+        }
         e.0
     }
 
@@ -575,6 +596,31 @@ impl Checkpoint {
                 (counters, n[6])
             }
         };
+        let unloading = match version {
+            2..=9 => None,
+            _ => match d.u64()? {
+                0 => None,
+                1 => {
+                    let mut rows: Vec<BedSample> = d
+                        .vecs::<SAMPLE_FLOATS>()?
+                        .into_iter()
+                        .map(sample_from)
+                        .collect();
+                    for row in &mut rows {
+                        row.die_normal_force_n = d.f64()?;
+                    }
+                    // The rows' mean strains continue from the loading's.
+                    set_mean_strains_after(samples.last(), &mut rows);
+                    Some(Unloading {
+                        samples: rows,
+                        lift_off_strain: d.f64()?,
+                        wall_time_s: d.f64()?,
+                        cut_short: None,
+                    })
+                }
+                other => bail!("unknown unloading flag {other}"),
+            },
+        };
         if !d.0.is_empty() {
             bail!("checkpoint has {} bytes after its end", d.0.len());
         }
@@ -602,6 +648,7 @@ impl Checkpoint {
                 snapshots_done,
                 counters,
                 counters_from_step,
+                unloading,
             },
             state: AssemblyState {
                 time: t[0],

@@ -42,6 +42,7 @@ pub mod series_report;
 pub mod snapshot_tables;
 pub mod snapshots;
 pub mod stress_profile;
+pub mod unloading;
 
 pub use scene::{DEFAULT_SCENE, Scene};
 
@@ -58,6 +59,11 @@ Output, in --out DIR (created if missing):
                    (granule solid volume / (die area x H0 (1 - C)); Heckel:
                    ln(1/(1 - D)) against the pressure), mean Heywood coefficient
                    (d_V and nominal d), min Jacobian, steps, energies
+  unloading.csv    (scene unload, on in the published scene) the same columns
+                   while the upper punch withdraws after the final strain at
+                   the punch speed, a row every tenth of the output interval,
+                   strain falling, until its force falls below 1 % of its
+                   largest (lift-off; at most 0.15 of strain)
   summary.json     the scene (and scene_toml, exact: --scene reads it),
                    Kawakita fit (a, 1/b, R^2, points; over the rows
                    with mean_strain >= kawakita_min_strain, 0.25, each
@@ -80,7 +86,11 @@ Output, in --out DIR (created if missing):
                    the stress through the compact at each snapshot: the
                    elements' mean axial and lateral stress in ten layers
                    beside the walls' pressures and Janssen's share
-                   (stress_by_height, from vtk/stress_<k>.csv),
+                   (stress_by_height, from vtk/stress_<k>.csv), the
+                   withdrawal (unloading: lift-off strain, in-die elastic
+                   recovery, residual die-wall and lower-punch pressure,
+                   the punches' work, the work given back, net work and
+                   plasticity factor net / punch work),
                    the material (every
                    parameter), final strain,
                    max pressure, initial bed height, counts, wall time, ns per
@@ -292,6 +302,13 @@ pub struct BedArgs {
     /// (0 ≤ κ ≤ 1).
     #[arg(long, value_name = "KAPPA", allow_negative_numbers = true)]
     pub hourglass_kappa: Option<f64>,
+
+    /// Override: after the final strain the upper punch withdraws at the
+    /// same speed until it comes free of the bed, for the unloading curve
+    /// and the in-die elastic recovery (true, the default) or the run ends
+    /// at the final strain (false).
+    #[arg(long, value_name = "BOOL")]
+    pub unload: Option<bool>,
 
     /// Override: granules are rigid bodies, without element work, until
     /// their first contact (true, the default) or finite-element bodies
@@ -608,6 +625,7 @@ impl BedArgs {
         set!(mass_scaling, "--mass-scaling");
         set!(selective_mass_scaling, "--selective-mass-scaling");
         set!(selective_mass_ratio, "--selective-mass-ratio");
+        set!(unload, "--unload");
         set!(rigid_until_touched, "--rigid-until-touched");
         set!(local_sweeps, "--local-sweeps");
         set!(hold_constraints, "--hold-constraints");
@@ -724,11 +742,19 @@ impl BedArgs {
             let reached = c.progress.die.strain_at(c.state.time);
             // The run loop's own test: no step once the time is reached.
             if c.state.time >= c.progress.die.time_of_strain(scene.final_strain) {
+                let withdrawal = match (scene.unload, &c.progress.unloading) {
+                    (true, None) => {
+                        "; the upper punch's withdrawal after it, which the checkpoint does not \
+                         hold, runs now"
+                    }
+                    (false, _) => " (without the withdrawal: scene unload = false)",
+                    (true, Some(_)) => "",
+                };
                 writeln!(
                     streams.stderr,
                     "note: the run in `{}` is already at C = {reached:.4}, at or past the final \
-                     strain {}: no step to take; its outputs are written again from the \
-                     checkpoint (a larger --strain continues it)",
+                     strain {}: no step of the loading to take; its outputs are written again \
+                     from the checkpoint (a larger --strain continues it){withdrawal}",
                     out.display(),
                     scene.final_strain
                 )?;
@@ -848,8 +874,10 @@ impl BedArgs {
         result: &mut run::BedRun,
         streams: &mut Streams<'_>,
     ) -> anyhow::Result<()> {
+        // The loading's curve is compared: the twin does not unload.
         let slow = Scene {
             punch_speed_m_s: 0.5 * scene.punch_speed_m_s,
+            unload: false,
             ..scene.clone()
         };
         let dir = out.join(HALF_SPEED_DIR);

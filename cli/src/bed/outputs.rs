@@ -15,6 +15,7 @@ use super::network::NetworkStats;
 use super::run::{BedRun, BedSample, GranuleAtEnd};
 use super::scene::Scene;
 use super::stress_profile::StressSummary;
+use super::unloading::{UNLOADING_CSV, UnloadingSummary};
 use crate::csv::{Field, write_table};
 use crate::output::{finite_ratio, write_json};
 use crate::progress::{StrainBar, draw_target, steps_per_second};
@@ -368,6 +369,10 @@ pub struct Summary<'a> {
     /// strain order (`vtk/stress_<k>.csv`, [`super::stress_profile`]):
     /// read from those files by [`write_all`], like `contact_network`.
     pub stress_by_height: Vec<StressSummary>,
+    /// The upper punch's withdrawal after the final strain (scene
+    /// `unload`; `None` without one): elastic recovery, residual die-wall
+    /// pressure, the work of the cycle.
+    pub unloading: Option<UnloadingSummary>,
     /// The granule material, every parameter (`None` if the scene's is
     /// invalid).
     pub material: Option<MaterialSummary>,
@@ -677,6 +682,7 @@ pub fn summary<'a>(scene: &'a Scene, run: &BedRun) -> Summary<'a> {
     if let Some(w) = not_quasi_static(scene, run, &certificate) {
         warnings.push(w);
     }
+    warnings.extend(run.unloading.as_ref().and_then(super::unloading::warning));
     Summary {
         version: env!("CARGO_PKG_VERSION"),
         scene,
@@ -711,6 +717,7 @@ pub fn summary<'a>(scene: &'a Scene, run: &BedRun) -> Summary<'a> {
         final_die_wall: die_wall_summary(run, &last),
         contact_network: Vec::new(),
         stress_by_height: Vec::new(),
+        unloading: run.unloading.as_ref().map(|u| UnloadingSummary::of(run, u)),
         material: material.map(MaterialSummary::from),
         yield_stress_pa: material.map_or(Real::NAN, |m| m.yield_stress_pa),
         eta0: material.map_or(Real::NAN, |m| m.eta0),
@@ -1052,6 +1059,18 @@ pub fn write_all(dir: &Path, scene: &Scene, run: &BedRun) -> anyhow::Result<()> 
         &COMPRESSION_COLUMNS,
         run.samples.iter().map(|s| row(s, run)),
     )?;
+    let unloading_csv = dir.join(UNLOADING_CSV);
+    match &run.unloading {
+        Some(u) => write_table(
+            &unloading_csv,
+            &COMPRESSION_COLUMNS,
+            u.samples.iter().map(|s| row(s, run)),
+        )?,
+        // A run without one leaves none from an earlier run in `dir`.
+        None if unloading_csv.is_file() => std::fs::remove_file(&unloading_csv)
+            .map_err(|e| anyhow::anyhow!("cannot remove `{}`: {e}", unloading_csv.display()))?,
+        None => {}
+    }
     let mut summary = summary(scene, run);
     let (network, left_out) = super::network::read_all(&dir.join(super::snapshots::VTK_DIR));
     summary.contact_network = network;

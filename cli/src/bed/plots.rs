@@ -388,14 +388,31 @@ pub fn plots(
 ) -> anyhow::Result<[(&'static str, String); PLOT_FILES.len()]> {
     let samples = &run.samples[..];
     const C: &str = "axial strain C = (H0 - H)/H0";
-    let pressure = against_strain(
+    let mut pressure = against_strain(
         samples,
         strain_of(true),
         [
             ("upper punch", |s| s.upper_pressure_pa * 1e-3),
             ("lower punch", |s| s.lower_pressure_pa * 1e-3),
         ],
-    );
+    )
+    .into_iter()
+    .collect::<Vec<_>>();
+    // The withdrawal after the final strain, from the turn on.
+    if let Some(u) = &run.unloading {
+        let turn = samples
+            .last()
+            .map(|s| (s.mean_strain, s.upper_pressure_pa * 1e-3));
+        pressure.push(Series::new(
+            "upper punch, withdrawing",
+            Mark::Line,
+            turn.into_iter().chain(
+                u.samples
+                    .iter()
+                    .map(|s| (s.mean_strain, s.upper_pressure_pa * 1e-3)),
+            ),
+        ));
+    }
     let coordination = against_strain(
         samples,
         strain_of(true),

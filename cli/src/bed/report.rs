@@ -29,7 +29,7 @@ pub const REPORT_FILE: &str = "report.html";
 /// meaning; any other field follows (nested objects such as `kawakita` and
 /// `heckel` are flattened to `kawakita.<field>`; the scene, `scene` and
 /// `scene_toml`, is shown as TOML instead).
-const FIELDS: [(&str, &str); 98] = [
+const FIELDS: [(&str, &str); 111] = [
     ("kawakita_a", "Kawakita a (limiting strain)"),
     ("kawakita_inv_b_pa", "Kawakita 1/b, Pa"),
     (
@@ -152,6 +152,52 @@ const FIELDS: [(&str, &str); 98] = [
         "final_die_wall.friction_to_normal",
         "|die-wall friction| / die-wall normal force at the end (Coulomb: at most μ)",
     ),
+    (
+        "unloading",
+        "the upper punch's withdrawal after the final strain: none (scene unload = false, or the run did not reach its final strain)",
+    ),
+    (
+        "unloading.rows",
+        "rows of the upper punch's withdrawal after the final strain (unloading.csv)",
+    ),
+    (
+        "unloading.from_strain",
+        "strain the punch withdrew from (the loading's last row)",
+    ),
+    (
+        "unloading.lift_off_strain",
+        "strain where the punch came free (its force below 1 % of its largest)",
+    ),
+    (
+        "unloading.elastic_recovery",
+        "in-die elastic recovery (H_lift − H_min)/H_min",
+    ),
+    (
+        "unloading.residual_die_wall_pressure_pa",
+        "die-wall pressure at lift-off, Pa",
+    ),
+    (
+        "unloading.residual_lower_pressure_pa",
+        "lower-punch pressure at lift-off, Pa",
+    ),
+    (
+        "unloading.loading_work_j",
+        "the punches' work up to the final strain, J",
+    ),
+    (
+        "unloading.returned_work_j",
+        "work the bed gave back to the withdrawing punch (the elastic work), J",
+    ),
+    ("unloading.net_work_j", "loading work − work given back, J"),
+    (
+        "unloading.plasticity_factor",
+        "plasticity factor net / (net + given back) (Stamm and Mathis)",
+    ),
+    (
+        "unloading.elastic_energy_at_end_j",
+        "granules' elastic energy at the final strain, J: the most the bed can give back",
+    ),
+    ("unloading.wall_time_s", "wall time of the withdrawal, s"),
     (
         "quasi_static.passed",
         "quasi-static certificate passed (every figure below its limit)",
@@ -396,6 +442,26 @@ fn key_results(summary: &Summary<'_>) -> String {
             },
         ),
         (
+            format!(
+                "unloading: in-die elastic recovery (H_lift − H_min)/H_min, the punch free below \
+                 {} % of its largest force; die-wall pressure left, kPa; work given back / the \
+                 punch's work; plasticity factor (net / punch work)",
+                100.0 * crate::bed::run::LIFT_OFF_FORCE_FRACTION
+            ),
+            match &summary.unloading {
+                None => "n/a (scene unload = false, or the run did not reach its final strain)"
+                    .to_owned(),
+                Some(u) => format!(
+                    "{}; {}; {} J / {} J; {}",
+                    num(u.elastic_recovery),
+                    kpa(u.residual_die_wall_pressure_pa),
+                    num(Some(u.returned_work_j)),
+                    num(Some(u.loading_work_j)),
+                    num(u.plasticity_factor)
+                ),
+            },
+        ),
+        (
             "coordination number Z at the end (averaged over the last output interval)".to_owned(),
             num(Some(summary.final_coordination)),
         ),
@@ -619,7 +685,10 @@ fn plot_caption(name: &str, summary: &Summary<'_>) -> Option<String> {
              at the interval's mean strain. Early on \
              the lower punch carries the bed's weight and takes the impulses of its settling, so \
              its pressure lies above the upper one's; later the die wall's friction keeps it \
-             below."
+             below. Where the scene unloads, the upper punch then withdraws at the same speed \
+             (unloading.csv) until its force falls below 1 % of its largest: the steep curve back \
+             from the turn, below the loading curve (the work the bed dissipated it does not give \
+             back)."
                 .to_owned()
         }
         "kawakita.svg" => format!(

@@ -14,6 +14,7 @@ use granbed_kernel::analysis::bed::{
     GranuleShape, bed_density, coordination_number, coordination_number_with_walls, granule_shape,
     surface_geometry,
 };
+use granbed_kernel::analysis::quasi_static::ImposedCompression;
 use granbed_kernel::dem::pour::{PourError, PourParams, PourStatus};
 
 use super::checkpoint::{self, Checkpoint};
@@ -136,10 +137,140 @@ pub fn interval_mean_strain(previous: Option<(Real, u64)>, strain: Real, steps: 
 /// Sets every sample's [`BedSample::mean_strain`] from its own and the
 /// previous sample's strain and steps ([`interval_mean_strain`]).
 pub fn set_mean_strains(samples: &mut [BedSample]) {
-    let mut previous = None;
+    set_mean_strains_after(None, samples);
+}
+
+/// [`set_mean_strains`] for rows that follow the row `after` (the
+/// withdrawal's after the loading's last).
+pub fn set_mean_strains_after(after: Option<&BedSample>, samples: &mut [BedSample]) {
+    let mut previous = after.map(|s| (s.strain, s.steps));
     for s in samples {
         s.mean_strain = interval_mean_strain(previous, s.strain, s.steps);
         previous = Some((s.strain, s.steps));
+    }
+}
+
+/// Output rows per output interval (`output_strain_interval`) while the
+/// upper punch withdraws: the unloading takes a small fraction of the
+/// loading's strain, so its curve needs closer rows.
+pub const UNLOADING_ROWS_PER_INTERVAL: u32 = 10;
+
+/// How far the upper punch withdraws at most, as nominal axial strain
+/// (and never past the strain it pressed to): a bed of soft granules
+/// recovers several per cent of its height (the published B2, yield strain
+/// σ_y/E = 3 %: about 7 % of H_min from C = 0.3 in the small bed of
+/// `tests/cli_bed_unloading.rs`); a bed that still pushes the punch after
+/// this much is reported as not come free.
+pub const MAX_WITHDRAWAL_STRAIN: Real = 0.15;
+
+/// The upper punch counts as free of the bed once its force, averaged over
+/// an output row's interval, is below this fraction of the largest it
+/// carried while pressing (a compaction simulator's force resolution).
+/// The bed lets go slowly: its granules' contacts soften as they unload,
+/// so the force has a long tail towards zero (the small bed of
+/// `tests/cli_bed_unloading.rs`: 1 % of the largest force 5 % of strain
+/// after the turn, not 0 by then).
+pub const LIFT_OFF_FORCE_FRACTION: Real = 0.01;
+
+/// What the upper punch's withdrawal after the final strain recorded
+/// (scene `unload`).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Unloading {
+    /// Output rows after the final strain's row, strain falling; the last
+    /// the first whose upper-punch force is below
+    /// [`LIFT_OFF_FORCE_FRACTION`] of the loading's largest (lift-off).
+    pub samples: Vec<BedSample>,
+    /// The nominal strain where the upper punch came free of the bed: where
+    /// its force crossed [`LIFT_OFF_FORCE_FRACTION`] of the loading's
+    /// largest, linear between the two rows' mean strains; NaN if it had
+    /// not when the withdrawal stopped.
+    pub lift_off_strain: Real,
+    /// Wall time of the withdrawal, s.
+    pub wall_time_s: f64,
+    /// Why the withdrawal stopped before lift-off or its limit (an
+    /// interrupt, a failed step); `None` if it completed. A withdrawal cut
+    /// short is not kept in the checkpoint: a resume runs it again.
+    pub cut_short: Option<String>,
+}
+
+/// A row of the averaging window `w` that ends at `strain` with the
+/// punches at `imposed`, after the row `previous`.
+type SampleOf<'a> = dyn Fn(&mut Assembly<'_>, &Window, Option<&BedSample>, Real, ImposedCompression) -> BedSample
+    + 'a;
+
+/// Withdraws the upper punch of `asm`, which has just pressed the bed to
+/// the last of the rows `loading`, at the punch speed, with a row every
+/// 1/[`UNLOADING_ROWS_PER_INTERVAL`] of the scene's output interval, until
+/// a row's upper-punch force falls below [`LIFT_OFF_FORCE_FRACTION`] of
+/// the loading's largest (lift-off), or the punch has withdrawn
+/// [`MAX_WITHDRAWAL_STRAIN`], or `interrupt` is set, or a step fails.
+fn withdraw(
+    asm: &mut Assembly<'_>,
+    die: &DieScene,
+    scene: &Scene,
+    loading: &[BedSample],
+    interrupt: Option<&AtomicBool>,
+    sample: &SampleOf<'_>,
+) -> Unloading {
+    let at_end = loading.last().copied().unwrap_or_default();
+    let free_below_n =
+        LIFT_OFF_FORCE_FRACTION * loading.iter().map(|s| s.upper_force_n).fold(0.0, Real::max);
+    let start = Instant::now();
+    let speed = die.punch_speed_m_s;
+    asm.withdraw_wall(wall_index::UPPER, speed);
+    let interval = scene.output_strain_interval / Real::from(UNLOADING_ROWS_PER_INTERVAL);
+    let limit = at_end.strain - MAX_WITHDRAWAL_STRAIN.min(at_end.strain);
+    let mut next = at_end.strain - interval;
+    let (mut window, mut previous) = (Window::new(), at_end);
+    let (mut samples, mut lift_off_strain, mut cut_short) = (Vec::new(), Real::NAN, None);
+    loop {
+        if let Err(e) = asm.step() {
+            cut_short = Some(format!("a step failed: {e}"));
+            break;
+        }
+        window.add_step(asm);
+        let upper_z_m = super::snapshots::die_geometry(asm).1;
+        let strain = die.strain_at_height(upper_z_m);
+        // The scene's exact contact holds from a strain on: a withdrawal
+        // back below it returns to the held constraints (a time-based
+        // switch would keep it on for the whole withdrawal).
+        if strain < scene.exact_contact_from_strain {
+            asm.set_exact_contact_from(Real::INFINITY);
+        }
+        if strain <= next + 1e-12 || strain <= limit {
+            let imposed = ImposedCompression {
+                lower_z_m: 0.0,
+                lower_velocity_m_s: 0.0,
+                upper_z_m,
+                upper_velocity_m_s: speed,
+            };
+            let s = sample(asm, &window, Some(&previous), strain, imposed);
+            samples.push(s);
+            window = Window::new();
+            while next >= strain - 1e-12 {
+                next -= interval;
+            }
+            if s.upper_force_n < free_below_n {
+                let (f0, f1) = (previous.upper_force_n, s.upper_force_n);
+                let t = (f0 - free_below_n) / (f0 - f1);
+                lift_off_strain = previous.mean_strain + t * (s.mean_strain - previous.mean_strain);
+                break;
+            }
+            if strain <= limit {
+                break;
+            }
+            previous = s;
+        }
+        if interrupt.is_some_and(|f| f.load(Ordering::SeqCst)) {
+            cut_short = Some(format!("interrupted at C = {strain:.4}"));
+            break;
+        }
+    }
+    Unloading {
+        samples,
+        lift_off_strain,
+        wall_time_s: start.elapsed().as_secs_f64(),
+        cut_short,
     }
 }
 
@@ -212,6 +343,11 @@ pub struct BedRun {
     /// Each granule where the run ended, in granule order (empty for a run
     /// stopped by an error: its last state is no state to show).
     pub final_granules: Vec<GranuleAtEnd>,
+    /// The upper punch's withdrawal after the final strain (scene
+    /// `unload`; `None` for a run that did not reach its final strain).
+    /// The run's other figures (the steps, timings, the final state) are
+    /// those of the loading.
+    pub unloading: Option<Unloading>,
 }
 
 /// A granule where a run ended.
@@ -283,6 +419,7 @@ impl BedRun {
             added_mass: Default::default(),
             hidden_overlap: None,
             final_granules: Vec::new(),
+            unloading: None,
         }
     }
 }
@@ -334,6 +471,31 @@ pub struct Window {
     pub min_j: Real,
     /// Largest nodal speed, m/s.
     pub max_speed: Real,
+}
+
+impl Window {
+    /// An empty window.
+    pub fn new() -> Self {
+        Self {
+            min_j: Real::INFINITY,
+            ..Self::default()
+        }
+    }
+
+    /// Adds the step `asm` has just taken.
+    fn add_step(&mut self, asm: &Assembly<'_>) {
+        let last = asm.last();
+        let dt = last.dt;
+        self.time += dt;
+        self.impulse[0] += last.walls[wall_index::UPPER].normal * dt;
+        self.impulse[1] += last.walls[wall_index::LOWER].normal * dt;
+        self.impulse[2] += last.walls[wall_index::DIE].tangential[2] * dt;
+        self.die_normal += last.walls[wall_index::DIE].normal * dt;
+        self.pairs += asm.contact().pairs_in_contact() as Real * dt;
+        self.walls += last.wall_contacts as Real * dt;
+        self.min_j = self.min_j.min(last.min_j);
+        self.max_speed = self.max_speed.max(last.max_node_speed_m_s);
+    }
 }
 
 /// Bed geometry from every granule's current surface (physics.md §7.5–6):
@@ -608,11 +770,16 @@ pub fn run_bed(
     let wall_before = resumed.map_or(0.0, |c| c.progress.compression_wall_time_s);
     let start = Instant::now();
     let wall = || wall_before + start.elapsed().as_secs_f64();
-    let sample = |asm: &mut Assembly<'_>, w: &Window, previous: Option<&BedSample>| {
+    // A row of the window `w` that ends at `strain` with the punches at
+    // `imposed` (pressing in, or the upper one withdrawing).
+    let sample = |asm: &mut Assembly<'_>,
+                  w: &Window,
+                  previous: Option<&BedSample>,
+                  strain: Real,
+                  imposed: ImposedCompression| {
         let [rho, rho_solid, a_dv, a_d] = geometry(asm, &mesh, eta0, d);
         asm.elastic_energy();
         let avg = |x: Real| if w.time > 0.0 { x / w.time } else { 0.0 };
-        let strain = die.strain_at(asm.time());
         BedSample {
             time_s: asm.time(),
             strain,
@@ -646,7 +813,7 @@ pub fn run_bed(
             penetration_m: asm.penetration().map_or(Real::NAN, |g| -g),
             steps: asm.steps(),
             energies: *asm.energies(),
-            kinetic_relative_j: asm.kinetic_relative_to(&die.imposed_at(asm.time())),
+            kinetic_relative_j: asm.kinetic_relative_to(&imposed),
         }
     };
     let mut snapshots: Vec<Real> = scene.snapshot_strains.clone();
@@ -661,13 +828,9 @@ pub fn run_bed(
             (p.samples.clone(), p.window, p.next_output, p.snapshots_done)
         }
         None => {
-            let first = sample(&mut asm, &Window::default(), None);
+            let first = sample(&mut asm, &Window::default(), None, 0.0, die.imposed_at(0.0));
             observer.sample(&first, 0.0);
-            let window = Window {
-                min_j: Real::INFINITY,
-                ..Window::default()
-            };
-            (vec![first], window, scene.output_strain_interval, 0)
+            (vec![first], Window::new(), scene.output_strain_interval, 0)
         }
     };
     while snapshots.get(snapshots_done).is_some_and(|&c| c <= 0.0) {
@@ -675,6 +838,11 @@ pub fn run_bed(
         snapshots_done += 1;
     }
     let dir = control.checkpoint_dir.as_deref();
+    // The withdrawal of a finished run resumed without a step: its
+    // checkpoints (rewritten for a changed scene) keep it.
+    let kept = resumed
+        .filter(|c| c.state.time >= die.time_of_strain(scene.final_strain))
+        .and_then(|c| c.progress.unloading.clone());
     let make =
         |asm: &Assembly<'_>, samples: &[BedSample], window: &Window, next: Real, done: usize| {
             Checkpoint {
@@ -689,6 +857,7 @@ pub fn run_bed(
                     snapshots_done: done,
                     counters: counters_before + asm.times(),
                     counters_from_step,
+                    unloading: kept.clone(),
                 },
                 state: asm.state(),
             }
@@ -713,17 +882,7 @@ pub fn run_bed(
             error = Some(e);
             break;
         }
-        let last = asm.last();
-        let dt = last.dt;
-        window.time += dt;
-        window.impulse[0] += last.walls[wall_index::UPPER].normal * dt;
-        window.impulse[1] += last.walls[wall_index::LOWER].normal * dt;
-        window.impulse[2] += last.walls[wall_index::DIE].tangential[2] * dt;
-        window.die_normal += last.walls[wall_index::DIE].normal * dt;
-        window.pairs += asm.contact().pairs_in_contact() as Real * dt;
-        window.walls += last.wall_contacts as Real * dt;
-        window.min_j = window.min_j.min(last.min_j);
-        window.max_speed = window.max_speed.max(last.max_node_speed_m_s);
+        window.add_step(&asm);
         let strain = die.strain_at(asm.time());
         while snapshots
             .get(snapshots_done)
@@ -733,13 +892,11 @@ pub fn run_bed(
             snapshots_done += 1;
         }
         if strain + 1e-12 >= next || asm.time() >= end {
-            let s = sample(&mut asm, &window, samples.last());
+            let imposed = die.imposed_at(asm.time());
+            let s = sample(&mut asm, &window, samples.last(), strain, imposed);
             observer.sample(&s, wall());
             samples.push(s);
-            window = Window {
-                min_j: Real::INFINITY,
-                ..Window::default()
-            };
+            window = Window::new();
             while next <= strain + 1e-12 {
                 next += scene.output_strain_interval;
             }
@@ -838,6 +995,32 @@ pub fn run_bed(
     };
     let steps = asm.steps();
     let strain_reached = die.strain_at(asm.time());
+    let phase_times = counters_before + asm.times();
+    // The withdrawal, after every figure of the loading is taken. A
+    // finished run resumed without a step keeps its checkpoint's; else
+    // the checkpoint of the loading's end is written again with it, so
+    // that `--resume --strain` still continues the loading.
+    let finished = error.is_none() && !stopped && !interrupted && asm.time() >= end;
+    let added_mass = AddedMass::of(&asm);
+    let unloading = match (finished && scene.unload, kept.clone(), samples.last()) {
+        (true, Some(kept), _) => Some(kept),
+        (true, None, Some(_)) => {
+            // One copy of the state at a time: the loading's is done with.
+            drop(last_good.take());
+            let at_end_checkpoint =
+                dir.map(|_| make(&asm, &samples, &window, next, snapshots_done));
+            let u = withdraw(&mut asm, &die, scene, &samples, control.interrupt, &sample);
+            if let (Some(dir), Some(mut c)) = (dir, at_end_checkpoint)
+                && u.cut_short.is_none()
+            {
+                c.progress.unloading = Some(u.clone());
+                c.write(dir)?;
+            }
+            interrupted |= control.interrupt.is_some_and(|f| f.load(Ordering::SeqCst));
+            Some(u)
+        }
+        _ => None,
+    };
     Ok(BedRun {
         samples,
         bed_height_m: die.bed_height_m,
@@ -850,7 +1033,7 @@ pub fn run_bed(
         element_steps: steps * (scene.granules * mesh.hexes.len()) as u64,
         pour_wall_time_s,
         wall_time_s,
-        phase_times: counters_before + asm.times(),
+        phase_times,
         counters_from_step,
         solid_volume_m3,
         threads: rayon::current_num_threads(),
@@ -861,9 +1044,10 @@ pub fn run_bed(
         error,
         checkpoint_strain,
         rate_change_rel: None,
-        added_mass: AddedMass::of(&asm),
+        added_mass,
         hidden_overlap,
         final_granules,
+        unloading,
     })
 }
 

@@ -89,6 +89,12 @@ final_strain = 0.3
 output_strain_interval = 0.005
 # VTU snapshots of the granules at these strains (vtk/ in the output).
 snapshot_strains = [0.0, 0.1, 0.2, 0.3]
+# After the final strain the upper punch withdraws at the same speed until it
+# comes free of the bed: the unloading curve (unloading.csv), the in-die
+# elastic recovery, the die wall's residual pressure and the work the bed gives
+# back. false (the value of scene files without this field): the run ends at
+# the final strain.
+unload = true
 
 # Checkpoints (checkpoint.bin in the output) every this many minutes of wall
 # time and every this much strain; resume with granbed-cli bed --resume DIR.
@@ -288,6 +294,11 @@ pub struct Scene {
     /// final strain lowered by `--strain` they are not written).
     #[serde(default)]
     pub snapshot_strains: Vec<f64>,
+    /// After the final strain, the upper punch withdraws at the same speed
+    /// until it comes free of the bed (absent: false, the run ends at the
+    /// final strain; the published scene's is true).
+    #[serde(default)]
+    pub unload: bool,
     /// Wall time between checkpoints, minutes (> 0).
     pub checkpoint_interval_minutes: f64,
     /// Strain between checkpoints (> 0).

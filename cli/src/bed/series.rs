@@ -306,6 +306,7 @@ fn single_run_files(dir: &Path) -> Vec<PathBuf> {
     let mut files = vec![
         dir.join(checkpoint::FILE_NAME),
         dir.join(outputs::COMPRESSION_CSV),
+        dir.join(super::unloading::UNLOADING_CSV),
         dir.join(outputs::SUMMARY_JSON),
         dir.join(report::REPORT_FILE),
     ];

@@ -143,6 +143,8 @@ fn scene_for(args: &WorkPrecisionArgs, size: &Size, setting: &Setting, seed: u64
         punch_speed_m_s: published.punch_speed_m_s * setting.speed_factor,
         final_strain: args.strain.unwrap_or(size.strain),
         snapshot_strains: Vec::new(),
+        // The study measures the loading.
+        unload: false,
         checkpoint_interval_minutes: 1e9,
         checkpoint_strain_interval: 1e9,
         element: setting.element_name().to_string(),

