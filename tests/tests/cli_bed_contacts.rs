@@ -198,7 +198,7 @@ fn the_contact_network_balances_the_inner_granules() {
             nz2_of(true),
             nz2_of(false)
         );
-        stress_through_the_compact(&dir, &s, k);
+        stress_through_the_compact(&dir, &s, k, k == last);
         if k < last {
             continue;
         }
@@ -316,11 +316,19 @@ fn the_contact_network_balances_the_inner_granules() {
 /// step: the elements' mean lateral stress is the die wall's pressure
 /// (the virial theorem; 1.5 % apart in this bed at C = 0.1 and 0.15), each
 /// layer's mean axial stress lies between the punches' pressures (the
-/// layers scatter by about 2 % of P_upper about the line between them;
-/// the bed's weight is allowed for), the die wall's friction leaves the
-/// upper half of the compact more loaded than the lower half, and the
-/// layers' solid fractions add up to the bed's, D0/(1 − C).
-fn stress_through_the_compact(dir: &std::path::Path, s: &serde_json::Value, k: usize) {
+/// layers scatter by up to 2 % of P_upper about the line between them;
+/// the bed's weight is allowed for), as does the compact's mean; at the
+/// last snapshot (`loaded`: the load well above the bed's weight) the die
+/// wall's friction leaves the upper half of the compact more loaded than
+/// the lower half; the layers' solid fractions add up to the bed's,
+/// D0/(1 − C); and the summary's figures are the file's, Janssen's share
+/// recomputed from its K, μ and H/D.
+fn stress_through_the_compact(
+    dir: &std::path::Path,
+    s: &serde_json::Value,
+    k: usize,
+    loaded: bool,
+) {
     let t = Table::read(&dir.join(format!("vtk/stress_{k}.csv")));
     assert_eq!(t.cells.len(), 10, "stress_{k}");
     let (bottom, top) = (t.num("bottom"), t.num("top"));
@@ -345,7 +353,7 @@ fn stress_through_the_compact(dir: &std::path::Path, s: &serde_json::Value, k: u
     let mean = |n: &str| t.num(n).iter().sum::<f64>() / 10.0;
     let d = number(s, "initial_solid_fraction") / (1.0 - strain);
     assert!(
-        (mean("solid_fraction") / d - 1.0).abs() < 2e-3,
+        (mean("solid_fraction") / d - 1.0).abs() < 2e-4,
         "solid fraction {} against D {d}",
         mean("solid_fraction")
     );
@@ -365,16 +373,28 @@ fn stress_through_the_compact(dir: &std::path::Path, s: &serde_json::Value, k: u
         "C = {strain}: mean lateral stress {lateral} Pa, die wall {wall} Pa"
     );
     let axial = t.num("axial_stress_pa");
-    let slack = weight + 0.05 * up;
+    let slack = weight + 0.03 * up;
     for (l, a) in axial.iter().enumerate() {
         assert!(
             *a > low - slack && *a < up + slack,
             "C = {strain} layer {l}: axial {a} Pa, punches {low} and {up} Pa"
         );
     }
+    let compact = mean("axial_stress_pa");
+    assert!(
+        compact > low - weight && compact < up + weight,
+        "C = {strain}: mean axial {compact} Pa, punches {low} and {up} Pa"
+    );
     let half = |r: core::ops::Range<usize>| axial[r].iter().sum::<f64>() / 5.0;
-    assert!(half(5..10) > half(0..5), "axial by layer {axial:?}");
+    assert!(
+        !loaded || half(5..10) > half(0..5),
+        "axial by layer {axial:?}"
+    );
     let entry = &s["stress_by_height"][k - 1];
+    assert_eq!(number(entry, "mean_axial_stress_pa"), compact);
+    let (mu, diameter) = (number(&s["material"], "friction"), 5e-3);
+    let janssen = (-4.0 * mu * (lateral / compact) * one("height_m") / diameter).exp();
+    assert!((number(entry, "janssen_lower_to_upper") / janssen - 1.0).abs() < 1e-12);
     assert_eq!(number(entry, "strain"), strain);
     assert_eq!(number(&entry["walls"], "die_wall_pa"), wall);
     assert_eq!(number(entry, "mean_lateral_stress_pa"), lateral);

@@ -523,8 +523,9 @@ fn a_checkpoint_with_a_nudged_float_decodes_and_resumes() {
     let payload = &bytes[36..];
     let resumed = (1..=64).find_map(|k| {
         let mut p = payload.to_vec();
-        // Before the counters (a nudged counter only moves a cost figure).
-        let at = p.len().checked_sub(COUNTER_BYTES + 8 * k)?;
+        // Before the counters (a nudged counter only moves a cost figure)
+        // and format 10's unloading flag (the last word).
+        let at = p.len().checked_sub(8 + COUNTER_BYTES + 8 * k)?;
         p[at] ^= 1;
         let mut b = bytes[..20].to_vec();
         b.extend_from_slice(&(p.len() as u64).to_le_bytes());

@@ -136,7 +136,13 @@ Output, in --out DIR (created if missing):
                    strong pairs' shares, the fabric <n_z^2> by number, by
                    force, over the strong and the weak pairs, the pairs'
                    mobilised friction and those sliding (none at C = 0)
-  plots/*.svg      pressure, coordination number, relative density and Heywood
+  vtk/stress_<k>.csv
+                   the stress through the compact: per tenth of its height,
+                   the elements' mean axial and lateral stress over the
+                   layer and its solid fraction, with the punches' and the
+                   die wall's pressures of the same step (none at C = 0)
+  plots/*.svg      pressure (and the curve back while the punch withdraws),
+                   coordination number, relative density and Heywood
                    coefficient against strain; Kawakita plot P/C vs P and
                    Heckel plot ln(1/(1 - D)) vs P, each with its fit; the
                    compaction profile, the bed's solid fraction D vs P; Z vs
@@ -144,9 +150,11 @@ Output, in --out DIR (created if missing):
                    the energy ledger vs strain; each granule's relative
                    density vs its height at the end; the die wall's
                    radial-to-axial stress ratio and mobilised friction vs
-                   strain
+                   strain; the axial stress by height at each snapshot with
+                   Janssen's curve
   report.html      one page: the warnings (or that there are none), the key
-                   results, the fits by window, the contact network, the plots with
+                   results, the fits by window, the contact network, the
+                   stress through the compact, the plots with
                    captions, the sections with their tables linked, the
                    summary table (rounded; hover a value for all its digits),
                    the tables' columns explained, and the scene
@@ -154,9 +162,12 @@ Output, in --out DIR (created if missing):
                    checkpoint_interval_minutes and checkpoint_strain_interval,
                    and at the end)
 
-`--resume DIR` on a finished run takes no step and writes its outputs again:
-with --kawakita-min-strain or --heckel-min-strain it refits the run, and its
-checkpoint keeps the new windows.
+`--resume DIR` on a finished run takes no step of the loading and writes its
+outputs again: with --kawakita-min-strain or --heckel-min-strain it refits the
+run, and its checkpoint keeps the new windows. Its withdrawal is kept unless
+the scene changed what it would do; else (none in the checkpoint, or
+--unload true on a run without one, as for checkpoints before format 10,
+whose scenes read unload = false) the withdrawal runs from the finished state.
 
 A series (--types, --seeds) keeps DIR/series.json (its members, scene and,
 for --types, its pour, exactly): `--resume DIR` on the series directory
@@ -204,7 +215,8 @@ reuse that packing.
 
 Without --scene the embedded published scene runs (print it with
 --print-scene): 1000 B2 granules of 1 mm on the 8x2 mesh in an 11.3 mm die,
-pressed to C = 0.3, about 17 minutes on 2 cores. The options marked
+pressed to C = 0.3, about 19 minutes on 2 cores, and the upper punch's
+withdrawal after it, about 3 more. The options marked
 Override above change the scene's fields. A fresh run into a directory that
 holds an unfinished run is refused (--resume continues it; --overwrite).
 
@@ -305,8 +317,10 @@ pub struct BedArgs {
 
     /// Override: after the final strain the upper punch withdraws at the
     /// same speed until it comes free of the bed, for the unloading curve
-    /// and the in-die elastic recovery (true, the default) or the run ends
-    /// at the final strain (false).
+    /// and the in-die elastic recovery (true, the published scene's; scene
+    /// files and checkpoints without the field read false), or the run ends
+    /// at the final strain (false). Allowed with --resume: on a finished
+    /// run, true runs the withdrawal if it has none, false drops it.
     #[arg(long, value_name = "BOOL")]
     pub unload: Option<bool>,
 
@@ -414,7 +428,7 @@ pub struct BedArgs {
     /// --held-reprojection, --nearest-penetrated-face,
     /// --exact-sweep-tolerance,
     /// --exact-contact-from-strain, --face-list-skin,
-    /// --time-step-floor, --max-mass-factor, --kawakita-min-strain,
+    /// --time-step-floor, --max-mass-factor, --unload, --kawakita-min-strain,
     /// --heckel-min-strain, -j and --quiet may be given with it.
     #[arg(long, value_name = "DIR", conflicts_with_all = ["scene", "out", "granule_type", "granules", "mesh", "seed", "die_diameter_mm", "diameter_mm", "punch_speed_m_s", "element", "hourglass_kappa", "rigid_until_touched", "local_sweeps", "selective_mass_scaling", "selective_mass_ratio"])]
     pub resume: Option<PathBuf>,
@@ -1213,6 +1227,11 @@ impl run::BedObserver for Observer {
     fn sample(&mut self, sample: &run::BedSample, elapsed_s: f64) {
         self.pour.finish();
         self.progress.update(sample, elapsed_s);
+    }
+
+    fn withdrawal(&mut self, row: &run::BedSample, elapsed_s: f64) {
+        self.pour.finish();
+        self.progress.withdrawing(row, elapsed_s);
     }
 
     fn pour(&mut self, status: &granbed_kernel::dem::pour::PourStatus, elapsed_s: f64) {

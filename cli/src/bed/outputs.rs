@@ -1161,6 +1161,25 @@ impl Progress {
         );
     }
 
+    /// Shows row `s` of the upper punch's withdrawal, `elapsed_s` into it:
+    /// the bar full, the message the withdrawal's.
+    pub fn withdrawing(&mut self, s: &BedSample, elapsed_s: f64) {
+        let bar = self.bar.get_or_insert_with(|| {
+            let bar = ProgressBar::with_draw_target(None, draw_target(self.quiet));
+            let template = "{prefix} [{elapsed_precise}] {bar:30} {msg}";
+            StrainBar::new(bar, template, &self.label, self.final_strain)
+        });
+        bar.show(
+            self.final_strain,
+            format!(
+                "withdrawing the upper punch: C {:.4}, P {:.2} kPa, {:.0} s",
+                s.strain,
+                s.upper_pressure_pa * 1e-3,
+                elapsed_s
+            ),
+        );
+    }
+
     /// Removes the bar, if drawn.
     pub fn finish(&self) {
         if let Some(bar) = &self.bar {

@@ -455,7 +455,7 @@ fn key_results(summary: &Summary<'_>) -> String {
                     "{}; {}; {} J / {} J; {}",
                     num(u.elastic_recovery),
                     kpa(u.residual_die_wall_pressure_pa),
-                    num(Some(u.returned_work_j)),
+                    num(u.returned_work_j),
                     num(Some(u.loading_work_j)),
                     num(u.plasticity_factor)
                 ),
@@ -591,7 +591,12 @@ fn stress_by_height(summary: &Summary<'_>) -> String {
          punch to the lower; the bed's weight adds its share downwards). K is the elements' \
          lateral over axial mean stress; Janssen's share exp(−4μK H/D) is what would reach \
          the lower punch if K were the same at every height and the wall's friction μ fully \
-         mobilised.</p>\n<table>\n<tr><th>C</th><th>H, mm</th><th>P_upper, kPa</th>\
+         mobilised. This K is the elements' in one step; the key results' K (summary.json's \
+         final_die_wall) is the die wall's pressure over the mean punch pressure averaged over \
+         the last output interval. The two lateral figures differ by a few per cent (2.5 % in \
+         the published scene at C = 0.3): the wall's pressure leaves out the friction of the \
+         punches' faces, and the theorem holds at rest, where the bed's inertia, its damping \
+         and the element's hourglass forces vanish.</p>\n<table>\n<tr><th>C</th><th>H, mm</th><th>P_upper, kPa</th>\
          <th>P_lower, kPa</th><th>mean axial stress, kPa</th><th>die-wall pressure (wall \
          forces), kPa</th><th>mean lateral stress (elements), kPa</th><th>K</th>\
          <th>P_lower / P_upper</th><th>Janssen's share</th><th>weight / die area, kPa</th>\
@@ -814,9 +819,14 @@ pub fn report_html(
     h.push_str(&stress_by_height(summary));
     writeln!(
         h,
-        "<p>Files: <a href=\"compression.csv\">compression.csv</a>, \
+        "<p>Files: <a href=\"compression.csv\">compression.csv</a>, {}\
          <a href=\"summary.json\">summary.json</a>, \
-         <a href=\"{VTK_DIR}/{PVD_FILE}\">{VTK_DIR}/{PVD_FILE}</a> (VTU snapshots for ParaView).</p>"
+         <a href=\"{VTK_DIR}/{PVD_FILE}\">{VTK_DIR}/{PVD_FILE}</a> (VTU snapshots for ParaView).</p>",
+        if summary.unloading.is_some() {
+            "<a href=\"unloading.csv\">unloading.csv</a> (the punch withdrawn), "
+        } else {
+            ""
+        }
     )?;
     writeln!(
         h,

@@ -158,18 +158,18 @@ pub const UNLOADING_ROWS_PER_INTERVAL: u32 = 10;
 /// How far the upper punch withdraws at most, as nominal axial strain
 /// (and never past the strain it pressed to): a bed of soft granules
 /// recovers several per cent of its height (the published B2, yield strain
-/// σ_y/E = 3 %: about 7 % of H_min from C = 0.3 in the small bed of
-/// `tests/cli_bed_unloading.rs`); a bed that still pushes the punch after
-/// this much is reported as not come free.
+/// σ_y/E = 3 %: 5.7 % of H_min from C = 0.3 in the published scene, about
+/// 7 % in a bed of 100 coarse granules in a 5 mm die); a bed that still
+/// pushes the punch after this much is reported as not come free.
 pub const MAX_WITHDRAWAL_STRAIN: Real = 0.15;
 
 /// The upper punch counts as free of the bed once its force, averaged over
 /// an output row's interval, is below this fraction of the largest it
 /// carried while pressing (a compaction simulator's force resolution).
 /// The bed lets go slowly: its granules' contacts soften as they unload,
-/// so the force has a long tail towards zero (the small bed of
-/// `tests/cli_bed_unloading.rs`: 1 % of the largest force 5 % of strain
-/// after the turn, not 0 by then).
+/// so the force has a long tail towards zero (a bed of 100 coarse
+/// granules pressed to 0.3: 1 % of the largest force 0.049 of strain after
+/// the turn, and still not 0 by then).
 pub const LIFT_OFF_FORCE_FRACTION: Real = 0.01;
 
 /// What the upper punch's withdrawal after the final strain recorded
@@ -182,8 +182,9 @@ pub struct Unloading {
     pub samples: Vec<BedSample>,
     /// The nominal strain where the upper punch came free of the bed: where
     /// its force crossed [`LIFT_OFF_FORCE_FRACTION`] of the loading's
-    /// largest, linear between the two rows' mean strains; NaN if it had
-    /// not when the withdrawal stopped.
+    /// largest, linear between the two rows' mean strains (the first row's
+    /// from the turn, with the loading's last force); NaN if it had not
+    /// when the withdrawal stopped.
     pub lift_off_strain: Real,
     /// Wall time of the withdrawal, s.
     pub wall_time_s: f64,
@@ -191,6 +192,26 @@ pub struct Unloading {
     /// interrupt, a failed step); `None` if it completed. A withdrawal cut
     /// short is not kept in the checkpoint: a resume runs it again.
     pub cut_short: Option<String>,
+}
+
+/// Whether a withdrawal run under the scene `then` (a checkpoint's TOML)
+/// is the one `now` would run from the same state: every field the same
+/// but those that do not reach the step (the fit windows, the snapshots,
+/// the checkpoints' intervals, the face lists' skin, which changes no bit)
+/// and the final strain (the state is past it either way).
+fn withdrawal_holds(then: &str, now: &Scene) -> bool {
+    Scene::from_toml(then).is_ok_and(|then| {
+        Scene {
+            kawakita_min_strain: now.kawakita_min_strain,
+            heckel_min_strain: now.heckel_min_strain,
+            snapshot_strains: now.snapshot_strains.clone(),
+            checkpoint_interval_minutes: now.checkpoint_interval_minutes,
+            checkpoint_strain_interval: now.checkpoint_strain_interval,
+            face_list_skin: now.face_list_skin,
+            final_strain: now.final_strain,
+            ..then
+        } == *now
+    })
 }
 
 /// A row of the averaging window `w` that ends at `strain` with the
@@ -204,12 +225,12 @@ type SampleOf<'a> = dyn Fn(&mut Assembly<'_>, &Window, Option<&BedSample>, Real,
 /// a row's upper-punch force falls below [`LIFT_OFF_FORCE_FRACTION`] of
 /// the loading's largest (lift-off), or the punch has withdrawn
 /// [`MAX_WITHDRAWAL_STRAIN`], or `interrupt` is set, or a step fails.
+/// `observer` sees each row.
 fn withdraw(
     asm: &mut Assembly<'_>,
-    die: &DieScene,
-    scene: &Scene,
+    (die, scene): (&DieScene, &Scene),
     loading: &[BedSample],
-    interrupt: Option<&AtomicBool>,
+    (interrupt, observer): (Option<&AtomicBool>, &mut dyn BedObserver),
     sample: &SampleOf<'_>,
 ) -> Unloading {
     let at_end = loading.last().copied().unwrap_or_default();
@@ -222,6 +243,9 @@ fn withdraw(
     let limit = at_end.strain - MAX_WITHDRAWAL_STRAIN.min(at_end.strain);
     let mut next = at_end.strain - interval;
     let (mut window, mut previous) = (Window::new(), at_end);
+    // The (strain, force) the lift-off is interpolated from: the turn, with
+    // the loading's last force, then each row's.
+    let mut before = (at_end.strain, at_end.upper_force_n);
     let (mut samples, mut lift_off_strain, mut cut_short) = (Vec::new(), Real::NAN, None);
     loop {
         if let Err(e) = asm.step() {
@@ -245,21 +269,23 @@ fn withdraw(
                 upper_velocity_m_s: speed,
             };
             let s = sample(asm, &window, Some(&previous), strain, imposed);
+            observer.withdrawal(&s, start.elapsed().as_secs_f64());
             samples.push(s);
             window = Window::new();
             while next >= strain - 1e-12 {
                 next -= interval;
             }
             if s.upper_force_n < free_below_n {
-                let (f0, f1) = (previous.upper_force_n, s.upper_force_n);
+                let ((c0, f0), f1) = (before, s.upper_force_n);
                 let t = (f0 - free_below_n) / (f0 - f1);
-                lift_off_strain = previous.mean_strain + t * (s.mean_strain - previous.mean_strain);
+                lift_off_strain = c0 + t * (s.mean_strain - c0);
                 break;
             }
             if strain <= limit {
                 break;
             }
             previous = s;
+            before = (s.mean_strain, s.upper_force_n);
         }
         if interrupt.is_some_and(|f| f.load(Ordering::SeqCst)) {
             cut_short = Some(format!("interrupted at C = {strain:.4}"));
@@ -540,6 +566,10 @@ pub trait BedObserver {
     /// The pour's state at one of its rest checks, `elapsed_s` into it
     /// (for progress; a fresh run's pour only). Nothing by default.
     fn pour(&mut self, _status: &PourStatus, _elapsed_s: f64) {}
+
+    /// A row of the upper punch's withdrawal after the final strain,
+    /// `elapsed_s` into it (for progress). Nothing by default.
+    fn withdrawal(&mut self, _row: &BedSample, _elapsed_s: f64) {}
 }
 
 /// A poured bed: the hand-over from the pour to the compression, made
@@ -842,6 +872,7 @@ pub fn run_bed(
     // checkpoints (rewritten for a changed scene) keep it.
     let kept = resumed
         .filter(|c| c.state.time >= die.time_of_strain(scene.final_strain))
+        .filter(|c| withdrawal_holds(&c.progress.scene_toml, scene))
         .and_then(|c| c.progress.unloading.clone());
     let make =
         |asm: &Assembly<'_>, samples: &[BedSample], window: &Window, next: Real, done: usize| {
@@ -1009,14 +1040,23 @@ pub fn run_bed(
             drop(last_good.take());
             let at_end_checkpoint =
                 dir.map(|_| make(&asm, &samples, &window, next, snapshots_done));
-            let u = withdraw(&mut asm, &die, scene, &samples, control.interrupt, &sample);
+            let u = withdraw(
+                &mut asm,
+                (&die, scene),
+                &samples,
+                (control.interrupt, observer),
+                &sample,
+            );
             if let (Some(dir), Some(mut c)) = (dir, at_end_checkpoint)
                 && u.cut_short.is_none()
             {
                 c.progress.unloading = Some(u.clone());
                 c.write(dir)?;
             }
-            interrupted |= control.interrupt.is_some_and(|f| f.load(Ordering::SeqCst));
+            // Only a withdrawal the interrupt cut short counts: one that
+            // completed in the step the signal came in is whole and kept.
+            interrupted |= u.cut_short.is_some()
+                && control.interrupt.is_some_and(|f| f.load(Ordering::SeqCst));
             Some(u)
         }
         _ => None,

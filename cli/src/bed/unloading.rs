@@ -44,21 +44,26 @@ pub struct UnloadingSummary {
     /// In-die elastic recovery (H_lift − H_min)/H_min = (C_max − C_lift)
     /// / (1 − C_max), H the height between the punches.
     pub elastic_recovery: Option<Real>,
-    /// The die wall's pressure over the last row's interval (at lift-off:
-    /// the residual radial stress), Pa.
+    /// The die wall's pressure over the lift-off row's interval: the
+    /// radial stress the compact keeps, Pa. This and the figures below that
+    /// need the punch free are `None` without a lift-off.
     pub residual_die_wall_pressure_pa: Option<Real>,
-    /// The lower punch's pressure over the last row's interval, Pa: at
-    /// lift-off the bed's weight less what the die wall's friction holds.
+    /// The lower punch's pressure over the lift-off row's interval, Pa:
+    /// the bed's weight plus the die wall's friction, which, reversed as
+    /// the compact expands upwards, presses it down.
     pub residual_lower_pressure_pa: Option<Real>,
     /// The punches' work on the bed up to the final strain, J.
     pub loading_work_j: Real,
-    /// The work the bed did on the withdrawing punch up to the last row,
-    /// J: the elastic work of the cycle.
-    pub returned_work_j: Real,
-    /// Loading work less the returned work, J.
-    pub net_work_j: Real,
-    /// Stamm and Mathis's plasticity factor net / (net + returned) =
-    /// net / loading work (`None` without loading work).
+    /// The work the bed did on the withdrawing punch up to lift-off, J:
+    /// the elastic work of the cycle.
+    pub returned_work_j: Option<Real>,
+    /// Loading work less the returned work, J: what the plastic flow, the
+    /// friction (the die wall's included: compaction simulators split it
+    /// off as the friction work) and the damping took.
+    pub net_work_j: Option<Real>,
+    /// The plasticity factor net / (net + returned) = net / loading work
+    /// (Stamm and Mathis's, with the die wall's friction work in the net
+    /// work rather than split off).
     pub plasticity_factor: Option<Real>,
     /// The granules' elastic energy Ψ at the final strain, J: the most the
     /// bed could give back.
@@ -71,25 +76,25 @@ impl UnloadingSummary {
     /// The figures of `run`'s withdrawal `u`, which followed its last row.
     pub fn of(run: &BedRun, u: &Unloading) -> Self {
         let at_end = run.samples.last().copied().unwrap_or_default();
-        let last = u.samples.last().copied().unwrap_or(at_end);
         let loading = at_end.energies.punch_work;
-        let returned = loading - last.energies.punch_work;
         let lift_off = Some(u.lift_off_strain).filter(|c| c.is_finite());
+        // The last row is the lift-off row when there is a lift-off.
+        let free = u.samples.last().filter(|_| lift_off.is_some());
+        let returned = free.map(|s| loading - s.energies.punch_work);
         let finite = |x: Real| Some(x).filter(|x| x.is_finite());
         Self {
             rows: u.samples.len(),
             from_strain: at_end.strain,
             lift_off_strain: lift_off,
             elastic_recovery: lift_off.map(|c| (at_end.strain - c) / (1.0 - at_end.strain)),
-            residual_die_wall_pressure_pa: u
-                .samples
-                .last()
-                .and_then(|s| finite(die_wall_pressure(run, s))),
-            residual_lower_pressure_pa: u.samples.last().map(|s| s.lower_pressure_pa),
+            residual_die_wall_pressure_pa: free.and_then(|s| finite(die_wall_pressure(run, s))),
+            residual_lower_pressure_pa: free.map(|s| s.lower_pressure_pa),
             loading_work_j: loading,
             returned_work_j: returned,
-            net_work_j: loading - returned,
-            plasticity_factor: (loading > 0.0).then(|| (loading - returned) / loading),
+            net_work_j: returned.map(|r| loading - r),
+            plasticity_factor: returned
+                .filter(|_| loading > 0.0)
+                .map(|r| (loading - r) / loading),
             elastic_energy_at_end_j: at_end.energies.elastic,
             wall_time_s: u.wall_time_s,
         }
@@ -154,7 +159,7 @@ mod tests {
         assert!((s.elastic_recovery.unwrap() - 0.02).abs() < 1e-12);
         assert_eq!(
             (s.loading_work_j, s.returned_work_j, s.net_work_j),
-            (10.0, 2.0, 8.0)
+            (10.0, Some(2.0), Some(8.0))
         );
         assert_eq!(s.plasticity_factor, Some(0.8));
         assert_eq!(s.elastic_energy_at_end_j, 3.0);
@@ -168,7 +173,14 @@ mod tests {
             lift_off_strain: Real::NAN,
             ..u.clone()
         };
-        assert_eq!(UnloadingSummary::of(&run, &none).elastic_recovery, None);
+        // Without a lift-off nothing that needs the punch free is given.
+        let s = UnloadingSummary::of(&run, &none);
+        assert_eq!((s.elastic_recovery, s.returned_work_j), (None, None));
+        assert_eq!(
+            (s.plasticity_factor, s.residual_die_wall_pressure_pa),
+            (None, None)
+        );
+        assert_eq!(s.loading_work_j, 10.0);
         assert!(warning(&none).unwrap().contains("no lift-off"));
         let cut = Unloading {
             cut_short: Some("interrupted at C = 0.2900".into()),
