@@ -39,31 +39,39 @@ fn bed(extra: &[&str]) -> common::Run {
 }
 
 /// Sets `flag` once the run has written `rows` output rows (the first at
-/// t = 0 included).
+/// t = 0 included), or with `withdrawal` once the upper punch's withdrawal
+/// has written `rows` rows.
 struct InterruptAfter {
     rows: usize,
     seen: usize,
     flag: &'static AtomicBool,
+    withdrawal: bool,
+}
+
+impl InterruptAfter {
+    /// Counts a row of the loading (`withdrawal` false) or the withdrawal.
+    fn count(&mut self, withdrawal: bool) {
+        if withdrawal == self.withdrawal {
+            self.seen += 1;
+            if self.seen == self.rows {
+                self.flag.store(true, Ordering::SeqCst);
+            }
+        }
+    }
 }
 
 impl BedObserver for InterruptAfter {
     fn sample(&mut self, _: &BedSample, _: f64) {
-        self.seen += 1;
-        if self.seen == self.rows {
-            self.flag.store(true, Ordering::SeqCst);
-        }
+        self.count(false);
+    }
+
+    fn withdrawal(&mut self, _: &BedSample, _: f64) {
+        self.count(true);
     }
 
     fn snapshot(&mut self, _: f64, _: &Assembly<'_>, _: &OwnedReference) -> anyhow::Result<()> {
         Ok(())
     }
-}
-
-/// The FNV-1a 64 checksum of the checkpoint format.
-fn fnv1a(bytes: &[u8]) -> u64 {
-    bytes.iter().fold(0xcbf2_9ce4_8422_2325, |h, &b| {
-        (h ^ u64::from(b)).wrapping_mul(0x0000_0100_0000_01b3)
-    })
 }
 
 /// Rewrites the format-10 checkpoint of `samples` output rows in `dir`,
@@ -76,19 +84,14 @@ fn fnv1a(bytes: &[u8]) -> u64 {
 fn downgrade_to_format_6(dir: &Path, samples: usize) {
     let path = dir.join(FILE_NAME);
     let bytes = std::fs::read(&path).unwrap();
-    assert_eq!(u32::from_le_bytes(bytes[16..20].try_into().unwrap()), 10);
+    assert_eq!(common::checkpoint_version(&bytes), 10);
     assert_eq!(
         bytes[bytes.len() - 8..],
         [0; 8],
         "a checkpoint without a withdrawal"
     );
     let payload = &bytes[36..bytes.len() - 8 - (8 + 3 * 8 + 7 * 8) - 8 * (1 + samples)];
-    let mut out = bytes[..16].to_vec();
-    out.extend_from_slice(&6u32.to_le_bytes());
-    out.extend_from_slice(&(payload.len() as u64).to_le_bytes());
-    out.extend_from_slice(&fnv1a(payload).to_le_bytes());
-    out.extend_from_slice(payload);
-    std::fs::write(&path, out).unwrap();
+    std::fs::write(&path, common::checkpoint_file(&bytes, 6, payload)).unwrap();
 }
 
 /// The cost figures that do not depend on the clock.
@@ -137,6 +140,7 @@ fn an_interrupted_run_keeps_its_work_and_resumes_to_the_same_bits() {
         rows: 6,
         seen: 0,
         flag: &FLAG,
+        withdrawal: false,
     };
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(1)
@@ -357,4 +361,81 @@ fn an_interrupt_during_the_pour_stops_it_at_its_next_check() {
     );
     assert_eq!(observer.rows, 0);
     assert!(!dir.join(FILE_NAME).exists());
+}
+
+/// An interrupt during the upper punch's withdrawal (scene `unload`, the
+/// published scene's) stops it after the step it is in: the run says it
+/// was interrupted, its withdrawal is cut short after the rows so far, and
+/// the checkpoint is the loading's end without it. Resumed, the finished
+/// run withdraws the punch afresh from there, to the rows and figures of
+/// a withdrawal never interrupted, bit for bit.
+#[test]
+fn an_interrupted_withdrawal_runs_again_from_the_loading_end() {
+    static FLAG: AtomicBool = AtomicBool::new(false);
+    let printed = cli(&[&["bed", "--print-scene"][..], &SMALL].concat());
+    let scene = Scene::from_toml(&printed.stdout).unwrap();
+    assert!(scene.unload, "the published scene unloads");
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(1)
+        .build()
+        .unwrap();
+    let (cut, whole) = (out_dir("withdrawal_cut"), out_dir("withdrawal_whole"));
+    let run_into = |dir: &Path, observer: &mut InterruptAfter, interrupt| {
+        std::fs::create_dir_all(dir).unwrap();
+        let control = RunControl {
+            checkpoint_dir: Some(dir.to_path_buf()),
+            interrupt,
+            ..RunControl::default()
+        };
+        pool.install(|| run_bed(&scene, &control, observer))
+            .unwrap()
+    };
+    let mut observer = InterruptAfter {
+        rows: 2,
+        seen: 0,
+        flag: &FLAG,
+        withdrawal: true,
+    };
+    let run = run_into(&cut, &mut observer, Some(&FLAG));
+    let u = run.unloading.as_ref().expect("a withdrawal");
+    assert!(run.interrupted && run.error.is_none());
+    assert_eq!(u.samples.len(), 2);
+    assert!(
+        u.cut_short
+            .as_deref()
+            .is_some_and(|w| w.starts_with("interrupted"))
+    );
+    let checkpoint = Checkpoint::read(&cut).unwrap();
+    assert!(checkpoint.progress.unloading.is_none());
+    assert_eq!(checkpoint.state.steps, run.steps, "the loading's end");
+
+    let mut quiet = InterruptAfter {
+        rows: usize::MAX,
+        seen: 0,
+        flag: &FLAG,
+        withdrawal: true,
+    };
+    let straight = run_into(&whole, &mut quiet, None);
+    let resumed = pool
+        .install(|| {
+            run_bed(
+                &scene,
+                &RunControl {
+                    resume: Some(checkpoint),
+                    checkpoint_dir: Some(cut.clone()),
+                    ..RunControl::default()
+                },
+                &mut quiet,
+            )
+        })
+        .unwrap();
+    assert!(!resumed.interrupted);
+    let (a, b) = (
+        resumed.unloading.expect("withdrawn again"),
+        straight.unloading.expect("withdrawn"),
+    );
+    assert!(a.cut_short.is_none() && a.lift_off_strain.is_finite());
+    assert_eq!(a.samples, b.samples);
+    assert_eq!(a.lift_off_strain.to_bits(), b.lift_off_strain.to_bits());
+    assert!(Checkpoint::read(&cut).unwrap().progress.unloading.is_some());
 }

@@ -181,23 +181,11 @@ fn the_punch_withdraws_until_the_bed_lets_go() {
     let path = plain.join("checkpoint.bin");
     let bytes = std::fs::read(&path).unwrap();
     assert_eq!(bytes[bytes.len() - 8..], [0; 8]);
-    let payload = &bytes[36..bytes.len() - 8];
-    let mut v9 = bytes[..16].to_vec();
-    v9.extend_from_slice(&9u32.to_le_bytes());
-    v9.extend_from_slice(&(payload.len() as u64).to_le_bytes());
-    v9.extend_from_slice(&fnv1a(payload).to_le_bytes());
-    v9.extend_from_slice(payload);
+    let v9 = common::checkpoint_file(&bytes, 9, &bytes[36..bytes.len() - 8]);
     std::fs::write(&path, v9).unwrap();
     let plain_s = plain.to_str().unwrap();
     let run = cli(&["bed", "--quiet", "--resume", plain_s, "--unload", "true"]);
     assert_eq!(run.code, 0, "{}", run.stderr);
     assert!(number(&summary(&plain)["unloading"], "rows") > 0.0);
     assert!(plain.join("unloading.csv").is_file());
-}
-
-/// FNV-1a 64, the checkpoint's checksum.
-fn fnv1a(bytes: &[u8]) -> u64 {
-    bytes.iter().fold(0xcbf2_9ce4_8422_2325, |h, &b| {
-        (h ^ u64::from(b)).wrapping_mul(0x0000_0100_0000_01b3)
-    })
 }

@@ -152,13 +152,6 @@ fn base_checkpoint() -> &'static (PathBuf, Vec<u8>) {
     })
 }
 
-/// FNV-1a 64, the checkpoint's checksum (as documented in checkpoint.rs).
-fn fnv1a(bytes: &[u8]) -> u64 {
-    bytes.iter().fold(0xcbf2_9ce4_8422_2325, |h, &b| {
-        (h ^ u64::from(b)).wrapping_mul(0x0000_0100_0000_01b3)
-    })
-}
-
 /// Writes `bytes` as the checkpoint of a fresh directory `name`.
 fn write_checkpoint(name: &str, bytes: &[u8]) -> PathBuf {
     let dir = common::fresh_dir("fuzz_files", name);
@@ -292,12 +285,7 @@ fn older(bytes: &[u8], cut: &[usize], version: u32) -> Vec<u8> {
         from = k + 8;
     }
     payload.extend_from_slice(&bytes[from..]);
-    let mut b = bytes[..16].to_vec();
-    b.extend_from_slice(&version.to_le_bytes());
-    b.extend_from_slice(&(payload.len() as u64).to_le_bytes());
-    b.extend_from_slice(&fnv1a(&payload).to_le_bytes());
-    b.extend_from_slice(&payload);
-    b
+    common::checkpoint_file(bytes, version, &payload)
 }
 
 /// Checkpoints of older formats still read: version 9 (before the
@@ -503,11 +491,11 @@ fn a_withdrawal_in_a_checkpoint_reads_back() {
     // withdrawal ends; 1 here: make it 2.
     let (_, without) = base_checkpoint();
     let flag = without.len() - 8;
-    let mut bytes = std::fs::read(d.join(FILE_NAME)).unwrap();
+    let bytes = std::fs::read(d.join(FILE_NAME)).unwrap();
     assert_eq!(bytes[flag..flag + 8], 1u64.to_le_bytes());
-    bytes[flag] = 2;
-    let sum = fnv1a(&bytes[36..]);
-    bytes[28..36].copy_from_slice(&sum.to_le_bytes());
+    let mut payload = bytes[36..].to_vec();
+    payload[flag - 36] = 2;
+    let bytes = common::checkpoint_file(&bytes, common::checkpoint_version(&bytes), &payload);
     let e = read(&write_checkpoint("withdrawal_flag", &bytes)).unwrap_err();
     assert!(e.contains("unknown unloading flag 2"), "{e}");
 }
@@ -527,10 +515,7 @@ fn a_checkpoint_with_a_nudged_float_decodes_and_resumes() {
         // and format 10's unloading flag (the last word).
         let at = p.len().checked_sub(8 + COUNTER_BYTES + 8 * k)?;
         p[at] ^= 1;
-        let mut b = bytes[..20].to_vec();
-        b.extend_from_slice(&(p.len() as u64).to_le_bytes());
-        b.extend_from_slice(&fnv1a(&p).to_le_bytes());
-        b.extend_from_slice(&p);
+        let b = common::checkpoint_file(bytes, common::checkpoint_version(bytes), &p);
         let dir = write_checkpoint("nudged", &b);
         read(&dir).ok()?;
         Some(common::cli(&[
@@ -569,10 +554,7 @@ proptest! {
         let (_, bytes) = base_checkpoint();
         let mut payload = bytes[36..].to_vec();
         apply(&mut payload, &edits);
-        let mut b = bytes[..20].to_vec();
-        b.extend_from_slice(&(payload.len() as u64).to_le_bytes());
-        b.extend_from_slice(&fnv1a(&payload).to_le_bytes());
-        b.extend_from_slice(&payload);
+        let b = common::checkpoint_file(bytes, common::checkpoint_version(bytes), &payload);
         let dir = write_checkpoint("payload", &b);
         if read(&dir).is_ok() {
             // It decoded: resuming must accept it or refuse it with an

@@ -1142,13 +1142,18 @@ impl Progress {
         }
     }
 
+    /// The bar, drawn with the indicatif `template` if not drawn yet.
+    fn bar(&mut self, template: &str) -> &StrainBar {
+        let (quiet, label, final_strain) = (self.quiet, &self.label, self.final_strain);
+        self.bar.get_or_insert_with(|| {
+            let bar = ProgressBar::with_draw_target(None, draw_target(quiet));
+            StrainBar::new(bar, template, label, final_strain)
+        })
+    }
+
     /// Shows sample `s`, taken `elapsed_s` into the compression.
     pub fn update(&mut self, s: &BedSample, elapsed_s: f64) {
-        let bar = self.bar.get_or_insert_with(|| {
-            let bar = ProgressBar::with_draw_target(None, draw_target(self.quiet));
-            let template = "{prefix} [{elapsed_precise}] {bar:30} C {msg} (ETA {eta})";
-            StrainBar::new(bar, template, &self.label, self.final_strain)
-        });
+        let bar = self.bar("{prefix} [{elapsed_precise}] {bar:30} C {msg} (ETA {eta})");
         bar.show(
             s.strain,
             format!(
@@ -1164,13 +1169,10 @@ impl Progress {
     /// Shows row `s` of the upper punch's withdrawal, `elapsed_s` into it:
     /// the bar full, the message the withdrawal's.
     pub fn withdrawing(&mut self, s: &BedSample, elapsed_s: f64) {
-        let bar = self.bar.get_or_insert_with(|| {
-            let bar = ProgressBar::with_draw_target(None, draw_target(self.quiet));
-            let template = "{prefix} [{elapsed_precise}] {bar:30} {msg}";
-            StrainBar::new(bar, template, &self.label, self.final_strain)
-        });
+        let end = self.final_strain;
+        let bar = self.bar("{prefix} [{elapsed_precise}] {bar:30} {msg}");
         bar.show(
-            self.final_strain,
+            end,
             format!(
                 "withdrawing the upper punch: C {:.4}, P {:.2} kPa, {:.0} s",
                 s.strain,

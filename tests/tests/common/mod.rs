@@ -346,3 +346,25 @@ pub fn read_vtu(path: &Path, arrays: &[&str]) -> Snapshot {
         types,
     }
 }
+
+/// A checkpoint file (`checkpoint.bin`) of `payload` labelled `version`:
+/// the magic of `file` (its first 16 bytes), the version, the payload's
+/// length and its FNV-1a 64 checksum, then the payload, as
+/// `bed::checkpoint` writes them. The tests make older formats and
+/// damaged files with it.
+pub fn checkpoint_file(file: &[u8], version: u32, payload: &[u8]) -> Vec<u8> {
+    let checksum = payload.iter().fold(0xcbf2_9ce4_8422_2325_u64, |h, &b| {
+        (h ^ u64::from(b)).wrapping_mul(0x0000_0100_0000_01b3)
+    });
+    let mut out = file[..16].to_vec();
+    out.extend_from_slice(&version.to_le_bytes());
+    out.extend_from_slice(&(payload.len() as u64).to_le_bytes());
+    out.extend_from_slice(&checksum.to_le_bytes());
+    out.extend_from_slice(payload);
+    out
+}
+
+/// The format version of the checkpoint file `file`.
+pub fn checkpoint_version(file: &[u8]) -> u32 {
+    u32::from_le_bytes(file[16..20].try_into().expect("a checkpoint header"))
+}
