@@ -277,7 +277,14 @@ fn withdraw(
             }
             if s.upper_force_n < free_below_n {
                 let ((c0, f0), f1) = (before, s.upper_force_n);
-                let t = (f0 - free_below_n) / (f0 - f1);
+                // The crossing between the two (at this row if the one
+                // before was below already, which only a loading that
+                // ended far below its largest force gives).
+                let t = if f0 > f1 {
+                    ((f0 - free_below_n) / (f0 - f1)).clamp(0.0, 1.0)
+                } else {
+                    1.0
+                };
                 lift_off_strain = c0 + t * (s.mean_strain - c0);
                 break;
             }
