@@ -69,6 +69,17 @@ fn three_types_from_one_pour_are_ordered_by_yield_stress() {
             assert_eq!(v, number(s, field), "{t}: {column}");
         }
     }
+    // The withdrawal's figures (the published scene unloads): NaN in the
+    // table where the summary has none.
+    for column in ["elastic_recovery", "plasticity_factor"] {
+        let values = table.num(column);
+        for ((t, s), v) in TYPES.iter().zip(&summaries).zip(values) {
+            match s["unloading"][column].as_f64() {
+                Some(x) => assert_eq!(v, x, "{t}: {column}"),
+                None => assert!(v.is_nan(), "{t}: {column} {v}"),
+            }
+        }
+    }
     for ((t, s), v) in TYPES
         .iter()
         .zip(&summaries)

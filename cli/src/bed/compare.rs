@@ -35,7 +35,7 @@ pub const PROFILE_SVG: &str = "comparison_profile.svg";
 
 /// Columns of [`COMPARISON_CSV`], in order (`NaN` where the summary has
 /// `null`, e.g. no Kawakita fit for a run that ended before its window).
-pub const COMPARISON_COLUMNS: [&str; 20] = [
+pub const COMPARISON_COLUMNS: [&str; 22] = [
     "type",
     "seed",
     "yield_stress_pa",
@@ -54,6 +54,8 @@ pub const COMPARISON_COLUMNS: [&str; 20] = [
     "final_pressure_pa",
     "final_relative_density",
     "final_coordination",
+    "elastic_recovery",
+    "plasticity_factor",
     "quasi_static_passed",
     "wall_time_s",
 ];
@@ -102,6 +104,12 @@ pub struct ComparisonRow {
     pub final_relative_density: Real,
     /// Coordination number Z at the end.
     pub final_coordination: Real,
+    /// In-die elastic recovery after the upper punch's withdrawal (summary
+    /// `unloading.elastic_recovery`; `None` without one or its lift-off).
+    pub elastic_recovery: Option<Real>,
+    /// Plasticity factor net / punch work of the withdrawal (summary
+    /// `unloading.plasticity_factor`).
+    pub plasticity_factor: Option<Real>,
     /// The run's quasi-static certificate passed (1 in the CSV; a row
     /// that failed it describes a bed with inertia in it: its summary's
     /// warning says which figure failed).
@@ -134,6 +142,8 @@ impl ComparisonRow {
             final_pressure_pa: s.final_pressure_pa,
             final_relative_density: s.final_relative_density,
             final_coordination: s.final_coordination,
+            elastic_recovery: s.unloading.and_then(|u| u.elastic_recovery),
+            plasticity_factor: s.unloading.and_then(|u| u.plasticity_factor),
             quasi_static_passed: s.quasi_static.passed,
             wall_time_s: s.wall_time_s,
             error: s.error.clone(),
@@ -192,6 +202,8 @@ impl ComparisonRow {
             self.final_pressure_pa.into(),
             self.final_relative_density.into(),
             self.final_coordination.into(),
+            opt(self.elastic_recovery),
+            opt(self.plasticity_factor),
             Field::Int(u64::from(self.quasi_static_passed)),
             self.wall_time_s.into(),
         ]

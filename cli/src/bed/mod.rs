@@ -182,7 +182,9 @@ alone with --resume DIR/<TYPE>), and DIR holds the comparison:
                    stress, eta0, Kawakita a, 1/b (Pa), R^2, points, kawakita_ok,
                    Heckel P_y (Pa), R^2, heckel_ok, D0, max pressure,
                    final strain, final pressure, final mean relative density,
-                   final coordination number, quasi_static_passed (1/0),
+                   final coordination number, in-die elastic recovery and
+                   plasticity factor (NaN without a withdrawal's lift-off),
+                   quasi_static_passed (1/0),
                    wall time; kawakita_ok / heckel_ok: 1 if the fit is a
                    material figure, 0 if absent or warned about (summary.json
                    says why)

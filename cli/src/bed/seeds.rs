@@ -80,7 +80,7 @@ pub type Figure = fn(&ComparisonRow) -> Option<Real>;
 /// the run's summary warns about (Kawakita outside the law's regime, Heckel
 /// with R² below [`super::outputs::FIT_MIN_R_SQUARED`]) is left out: its figures are not
 /// material figures, and one such run (a 1/b ≤ 0, say) would move the mean.
-pub const SPREAD_FIGURES: [(&str, Figure); 8] = [
+pub const SPREAD_FIGURES: [(&str, Figure); 10] = [
     ("kawakita_a", |r| r.kawakita_a.filter(|_| r.kawakita_ok)),
     ("kawakita_inv_b_pa", |r| {
         r.kawakita_inv_b_pa.filter(|_| r.kawakita_ok)
@@ -93,6 +93,8 @@ pub const SPREAD_FIGURES: [(&str, Figure); 8] = [
     ("final_pressure_pa", |r| Some(r.final_pressure_pa)),
     ("final_relative_density", |r| Some(r.final_relative_density)),
     ("final_coordination", |r| Some(r.final_coordination)),
+    ("elastic_recovery", |r| r.elastic_recovery),
+    ("plasticity_factor", |r| r.plasticity_factor),
 ];
 
 /// Columns of [`SPREAD_CSV`], in order.
@@ -351,6 +353,8 @@ mod tests {
                 final_pressure_pa: 0.0,
                 final_relative_density: 0.8,
                 final_coordination: 0.0,
+                elastic_recovery: None,
+                plasticity_factor: None,
                 quasi_static_passed: true,
                 wall_time_s: 0.0,
                 error: None,

@@ -78,6 +78,8 @@ fn spread_name(figure: &str) -> &'static str {
         "final_pressure_pa" => "final pressure, kPa",
         "final_relative_density" => "final granule relative density",
         "final_coordination" => "final coordination number Z",
+        "elastic_recovery" => "in-die elastic recovery",
+        "plasticity_factor" => "plasticity factor",
         _ => "",
     }
 }
@@ -132,6 +134,7 @@ pub fn series_report_html(report: &SeriesReport<'_>) -> anyhow::Result<String> {
          <table>\n<tr><th>run</th><th>yield stress, kPa</th><th>η0</th><th>D0</th>\
          <th>Kawakita a</th><th>Kawakita 1/b, kPa</th><th>Heckel P_y, kPa</th>\
          <th>largest P, kPa</th><th>C reached</th><th>final η</th><th>final Z</th>\
+         <th>elastic recovery</th><th>plasticity factor</th>\
          <th>quasi-static</th><th>wall time, s</th></tr>"
     )?;
     for (row, dir) in report.rows.iter().zip(&report.member_dirs) {
@@ -150,7 +153,7 @@ pub fn series_report_html(report: &SeriesReport<'_>) -> anyhow::Result<String> {
         writeln!(
             h,
             "<tr{class}><td><a href=\"{0}/{REPORT_FILE}\">{0}</a></td>{1}{2}{3}{4}{5}{6}{7}{8}{9}{10}\
-             <td>{certificate}</td>{11}</tr>",
+             {11}{12}<td>{certificate}</td>{13}</tr>",
             html_escape(dir),
             cell(&kpa(Some(row.yield_stress_pa))),
             cell(&num(Some(row.eta0))),
@@ -174,6 +177,8 @@ pub fn series_report_html(report: &SeriesReport<'_>) -> anyhow::Result<String> {
             cell(&num(Some(row.final_strain))),
             cell(&num(Some(row.final_relative_density))),
             cell(&num(Some(row.final_coordination))),
+            cell(&num(row.elastic_recovery)),
+            cell(&num(row.plasticity_factor)),
             cell(&format!("{:.1}", row.wall_time_s)),
         )?;
     }
@@ -240,6 +245,8 @@ mod tests {
             final_pressure_pa: 1.5e6,
             final_relative_density: 0.912_345,
             final_coordination: 6.789,
+            elastic_recovery: Some(0.0567),
+            plasticity_factor: Some(0.9),
             quasi_static_passed: passed,
             wall_time_s: 12.345,
             error: None,
