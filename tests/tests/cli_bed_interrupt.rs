@@ -20,7 +20,7 @@ use common::{Table, cli, number, summary};
 use granbed_cli::assembly::Assembly;
 use granbed_cli::bed::Scene;
 use granbed_cli::bed::checkpoint::{Checkpoint, FILE_NAME};
-use granbed_cli::bed::run::{BedObserver, BedSample, RunControl, pour, run_bed};
+use granbed_cli::bed::run::{BedObserver, BedSample, CutShort, RunControl, pour, run_bed};
 use granbed_cli::model::OwnedReference;
 use granbed_cli::signal::INTERRUPT;
 use granbed_kernel::dem::pour::PourStatus;
@@ -400,10 +400,12 @@ fn an_interrupted_withdrawal_runs_again_from_the_loading_end() {
     let u = run.unloading.as_ref().expect("a withdrawal");
     assert!(run.interrupted && run.error.is_none());
     assert_eq!(u.samples.len(), 2);
-    assert!(
-        u.cut_short
-            .as_deref()
-            .is_some_and(|w| w.starts_with("interrupted"))
+    // Stopped after the step of its second row, at that row's strain.
+    assert_eq!(
+        u.cut_short,
+        Some(CutShort::Interrupted {
+            strain: u.samples[1].strain
+        })
     );
     let checkpoint = Checkpoint::read(&cut).unwrap();
     assert!(checkpoint.progress.unloading.is_none());

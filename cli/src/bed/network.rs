@@ -258,14 +258,7 @@ fn read_network(snapshot: usize, path: &Path) -> anyhow::Result<NetworkStats> {
 /// could not be read was left out (a damaged file must not cost the run's
 /// other outputs). None if the folder is not there.
 pub fn read_all(vtk_dir: &Path) -> (Vec<NetworkStats>, Vec<String>) {
-    let (mut stats, mut left_out) = (Vec::new(), Vec::new());
-    for (k, path) in &super::snapshots::numbered_files(vtk_dir, "network_", ".csv") {
-        match read_network(*k, path) {
-            Ok(s) => stats.push(s),
-            Err(e) => left_out.push(format!("{e:#}; left out of contact_network")),
-        }
-    }
-    (stats, left_out)
+    super::snapshots::read_snapshot_files(vtk_dir, "network_", "contact_network", read_network)
 }
 
 #[cfg(test)]

@@ -188,10 +188,31 @@ pub struct Unloading {
     pub lift_off_strain: Real,
     /// Wall time of the withdrawal, s.
     pub wall_time_s: f64,
-    /// Why the withdrawal stopped before lift-off or its limit (an
-    /// interrupt, a failed step); `None` if it completed. A withdrawal cut
-    /// short is not kept in the checkpoint: a resume runs it again.
-    pub cut_short: Option<String>,
+    /// Why the withdrawal stopped before lift-off or its limit; `None` if
+    /// it completed. A withdrawal cut short is not kept in the checkpoint:
+    /// a resume runs it again.
+    pub cut_short: Option<CutShort>,
+}
+
+/// Why a withdrawal stopped before lift-off or its limit.
+#[derive(Clone, Debug, PartialEq)]
+pub enum CutShort {
+    /// `RunControl::interrupt` was set; the strain the punch had reached.
+    Interrupted {
+        /// Nominal strain at the step the withdrawal stopped after.
+        strain: Real,
+    },
+    /// A step failed (the assembly's error, as text).
+    StepFailed(String),
+}
+
+impl core::fmt::Display for CutShort {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        match self {
+            Self::Interrupted { strain } => write!(f, "interrupted at C = {strain:.4}"),
+            Self::StepFailed(e) => write!(f, "a step failed: {e}"),
+        }
+    }
 }
 
 /// Whether a withdrawal run under the scene `then` (a checkpoint's TOML)
@@ -249,7 +270,7 @@ fn withdraw(
     let (mut samples, mut lift_off_strain, mut cut_short) = (Vec::new(), Real::NAN, None);
     loop {
         if let Err(e) = asm.step() {
-            cut_short = Some(format!("a step failed: {e}"));
+            cut_short = Some(CutShort::StepFailed(e.to_string()));
             break;
         }
         window.add_step(asm);
@@ -295,7 +316,7 @@ fn withdraw(
             before = (s.mean_strain, s.upper_force_n);
         }
         if interrupt.is_some_and(|f| f.load(Ordering::SeqCst)) {
-            cut_short = Some(format!("interrupted at C = {strain:.4}"));
+            cut_short = Some(CutShort::Interrupted { strain });
             break;
         }
     }
@@ -1062,8 +1083,7 @@ pub fn run_bed(
             }
             // Only a withdrawal the interrupt cut short counts: one that
             // completed in the step the signal came in is whole and kept.
-            interrupted |= u.cut_short.is_some()
-                && control.interrupt.is_some_and(|f| f.load(Ordering::SeqCst));
+            interrupted |= matches!(u.cut_short, Some(CutShort::Interrupted { .. }));
             Some(u)
         }
         _ => None,

@@ -351,6 +351,26 @@ pub fn numbered_files(dir: &Path, prefix: &str, suffix: &str) -> Vec<(usize, Pat
     found
 }
 
+/// Every file `<prefix><k>.csv` in `vtk_dir`, in the order of k, read by
+/// `read` (given k and the path), and why each file that could not be read
+/// was left out of the summary's `field` (a damaged file must not cost the
+/// run's other outputs). Nothing if the folder is not there.
+pub fn read_snapshot_files<T>(
+    vtk_dir: &Path,
+    prefix: &str,
+    field: &str,
+    read: impl Fn(usize, &Path) -> anyhow::Result<T>,
+) -> (Vec<T>, Vec<String>) {
+    let (mut read_in, mut left_out) = (Vec::new(), Vec::new());
+    for (k, path) in numbered_files(vtk_dir, prefix, ".csv") {
+        match read(k, &path) {
+            Ok(t) => read_in.push(t),
+            Err(e) => left_out.push(format!("{e:#}; left out of {field}")),
+        }
+    }
+    (read_in, left_out)
+}
+
 /// The die's radius and the upper punch's height of `asm`, m (from its
 /// walls; NaN and 0 for a scene without them).
 pub fn die_geometry(asm: &Assembly<'_>) -> (Real, Real) {

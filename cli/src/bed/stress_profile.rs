@@ -209,11 +209,12 @@ impl StressProfile {
         })
     }
 
-    /// The profile of snapshot `snapshot` from its file's rows (the wall
-    /// readings and strain are the first row's; every row repeats them).
-    fn from_rows(snapshot: usize, rows: &[[Real; 11]]) -> Option<Self> {
-        let first = rows.first()?;
-        Some(Self {
+    /// The profile of snapshot `snapshot` from its file's [`LAYERS`] rows
+    /// (the wall readings and strain are the first row's; every row
+    /// repeats them).
+    fn from_rows(snapshot: usize, rows: &[[Real; 11]; LAYERS]) -> Self {
+        let first = &rows[0];
+        Self {
             snapshot,
             strain: first[0],
             walls: WallReadings {
@@ -233,7 +234,7 @@ impl StressProfile {
                     lateral_stress_pa: r[5],
                 })
                 .collect(),
-        })
+        }
     }
 
     /// The mean of `value` over the layers: over the compact, as the layers
@@ -288,14 +289,15 @@ impl StressSummary {
     /// wall's friction coefficient is `mu`.
     pub fn of(profile: &StressProfile, die_radius_m: Real, mu: Option<Real>) -> Self {
         let axial = profile.mean(|l| l.axial_stress_pa);
-        let k = profile.mean(|l| l.lateral_stress_pa) / axial;
+        let lateral = profile.mean(|l| l.lateral_stress_pa);
+        let k = lateral / axial;
         let w = profile.walls;
         Self {
             snapshot: profile.snapshot,
             strain: profile.strain,
             walls: w,
             mean_axial_stress_pa: axial,
-            mean_lateral_stress_pa: profile.mean(|l| l.lateral_stress_pa),
+            mean_lateral_stress_pa: lateral,
             lateral_to_axial: k,
             lower_to_upper: w.lower_punch_pa / w.upper_punch_pa,
             janssen_lower_to_upper: mu
@@ -310,22 +312,12 @@ impl StressSummary {
 /// be read was left out (a damaged file must not cost the run's other
 /// outputs).
 pub fn read_all(vtk_dir: &Path) -> (Vec<StressProfile>, Vec<String>) {
-    let (mut profiles, mut left_out) = (Vec::new(), Vec::new());
-    for (k, path) in &super::snapshots::numbered_files(vtk_dir, "stress_", ".csv") {
-        let read = read_table(path, &STRESS_COLUMNS).and_then(|rows| {
-            anyhow::ensure!(
-                rows.len() == LAYERS,
-                "`{}`: not {LAYERS} rows",
-                path.display()
-            );
-            StressProfile::from_rows(*k, &rows).ok_or_else(|| anyhow::anyhow!("no rows"))
-        });
-        match read {
-            Ok(p) => profiles.push(p),
-            Err(e) => left_out.push(format!("{e:#}; left out of stress_by_height")),
-        }
-    }
-    (profiles, left_out)
+    super::snapshots::read_snapshot_files(vtk_dir, "stress_", "stress_by_height", |k, path| {
+        let rows: [[Real; 11]; LAYERS] = read_table(path, &STRESS_COLUMNS)?
+            .try_into()
+            .map_err(|_| anyhow::anyhow!("`{}`: not {LAYERS} rows", path.display()))?;
+        Ok(StressProfile::from_rows(k, &rows))
+    })
 }
 
 #[cfg(test)]

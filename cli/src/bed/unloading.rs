@@ -183,7 +183,7 @@ mod tests {
         assert_eq!(s.loading_work_j, 10.0);
         assert!(warning(&none).unwrap().contains("no lift-off"));
         let cut = Unloading {
-            cut_short: Some("interrupted at C = 0.2900".into()),
+            cut_short: Some(crate::bed::run::CutShort::Interrupted { strain: 0.29 }),
             ..none
         };
         assert!(warning(&cut).unwrap().contains("interrupted at C = 0.2900"));
