@@ -10,7 +10,10 @@
 //! the contacts table's: a broad force distribution whose strong pairs
 //! align with the die axis. The stress through the compact
 //! (`vtk/stress_<k>.csv`, the summary's `stress_by_height`) is what the
-//! walls read in the same step.
+//! walls read in the same step, and the density map
+//! (`vtk/density_map_<k>.csv`, the summary's `final_density_map`) tiles
+//! the compact: it holds the bed's solid, and its rings add up to the
+//! stress file's layers.
 
 mod common;
 
@@ -41,6 +44,22 @@ fn the_contact_network_balances_the_inner_granules() {
         let path = dir.join(format!("vtk/{table}_0.csv"));
         assert!(!path.exists(), "{}", path.display());
     }
+    // The density map needs no forces: the pour's packing has one too.
+    density_map_tiles_the_compact(&dir, &s, 0);
+    // The summary's map is the last snapshot's file, and the report shows
+    // it as a table of LAYERS rows below its header.
+    let map = Table::read(&dir.join(format!("vtk/density_map_{last}.csv")));
+    let cells = s["final_density_map"]["cells"].as_array().unwrap();
+    let phi = map.num("solid_fraction");
+    assert_eq!(cells.len(), phi.len());
+    for (cell, phi) in cells.iter().zip(&phi) {
+        assert_eq!(number(cell, "solid_fraction"), *phi);
+    }
+    let densest = phi.iter().cloned().fold(f64::MIN, f64::max);
+    assert_eq!(
+        number(&s["final_density_map"]["densest"], "solid_fraction"),
+        densest
+    );
     // The report shows the network's table: a row per snapshot with one.
     let html = std::fs::read_to_string(dir.join("report.html")).unwrap();
     let table = &html[html
@@ -50,6 +69,12 @@ fn the_contact_network_balances_the_inner_granules() {
     assert_eq!(table.matches("<tr>").count(), 1 + last, "{table}");
     assert!(table.contains("<th>force_fabric_zz</th>"), "{table}");
     assert!(html.contains(&format!("href=\"vtk/network_{last}.csv\"")));
+    assert!(html.contains(&format!("href=\"vtk/density_map_{last}.csv\"")));
+    let table = &html[html
+        .find("<h3>The density through the compact</h3>")
+        .expect("no density table")..];
+    let table = &table[..table.find("</table>").unwrap()];
+    assert_eq!(table.matches("<tr>").count(), 1 + 10, "{table}");
     for k in 1..=last {
         let contacts = Table::read(&dir.join(format!("vtk/contacts_{k}.csv")));
         let granules = Table::read(&dir.join(format!("vtk/granules_{k}.csv")));
@@ -199,6 +224,7 @@ fn the_contact_network_balances_the_inner_granules() {
             nz2_of(false)
         );
         stress_through_the_compact(&dir, &s, k, k == last);
+        density_map_tiles_the_compact(&dir, &s, k);
         if k < last {
             continue;
         }
@@ -280,7 +306,7 @@ fn the_contact_network_balances_the_inner_granules() {
     // again: the tables of its end, which need a step's forces, stay as
     // the run left them.
     let tables = |k: usize| {
-        ["contacts", "granules", "network", "stress"]
+        ["contacts", "granules", "network", "stress", "density_map"]
             .map(|t| std::fs::read(dir.join(format!("vtk/{t}_{k}.csv"))).unwrap())
     };
     let before = tables(last);
@@ -290,7 +316,7 @@ fn the_contact_network_balances_the_inner_granules() {
         tables(last) == before,
         "the resumed run changed the end's tables"
     );
-    for field in ["contact_network", "stress_by_height"] {
+    for field in ["contact_network", "stress_by_height", "final_density_map"] {
         assert_eq!(
             summary(&dir)[field],
             s[field],
@@ -303,7 +329,7 @@ fn the_contact_network_balances_the_inner_granules() {
     argv.extend_from_slice(&small_bed("100", "0.05"));
     assert_eq!(cli(&argv).code, 0);
     for k in 1..=last {
-        for table in ["contacts", "granules", "network", "stress"] {
+        for table in ["contacts", "granules", "network", "stress", "density_map"] {
             let path = dir.join(format!("vtk/{table}_{k}.csv"));
             // k = 1 is now the final state at 0.05; k = 2 is gone.
             assert_eq!(path.is_file(), k == 1, "{}", path.display());
@@ -400,4 +426,72 @@ fn stress_through_the_compact(
     assert_eq!(number(entry, "mean_lateral_stress_pa"), lateral);
     assert_eq!(number(entry, "lower_to_upper"), low / up);
     assert_eq!(entry["layers"].as_array().unwrap().len(), 10);
+}
+
+/// The density map of snapshot k (`vtk/density_map_<k>.csv`): its cells,
+/// rings of equal width by tenths of the height, tile the die between the
+/// punches; their solid volumes Σ φ V_cell add up to the bed's solid
+/// (D0 π R_d² H0, to round-off: every element counts in some cell); and
+/// after a step each layer's cells, weighted by their volumes, give that
+/// layer of the stress file (the same elements, summed by cell first).
+fn density_map_tiles_the_compact(dir: &std::path::Path, s: &serde_json::Value, k: usize) {
+    const RINGS: usize = 5;
+    let t = Table::read(&dir.join(format!("vtk/density_map_{k}.csv")));
+    assert_eq!(t.cells.len(), RINGS * 10, "density_map_{k}");
+    let [inner, outer, bottom, top] = ["inner", "outer", "bottom", "top"].map(|n| t.num(n));
+    let (h, r) = (t.num("height_m")[0], t.num("die_radius_m")[0]);
+    assert_eq!(r, 2.5e-3);
+    let pi = core::f64::consts::PI;
+    let mut volumes = Vec::new();
+    for i in 0..t.cells.len() {
+        let (l, ring) = (i / RINGS, i % RINGS);
+        assert_eq!(
+            (inner[i], outer[i], bottom[i], top[i]),
+            (
+                ring as f64 / RINGS as f64,
+                (ring + 1) as f64 / RINGS as f64,
+                l as f64 / 10.0,
+                (l + 1) as f64 / 10.0
+            )
+        );
+        volumes.push(pi * r * r * (outer[i].powi(2) - inner[i].powi(2)) * h / 10.0);
+    }
+    let phi = t.num("solid_fraction");
+    let solid: f64 = phi.iter().zip(&volumes).map(|(p, v)| p * v).sum();
+    let bed = number(s, "initial_solid_fraction") * pi * r * r * number(s, "initial_bed_height_m");
+    assert!(
+        (solid / bed - 1.0).abs() < 1e-9,
+        "snapshot {k}: the map's solid {solid} m³ against the bed's {bed} m³"
+    );
+    // Each ring's mean over the layers near the bed's solid fraction D
+    // (the map's radii right), the ring at the die wall below it: spheres
+    // pack loosely within half a diameter of a wall (the ring is 0.5 mm,
+    // half a granule, wide), in the pour and after.
+    let d = solid / (pi * r * r * h);
+    for ring in 0..RINGS {
+        let mean = (0..10).map(|l| phi[l * RINGS + ring]).sum::<f64>() / 10.0;
+        assert!(
+            (mean / d - 1.0).abs() < 0.35 && (ring < RINGS - 1 || mean < d),
+            "snapshot {k} ring {ring}: solid fraction {mean}, the bed's {d}"
+        );
+    }
+    if k == 0 {
+        assert!((h / number(s, "initial_bed_height_m") - 1.0).abs() < 1e-12);
+        return;
+    }
+    let layers = Table::read(&dir.join(format!("vtk/stress_{k}.csv")));
+    let layer_volume = pi * r * r * h / 10.0;
+    for column in ["solid_fraction", "axial_stress_pa", "lateral_stress_pa"] {
+        let cells = t.num(column);
+        for (l, want) in layers.num(column).iter().enumerate() {
+            let got: f64 = (0..RINGS)
+                .map(|ring| cells[l * RINGS + ring] * volumes[l * RINGS + ring])
+                .sum::<f64>()
+                / layer_volume;
+            assert!(
+                (got - want).abs() <= 1e-10 * want.abs(),
+                "snapshot {k} layer {l} {column}: rings {got}, stress file {want}"
+            );
+        }
+    }
 }

@@ -290,6 +290,7 @@ fn snapshots_plots_and_report() {
         "density_height.svg",
         "die_wall_strain.svg",
         "stress_height.svg",
+        "density_map.svg",
     ] {
         let svg = std::fs::read_to_string(dir.join("plots").join(name))
             .unwrap_or_else(|e| panic!("{name}: {e}"));
@@ -303,7 +304,7 @@ fn snapshots_plots_and_report() {
     let html = std::fs::read_to_string(dir.join("report.html")).unwrap();
     assert!(html.starts_with("<!DOCTYPE html>"));
     assert!(html.trim_end().ends_with("</html>"));
-    assert_eq!(html.matches("<svg").count(), 12);
+    assert_eq!(html.matches("<svg").count(), 13);
     let s = summary(&dir);
     // The final solid fraction is the last row's, and the material every
     // parameter of the type (B2: E 1 MPa, true density 1500 kg/m³).
@@ -347,7 +348,7 @@ fn snapshots_plots_and_report() {
     let key = html.find("<h2>Key results</h2>").expect("no key results");
     assert!(key < html.find("<h2>Plots</h2>").unwrap());
     assert!(html.contains("solid fraction D: poured (D0) → at the end, in the die"));
-    assert_eq!(html.matches("<p class=\"caption\">").count(), 12);
+    assert_eq!(html.matches("<p class=\"caption\">").count(), 13);
     // The Kawakita fit over each window, the Heckel fit on the mean punch
     // pressure over the Heckel rows, and a glossary row for every column
     // of compression.csv, in its order.

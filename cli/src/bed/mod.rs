@@ -29,6 +29,7 @@ pub const HALF_SPEED_DIR: &str = "half_speed";
 
 pub mod checkpoint;
 pub mod compare;
+pub mod density_map;
 pub mod network;
 pub mod outputs;
 pub mod plots;
@@ -87,6 +88,11 @@ Output, in --out DIR (created if missing):
                    elements' mean axial and lateral stress in ten layers
                    beside the walls' pressures and Janssen's share
                    (stress_by_height, from vtk/stress_<k>.csv), the
+                   solid fraction and stresses in the compact's radial x
+                   height section at the last snapshot, with its densest
+                   and loosest cells and the top-to-bottom density ratios
+                   at the wall and the axis (final_density_map, from
+                   vtk/density_map_<k>.csv), the
                    withdrawal (unloading: lift-off strain, in-die elastic
                    recovery, residual die-wall and lower-punch pressure,
                    the punches' work, the work given back, net work and
@@ -141,6 +147,10 @@ Output, in --out DIR (created if missing):
                    the elements' mean axial and lateral stress over the
                    layer and its solid fraction, with the punches' and the
                    die wall's pressures of the same step (none at C = 0)
+  vtk/density_map_<k>.csv
+                   the compact's radial x height section: in 5 rings of
+                   equal width by 10 layers, each cell's solid fraction and
+                   mean axial and lateral stress (at C = 0 too)
   plots/*.svg      pressure (and the curve back while the punch withdraws),
                    coordination number, relative density and Heywood
                    coefficient against strain; Kawakita plot P/C vs P and
@@ -151,10 +161,11 @@ Output, in --out DIR (created if missing):
                    density vs its height at the end; the die wall's
                    radial-to-axial stress ratio and mobilised friction vs
                    strain; the axial stress by height at each snapshot with
-                   Janssen's curve
+                   Janssen's curve; the density map (solid fraction and
+                   axial stress by radius and height) at the last snapshot
   report.html      one page: the warnings (or that there are none), the key
                    results, the fits by window, the contact network, the
-                   stress through the compact, the plots with
+                   stress through the compact, the density map, the plots with
                    captions, the sections with their tables linked, the
                    summary table (rounded; hover a value for all its digits),
                    the tables' columns explained, and the scene

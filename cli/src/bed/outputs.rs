@@ -11,6 +11,7 @@ use granbed_kernel::analysis::quasi_static::LoadSample;
 use indicatif::ProgressBar;
 use serde::Serialize;
 
+use super::density_map::MapSummary;
 use super::network::NetworkStats;
 use super::run::{BedRun, BedSample, GranuleAtEnd};
 use super::scene::Scene;
@@ -369,6 +370,11 @@ pub struct Summary<'a> {
     /// strain order (`vtk/stress_<k>.csv`, [`super::stress_profile`]):
     /// read from those files by [`write_all`], like `contact_network`.
     pub stress_by_height: Vec<StressSummary>,
+    /// The density and stress in the compact's radial × height section at
+    /// the last snapshot (`vtk/density_map_<k>.csv`,
+    /// [`super::density_map`]): read from that file by [`write_all`], like
+    /// `contact_network`; `None` without one or with a NaN cell.
+    pub final_density_map: Option<MapSummary>,
     /// The upper punch's withdrawal after the final strain (scene
     /// `unload`; `None` without one): elastic recovery, residual die-wall
     /// pressure, the work of the cycle.
@@ -717,6 +723,7 @@ pub fn summary<'a>(scene: &'a Scene, run: &BedRun) -> Summary<'a> {
         final_die_wall: die_wall_summary(run, &last),
         contact_network: Vec::new(),
         stress_by_height: Vec::new(),
+        final_density_map: None,
         unloading: run.unloading.as_ref().map(|u| UnloadingSummary::of(run, u)),
         material: material.map(MaterialSummary::from),
         yield_stress_pa: material.map_or(Real::NAN, |m| m.yield_stress_pa),
@@ -1082,6 +1089,9 @@ pub fn write_all(dir: &Path, scene: &Scene, run: &BedRun) -> anyhow::Result<()> 
         .iter()
         .map(|p| StressSummary::of(p, 0.5e-3 * scene.die_diameter_mm, mu))
         .collect();
+    summary.warnings.extend(left_out);
+    let (maps, left_out) = super::density_map::read_all(&dir.join(super::snapshots::VTK_DIR));
+    summary.final_density_map = maps.last().and_then(MapSummary::of);
     summary.warnings.extend(left_out);
     write_json(&dir.join(SUMMARY_JSON), &summary)?;
     let svgs = super::plots::write_plots(dir, run, &summary)?;

@@ -25,7 +25,12 @@
 //!   ended against its height in the compact, with the layer means;
 //! * `die_wall_strain.svg`: the die wall's radial-to-axial stress ratio and
 //!   its mobilised friction |F_z|/F_n against C, from where the punches
-//!   carry load.
+//!   carry load;
+//! * `stress_height.svg`: the axial stress through the compact's height at
+//!   each snapshot, with Janssen's curve;
+//! * `density_map.svg`: the solid fraction and axial stress in the
+//!   compact's radial × height section at the last snapshot
+//!   ([`super::density_map::map_svg`]).
 //!
 //! The averaged quantities (pressures, Z, the die wall's forces) are drawn
 //! at each output interval's mean strain, those taken at the rows
@@ -47,7 +52,7 @@ use granbed_kernel::Real;
 pub const PLOTS_DIR: &str = "plots";
 
 /// The plot files, in the order [`write_plots`] writes them.
-pub const PLOT_FILES: [&str; 12] = [
+pub const PLOT_FILES: [&str; 13] = [
     "pressure_strain.svg",
     "kawakita.svg",
     "heckel.svg",
@@ -60,6 +65,7 @@ pub const PLOT_FILES: [&str; 12] = [
     "density_height.svg",
     "die_wall_strain.svg",
     "stress_height.svg",
+    "density_map.svg",
 ];
 
 /// The energy ledger's terms drawn by `energy_strain.svg`, J, with their
@@ -493,6 +499,7 @@ pub fn plots(
         density_height_f,
         die_wall_f,
         stress_height_f,
+        density_map_f,
     ] = PLOT_FILES;
     // Unlabelled: the title and axes say what the one curve is (no legend).
     let profile = [(
@@ -578,6 +585,10 @@ pub fn plots(
         (
             stress_height_f,
             stress_height_svg(summary, 0.5e-3 * summary.scene.die_diameter_mm)?,
+        ),
+        (
+            density_map_f,
+            super::density_map::map_svg(summary.final_density_map.as_ref()),
         ),
     ])
 }

@@ -8,6 +8,7 @@
 use core::fmt::Write as _;
 use std::path::Path;
 
+use super::density_map::MAP_COLUMNS;
 use super::network::{NETWORK_COLUMNS, network_file};
 use super::outputs::{COMPRESSION_COLUMNS, Summary};
 use super::scene::{DEFAULT_SCENE, Scene};
@@ -29,7 +30,7 @@ pub const REPORT_FILE: &str = "report.html";
 /// meaning; any other field follows (nested objects such as `kawakita` and
 /// `heckel` are flattened to `kawakita.<field>`; the scene, `scene` and
 /// `scene_toml`, is shown as TOML instead).
-const FIELDS: [(&str, &str); 111] = [
+const FIELDS: [(&str, &str); 112] = [
     ("kawakita_a", "Kawakita a (limiting strain)"),
     ("kawakita_inv_b_pa", "Kawakita 1/b, Pa"),
     (
@@ -341,6 +342,8 @@ const FIELDS: [(&str, &str); 111] = [
     ("contact_network", ""),
     // Its own table, "The stress through the compact".
     ("stress_by_height", ""),
+    // Its own table, "The density through the compact", and density_map.svg.
+    ("final_density_map", ""),
 ];
 
 /// The summary's fields as rows, in [`FIELDS`]' order, then the others;
@@ -630,6 +633,59 @@ fn stress_by_height(summary: &Summary<'_>) -> String {
     h
 }
 
+/// The density map of the last snapshot (`summary.final_density_map`)
+/// as a table: the layers top first, the rings from the axis out, each
+/// cell's solid fraction; and where it is densest and loosest. Nothing if
+/// the run has none.
+fn density_map(summary: &Summary<'_>) -> String {
+    use super::density_map::{LAYERS, RINGS};
+    let Some(s) = &summary.final_density_map else {
+        return String::new();
+    };
+    let m = &s.map;
+    // The cells' bounds are tenths and fifths.
+    let span = |a: f64, b: f64| format!("{a:.1}–{b:.1}");
+    let mut h = format!(
+        "<h3>The density through the compact</h3>\n<p>The solid fraction at C = {} in the \
+         compact's radial × height section (plots/density_map.svg draws it with the axial \
+         stress; vtk/density_map_&lt;k&gt;.csv has every snapshot's): each cell's granule \
+         solid over its volume, rows from the upper punch down, columns from the die's axis \
+         out to its wall (r/R<sub>d</sub>). The ring at the wall is {} times as dense in its \
+         upper half as in its lower half, the disc at the axis {} times (the tenths at the \
+         punches are loose in any bed: spheres touch a flat punch at points). Densest cell: {} \
+         (r/R<sub>d</sub> {}, z/H {}); loosest: {} (r/R<sub>d</sub> {}, z/H {}).\
+         </p>\n<table>\n<tr><th>z/H</th>",
+        num(Some(m.strain)),
+        num(Some(s.wall_top_to_bottom)),
+        num(Some(s.axis_top_to_bottom)),
+        num(Some(s.densest.solid_fraction)),
+        span(s.densest.inner, s.densest.outer),
+        span(s.densest.bottom, s.densest.top),
+        num(Some(s.loosest.solid_fraction)),
+        span(s.loosest.inner, s.loosest.outer),
+        span(s.loosest.bottom, s.loosest.top),
+    );
+    for r in 0..RINGS {
+        let c = m.cell(r, 0);
+        let _ = write!(h, "<th>{}</th>", span(c.inner, c.outer));
+    }
+    h.push_str("</tr>\n");
+    for l in (0..LAYERS).rev() {
+        let c = m.cell(0, l);
+        let _ = write!(h, "<tr><td>{}</td>", span(c.bottom, c.top));
+        for r in 0..RINGS {
+            let _ = write!(
+                h,
+                "<td class=\"num\">{}</td>",
+                num(Some(m.cell(r, l).solid_fraction))
+            );
+        }
+        h.push_str("</tr>\n");
+    }
+    h.push_str("</table>\n");
+    h
+}
+
 /// A table cell's text: an integer as is, a float rounded as the report's
 /// other figures ([`num`]).
 fn field_text(cell: Field) -> String {
@@ -675,6 +731,14 @@ fn glossaries() -> String {
          its height, bottom first, with the walls' readings in the snapshot's step repeated \
          on every row (the report's table \"The stress through the compact\").",
         &STRESS_COLUMNS,
+    ));
+    h.push_str(&glossary(
+        "vtk/density_map_<k>.csv",
+        "Beside snapshot k (the pour's too, at C = 0): the compact's radial × height \
+         section, one row per cell, layers bottom first and within a layer the rings from the \
+         die's axis out, with the compact's height and the die's radius repeated on every row \
+         (the report's table \"The density through the compact\", plots/density_map.svg).",
+        &MAP_COLUMNS,
     ));
     h
 }
@@ -775,6 +839,17 @@ fn plot_caption(name: &str, summary: &Summary<'_>) -> Option<String> {
              wall's friction coefficient μ: the fall if K were the same at every height and \
              every granule at the wall slid."
             .to_owned(),
+        "density_map.svg" => "The compact's half-section at the last snapshot, between the \
+             die's axis (left) and its wall (right, the thick line), the lower punch at the \
+             bottom, drawn to scale: in rings of equal width and tenths of the height, the solid \
+             fraction (the granules' solid over the cell's volume) and the mean axial stress \
+             −σ_zz over the cell (vtk/density_map_<k>.csv; table \"The density through the \
+             compact\"). Each panel is coloured from its smallest value (dark) to its largest \
+             (yellow). The die wall's friction holds the load back, so a compact pressed from \
+             above is usually densest at its top outer edge and loosest at its bottom outer \
+             edge. The disc at the axis holds only a few granules, so its cells are the \
+             noisiest."
+            .to_owned(),
         "energy_strain.svg" => "Where the punch's work went, totals so far against the strain \
              (compression.csv's energy columns): the elastic energy stored in the \
              granules, the plastic dissipation, the contact losses (friction and the \
@@ -817,6 +892,7 @@ pub fn report_html(
     h.push_str(&fits_by_window(summary));
     h.push_str(&contact_network(summary));
     h.push_str(&stress_by_height(summary));
+    h.push_str(&density_map(summary));
     writeln!(
         h,
         "<p>Files: <a href=\"compression.csv\">compression.csv</a>, {}\
@@ -904,6 +980,7 @@ fn snapshot_files(dir: &Path) -> Vec<SnapshotFiles> {
                 granules_file(k),
                 network_file(k),
                 stress_file(k),
+                super::density_map::map_file(k),
             ]
             .into_iter()
             .filter(|name| dir.join(VTK_DIR).join(name).is_file())
@@ -1037,6 +1114,8 @@ mod tests {
             ("vtk/contacts_&lt;k&gt;.csv", &CONTACT_COLUMNS[..]),
             ("vtk/granules_&lt;k&gt;.csv", &GRANULE_COLUMNS[..]),
             ("vtk/network_&lt;k&gt;.csv", &NETWORK_COLUMNS[..]),
+            ("vtk/stress_&lt;k&gt;.csv", &STRESS_COLUMNS[..]),
+            ("vtk/density_map_&lt;k&gt;.csv", &MAP_COLUMNS[..]),
         ] {
             let table = &glossary[glossary.find(&format!("<h3>{file}</h3>")).unwrap()..];
             let table = &table[..table.find("</table>").unwrap()];

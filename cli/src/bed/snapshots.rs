@@ -27,6 +27,7 @@ use vtkio::model::{
     Version, VertexNumbers, Vtk,
 };
 
+use super::density_map::{density_map, write_map};
 use super::network::{network_stats, write_network};
 use super::section::{Frame, Quantity, SectionInput, section_svg};
 use super::snapshot_tables::{
@@ -106,6 +107,9 @@ pub struct ElementFields {
     pub volume_m3: Vec<Real>,
     /// Height of the element's centre (the mean of its nodes' z), m.
     pub height_m: Vec<Real>,
+    /// Distance of the element's centre from the die's axis (the z axis),
+    /// m.
+    pub radius_m: Vec<Real>,
 }
 
 /// The pressure −tr σ/3 and von Mises stress √(3/2)‖dev σ‖ of a Cauchy
@@ -160,8 +164,12 @@ pub fn element_fields(asm: &Assembly<'_>, mesh: &OwnedReference) -> ElementField
             f.relative_density.push(eta0 / o.j);
             f.lateral_stress_pa.push(-0.5 * (o.sigma[0] + o.sigma[1]));
             f.volume_m3.push(o.j * reference.volume);
-            f.height_m
-                .push(hex.iter().map(|&n| g.x[n as usize][2]).sum::<Real>() / 8.0);
+            let centre = hex.iter().fold([0.0; 3], |c, &n| {
+                let x = g.x[n as usize];
+                [c[0] + x[0], c[1] + x[1], c[2] + x[2]]
+            });
+            f.height_m.push(centre[2] / 8.0);
+            f.radius_m.push(centre[0].hypot(centre[1]) / 8.0);
         }
     }
     f
@@ -432,7 +440,8 @@ fn section_input<'a>(
 
 /// Removes the snapshots an earlier run left in `out`/[`VTK_DIR`]
 /// (`bed_<k>.vtu`, `section_<k>.svg`, `contacts_<k>.csv`, `granules_<k>.csv`,
-/// `network_<k>.csv`, `stress_<k>.csv` and [`PVD_FILE`]; nothing else), so that a fresh run
+/// `network_<k>.csv`, `stress_<k>.csv`, `density_map_<k>.csv` and
+/// [`PVD_FILE`]; nothing else), so that a fresh run
 /// into the same directory does not leave stale snapshots beside its own
 /// (e.g. of strains it does not reach). Returns how many files went.
 pub fn remove_old(out: &Path) -> anyhow::Result<usize> {
@@ -450,7 +459,8 @@ pub fn remove_old(out: &Path) -> anyhow::Result<usize> {
             || numbered(name, "contacts_", ".csv").is_some()
             || numbered(name, "granules_", ".csv").is_some()
             || numbered(name, "network_", ".csv").is_some()
-            || numbered(name, "stress_", ".csv").is_some();
+            || numbered(name, "stress_", ".csv").is_some()
+            || numbered(name, "density_map_", ".csv").is_some();
         if (snapshot || name == PVD_FILE) && entry.path().is_file() {
             std::fs::remove_file(entry.path())
                 .with_context(|| format!("cannot remove `{}`", entry.path().display()))?;
@@ -503,9 +513,10 @@ impl SnapshotWriter {
         }
     }
 
-    /// Writes `bed_<k>.vtu` of `asm` at `strain`, its section picture and,
-    /// if `asm` has taken a step, its tables ([`super::snapshot_tables`]),
-    /// and rewrites `bed.pvd`.
+    /// Writes `bed_<k>.vtu` of `asm` at `strain`, its section picture, its
+    /// density map ([`super::density_map`]) and, if `asm` has taken a
+    /// step, its tables ([`super::snapshot_tables`]), and rewrites
+    /// `bed.pvd`.
     pub fn write(
         &mut self,
         strain: Real,
@@ -528,6 +539,11 @@ impl SnapshotWriter {
             &self.dir.join(section_file(k)),
             &section_svg(&section_input(asm, mesh, &elements, strain)),
         )?;
+        let (die_radius_m, height_m) = die_geometry(asm);
+        write_map(
+            &self.dir,
+            &density_map(k, strain, &elements, die_radius_m, height_m),
+        )?;
         // The tables need a step's contact forces: none at C = 0, before
         // the first step.
         if asm.has_stepped() {
@@ -545,7 +561,6 @@ impl SnapshotWriter {
             )?;
             let mu = asm.params().contact.friction;
             write_network(&self.dir, k, &network_stats(k, strain, mu, &contacts))?;
-            let (die_radius_m, _) = die_geometry(asm);
             let profile =
                 stress_profile(k, strain, &elements, die_radius_m, wall_readings(asm, mesh));
             write_profile(&self.dir, &profile)?;

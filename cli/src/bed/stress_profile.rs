@@ -155,17 +155,8 @@ pub fn stress_profile(
     die_radius_m: Real,
     walls: WallReadings,
 ) -> StressProfile {
-    let mut sums = [[0.0; 3]; LAYERS];
     let height = walls.height_m;
-    for e in 0..fields.volume_m3.len() {
-        let at = (fields.height_m[e] / height * LAYERS as Real).floor();
-        // `as` saturates: below 0 (and NaN) to 0, past the top to LAYERS.
-        let l = (at as usize).min(LAYERS - 1);
-        let v = fields.volume_m3[e];
-        sums[l][0] += v * fields.relative_density[e];
-        sums[l][1] += v * fields.axial_stress_pa[e];
-        sums[l][2] += v * fields.lateral_stress_pa[e];
-    }
+    let sums = super::density_map::cell_sums(fields, die_radius_m, height, 1);
     let layer_volume =
         core::f64::consts::PI * die_radius_m * die_radius_m * height / LAYERS as Real;
     let layers = sums
