@@ -225,6 +225,7 @@ fn the_contact_network_balances_the_inner_granules() {
         );
         stress_through_the_compact(&dir, &s, k, k == last);
         density_map_tiles_the_compact(&dir, &s, k);
+        the_interior_has_more_contacts(&dir, &granules, k);
         if k < last {
             continue;
         }
@@ -494,4 +495,42 @@ fn density_map_tiles_the_compact(dir: &std::path::Path, s: &serde_json::Value, k
             );
         }
     }
+}
+
+/// The network file's interior (`interior_granules`,
+/// `interior_coordination`) recomputed from the granules table: the
+/// granules whose centres lie at least a diameter (1 mm) from the die wall
+/// and both punches, and their contacts per granule; it has more contacts
+/// per granule than the whole bed (a granule at a wall has fewer granule
+/// neighbours).
+fn the_interior_has_more_contacts(dir: &std::path::Path, granules: &Table, k: usize) {
+    let network = Table::read(&dir.join(format!("vtk/network_{k}.csv")));
+    let height = Table::read(&dir.join(format!("vtk/stress_{k}.csv"))).num("height_m")[0];
+    let (x, y, z) = (
+        granules.num("x_m"),
+        granules.num("y_m"),
+        granules.num("z_m"),
+    );
+    let contacts = granules.num("contacts");
+    let d = 1e-3;
+    let inside: Vec<usize> = (0..x.len())
+        .filter(|&g| x[g].hypot(y[g]) <= 2.5e-3 - d && z[g] >= d && z[g] <= height - d)
+        .collect();
+    let z_inside = inside.iter().map(|&g| contacts[g]).sum::<f64>() / inside.len() as f64;
+    let z_bed = contacts.iter().sum::<f64>() / contacts.len() as f64;
+    assert_eq!(network.num("interior_granules")[0], inside.len() as f64);
+    assert!(
+        inside.len() >= 10,
+        "snapshot {k}: {} interior granules",
+        inside.len()
+    );
+    let reported = network.num("interior_coordination")[0];
+    assert!(
+        (reported - z_inside).abs() <= 1e-12 * z_inside,
+        "snapshot {k}: interior Z {reported}, from the granules {z_inside}"
+    );
+    assert!(
+        z_inside > z_bed,
+        "snapshot {k}: interior Z {z_inside}, the bed's {z_bed}"
+    );
 }

@@ -141,7 +141,9 @@ Output, in --out DIR (created if missing):
                    the contact network in figures: quantiles of f/<f>, the
                    strong pairs' shares, the fabric <n_z^2> by number, by
                    force, over the strong and the weak pairs, the pairs'
-                   mobilised friction and those sliding (none at C = 0)
+                   mobilised friction and those sliding, and the interior's
+                   coordination number: the granules at least a diameter
+                   from every wall (none at C = 0)
   vtk/stress_<k>.csv
                    the stress through the compact: per tenth of its height,
                    the elements' mean axial and lateral stress over the

@@ -23,7 +23,7 @@ use super::snapshot_tables::ContactRow;
 use crate::csv::{Field, write_table};
 
 /// Columns of a network file, in order: (name, meaning with its unit).
-pub const NETWORK_COLUMNS: [(&str, &str); 14] = [
+pub const NETWORK_COLUMNS: [(&str, &str); 16] = [
     (
         "strain",
         "the snapshot's nominal axial strain C (the state is that of the step that first reached it)",
@@ -77,7 +77,61 @@ pub const NETWORK_COLUMNS: [(&str, &str); 14] = [
         "sliding_share",
         "share of the pairs whose friction reaches 0.99 μ f (Coulomb's limit μ f, to 1 %): the pairs sliding as a whole; the mobilisation is spread smoothly up to μ, so many pairs lie just below",
     ),
+    (
+        "interior_granules",
+        "granules whose centre of mass lies at least one nominal diameter d from the die wall and from both punches: the bed's interior (0 in files written before the column existed)",
+    ),
+    (
+        "interior_coordination",
+        "their granule contacts per granule (the contacts table's pairs they are in, over their number): the coordination number without the walls' deficit (a granule at a wall has fewer granule neighbours), the one packing models such as Arzt's describe; NaN without an interior granule",
+    ),
 ];
+
+/// Columns of the network files written before the interior's.
+const COLUMNS_BEFORE_INTERIOR: usize = 14;
+
+/// The bed's interior in a snapshot: its granules and their mean granule
+/// contacts ([`interior`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Interior {
+    /// Granules in the interior.
+    pub granules: usize,
+    /// Their granule contacts per granule (NaN without one).
+    pub coordination: Real,
+}
+
+/// The interior of a bed whose granules' centres of mass are `centres`
+/// (m, the die's axis x = y = 0, the lower punch z = 0), in contact as
+/// `rows` say, in a die of radius `die_radius_m` with the punches
+/// `height_m` apart: the granules at least `margin_m` (a granule's
+/// diameter) from the die wall and from both punches, and their contacts
+/// per granule.
+pub fn interior(
+    centres: &[[Real; 3]],
+    rows: &[ContactRow],
+    die_radius_m: Real,
+    height_m: Real,
+    margin_m: Real,
+) -> Interior {
+    let inside: Vec<bool> = centres
+        .iter()
+        .map(|c| {
+            c[0].hypot(c[1]) <= die_radius_m - margin_m
+                && c[2] >= margin_m
+                && c[2] <= height_m - margin_m
+        })
+        .collect();
+    let is_inside = |g: u32| inside.get(g as usize).copied().unwrap_or(false);
+    let contacts = rows
+        .iter()
+        .map(|r| u64::from(is_inside(r.a)) + u64::from(is_inside(r.b)))
+        .sum::<u64>();
+    let granules = inside.iter().filter(|&&i| i).count();
+    Interior {
+        granules,
+        coordination: contacts as Real / granules as Real,
+    }
+}
 
 /// One snapshot's network in figures ([`NETWORK_COLUMNS`]). A snapshot
 /// without pairs has `pairs` 0 and every ratio NaN (`null` in JSON); one
@@ -116,6 +170,10 @@ pub struct NetworkStats {
     pub friction_to_normal: Real,
     /// Share of the pairs at Coulomb's limit ([`SLIDING_AT`]).
     pub sliding_share: Real,
+    /// Granules in the bed's interior ([`interior`]).
+    pub interior_granules: usize,
+    /// Their granule contacts per granule.
+    pub interior_coordination: Real,
 }
 
 /// The `q` quantile (0 ≤ q ≤ 1) of the ascending `sorted`, linear between
@@ -142,8 +200,14 @@ fn quantile(sorted: &[Real], q: Real) -> Real {
 pub const SLIDING_AT: Real = 0.99;
 
 /// The figures of the contact `rows` of snapshot `snapshot` at `strain`,
-/// the pairs' friction coefficient `mu`.
-pub fn network_stats(snapshot: usize, strain: Real, mu: Real, rows: &[ContactRow]) -> NetworkStats {
+/// the pairs' friction coefficient `mu`, with the bed's `interior`.
+pub fn network_stats(
+    snapshot: usize,
+    strain: Real,
+    mu: Real,
+    rows: &[ContactRow],
+    interior: Interior,
+) -> NetworkStats {
     let n = rows.len() as Real;
     let total: Real = rows.iter().map(|r| r.normal_n).sum();
     let mean = total / n;
@@ -183,12 +247,14 @@ pub fn network_stats(snapshot: usize, strain: Real, mu: Real, rows: &[ContactRow
             .filter(|r| r.friction_n >= SLIDING_AT * mu * r.normal_n && r.normal_n > 0.0)
             .count() as Real
             / n,
+        interior_granules: interior.granules,
+        interior_coordination: interior.coordination,
     }
 }
 
 impl NetworkStats {
     /// The row's cells, as [`NETWORK_COLUMNS`] lists them.
-    pub fn fields(&self) -> [Field; 14] {
+    pub fn fields(&self) -> [Field; 16] {
         [
             self.strain.into(),
             Field::Int(self.pairs as u64),
@@ -204,12 +270,14 @@ impl NetworkStats {
             self.weak_fabric_zz.into(),
             self.friction_to_normal.into(),
             self.sliding_share.into(),
+            Field::Int(self.interior_granules as u64),
+            self.interior_coordination.into(),
         ]
     }
 
     /// The figures of snapshot `snapshot` from the cells of its network
     /// file's row, in [`NETWORK_COLUMNS`]' order.
-    fn from_cells(snapshot: usize, c: &[Real; 14]) -> Self {
+    fn from_cells(snapshot: usize, c: &[Real; 16]) -> Self {
         Self {
             snapshot,
             strain: c[0],
@@ -226,6 +294,8 @@ impl NetworkStats {
             weak_fabric_zz: c[11],
             friction_to_normal: c[12],
             sliding_share: c[13],
+            interior_granules: c[14] as usize,
+            interior_coordination: c[15],
         }
     }
 }
@@ -245,12 +315,35 @@ pub fn write_network(vtk_dir: &Path, k: usize, stats: &NetworkStats) -> anyhow::
 }
 
 /// Reads the network file of snapshot `snapshot`: its header must be
-/// [`NETWORK_COLUMNS`]' names and it must hold one row of numbers.
+/// [`NETWORK_COLUMNS`]' names, or their first
+/// [`COLUMNS_BEFORE_INTERIOR`] (a file written before the interior's
+/// columns, read with none: 0 granules, NaN), and it must hold one row of
+/// numbers.
 fn read_network(snapshot: usize, path: &Path) -> anyhow::Result<NetworkStats> {
-    match crate::csv::read_table(path, &NETWORK_COLUMNS)?[..] {
-        [cells] => Ok(NetworkStats::from_cells(snapshot, &cells)),
-        _ => anyhow::bail!("`{}`: not one row", path.display()),
+    use crate::csv::read_table;
+    fn one<const N: usize>(rows: &[[Real; N]], path: &Path) -> anyhow::Result<[Real; N]> {
+        match rows {
+            [cells] => Ok(*cells),
+            _ => anyhow::bail!("`{}`: not one row", path.display()),
+        }
     }
+    let cells = match read_table(path, &NETWORK_COLUMNS) {
+        Ok(rows) => one(&rows, path)?,
+        Err(e) => {
+            let older: [(&str, &str); COLUMNS_BEFORE_INTERIOR] =
+                core::array::from_fn(|i| NETWORK_COLUMNS[i]);
+            let Ok(rows) = read_table(path, &older) else {
+                return Err(e);
+            };
+            let c = one(&rows, path)?;
+            core::array::from_fn(|i| match i {
+                i if i < COLUMNS_BEFORE_INTERIOR => c[i],
+                COLUMNS_BEFORE_INTERIOR => 0.0,
+                _ => Real::NAN,
+            })
+        }
+    };
+    Ok(NetworkStats::from_cells(snapshot, &cells))
 }
 
 /// The network files in `vtk_dir`, in the order of k (the snapshots'
@@ -290,7 +383,7 @@ mod tests {
             pair(3.0, [0.0, 0.0, 1e-3], 0.0),
             pair(6.0, [0.0, 0.0, -3e-3], 1.5),
         ];
-        let s = network_stats(7, 0.2, 0.5, &rows);
+        let s = network_stats(7, 0.2, 0.5, &rows, NO_INTERIOR);
         assert_eq!((s.snapshot, s.strain, s.pairs), (7, 0.2, 4));
         assert_eq!(s.mean_normal_force_n, 3.0);
         assert!((s.median_to_mean - 2.5 / 3.0).abs() < 1e-15);
@@ -311,7 +404,10 @@ mod tests {
             pair(1.0, [0.0, 0.0, 1e-3], 0.995 * 0.1),
             pair(1.0, [0.0, 0.0, 1e-3], 0.985 * 0.1),
         ];
-        assert_eq!(network_stats(0, 0.1, 0.1, &near).sliding_share, 0.5);
+        assert_eq!(
+            network_stats(0, 0.1, 0.1, &near, NO_INTERIOR).sliding_share,
+            0.5
+        );
     }
 
     /// A file written reads back to the same figures, to the bit; a
@@ -324,8 +420,12 @@ mod tests {
             pair(0.1, [1e-3, 2e-3, 3e-3], 0.01),
             pair(0.7, [-1e-3, 0.5e-3, 2e-3], 0.05),
         ];
-        let full = network_stats(2, 0.1 + 0.2, 0.1, &rows);
-        let empty = network_stats(10, 0.3, 0.1, &[]);
+        let inside = Interior {
+            granules: 3,
+            coordination: 5.0 / 3.0,
+        };
+        let full = network_stats(2, 0.1 + 0.2, 0.1, &rows, inside);
+        let empty = network_stats(10, 0.3, 0.1, &[], NO_INTERIOR);
         assert_eq!(empty.pairs, 0);
         assert!(empty.median_to_mean.is_nan() && empty.fabric_zz.is_nan());
         write_network(&dir, 2, &full).unwrap();
@@ -345,6 +445,57 @@ mod tests {
                 && left_out[0].contains("header"),
             "{left_out:?}"
         );
+        // A file written before the interior's columns reads with none.
+        let text = std::fs::read_to_string(dir.join(network_file(2))).unwrap();
+        let old: String = text
+            .lines()
+            .map(|l| {
+                l.split(',')
+                    .take(COLUMNS_BEFORE_INTERIOR)
+                    .collect::<Vec<_>>()
+                    .join(",")
+                    + "\n"
+            })
+            .collect();
+        std::fs::write(dir.join(network_file(2)), old).unwrap();
+        let (back, _) = read_all(&dir);
+        assert_eq!(back[0].fabric_zz, full.fabric_zz);
+        assert_eq!(back[0].interior_granules, 0);
+        assert!(back[0].interior_coordination.is_nan());
         std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    /// No interior: the figures of a bed too small for one.
+    const NO_INTERIOR: Interior = Interior {
+        granules: 0,
+        coordination: Real::NAN,
+    };
+
+    /// In a die of radius 5 mm with the punches 6 mm apart and a margin of
+    /// 1 mm, the granules whose centres lie within r ≤ 4 mm and
+    /// 1 ≤ z ≤ 5 mm are inside; each pair counts once for each granule of
+    /// it that is.
+    #[test]
+    fn the_interior_is_away_from_every_wall() {
+        let centres = [
+            [0.0, 0.0, 3e-3],    // inside
+            [3e-3, 2e-3, 2e-3],  // r = 3.6 mm: inside
+            [3e-3, 3e-3, 3e-3],  // r = 4.2 mm: at the wall
+            [0.0, 1e-3, 0.5e-3], // at the lower punch
+            [1e-3, 0.0, 5.5e-3], // at the upper punch
+        ];
+        let pair = |a, b| ContactRow {
+            a,
+            b,
+            ..super::tests::pair(1.0, [0.0, 0.0, 1e-3], 0.0)
+        };
+        let rows = [pair(0, 1), pair(0, 2), pair(2, 3), pair(1, 4), pair(0, 4)];
+        let i = interior(&centres, &rows, 5e-3, 6e-3, 1e-3);
+        // Granule 0 is in three pairs, granule 1 in two.
+        assert_eq!(i.granules, 2);
+        assert_eq!(i.coordination, 2.5);
+        let none = interior(&centres[2..], &[], 5e-3, 6e-3, 1e-3);
+        assert_eq!(none.granules, 0);
+        assert!(none.coordination.is_nan());
     }
 }

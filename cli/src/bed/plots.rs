@@ -419,14 +419,30 @@ pub fn plots(
             ),
         ));
     }
-    let coordination = against_strain(
+    let mut coordination = against_strain(
         samples,
         strain_of(true),
         [
             ("granule pairs", |s| s.coordination),
             ("with walls", |s| s.coordination_with_walls),
         ],
-    );
+    )
+    .into_iter()
+    .collect::<Vec<_>>();
+    // The interior's, from the snapshots' contact networks.
+    let interior: Vec<(f64, f64)> = summary
+        .contact_network
+        .iter()
+        .map(|n| (n.strain, n.interior_coordination))
+        .filter(|(_, z)| z.is_finite())
+        .collect();
+    if !interior.is_empty() {
+        coordination.push(Series::new(
+            "interior granules (a diameter from every wall), at the snapshots",
+            Mark::Dots,
+            interior.into_iter(),
+        ));
+    }
     let density = against_strain(
         samples,
         strain_of(false),

@@ -778,7 +778,12 @@ fn plot_caption(name: &str, summary: &Summary<'_>) -> Option<String> {
         ),
         "coordination_strain.svg" => "The mean coordination number Z against the strain: \
              granule–granule contacts per granule, and with the die and punch contacts counted \
-             too."
+             too; and at each snapshot after a step, the granule contacts per granule of the \
+             bed's interior, the granules whose centres lie at least a diameter from the die \
+             wall and both punches (vtk/network_<k>.csv's interior_coordination): a granule at a \
+             wall has fewer granule neighbours, so the interior's Z is the one packing models \
+             such as Arzt's describe. It is taken in the snapshot's step, the curves are \
+             averaged over each output interval."
             .to_owned(),
         "relative_density_strain.svg" => "The granules' own relative density against the \
              strain (their solid over their volume, without the voids between them): the mean \

@@ -28,7 +28,7 @@ use vtkio::model::{
 };
 
 use super::density_map::{density_map, write_map};
-use super::network::{network_stats, write_network};
+use super::network::{interior, network_stats, write_network};
 use super::section::{Frame, Quantity, SectionInput, section_svg};
 use super::snapshot_tables::{
     CONTACT_COLUMNS, ContactRow, GRANULE_COLUMNS, centres_of_mass, contact_rows, contacts_file,
@@ -560,7 +560,12 @@ impl SnapshotWriter {
                 granule_rows(&centres, &granules, &contacts).into_iter(),
             )?;
             let mu = asm.params().contact.friction;
-            write_network(&self.dir, k, &network_stats(k, strain, mu, &contacts))?;
+            let inside = interior(&centres, &contacts, die_radius_m, height_m, self.d_fixed_m);
+            write_network(
+                &self.dir,
+                k,
+                &network_stats(k, strain, mu, &contacts, inside),
+            )?;
             let profile =
                 stress_profile(k, strain, &elements, die_radius_m, wall_readings(asm, mesh));
             write_profile(&self.dir, &profile)?;
