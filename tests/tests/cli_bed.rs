@@ -611,7 +611,8 @@ fn heavy_mass_scaling_fails_the_quasi_static_certificate() {
 /// twin is in `half_speed/` with half the speed, twice the time to the
 /// final strain and about twice the steps, the
 /// change of P(C) is in the certificate, and `passed` holds all three
-/// figures to their limits.
+/// figures to their limits; the twin withdraws its punch too, and the
+/// change of the in-die elastic recovery is the withdrawal's check.
 #[test]
 fn the_rate_check_presses_the_same_bed_at_half_speed() {
     let dir = out_dir("rate_check");
@@ -661,6 +662,36 @@ fn the_rate_check_presses_the_same_bed_at_half_speed() {
     assert_eq!(q["passed"], within, "{q}");
     // Without the check the field is null and does not decide.
     assert!(summary(&dir.join("half_speed"))["quasi_static"]["rate_change_rel"].is_null());
+    // The twin withdraws its punch too: the withdrawal's check is its
+    // recovery against the run's, judged against the same limit, and a
+    // failed check is a warning.
+    let (recovery, half) = (
+        number(&s["unloading"], "elastic_recovery"),
+        number(&twin["unloading"], "elastic_recovery"),
+    );
+    let check = &s["unloading"]["half_speed"];
+    assert_eq!(number(check, "elastic_recovery"), half);
+    assert_eq!(
+        number(check, "plasticity_factor"),
+        number(&twin["unloading"], "plasticity_factor")
+    );
+    let change = (half - recovery).abs() / recovery;
+    assert!((number(check, "recovery_change_rel") - change).abs() <= 1e-15 * change);
+    let passed = change < granbed_kernel::analysis::quasi_static::RATE_CHANGE_LIMIT;
+    assert_eq!(check["passed"], passed, "{check}");
+    let warned = s["warnings"].as_array().unwrap().iter().any(|w| {
+        w.as_str()
+            .unwrap()
+            .starts_with("the withdrawal is not quasi-static")
+    });
+    assert_eq!(warned, !passed, "{}", s["warnings"]);
+    assert!(
+        run.stderr
+            .contains("rate check of the withdrawal: half the punch speed changes"),
+        "{}",
+        run.stderr
+    );
+    assert!(twin["unloading"]["half_speed"].is_null());
 }
 
 /// Runs the bed of `args` twice, with `--<flag> true` and `--<flag>

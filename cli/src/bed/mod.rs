@@ -501,7 +501,9 @@ pub struct BedArgs {
 
     /// The quasi-static certificate's rate check: after the run, press the
     /// same bed again at half the punch speed (into DIR/half_speed; about
-    /// twice the run's cost) and require P(C) to move by less than 5 %.
+    /// twice the run's cost) and require P(C) to move by less than 5 %; a
+    /// scene that unloads is withdrawn at half the speed too, and its
+    /// in-die elastic recovery must move by less than 5 %.
     #[arg(long, conflicts_with_all = ["types", "stop_at_strain"])]
     pub rate_check: bool,
 
@@ -903,10 +905,10 @@ impl BedArgs {
         result: &mut run::BedRun,
         streams: &mut Streams<'_>,
     ) -> anyhow::Result<()> {
-        // The loading's curve is compared: the twin does not unload.
+        // The twin withdraws its punch if the run does, for the
+        // withdrawal's own check.
         let slow = Scene {
             punch_speed_m_s: 0.5 * scene.punch_speed_m_s,
-            unload: false,
             ..scene.clone()
         };
         let dir = out.join(HALF_SPEED_DIR);
@@ -945,9 +947,14 @@ impl BedArgs {
         };
         result.rate_change_rel =
             crate::quasi_static::rate_change(&curve(result), &curve(&twin), scene.final_strain);
+        result.half_speed_unloading = twin
+            .unloading
+            .as_ref()
+            .map(|u| unloading::UnloadingSummary::of(&twin, u));
         outputs::write_all(out, scene, result)?;
         if !self.quiet {
-            let q = outputs::summary(scene, result).quasi_static;
+            let summary = outputs::summary(scene, result);
+            let q = summary.quasi_static;
             writeln!(
                 streams.stderr,
                 "rate check: half the punch speed changes P(C) by {} (limit {}); quasi-static \
@@ -958,6 +965,22 @@ impl BedArgs {
                 granbed_kernel::analysis::quasi_static::RATE_CHANGE_LIMIT,
                 if q.passed { "passed" } else { "FAILED" }
             )?;
+            if let Some(check) = summary.unloading.and_then(|u| u.half_speed) {
+                writeln!(
+                    streams.stderr,
+                    "rate check of the withdrawal: half the punch speed changes the in-die \
+                     elastic recovery by {} (limit {}): {}",
+                    check
+                        .recovery_change_rel
+                        .map_or("n/a (no lift-off)".to_owned(), |r| format!("{r:.4}")),
+                    granbed_kernel::analysis::quasi_static::RATE_CHANGE_LIMIT,
+                    match check.passed {
+                        Some(true) => "passed",
+                        Some(false) => "FAILED (see the warning in summary.json)",
+                        None => "not judged",
+                    }
+                )?;
+            }
         }
         Ok(())
     }

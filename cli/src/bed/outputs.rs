@@ -689,6 +689,8 @@ pub fn summary<'a>(scene: &'a Scene, run: &BedRun) -> Summary<'a> {
         warnings.push(w);
     }
     warnings.extend(run.unloading.as_ref().and_then(super::unloading::warning));
+    let unloading = run.unloading.as_ref().map(|u| UnloadingSummary::of(run, u));
+    warnings.extend(unloading.as_ref().and_then(super::unloading::rate_warning));
     Summary {
         version: env!("CARGO_PKG_VERSION"),
         scene,
@@ -724,7 +726,7 @@ pub fn summary<'a>(scene: &'a Scene, run: &BedRun) -> Summary<'a> {
         contact_network: Vec::new(),
         stress_by_height: Vec::new(),
         final_density_map: None,
-        unloading: run.unloading.as_ref().map(|u| UnloadingSummary::of(run, u)),
+        unloading,
         material: material.map(MaterialSummary::from),
         yield_stress_pa: material.map_or(Real::NAN, |m| m.yield_stress_pa),
         eta0: material.map_or(Real::NAN, |m| m.eta0),

@@ -30,7 +30,7 @@ pub const REPORT_FILE: &str = "report.html";
 /// meaning; any other field follows (nested objects such as `kawakita` and
 /// `heckel` are flattened to `kawakita.<field>`; the scene, `scene` and
 /// `scene_toml`, is shown as TOML instead).
-const FIELDS: [(&str, &str); 112] = [
+const FIELDS: [(&str, &str); 117] = [
     ("kawakita_a", "Kawakita a (limiting strain)"),
     ("kawakita_inv_b_pa", "Kawakita 1/b, Pa"),
     (
@@ -199,6 +199,26 @@ const FIELDS: [(&str, &str); 112] = [
         "granules' elastic energy at the final strain, J: the most the bed can give back",
     ),
     ("unloading.wall_time_s", "wall time of the withdrawal, s"),
+    (
+        "unloading.half_speed",
+        "the withdrawal's rate check: none (run without --rate-check)",
+    ),
+    (
+        "unloading.half_speed.elastic_recovery",
+        "in-die elastic recovery of the same bed pressed and withdrawn at half the punch speed",
+    ),
+    (
+        "unloading.half_speed.plasticity_factor",
+        "plasticity factor at half the punch speed",
+    ),
+    (
+        "unloading.half_speed.recovery_change_rel",
+        "|recovery at half speed − recovery| / recovery",
+    ),
+    (
+        "unloading.half_speed.passed",
+        "the withdrawal's rate check passed (the recovery's change below 0.05)",
+    ),
     (
         "quasi_static.passed",
         "quasi-static certificate passed (every figure below its limit)",

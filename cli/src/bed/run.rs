@@ -389,6 +389,10 @@ pub struct BedRun {
     /// change of P(C) when the same bed is pressed at half the punch speed
     /// (None: not checked).
     pub rate_change_rel: Option<Real>,
+    /// The withdrawal's rate check (`--rate-check` on a scene that
+    /// unloads): the withdrawal's figures of the same bed pressed and
+    /// withdrawn at half the punch speed (None: not checked).
+    pub half_speed_unloading: Option<super::unloading::UnloadingSummary>,
     /// What variable mass scaling did (scene `time_step_floor`).
     pub added_mass: AddedMass,
     /// The overlap by geometry at the end of the run, if
@@ -460,6 +464,7 @@ impl BedRun {
             pour_wall_time_s: 0.0,
             wall_time_s: 0.0,
             rate_change_rel: None,
+            half_speed_unloading: None,
             phase_times: Default::default(),
             counters_from_step: 0,
             solid_volume_m3: 1.0,
@@ -1111,6 +1116,7 @@ pub fn run_bed(
         error,
         checkpoint_strain,
         rate_change_rel: None,
+        half_speed_unloading: None,
         added_mass,
         hidden_overlap,
         final_granules,

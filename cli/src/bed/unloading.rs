@@ -17,6 +17,12 @@
 //!   friction and damping) and Stamm and Mathis's plasticity factor, net /
 //!   (net + elastic).
 //!
+//! With `--rate-check` the same bed is pressed and withdrawn at half the
+//! punch speed, and the recovery's change is the withdrawal's check
+//! ([`UnloadingRateCheck`]): at the turn the punch reverses at once, and
+//! the rate-dependent share of the load (inertia, damping) falls away
+//! first, so a punch too fast shifts the recovery.
+//!
 //! What the physics guarantees, and the tests check: the unloading curve
 //! lies below the loading curve (what the bed dissipated it cannot give
 //! back), and the work given back is at most the granules' elastic energy
@@ -70,6 +76,47 @@ pub struct UnloadingSummary {
     pub elastic_energy_at_end_j: Real,
     /// Wall time of the withdrawal, s (not in the run's cost figures).
     pub wall_time_s: f64,
+    /// The rate check (`--rate-check`): the same bed pressed and withdrawn
+    /// at half the punch speed (`None`: not checked).
+    pub half_speed: Option<UnloadingRateCheck>,
+}
+
+/// The withdrawal's rate check: its figures at half the punch speed and
+/// how far they moved. The recovery is the withdrawal's headline figure
+/// and the one inertia and damping shift most (at the turn the punch
+/// reverses at once, and the rate-dependent share of the load falls away
+/// first), so it is the one judged.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct UnloadingRateCheck {
+    /// The in-die elastic recovery at half the punch speed.
+    pub elastic_recovery: Option<Real>,
+    /// The plasticity factor at half the punch speed.
+    pub plasticity_factor: Option<Real>,
+    /// |recovery at half speed − recovery| / recovery (`None` without a
+    /// lift-off in either run).
+    pub recovery_change_rel: Option<Real>,
+    /// The change below the loading's rate-check limit
+    /// ([`granbed_kernel::analysis::quasi_static::RATE_CHANGE_LIMIT`]):
+    /// the withdrawal's figures do not depend on the speed (`None`
+    /// without a change to judge).
+    pub passed: Option<bool>,
+}
+
+impl UnloadingRateCheck {
+    /// The check of a withdrawal whose recovery is `recovery` against the
+    /// figures `half` of its twin at half the speed.
+    pub fn of(recovery: Option<Real>, half: &UnloadingSummary) -> Self {
+        let change = recovery
+            .zip(half.elastic_recovery)
+            .filter(|(r, _)| *r > 0.0)
+            .map(|(r, h)| (h - r).abs() / r);
+        Self {
+            elastic_recovery: half.elastic_recovery,
+            plasticity_factor: half.plasticity_factor,
+            recovery_change_rel: change,
+            passed: change.map(|c| c < granbed_kernel::analysis::quasi_static::RATE_CHANGE_LIMIT),
+        }
+    }
 }
 
 impl UnloadingSummary {
@@ -82,11 +129,12 @@ impl UnloadingSummary {
         let free = u.samples.last().filter(|_| lift_off.is_some());
         let returned = free.map(|s| loading - s.energies.punch_work);
         let finite = |x: Real| Some(x).filter(|x| x.is_finite());
+        let elastic_recovery = lift_off.map(|c| (at_end.strain - c) / (1.0 - at_end.strain));
         Self {
             rows: u.samples.len(),
             from_strain: at_end.strain,
             lift_off_strain: lift_off,
-            elastic_recovery: lift_off.map(|c| (at_end.strain - c) / (1.0 - at_end.strain)),
+            elastic_recovery,
             residual_die_wall_pressure_pa: free.and_then(|s| finite(die_wall_pressure(run, s))),
             residual_lower_pressure_pa: free.map(|s| s.lower_pressure_pa),
             loading_work_j: loading,
@@ -97,8 +145,29 @@ impl UnloadingSummary {
                 .map(|r| (loading - r) / loading),
             elastic_energy_at_end_j: at_end.energies.elastic,
             wall_time_s: u.wall_time_s,
+            half_speed: run
+                .half_speed_unloading
+                .as_ref()
+                .map(|half| UnloadingRateCheck::of(elastic_recovery, half)),
         }
     }
+}
+
+/// The warning of a withdrawal whose rate check failed: its recovery
+/// moved by more than the limit at half the speed.
+pub fn rate_warning(s: &UnloadingSummary) -> Option<String> {
+    let check = s.half_speed?;
+    (check.passed == Some(false)).then(|| {
+        format!(
+            "the withdrawal is not quasi-static: at half the punch speed its in-die elastic \
+             recovery is {:.4} against {:.4}, a change of {:.3} [limit {}]; a slower punch \
+             (--punch-speed-m-s) gives figures nearer the material's",
+            check.elastic_recovery.unwrap_or(Real::NAN),
+            s.elastic_recovery.unwrap_or(Real::NAN),
+            check.recovery_change_rel.unwrap_or(Real::NAN),
+            granbed_kernel::analysis::quasi_static::RATE_CHANGE_LIMIT
+        )
+    })
 }
 
 /// The warning of a withdrawal that did not see the punch come free, or
@@ -187,5 +256,55 @@ mod tests {
             ..none
         };
         assert!(warning(&cut).unwrap().contains("interrupted at C = 0.2900"));
+    }
+
+    /// The withdrawal's rate check: the twin's recovery against the run's,
+    /// judged against the limit 0.05 (not reached: passed); no check
+    /// without a lift-off in either run.
+    #[test]
+    fn the_withdrawal_rate_check() {
+        let mut run = BedRun::of_samples(vec![row(0.0, 0.0, 0.0, 0.0), row(0.3, 5.0, 10.0, 3.0)]);
+        run.bed_height_m = 1.0;
+        run.die_radius_m = 1.0;
+        let u = |lift_off_strain| Unloading {
+            samples: vec![row(0.29, 1.0, 8.5, 1.0), row(0.285, 0.0, 8.0, 0.5)],
+            lift_off_strain,
+            wall_time_s: 1.0,
+            cut_short: None,
+        };
+        // Recovery 0.014/0.7 = 0.02 here; 0.0147/0.7 = 0.021 in the twin.
+        let twin = UnloadingSummary::of(&run, &u(0.3 - 0.0147));
+        run.half_speed_unloading = Some(twin);
+        let s = UnloadingSummary::of(&run, &u(0.286));
+        let check = s.half_speed.unwrap();
+        assert_eq!(check.elastic_recovery, twin.elastic_recovery);
+        assert!((check.recovery_change_rel.unwrap() - 0.05).abs() < 1e-9);
+        assert_eq!(
+            check.passed,
+            Some(check.recovery_change_rel.unwrap() < 0.05)
+        );
+        let passed = UnloadingRateCheck::of(Some(0.0205), &twin);
+        assert!((passed.recovery_change_rel.unwrap() - 0.0005 / 0.0205).abs() < 1e-9);
+        assert_eq!(passed.passed, Some(true));
+        let failed = UnloadingSummary {
+            half_speed: Some(UnloadingRateCheck::of(Some(0.019), &twin)),
+            ..s
+        };
+        assert!(
+            rate_warning(&failed)
+                .unwrap()
+                .contains("a change of 0.105 [limit 0.05]")
+        );
+        let ok = UnloadingSummary {
+            half_speed: Some(passed),
+            ..s
+        };
+        assert_eq!(rate_warning(&ok), None);
+        let none = UnloadingRateCheck::of(None, &twin);
+        assert_eq!((none.recovery_change_rel, none.passed), (None, None));
+        assert_eq!(
+            UnloadingSummary::of(&BedRun::of_samples(Vec::new()), &u(0.29)).half_speed,
+            None
+        );
     }
 }
