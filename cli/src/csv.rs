@@ -143,13 +143,25 @@ pub fn read_table<const N: usize>(
     path: &Path,
     columns: &[(&str, &str); N],
 ) -> anyhow::Result<Vec<[f64; N]>> {
+    read_table_or_older(path, columns, N)
+}
+
+/// [`read_table`] of a table whose files written by older builds hold
+/// only the first `older` of `columns` (the later ones added since): such
+/// a file is read too, NaN in the columns it lacks.
+pub fn read_table_or_older<const N: usize>(
+    path: &Path,
+    columns: &[(&str, &str); N],
+    older: usize,
+) -> anyhow::Result<Vec<[f64; N]>> {
     let text = std::fs::read_to_string(path)
         .with_context(|| format!("cannot read `{}`", path.display()))?;
     let mut lines = text.lines();
     let names = columns.map(|c| c.0);
     let header: Vec<&str> = lines.next().unwrap_or_default().split(',').collect();
+    let held = header.len();
     anyhow::ensure!(
-        header == names,
+        (held == N || held == older.min(N)) && header == names[..held],
         "`{}`: the header is not {}",
         path.display(),
         names.join(",")
@@ -169,13 +181,15 @@ pub fn read_table<const N: usize>(
                         i + 2
                     )
                 })?;
-            cells.try_into().map_err(|_| {
-                anyhow::anyhow!(
-                    "`{}` line {}: not {N} cells, one per header column",
-                    path.display(),
-                    i + 2
-                )
-            })
+            anyhow::ensure!(
+                cells.len() == held,
+                "`{}` line {}: not {held} cells, one per header column",
+                path.display(),
+                i + 2
+            );
+            Ok(core::array::from_fn(|c| {
+                cells.get(c).copied().unwrap_or(f64::NAN)
+            }))
         })
         .collect()
 }

@@ -454,6 +454,11 @@ fn add_wall(total: &mut WallForce, w: &WallForce, sum_contacts: bool) {
         total.contacts.max(w.contacts)
     };
     total.min_gap = total.min_gap.min(w.min_gap);
+    for (t, v) in total.virial.iter_mut().zip(w.virial) {
+        for (t, v) in t.iter_mut().zip(v) {
+            *t += v;
+        }
+    }
 }
 
 impl Assembly<'_> {

@@ -320,30 +320,12 @@ pub fn write_network(vtk_dir: &Path, k: usize, stats: &NetworkStats) -> anyhow::
 /// columns, read with none: 0 granules, NaN), and it must hold one row of
 /// numbers.
 fn read_network(snapshot: usize, path: &Path) -> anyhow::Result<NetworkStats> {
-    use crate::csv::read_table;
-    fn one<const N: usize>(rows: &[[Real; N]], path: &Path) -> anyhow::Result<[Real; N]> {
-        match rows {
-            [cells] => Ok(*cells),
-            _ => anyhow::bail!("`{}`: not one row", path.display()),
-        }
+    let rows = crate::csv::read_table_or_older(path, &NETWORK_COLUMNS, COLUMNS_BEFORE_INTERIOR)?;
+    // NaN granules read as 0 (`as` saturates).
+    match rows[..] {
+        [cells] => Ok(NetworkStats::from_cells(snapshot, &cells)),
+        _ => anyhow::bail!("`{}`: not one row", path.display()),
     }
-    let cells = match read_table(path, &NETWORK_COLUMNS) {
-        Ok(rows) => one(&rows, path)?,
-        Err(e) => {
-            let older: [(&str, &str); COLUMNS_BEFORE_INTERIOR] =
-                core::array::from_fn(|i| NETWORK_COLUMNS[i]);
-            let Ok(rows) = read_table(path, &older) else {
-                return Err(e);
-            };
-            let c = one(&rows, path)?;
-            core::array::from_fn(|i| match i {
-                i if i < COLUMNS_BEFORE_INTERIOR => c[i],
-                COLUMNS_BEFORE_INTERIOR => 0.0,
-                _ => Real::NAN,
-            })
-        }
-    };
-    Ok(NetworkStats::from_cells(snapshot, &cells))
 }
 
 /// The network files in `vtk_dir`, in the order of k (the snapshots'

@@ -405,12 +405,17 @@ pub fn wall_readings(asm: &Assembly<'_>, mesh: &OwnedReference) -> WallReadings 
     let params = asm.params();
     let granule_volume: Real = mesh.elements.iter().map(|e| e.volume).sum();
     let mass = asm.granules().len() as Real * params.material.density0 * granule_volume;
+    let volume = area * height_m;
+    // Σ over the walls in their order, a fixed order.
+    let virial = |a: usize, b: usize| walls.iter().map(|w| w.virial[a][b]).sum::<Real>();
     WallReadings {
         height_m,
         upper_punch_pa: walls[UPPER].normal / area,
         lower_punch_pa: walls[LOWER].normal / area,
         die_wall_pa: walls[DIE].normal / (2.0 * core::f64::consts::PI * die_radius_m * height_m),
         weight_pa: mass * params.gravity_m_s2 / area,
+        walls_lateral_pa: -0.5 * (virial(0, 0) + virial(1, 1)) / volume,
+        walls_axial_pa: -virial(2, 2) / volume,
     }
 }
 

@@ -48,13 +48,13 @@ use granbed_kernel::Real;
 use serde::Serialize;
 
 use super::snapshots::ElementFields;
-use crate::csv::{Field, read_table, write_table};
+use crate::csv::{Field, read_table_or_older, write_table};
 
 /// Layers of equal height the compact is cut into.
 pub const LAYERS: usize = 10;
 
 /// Columns of a stress file, in order: (name, meaning with its unit).
-pub const STRESS_COLUMNS: [(&str, &str); 11] = [
+pub const STRESS_COLUMNS: [(&str, &str); 13] = [
     (
         "strain",
         "the snapshot's nominal axial strain C (the state is that of the step that first reached it)",
@@ -96,7 +96,18 @@ pub const STRESS_COLUMNS: [(&str, &str); 11] = [
         "weight_pa",
         "the bed's weight (the granules' physical mass, without mass scaling, times g) over the die's area, Pa",
     ),
+    (
+        "walls_lateral_pa",
+        "−Σ (x f_x + y f_y)/2 over every force f the walls (die and punches, friction included) put on the granules' nodes at x, over the compact's volume π R_d² H, Pa: by the virial theorem the compact's mean lateral stress at rest, the punches' faces' friction included (NaN in files written before the column existed)",
+    ),
+    (
+        "walls_axial_pa",
+        "−Σ z f_z over the same forces over π R_d² H, Pa: by the virial theorem the compact's mean axial stress at rest (the upper punch's share is its pressure times H/H, the die wall's friction the rest; NaN in older files)",
+    ),
 ];
+
+/// Columns of the stress files written before the walls' virials.
+const COLUMNS_BEFORE_VIRIAL: usize = 11;
 
 /// One layer of a profile.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]
@@ -127,6 +138,12 @@ pub struct WallReadings {
     pub die_wall_pa: Real,
     /// The bed's weight / π R_d², Pa.
     pub weight_pa: Real,
+    /// −Σ (x f_x + y f_y)/2 over the walls' forces on the nodes, over the
+    /// compact's volume, Pa: the virial theorem's mean lateral stress.
+    pub walls_lateral_pa: Real,
+    /// −Σ z f_z over the walls' forces over the compact's volume, Pa: the
+    /// virial theorem's mean axial stress.
+    pub walls_axial_pa: Real,
 }
 
 /// The profile of one snapshot: what its file holds.
@@ -180,7 +197,7 @@ pub fn stress_profile(
 
 impl StressProfile {
     /// The file's rows, one per layer.
-    fn rows(&self) -> impl Iterator<Item = [Field; 11]> + '_ {
+    fn rows(&self) -> impl Iterator<Item = [Field; 13]> + '_ {
         let w = self.walls;
         self.layers.iter().map(move |l| {
             [
@@ -195,6 +212,8 @@ impl StressProfile {
                 w.lower_punch_pa,
                 w.die_wall_pa,
                 w.weight_pa,
+                w.walls_lateral_pa,
+                w.walls_axial_pa,
             ]
             .map(Field::from)
         })
@@ -203,7 +222,7 @@ impl StressProfile {
     /// The profile of snapshot `snapshot` from its file's [`LAYERS`] rows
     /// (the wall readings and strain are the first row's; every row
     /// repeats them).
-    fn from_rows(snapshot: usize, rows: &[[Real; 11]; LAYERS]) -> Self {
+    fn from_rows(snapshot: usize, rows: &[[Real; 13]; LAYERS]) -> Self {
         let first = &rows[0];
         Self {
             snapshot,
@@ -214,6 +233,8 @@ impl StressProfile {
                 lower_punch_pa: first[8],
                 die_wall_pa: first[9],
                 weight_pa: first[10],
+                walls_lateral_pa: first[11],
+                walls_axial_pa: first[12],
             },
             layers: rows
                 .iter()
@@ -304,9 +325,10 @@ impl StressSummary {
 /// outputs).
 pub fn read_all(vtk_dir: &Path) -> (Vec<StressProfile>, Vec<String>) {
     super::snapshots::read_snapshot_files(vtk_dir, "stress_", "stress_by_height", |k, path| {
-        let rows: [[Real; 11]; LAYERS] = read_table(path, &STRESS_COLUMNS)?
-            .try_into()
-            .map_err(|_| anyhow::anyhow!("`{}`: not {LAYERS} rows", path.display()))?;
+        let rows: [[Real; 13]; LAYERS] =
+            read_table_or_older(path, &STRESS_COLUMNS, COLUMNS_BEFORE_VIRIAL)?
+                .try_into()
+                .map_err(|_| anyhow::anyhow!("`{}`: not {LAYERS} rows", path.display()))?;
         Ok(StressProfile::from_rows(k, &rows))
     })
 }
@@ -322,6 +344,8 @@ mod tests {
             lower_punch_pa: 1.5e4,
             die_wall_pa: 8e3,
             weight_pa: 10.0,
+            walls_lateral_pa: 8.1e3,
+            walls_axial_pa: 1.7e4,
         }
     }
 

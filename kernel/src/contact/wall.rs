@@ -47,6 +47,12 @@ pub struct WallForce {
     pub contacts: usize,
     /// Most negative predicted gap, m (0 if none).
     pub min_gap: Real,
+    /// Σ x ⊗ f over the forces f (normal and friction) the pass put on the
+    /// nodes, x each node's predicted position, N·m (`virial[i][j]` =
+    /// Σ x_i f_j): the wall's share of ∫ σ dV over a body at rest, by the
+    /// virial theorem (∫ σ dV = Σ x ⊗ f over the forces on its boundary,
+    /// without body forces).
+    pub virial: [[Real; 3]; 3],
 }
 
 /// The nodes of one body as a contact pass sees them; one entry per node.
@@ -306,6 +312,11 @@ pub fn wall_contact(
         }
         for a in 0..3 {
             f_c[i][a] += f[a];
+        }
+        for (row, x) in out.virial.iter_mut().zip(xp) {
+            for (v, f) in row.iter_mut().zip(f) {
+                *v += x * f;
+            }
         }
         out.normal += fn_mag;
         out.contacts += 1;
