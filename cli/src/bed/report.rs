@@ -30,7 +30,7 @@ pub const REPORT_FILE: &str = "report.html";
 /// meaning; any other field follows (nested objects such as `kawakita` and
 /// `heckel` are flattened to `kawakita.<field>`; the scene, `scene` and
 /// `scene_toml`, is shown as TOML instead).
-const FIELDS: [(&str, &str); 117] = [
+const FIELDS: [(&str, &str); 116] = [
     ("kawakita_a", "Kawakita a (limiting strain)"),
     ("kawakita_inv_b_pa", "Kawakita 1/b, Pa"),
     (
@@ -200,24 +200,20 @@ const FIELDS: [(&str, &str); 117] = [
     ),
     ("unloading.wall_time_s", "wall time of the withdrawal, s"),
     (
-        "unloading.half_speed",
-        "the withdrawal's rate check: none (run without --rate-check)",
+        "unloading.half_speed_elastic_recovery",
+        "in-die elastic recovery of the same bed pressed and withdrawn at half the punch speed (--rate-check)",
     ),
     (
-        "unloading.half_speed.elastic_recovery",
-        "in-die elastic recovery of the same bed pressed and withdrawn at half the punch speed",
-    ),
-    (
-        "unloading.half_speed.plasticity_factor",
+        "unloading.half_speed_plasticity_factor",
         "plasticity factor at half the punch speed",
     ),
     (
-        "unloading.half_speed.recovery_change_rel",
+        "unloading.half_speed_recovery_change_rel",
         "|recovery at half speed − recovery| / recovery",
     ),
     (
-        "unloading.half_speed.passed",
-        "the withdrawal's rate check passed (the recovery's change below 0.05)",
+        "unloading.half_speed_passed",
+        "the unloading's rate check passed (the recovery's change below 0.05)",
     ),
     (
         "quasi_static.passed",
@@ -369,8 +365,9 @@ const FIELDS: [(&str, &str); 117] = [
 /// The summary's fields as rows, in [`FIELDS`]' order, then the others;
 /// the scene is shown as TOML below the table, not as rows.
 fn rows(summary: &Summary<'_>) -> anyhow::Result<Vec<Row>> {
+    // The density map has its own table and plot; its cells are no rows.
     summary_rows(summary, &FIELDS, |k| {
-        k.starts_with("scene.") || k == "scene_toml"
+        k.starts_with("scene.") || k == "scene_toml" || k.starts_with("final_density_map.")
     })
 }
 
@@ -1049,14 +1046,33 @@ mod tests {
     }
 
     /// Every row of the summary table says what it is, whether the
-    /// overlap by geometry was measured or not, and the scene is not a row
-    /// (it is shown as TOML below the table).
+    /// overlap by geometry was measured or not, with a withdrawal and its
+    /// rate check and a density map (its own table, no rows), and the
+    /// scene is not a row (it is shown as TOML below the table).
     #[test]
     fn every_row_has_a_meaning_and_the_scene_is_no_row() {
         use crate::assembly::overlap::Overlap;
-        use crate::bed::run::HiddenOverlap;
+        use crate::bed::run::{HiddenOverlap, Unloading};
         let scene = Scene::published();
         let mut run = loading_run();
+        let last = *run.samples.last().unwrap();
+        run.unloading = Some(Unloading {
+            samples: vec![last],
+            lift_off_strain: last.strain - 1e-3,
+            wall_time_s: 1.0,
+            cut_short: None,
+        });
+        run.half_speed_unloading = run
+            .unloading
+            .as_ref()
+            .map(|u| crate::bed::unloading::UnloadingSummary::of(&run, u));
+        let map = crate::bed::density_map::density_map(
+            3,
+            0.3,
+            &crate::bed::snapshots::ElementFields::default(),
+            1e-3,
+            1e-3,
+        );
         for measured in [false, true] {
             if measured {
                 run.hidden_overlap = Some(HiddenOverlap {
@@ -1069,8 +1085,15 @@ mod tests {
                     wall_time_s: 0.1,
                 });
             }
-            let summary = crate::bed::outputs::summary(&scene, &run);
+            let mut summary = crate::bed::outputs::summary(&scene, &run);
+            summary.final_density_map = crate::bed::density_map::MapSummary::of(&map);
+            assert!(summary.final_density_map.is_some());
             let rows = rows(&summary).unwrap();
+            assert!(
+                rows.iter()
+                    .any(|r| r.key == "unloading.half_speed_recovery_change_rel"),
+                "{rows:?}"
+            );
             let blank: Vec<&str> = rows
                 .iter()
                 .filter(|r| r.meaning.is_empty())
