@@ -32,6 +32,7 @@
 
 use std::path::Path;
 
+use anyhow::Context as _;
 use granbed_kernel::Real;
 use serde::Serialize;
 
@@ -63,7 +64,7 @@ pub const MAP_COLUMNS: [(&str, &str); 10] = [
     ("top", "the cell's upper face, as a fraction of H"),
     (
         "solid_fraction",
-        "the solid volume of the elements whose centres lie in the cell (η0 V0 each) over the cell's volume π (r_outer² − r_inner²) H/10",
+        "the solid volume of the elements whose centres lie in the cell (η0 V0 each) over the cell's volume π R_d² (outer² − inner²) H (top − bottom)",
     ),
     (
         "axial_stress_pa",
@@ -129,33 +130,37 @@ pub struct DensityMap {
 }
 
 /// The sums Σ v η, Σ v (−σ_zz), Σ v (−(σ_xx + σ_yy)/2) over the elements
-/// of `fields` in each of `rings` × [`LAYERS`] cells (index
+/// of `fields` in each of `rings` (at least 1) × [`LAYERS`] cells (index
 /// `layer * rings + ring`) of a die of radius `die_radius_m` with the
-/// punches `height_m` apart, the lower one at z = 0. An element whose
-/// centre lies outside the compact counts in the nearest cell; NaN fields
+/// punches `height_m` apart, the lower one at z = 0. A cell holds its
+/// lower and inner bounds, not its upper and outer ones. An element whose
+/// centre lies outside the compact counts in the nearest cell, one with a
+/// NaN or missing position in the bottom cell at the axis; NaN values
 /// make their cell's sums NaN. With one ring these are the layers of the
-/// stress file, summed in the same order.
+/// stress file (the radii not read).
 pub fn cell_sums(
     fields: &ElementFields,
     die_radius_m: Real,
     height_m: Real,
     rings: usize,
 ) -> Vec<[Real; 3]> {
+    let rings = rings.max(1);
     let mut sums = vec![[0.0; 3]; rings * LAYERS];
     // `as` saturates: below 0 (and NaN) to 0, past the end to the count.
     let index = |x: Real, n: usize| ((x * n as Real).floor() as usize).min(n - 1);
+    let at = |v: &[Real], e: usize| v.get(e).copied().unwrap_or(Real::NAN);
     for e in 0..fields.volume_m3.len() {
-        let l = index(fields.height_m[e] / height_m, LAYERS);
+        let l = index(at(&fields.height_m, e) / height_m, LAYERS);
         let r = if rings == 1 {
             0
         } else {
-            index(fields.radius_m[e] / die_radius_m, rings)
+            index(at(&fields.radius_m, e) / die_radius_m, rings)
         };
         let v = fields.volume_m3[e];
         let s = &mut sums[l * rings + r];
-        s[0] += v * fields.relative_density[e];
-        s[1] += v * fields.axial_stress_pa[e];
-        s[2] += v * fields.lateral_stress_pa[e];
+        s[0] += v * at(&fields.relative_density, e);
+        s[1] += v * at(&fields.axial_stress_pa, e);
+        s[2] += v * at(&fields.lateral_stress_pa, e);
     }
     sums
 }
@@ -279,7 +284,8 @@ pub struct MapSummary {
     /// The cell of the smallest solid fraction.
     pub loosest: MapCell,
     /// The solid fraction of the ring at the die wall, its upper half over
-    /// its lower half (the mean of each half's layers, of equal volumes):
+    /// its lower half (the mean of each half's layers, of equal volumes;
+    /// `null` in JSON where the lower half is empty):
     /// above 1 where the wall's friction left the bottom outer edge looser
     /// than the top outer edge. Halves rather than the layers at the
     /// punches, which a flat punch leaves loose (spheres touch it at
@@ -332,11 +338,13 @@ const GAP: Real = 30.0;
 pub fn map_svg(summary: Option<&MapSummary>) -> String {
     use core::fmt::Write as _;
     let Some(s) = summary else {
-        return "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"400\" height=\"60\">\
+        return "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"620\" height=\"60\">\
                 <text x=\"10\" y=\"35\" font-family=\"sans-serif\" font-size=\"14\">\
-                No density map: the run wrote no snapshot.</text></svg>\n"
+                No density map: none in vtk/ (none written or readable), or a cell not finite.\
+                </text></svg>\n"
             .to_owned();
     };
+
     let m = &s.map;
     let scale = PANEL / m.die_radius_m;
     let height = m.height_m * scale;
@@ -443,22 +451,37 @@ pub fn map_svg(summary: Option<&MapSummary>) -> String {
     svg
 }
 
-/// The map files in `vtk_dir`, in the order of k, each read (header and
-/// [`RINGS`] × [`LAYERS`] numeric rows checked), and why each file that
-/// could not be read was left out.
+/// The map of snapshot `k` from its file `path` (header and [`RINGS`] ×
+/// [`LAYERS`] numeric rows checked).
+fn read_map(k: usize, path: &Path) -> anyhow::Result<DensityMap> {
+    let rows: [[Real; 10]; RINGS * LAYERS] = read_table(path, &MAP_COLUMNS)?
+        .try_into()
+        .map_err(|_| anyhow::anyhow!("`{}`: not {} rows", path.display(), RINGS * LAYERS))?;
+    Ok(DensityMap::from_rows(k, &rows))
+}
+
+/// The map files in `vtk_dir`, in the order of k, each read, and why each
+/// file that could not be read was left out.
 pub fn read_all(vtk_dir: &Path) -> (Vec<DensityMap>, Vec<String>) {
-    super::snapshots::read_snapshot_files(
-        vtk_dir,
-        "density_map_",
-        "final_density_map",
-        |k, path| {
-            let rows: [[Real; 10]; RINGS * LAYERS] =
-                read_table(path, &MAP_COLUMNS)?.try_into().map_err(|_| {
-                    anyhow::anyhow!("`{}`: not {} rows", path.display(), RINGS * LAYERS)
-                })?;
-            Ok(DensityMap::from_rows(k, &rows))
-        },
-    )
+    super::snapshots::read_snapshot_files(vtk_dir, "density_map_", "the density maps", read_map)
+}
+
+/// The figures of the last map file in `vtk_dir` (the largest k) for
+/// `summary.json`'s `final_density_map`: `Ok(None)` without a map file;
+/// an error naming the file if it cannot be read or a cell of its map is
+/// not finite (an earlier snapshot's map does not stand in for it).
+pub fn read_last(vtk_dir: &Path) -> anyhow::Result<Option<MapSummary>> {
+    let Some((k, path)) = super::snapshots::numbered_files(vtk_dir, "density_map_", ".csv").pop()
+    else {
+        return Ok(None);
+    };
+    let map = read_map(k, &path)?;
+    MapSummary::of(&map).map(Some).with_context(|| {
+        format!(
+            "`{}`: a cell's solid fraction is not finite (an element inverted?)",
+            path.display()
+        )
+    })
 }
 
 #[cfg(test)]
@@ -537,6 +560,31 @@ mod tests {
         let m = density_map(0, 0.1, &nan, r, h);
         assert!(m.cell(0, 0).solid_fraction.is_nan() && m.cell(1, 0).solid_fraction == 0.0);
         assert_eq!(MapSummary::of(&m), None);
+    }
+
+    /// A cell holds its lower and inner bounds: an element exactly at
+    /// r = 0.2 R_d lies in the second ring, one at z = H/2 in the sixth
+    /// layer; one at the die wall or the upper punch in the last ring or
+    /// layer; a NaN position in the bottom cell at the axis.
+    #[test]
+    fn the_bounds_belong_to_the_cell_above() {
+        let f = fields(&[
+            (0.2, 0.05, 1.0),
+            (0.1, 0.5, 2.0),
+            (1.0, 1.0, 4.0),
+            (Real::NAN, Real::NAN, 8.0),
+        ]);
+        let m = density_map(0, 0.0, &f, 1.0, 1.0);
+        let volume = |c: &MapCell| c.volume_m3(1.0, 1.0);
+        let axial = |ring, layer| {
+            let c = m.cell(ring, layer);
+            c.axial_stress_pa * volume(c) / 1e-9
+        };
+        let close = |a: Real, b: Real| (a - b).abs() <= 1e-12 * b;
+        assert!(close(axial(1, 0), 1.0));
+        assert!(close(axial(0, 5), 2.0));
+        assert!(close(axial(RINGS - 1, LAYERS - 1), 4.0));
+        assert!(close(axial(0, 0), 8.0));
     }
 
     /// A map written reads back to the same bits; a file with a row

@@ -79,11 +79,11 @@ pub const NETWORK_COLUMNS: [(&str, &str); 16] = [
     ),
     (
         "interior_granules",
-        "granules whose centre of mass lies at least one nominal diameter d from the die wall and from both punches: the bed's interior (0 in files written before the column existed)",
+        "granules whose centre of mass lies at least one nominal diameter d from the die wall and from both punches: the bed's interior (NaN, null in summary.json, in files written before the column existed)",
     ),
     (
         "interior_coordination",
-        "their granule contacts per granule (the contacts table's pairs they are in, over their number): the coordination number without the walls' deficit (a granule at a wall has fewer granule neighbours), the one packing models such as Arzt's describe; NaN without an interior granule",
+        "their granule contacts per granule (the contacts table's pairs they are in, over their number): the coordination number without the walls' deficit (a granule at a wall has fewer granule neighbours), the one packing models such as Arzt's describe; NaN without an interior granule and in older files",
     ),
 ];
 
@@ -170,8 +170,9 @@ pub struct NetworkStats {
     pub friction_to_normal: Real,
     /// Share of the pairs at Coulomb's limit ([`SLIDING_AT`]).
     pub sliding_share: Real,
-    /// Granules in the bed's interior ([`interior`]).
-    pub interior_granules: usize,
+    /// Granules in the bed's interior ([`interior`]; `None` from a file
+    /// written before the column existed).
+    pub interior_granules: Option<usize>,
     /// Their granule contacts per granule.
     pub interior_coordination: Real,
 }
@@ -247,7 +248,7 @@ pub fn network_stats(
             .filter(|r| r.friction_n >= SLIDING_AT * mu * r.normal_n && r.normal_n > 0.0)
             .count() as Real
             / n,
-        interior_granules: interior.granules,
+        interior_granules: Some(interior.granules),
         interior_coordination: interior.coordination,
     }
 }
@@ -270,7 +271,8 @@ impl NetworkStats {
             self.weak_fabric_zz.into(),
             self.friction_to_normal.into(),
             self.sliding_share.into(),
-            Field::Int(self.interior_granules as u64),
+            self.interior_granules
+                .map_or(Field::Real(Real::NAN), |n| Field::Int(n as u64)),
             self.interior_coordination.into(),
         ]
     }
@@ -294,7 +296,7 @@ impl NetworkStats {
             weak_fabric_zz: c[11],
             friction_to_normal: c[12],
             sliding_share: c[13],
-            interior_granules: c[14] as usize,
+            interior_granules: c[14].is_finite().then_some(c[14] as usize),
             interior_coordination: c[15],
         }
     }
@@ -317,11 +319,10 @@ pub fn write_network(vtk_dir: &Path, k: usize, stats: &NetworkStats) -> anyhow::
 /// Reads the network file of snapshot `snapshot`: its header must be
 /// [`NETWORK_COLUMNS`]' names, or their first
 /// [`COLUMNS_BEFORE_INTERIOR`] (a file written before the interior's
-/// columns, read with none: 0 granules, NaN), and it must hold one row of
+/// columns, read without them: `None`, NaN), and it must hold one row of
 /// numbers.
 fn read_network(snapshot: usize, path: &Path) -> anyhow::Result<NetworkStats> {
     let rows = crate::csv::read_table_or_older(path, &NETWORK_COLUMNS, COLUMNS_BEFORE_INTERIOR)?;
-    // NaN granules read as 0 (`as` saturates).
     match rows[..] {
         [cells] => Ok(NetworkStats::from_cells(snapshot, &cells)),
         _ => anyhow::bail!("`{}`: not one row", path.display()),
@@ -442,7 +443,7 @@ mod tests {
         std::fs::write(dir.join(network_file(2)), old).unwrap();
         let (back, _) = read_all(&dir);
         assert_eq!(back[0].fabric_zz, full.fabric_zz);
-        assert_eq!(back[0].interior_granules, 0);
+        assert_eq!(back[0].interior_granules, None);
         assert!(back[0].interior_coordination.is_nan());
         std::fs::remove_dir_all(&dir).unwrap();
     }

@@ -1092,9 +1092,12 @@ pub fn write_all(dir: &Path, scene: &Scene, run: &BedRun) -> anyhow::Result<()> 
         .map(|p| StressSummary::of(p, 0.5e-3 * scene.die_diameter_mm, mu))
         .collect();
     summary.warnings.extend(left_out);
-    let (maps, left_out) = super::density_map::read_all(&dir.join(super::snapshots::VTK_DIR));
-    summary.final_density_map = maps.last().and_then(MapSummary::of);
-    summary.warnings.extend(left_out);
+    match super::density_map::read_last(&dir.join(super::snapshots::VTK_DIR)) {
+        Ok(map) => summary.final_density_map = map,
+        Err(e) => summary
+            .warnings
+            .push(format!("{e:#}; no final_density_map")),
+    }
     write_json(&dir.join(SUMMARY_JSON), &summary)?;
     let svgs = super::plots::write_plots(dir, run, &summary)?;
     super::report::write_report(dir, scene, &summary, &svgs)

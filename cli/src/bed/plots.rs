@@ -429,7 +429,8 @@ pub fn plots(
     )
     .into_iter()
     .collect::<Vec<_>>();
-    // The interior's, from the snapshots' contact networks.
+    // At the snapshots, from their contact networks (the pairs that carried
+    // a force in the step, any sweep): the whole bed's and the interior's.
     let interior: Vec<(f64, f64)> = summary
         .contact_network
         .iter()
@@ -437,8 +438,17 @@ pub fn plots(
         .filter(|(_, z)| z.is_finite())
         .collect();
     if !interior.is_empty() {
+        let granules = summary.scene.granules as f64;
         coordination.push(Series::new(
-            "interior granules (a diameter from every wall), at the snapshots",
+            "whole bed, pairs with a force in the snapshot's step",
+            Mark::Rings,
+            summary
+                .contact_network
+                .iter()
+                .map(|n| (n.strain, 2.0 * n.pairs as f64 / granules)),
+        ));
+        coordination.push(Series::new(
+            "interior granules (centres a diameter from every wall), the same",
             Mark::Dots,
             interior.into_iter(),
         ));

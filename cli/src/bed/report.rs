@@ -673,8 +673,8 @@ fn density_map(summary: &Summary<'_>) -> String {
          (r/R<sub>d</sub> {}, z/H {}); loosest: {} (r/R<sub>d</sub> {}, z/H {}).\
          </p>\n<table>\n<tr><th>z/H</th>",
         num(Some(m.strain)),
-        num(Some(s.wall_top_to_bottom)),
-        num(Some(s.axis_top_to_bottom)),
+        num(Some(s.wall_top_to_bottom).filter(|r| r.is_finite())),
+        num(Some(s.axis_top_to_bottom).filter(|r| r.is_finite())),
         num(Some(s.densest.solid_fraction)),
         span(s.densest.inner, s.densest.outer),
         span(s.densest.bottom, s.densest.top),
@@ -795,12 +795,15 @@ fn plot_caption(name: &str, summary: &Summary<'_>) -> Option<String> {
         ),
         "coordination_strain.svg" => "The mean coordination number Z against the strain: \
              granule–granule contacts per granule, and with the die and punch contacts counted \
-             too; and at each snapshot after a step, the granule contacts per granule of the \
-             bed's interior, the granules whose centres lie at least a diameter from the die \
-             wall and both punches (vtk/network_<k>.csv's interior_coordination): a granule at a \
-             wall has fewer granule neighbours, so the interior's Z is the one packing models \
-             such as Arzt's describe. It is taken in the snapshot's step, the curves are \
-             averaged over each output interval."
+             too (the pairs touching in each step's first sweep, averaged over each output \
+             interval); and at each snapshot after a step, from its contacts table (the pairs \
+             that carried a force in the step, in any sweep), the whole bed's granule contacts \
+             per granule (rings) and those of the bed's interior, the granules whose centres lie \
+             at least a diameter from the die wall and both punches (dots; vtk/network_<k>.csv's \
+             interior_coordination): a granule at a wall has fewer granule neighbours, so the \
+             interior's Z is the one packing models such as Arzt's describe. The rings and the \
+             dots count alike, so the gap between them is the walls'; the rings against the \
+             curve show how the two ways of counting compare."
             .to_owned(),
         "relative_density_strain.svg" => "The granules' own relative density against the \
              strain (their solid over their volume, without the voids between them): the mean \

@@ -406,6 +406,53 @@ mod tests {
         assert!(p.layers[0].axial_stress_pa.is_nan() && p.layers[5].axial_stress_pa > 0.0);
     }
 
+    /// The layers are those of a loop written out here, independent of
+    /// the binning the density map shares: each element in the layer
+    /// floor(10 z/H) (clamped), its volume-weighted values summed in
+    /// element order and divided by the layer's volume, bit for bit, on
+    /// elements spread over and beyond the compact.
+    #[test]
+    fn the_layers_are_those_of_a_plain_loop() {
+        let (r, h) = (2e-3, 1.5e-3);
+        // A fixed pseudo-random sequence in [0, 1).
+        let mut state: u64 = 0x2545_f491_4f6c_dd1d;
+        let mut next = || {
+            state = state
+                .wrapping_mul(6_364_136_223_846_793_005)
+                .wrapping_add(1_442_695_040_888_963_407);
+            (state >> 11) as Real / (1u64 << 53) as Real
+        };
+        let mut f = ElementFields::default();
+        for _ in 0..500 {
+            f.height_m.push(h * (1.2 * next() - 0.1));
+            f.volume_m3.push(1e-12 * (0.5 + next()));
+            f.relative_density.push(0.4 + 0.5 * next());
+            f.axial_stress_pa.push(1e4 * (next() - 0.2));
+            f.lateral_stress_pa.push(5e3 * next());
+        }
+        let mut sums = [[0.0; 3]; LAYERS];
+        for e in 0..f.volume_m3.len() {
+            let at = (f.height_m[e] / h * LAYERS as Real).floor();
+            let l = if at < 0.0 {
+                0
+            } else {
+                (at as usize).min(LAYERS - 1)
+            };
+            let v = f.volume_m3[e];
+            sums[l][0] += v * f.relative_density[e];
+            sums[l][1] += v * f.axial_stress_pa[e];
+            sums[l][2] += v * f.lateral_stress_pa[e];
+        }
+        let layer = core::f64::consts::PI * r * r * h / LAYERS as Real;
+        let p = stress_profile(1, 0.2, &f, r, walls(h));
+        for (l, (got, want)) in p.layers.iter().zip(&sums).enumerate() {
+            assert_eq!(got.solid_fraction, want[0] / layer, "layer {l}");
+            assert_eq!(got.axial_stress_pa, want[1] / layer, "layer {l}");
+            assert_eq!(got.lateral_stress_pa, want[2] / layer, "layer {l}");
+        }
+        assert!(sums.iter().all(|s| s[0] > 0.0));
+    }
+
     /// A profile written reads back to the same bits; a file with a row
     /// missing is left out, and said so; the others are read.
     #[test]
