@@ -418,13 +418,13 @@ fn stress_through_the_compact(
         "axial by layer {axial:?}"
     );
     // The virial theorem with every wall force, the punches' faces'
-    // friction included: the lateral stress (measured within 1.4 % in this
-    // bed and the published scene's; what is left is the bed's inertia, its
-    // damping and the hourglass forces). The axial one takes the inertia of
-    // the punches' load as it is handed down in bursts (4.4 % off in this
-    // bed's last step at C = 0.15, within 1.5 % elsewhere, BENCHMARKS.md):
-    // it is held between the punches' pressures, where the die wall's
-    // friction along the height puts it.
+    // friction included: the lateral stress (measured within 1.4 % on this
+    // kind of bed; what is left is the bed's inertia, its damping and the
+    // hourglass forces, none of which the walls' forces hold). The axial
+    // one was 4.4 % off in this bed's last step at C = 0.15 (within 1.5 %
+    // at the other snapshots measured, BENCHMARKS.md; which of those terms
+    // it is was not measured), so it is held only between the punches'
+    // pressures, where the die wall's friction along the height puts it.
     let walls_lateral = one("walls_lateral_pa");
     assert!(
         (lateral / walls_lateral - 1.0).abs() < 0.02,
