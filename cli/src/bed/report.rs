@@ -613,12 +613,15 @@ fn stress_by_height(summary: &Summary<'_>) -> String {
          the lower punch if K were the same at every height and the wall's friction μ fully \
          mobilised. This K is the elements' in one step; the key results' K (summary.json's \
          final_die_wall) is the die wall's pressure over the mean punch pressure averaged over \
-         the last output interval. The two lateral figures differ by a few per cent (2.5 % in \
-         the published scene at C = 0.3): the wall's pressure leaves out the friction of the \
-         punches' faces, and the theorem holds at rest, where the bed's inertia, its damping \
-         and the element's hourglass forces vanish.</p>\n<table>\n<tr><th>C</th><th>H, mm</th><th>P_upper, kPa</th>\
+         the last output interval. The die wall's pressure leaves out the friction of the \
+         punches' faces (2.5 % apart in the published scene at C = 0.3); the theorem's own \
+         figure, −Σ (x f<sub>x</sub> + y f<sub>y</sub>)/2 over every wall force over the \
+         compact's volume, has it (0.6 % apart there). What is left is the bed's inertia, its \
+         damping and the element's hourglass forces, which vanish at rest.</p>\n<table>\n\
+         <tr><th>C</th><th>H, mm</th><th>P_upper, kPa</th>\
          <th>P_lower, kPa</th><th>mean axial stress, kPa</th><th>die-wall pressure (wall \
-         forces), kPa</th><th>mean lateral stress (elements), kPa</th><th>K</th>\
+         forces), kPa</th><th>mean lateral stress (elements), kPa</th><th>mean lateral stress \
+         (all the walls' virial), kPa</th><th>K</th>\
          <th>P_lower / P_upper</th><th>Janssen's share</th><th>weight / die area, kPa</th>\
          </tr>\n",
     );
@@ -637,8 +640,12 @@ fn stress_by_height(summary: &Summary<'_>) -> String {
                 s.mean_axial_stress_pa,
                 w.die_wall_pa,
                 s.mean_lateral_stress_pa,
+                w.walls_lateral_pa,
             ]
-            .map(|p| format!("<td class=\"num\">{}</td>", kpa(Some(p))))
+            .map(|p| format!(
+                "<td class=\"num\">{}</td>",
+                kpa(Some(p).filter(|p| p.is_finite()))
+            ))
             .concat(),
             num(Some(s.lateral_to_axial)),
             num(Some(s.lower_to_upper)),
