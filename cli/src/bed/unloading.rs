@@ -18,10 +18,11 @@
 //!   (net + elastic).
 //!
 //! With `--rate-check` the same bed is pressed and withdrawn at half the
-//! punch speed, and the recovery's change is the withdrawal's check
+//! punch speed, and the recovery's change is the unloading's check
 //! ([`UnloadingRateCheck`]): at the turn the punch reverses at once, and
 //! the rate-dependent share of the load (inertia, damping) falls away
-//! first, so a punch too fast shifts the recovery.
+//! first (half the speed halves the first row's fall, BENCHMARKS.md), so
+//! a punch too fast can shift the recovery.
 //!
 //! What the physics guarantees, and the tests check: the unloading curve
 //! lies below the loading curve (what the bed dissipated it cannot give
@@ -85,12 +86,11 @@ pub struct UnloadingSummary {
 /// The rate check of the compaction cycle's unloading: the same bed
 /// pressed and withdrawn at half the punch speed (`--rate-check`'s twin),
 /// its figures and how far the in-die elastic recovery moved. The
-/// recovery is the withdrawal's headline figure and the one inertia and
-/// damping shift most (at the turn the punch reverses at once, and the
-/// rate-dependent share of the load falls away first), so it is the one
-/// judged. The twin is pressed at half speed too, so the change is the
-/// whole cycle's rate dependence, the loading's included. Flattened into
-/// `unloading` as `half_speed_*`.
+/// recovery is the withdrawal's headline figure, so it is the one judged
+/// (on the published scene it moved 1.9 %, the work given back 3.9 %,
+/// BENCHMARKS.md). The twin is pressed at half speed too, so the change is
+/// the whole cycle's rate dependence, the loading's included. Flattened
+/// into `unloading` as `half_speed_*`.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
 pub struct UnloadingRateCheck {
     /// The in-die elastic recovery at half the punch speed (`None`: not
