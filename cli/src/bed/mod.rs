@@ -217,7 +217,8 @@ With --seeds S1,S2,..., the scene is poured and compressed once per seed into
 run-to-run spread:
   seeds.csv        one row per seed, the columns of comparison.csv
   seeds_spread.csv per figure (Kawakita a and 1/b, Heckel P_y, D0, max and final
-                   pressure, final relative density and Z): runs, left_out (no
+                   pressure, final relative density and Z, in-die elastic
+                   recovery and plasticity factor): runs, left_out (no
                    fit, or a fit the run's summary warns about), mean, sample
                    standard deviation, min, max, spread = max - min
   seeds.json       both tables

@@ -63,11 +63,11 @@ pub const MIN_STRAIN_INTERVAL: f64 = 1e-6;
 /// punch at 50 mm/s to 30 % axial strain, friction 0.1, ξ = 0.5.
 pub const DEFAULT_SCENE: &str = r#"# granbed bed scene (format version 1). Units are in the field names.
 # A field left out takes its value from before the field existed: for the
-# numerics fields below (mass scaling, time_step_floor, hold_constraints,
+# fields below (mass scaling, time_step_floor, hold_constraints,
 # contact_search_interval, contact_capture, held_reprojection,
-# nearest_penetrated_face, sweep_tolerance, exact_sweep_tolerance) that is not the
-# published value, and granbed-cli bed warns
-# with the values it uses.
+# nearest_penetrated_face, sweep_tolerance, exact_sweep_tolerance,
+# exact_contact_from_strain, unload, snapshot_strains) that is not the
+# published value, and granbed-cli bed warns with the values it uses.
 version = 1
 
 # Granules: a standard type A1...C3 (A/B/C: yield stress 10/30/100 kPa;

@@ -106,8 +106,8 @@ pub struct WorkPrecisionArgs {
     #[arg(long, value_name = "MM", allow_negative_numbers = true)]
     pub die_diameter_mm: Option<f64>,
 
-    /// bed-small: final axial strain (0 < C ≤ 0.9; default 0.3; 0.1 with
-    /// --quick).
+    /// bed-small: final axial strain (0 < C ≤ 0.9; default 0.3, with
+    /// --quick too).
     #[arg(long, value_name = "C", allow_negative_numbers = true)]
     pub strain: Option<f64>,
 
