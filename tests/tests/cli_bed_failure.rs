@@ -9,7 +9,10 @@
 //! * the speed watchdog, set tight on a sane run, stops it by name;
 //! * with both watchdogs off, the kernel's failure (granule, element,
 //!   step) stops it, again with a readable, finite checkpoint;
-//! * out-of-range factors are rejected by name.
+//! * out-of-range factors are rejected by name;
+//! * a snapshot that cannot be written mid-run stops it with a checkpoint
+//!   of the step it failed at, from which `--resume` writes the snapshot
+//!   and finishes the run with the bits of a run never stopped.
 
 mod common;
 
@@ -184,4 +187,51 @@ fn out_of_range_factors_are_rejected_by_name() {
         assert_eq!(r.code, 2, "{field}: {}", r.stderr);
         assert!(r.stderr.contains(field), "{field} not named:\n{}", r.stderr);
     }
+}
+
+#[test]
+fn a_snapshot_that_cannot_be_written_keeps_the_run_for_resume() {
+    let dir = common::fresh_dir("cli_bed_failure", "snapshot");
+    let scene = scene_file(&dir, 0.9, [2.0, 2000.0]);
+    let text = std::fs::read_to_string(&scene).unwrap();
+    let text = text.replace(
+        "snapshot_strains = [0.0]",
+        "snapshot_strains = [0.0, 0.005]",
+    );
+    assert!(text.contains("snapshot_strains = [0.0, 0.005]"));
+    std::fs::write(&scene, text).unwrap();
+    // The reference: the same run, never stopped.
+    let reference = dir.join("reference");
+    let r = run(&scene, &reference);
+    assert_eq!(r.code, 0, "{}", r.stderr);
+    // A directory where the second snapshot's file goes: a fresh run
+    // removes old files only, so the snapshot at C = 0 is written and the
+    // one at 0.5 % cannot be.
+    let out = dir.join("out");
+    let blocker = out.join("vtk").join("bed_1.vtu");
+    std::fs::create_dir_all(&blocker).unwrap();
+    let r = run(&scene, &out);
+    assert_eq!(r.code, 1, "the run must stop:\n{}", r.stderr);
+    for needle in ["bed_1.vtu", "the run so far is kept in", "--resume"] {
+        assert!(r.stderr.contains(needle), "no `{needle}` in:\n{}", r.stderr);
+    }
+    let c = usable_checkpoint(&out);
+    assert_eq!(
+        c.progress.snapshots_done, 1,
+        "the checkpoint must leave the failed snapshot to do"
+    );
+    assert!(
+        c.state.steps > 0 && c.progress.die.strain_at(c.state.time) >= 0.005 - 1e-12,
+        "the checkpoint must hold the step the snapshot failed at"
+    );
+    std::fs::remove_dir(&blocker).unwrap();
+    let resumed = cli(&["bed", "--quiet", "--resume", out.to_str().unwrap()]);
+    assert_eq!(resumed.code, 0, "resume failed:\n{}", resumed.stderr);
+    assert!(blocker.is_file(), "the resumed run writes the snapshot");
+    let csv = |d: &Path| std::fs::read_to_string(d.join("compression.csv")).unwrap();
+    assert_eq!(
+        csv(&out),
+        csv(&reference),
+        "the resumed run must give the bits of the run never stopped"
+    );
 }

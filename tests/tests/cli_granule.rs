@@ -435,7 +435,7 @@ fn platens_carry_equal_forces() {
 fn bad_input_names_the_flag() {
     let dir = out_dir("bad");
     let out = dir.to_str().unwrap();
-    let cases: [(&[&str], &str); 15] = [
+    let cases: [(&[&str], &str); 17] = [
         (&["--strain", "0"], "--strain"),
         (
             &["--diameter-mm", "0"],
@@ -444,6 +444,14 @@ fn bad_input_names_the_flag() {
         (&["--diameter-mm", "1e300"], "`--diameter-mm 1e300`"),
         (&["--strain", "0.95"], "--strain"),
         (&["--speed-mm-s", "-1"], "--speed-mm-s"),
+        (
+            &["--speed-mm-s", "1e-9"],
+            "`--speed-mm-s 1e-9` rejected (allowed: 0.1 <= speed <= 10000 mm/s",
+        ),
+        (
+            &["--output-strain", "1e-300"],
+            "`--output-strain 1e-300` rejected (allowed: 1e-6 <= interval",
+        ),
         (&["--gravity"], "--gravity"),
         (&["--mesh", "3x1"], "--mesh"),
         (&["--damping-ratio", "3"], "--damping-ratio"),

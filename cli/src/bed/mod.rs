@@ -313,7 +313,7 @@ pub struct BedArgs {
     #[arg(long, value_name = "MM", allow_negative_numbers = true)]
     pub die_diameter_mm: Option<f64>,
 
-    /// Override: granule diameter, mm (0 < d < 2000; the die must stay
+    /// Override: granule diameter, mm (0.001 ≤ d < 2000; the die must stay
     /// more than 4 granule diameters wide).
     #[arg(long, value_name = "MM", allow_negative_numbers = true)]
     pub diameter_mm: Option<f64>,

@@ -588,7 +588,8 @@ pub trait BedObserver {
     /// The state when the strain first reaches `strain`, one of the
     /// scene's `snapshot_strains` (and at t = 0 for a strain of 0), and at
     /// the end of a run that reached its final strain, at that strain,
-    /// if the list has none that high. An error stops the run.
+    /// if the list has none that high. An error stops the run; mid-run,
+    /// after a checkpoint of the step (`--resume` writes the snapshot).
     fn snapshot(
         &mut self,
         strain: Real,
@@ -948,11 +949,19 @@ pub fn run_bed(
         }
         window.add_step(&asm);
         let strain = die.strain_at(asm.time());
+        // A snapshot that cannot be written (a full disk, say) ends the run
+        // after this step's row and a checkpoint of it: the step itself
+        // succeeded, and the run so far is kept for `--resume`, which
+        // writes the snapshot again.
+        let mut snapshot_failed = None;
         while snapshots
             .get(snapshots_done)
             .is_some_and(|&c| strain + 1e-12 >= c)
         {
-            observer.snapshot(snapshots[snapshots_done], &asm, &mesh)?;
+            if let Err(e) = observer.snapshot(snapshots[snapshots_done], &asm, &mesh) {
+                snapshot_failed = Some(e);
+                break;
+            }
             snapshots_done += 1;
         }
         if strain + 1e-12 >= next || asm.time() >= end {
@@ -974,6 +983,7 @@ pub fn run_bed(
         let interrupt = control.interrupt.is_some_and(|f| f.load(Ordering::SeqCst));
         if stop
             || interrupt
+            || snapshot_failed.is_some()
             || strain >= next_checkpoint_strain
             || last_checkpoint.elapsed().as_secs_f64() >= every_s
         {
@@ -985,6 +995,17 @@ pub fn run_bed(
             while next_checkpoint_strain <= strain {
                 next_checkpoint_strain += scene.checkpoint_strain_interval;
             }
+        }
+        if let Some(e) = snapshot_failed {
+            return Err(match dir {
+                Some(dir) => anyhow::anyhow!(
+                    "{e:#}; the run so far is kept in {}: `granbed-cli bed --resume {}` continues \
+                     it",
+                    dir.join(checkpoint::FILE_NAME).display(),
+                    dir.display()
+                ),
+                None => e,
+            });
         }
         if stop {
             stopped = true;

@@ -53,6 +53,13 @@ const _: () = assert!(MAX_FINAL_STRAIN == 0.9);
 /// window; the scene field `heckel_min_strain` sets another.
 pub const HECKEL_MIN_STRAIN: f64 = granbed_kernel::analysis::bed::KAWAKITA_MIN_STRAIN;
 
+/// The smallest granule diameter, mm (`granule`'s and `pack`'s floor,
+/// [`crate::granule::DIAMETER_RANGE_MM`]): the pour's time step scales with
+/// the diameter while its ramp and time limit are absolute, so far smaller
+/// granules would pour for ever (at 10⁻⁶⁰ mm the step underflows to 0).
+pub const MIN_DIAMETER_MM: f64 = crate::granule::DIAMETER_RANGE_MM[0];
+const _: () = assert!(MIN_DIAMETER_MM == 0.001, "spelled out in the range");
+
 /// The smallest output and checkpoint strain interval: the run steps its
 /// next output strain forward by the interval, and an interval below the
 /// round-off of the strain never got past it.
@@ -274,7 +281,7 @@ pub struct Scene {
     pub granule_type: String,
     /// Number of granules, 1 ≤ N ≤ 100000.
     pub granules: usize,
-    /// Granule diameter, mm.
+    /// Granule diameter, mm, [`MIN_DIAMETER_MM`] ≤ d < 2000.
     pub diameter_mm: f64,
     /// Mesh level `NxM`.
     pub mesh: String,
@@ -635,10 +642,10 @@ impl Scene {
                 "1..=100000",
             ),
             (
-                self.diameter_mm > 0.0 && self.diameter_mm < 2000.0,
+                self.diameter_mm >= MIN_DIAMETER_MM && self.diameter_mm < 2000.0,
                 "diameter_mm",
                 self.diameter_mm,
-                "0 < d < 2000",
+                "0.001 <= d < 2000",
             ),
             (
                 self.die_diameter_mm > 4.0 * self.diameter_mm
@@ -1053,6 +1060,16 @@ mod tests {
             let e = bad(from, to);
             assert!(e.contains(field) && e.contains("1e-6"), "{e}");
         }
+        // A granule so small that its pour would never end (the die kept at
+        // ten diameters, inside its own range).
+        let tiny = DEFAULT_SCENE
+            .replace("diameter_mm = 1.0", "diameter_mm = 1e-60")
+            .replace("die_diameter_mm = 11.3", "die_diameter_mm = 1e-59");
+        let e = format!("{:#}", Scene::from_toml(&tiny).unwrap_err());
+        assert!(
+            e.contains("`diameter_mm`") && e.contains("0.001 <= d < 2000"),
+            "{e}"
+        );
         let e = bad(
             "exact_sweep_tolerance = 0.005",
             "exact_sweep_tolerance = 0.5",

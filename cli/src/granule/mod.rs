@@ -42,6 +42,16 @@ use summary::{RunSetup, Summary, symmetry_name};
 /// Radius of the simulated granule, m (the published 1 mm granule).
 pub const GRANULE_RADIUS_M: Real = 0.5e-3;
 
+/// The slowest `--speed-mm-s`, mm/s (a fiftieth of the standard 5 mm/s):
+/// the run's steps grow as 1/speed (at 10⁻⁶ mm/s about 10¹⁴ steps).
+pub const MIN_SPEED_MM_S: f64 = 0.1;
+
+/// The smallest `--output-strain` (the bed's floor,
+/// [`crate::bed::scene::MIN_STRAIN_INTERVAL`]): every interval ends in a
+/// sample the run keeps, so a smaller one would keep one every step.
+pub const MIN_OUTPUT_STRAIN: f64 = crate::bed::scene::MIN_STRAIN_INTERVAL;
+const _: () = assert!(MIN_OUTPUT_STRAIN == 1e-6, "spelled out in the message");
+
 /// The granule diameters `--diameter-mm` accepts (`granule`,
 /// `export-mesh`), mm: those of the browser calculator, 1 µm to 1 m.
 pub const DIAMETER_RANGE_MM: [f64; 2] = [1.0e-3, 1.0e3];
@@ -246,7 +256,7 @@ pub struct GranuleArgs {
     pub strain: f64,
 
     /// Speed at which the platens approach each other, mm/s
-    /// (0 < speed ≤ 10000); each platen moves at half of it.
+    /// (0.1 ≤ speed ≤ 10000); each platen moves at half of it.
     #[arg(
         long,
         value_name = "MM_S",
@@ -280,7 +290,7 @@ pub struct GranuleArgs {
     pub literal_return: bool,
 
     /// Strain between samples (CSV rows); the platen forces are averaged
-    /// over each interval (0 < interval ≤ --strain).
+    /// over each interval (10⁻⁶ ≤ interval ≤ --strain).
     #[arg(
         long,
         value_name = "STRAIN",
@@ -389,14 +399,14 @@ impl GranuleArgs {
         let message = match field {
             "damping_ratio" => format!("`--damping-ratio {value}` rejected"),
             "approach_speed_m_s" => format!(
-                "`--speed-mm-s {}` rejected (allowed: 0 < speed <= 10000 mm/s)",
+                "`--speed-mm-s {}` rejected (allowed: 0.1 <= speed <= 10000 mm/s)",
                 self.speed_mm_s
             ),
             "friction" => format!("`--friction {value}` rejected (granule-platen friction)"),
             "final_strain" => format!("`--strain {value}` rejected"),
             "time_step_safety" => format!("`--time-step-safety {value}` rejected"),
             "output_strain_interval" => format!(
-                "`--output-strain {value}` rejected (with `--strain {}`)",
+                "`--output-strain {value}` rejected (allowed: 1e-6 <= interval <= `--strain` = {})",
                 self.strain
             ),
             "hourglass_kappa" => format!("`--hourglass-kappa {value}` rejected"),
@@ -409,6 +419,31 @@ impl GranuleArgs {
             other => format!("experiment parameter `{other}` = {value} rejected"),
         };
         anyhow::Error::new(err).context(InputError(message))
+    }
+
+    /// The floors the kernel leaves to its caller (its platen scene takes
+    /// any speed and interval above zero, as a granule resting under
+    /// gravity needs): a run of this command cannot be interrupted without
+    /// losing it, so a speed or an output interval that would make it
+    /// endless is a usage error.
+    fn check_run_length(&self) -> anyhow::Result<()> {
+        if !(MIN_SPEED_MM_S..).contains(&self.speed_mm_s) {
+            return Err(InputError(format!(
+                "`--speed-mm-s {}` rejected (allowed: {MIN_SPEED_MM_S} <= speed <= 10000 mm/s: the \
+                 run's steps grow as 1/speed)",
+                crate::numbers::short(self.speed_mm_s)
+            ))
+            .into());
+        }
+        if !(MIN_OUTPUT_STRAIN..).contains(&self.output_strain) {
+            return Err(InputError(format!(
+                "`--output-strain {}` rejected (allowed: 1e-6 <= interval <= `--strain`: each \
+                 interval keeps a sample)",
+                crate::numbers::short(self.output_strain)
+            ))
+            .into());
+        }
+        Ok(())
     }
 
     /// The granule types to run.
@@ -430,6 +465,7 @@ impl GranuleArgs {
             ))
             .into());
         }
+        self.check_run_length()?;
         let mut jobs = Vec::new();
         for granule_type in self.types() {
             let material = MaterialArgs {

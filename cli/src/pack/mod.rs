@@ -108,7 +108,8 @@ impl<const EXP: i32> FromStr for Scaled<EXP> {
             None => (text, Some(0)),
         };
         let si = exp
-            .and_then(|e| format!("{mantissa}e{}", e + EXP).parse::<f64>().ok())
+            .and_then(|e| e.checked_add(EXP))
+            .and_then(|e| format!("{mantissa}e{e}").parse::<f64>().ok())
             .unwrap_or(given * 10f64.powi(EXP));
         Ok(Self { given, si })
     }
@@ -530,6 +531,13 @@ mod tests {
         assert_eq!(inf.si, f64::INFINITY);
         assert!("abc".parse::<Millimetres>().is_err());
         assert_eq!(mm.to_string(), "11.3");
+        // An exponent at the end of i32's range is shifted without
+        // overflow (the test profile checks overflow): the value is then
+        // scaled in floating point, 0 and ∞ here.
+        let tiny: Millimetres = "1e-2147483648".parse().unwrap();
+        assert_eq!(tiny.si, 0.0);
+        let huge: Megapascals = "1e2147483647".parse().unwrap();
+        assert_eq!(huge.si, f64::INFINITY);
     }
 
     #[test]

@@ -74,9 +74,13 @@ impl Grid {
         }
     }
 
-    /// Number of cells (the length of the `head` buffer).
+    /// Number of cells (the length of the `head` buffer); `usize::MAX` if
+    /// that does not fit (no buffer can hold it, so no pour starts).
     pub fn cells(&self) -> usize {
-        self.nxy * self.nxy * self.nz
+        self.nxy
+            .checked_mul(self.nxy)
+            .and_then(|layer| layer.checked_mul(self.nz))
+            .unwrap_or(usize::MAX)
     }
 
     fn coord(&self, c: Real, n: usize) -> usize {

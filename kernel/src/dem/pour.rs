@@ -16,6 +16,11 @@ use crate::dem::neighbors::{DIE, FLOOR, Grid, GridScratch, Pair, PairOverflow, b
 use crate::math;
 use crate::rng::Rng;
 
+/// The widest die a pour accepts, in lattice spacings of its radius: the
+/// checks walk one layer of the lattice (about 3·10⁸ sites at this bound),
+/// and an infinite die would be walked without end.
+pub const MAX_DIE_LATTICE_SPACINGS: Real = 1.0e4;
+
 /// Parameters of the pour (SI).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct PourParams {
@@ -34,7 +39,8 @@ pub struct PourParams {
     pub friction_particle: Real,
     /// Sphere–wall friction; ≥ 0.
     pub friction_wall: Real,
-    /// Die radius, m; > 2·radius.
+    /// Die radius, m; > 2·radius and ≤ [`MAX_DIE_LATTICE_SPACINGS`] ×
+    /// `lattice_spacing`.
     pub die_radius: Real,
     /// Gravity, m/s² (in −z); > 0.
     pub gravity_m_s2: Real,
@@ -164,7 +170,8 @@ impl PourParams {
 
     fn validate(&self) -> Result<(), PourError> {
         let d = 2.0 * self.radius;
-        let checks: [(bool, &'static str, Real, &'static str); 12] = [
+        let finite = |v: Real| v.is_finite();
+        let checks: [(bool, &'static str, Real, &'static str); 15] = [
             (
                 (1..=100_000).contains(&self.granules),
                 "granules",
@@ -202,22 +209,48 @@ impl PourParams {
                 ">= 0",
             ),
             (
-                self.die_radius > 2.0 * d,
-                "die_radius",
-                self.die_radius,
-                "> 2 diameters",
-            ),
-            (
-                self.gravity_m_s2 > 0.0,
-                "gravity_m_s2",
-                self.gravity_m_s2,
-                "> 0",
-            ),
-            (
-                self.lattice_spacing >= d + 2.0 * self.jitter && self.jitter >= 0.0,
+                self.lattice_spacing >= d + 2.0 * self.jitter
+                    && finite(self.lattice_spacing)
+                    && self.jitter >= 0.0,
                 "lattice_spacing",
                 self.lattice_spacing,
-                ">= diameter + 2 jitter",
+                ">= diameter + 2 jitter, finite",
+            ),
+            // Bounded before `sites` walks the lattice: an infinite die
+            // would walk it without end.
+            (
+                self.die_radius > 2.0 * d
+                    && self.die_radius <= MAX_DIE_LATTICE_SPACINGS * self.lattice_spacing,
+                "die_radius",
+                self.die_radius,
+                "> 2 diameters and <= 10000 lattice spacings",
+            ),
+            (
+                self.gravity_m_s2 > 0.0 && finite(self.gravity_m_s2),
+                "gravity_m_s2",
+                self.gravity_m_s2,
+                "> 0, finite",
+            ),
+            (
+                self.initial_speed >= 0.0 && finite(self.initial_speed),
+                "initial_speed",
+                self.initial_speed,
+                ">= 0, finite",
+            ),
+            (
+                self.damping_max >= 0.0 && finite(self.damping_max),
+                "damping_max",
+                self.damping_max,
+                ">= 0, finite",
+            ),
+            (
+                self.rest_speed > 0.0
+                    && finite(self.rest_speed)
+                    && self.rest_kinetic_energy > 0.0
+                    && finite(self.rest_kinetic_energy),
+                "rest_speed",
+                self.rest_speed.min(self.rest_kinetic_energy),
+                "rest speed and kinetic energy > 0, finite",
             ),
             (
                 self.restitution_start > 0.0
@@ -229,13 +262,19 @@ impl PourParams {
                 "0 < e <= 1",
             ),
             (
-                self.ramp.0 >= 0.0 && self.ramp.1 > self.ramp.0 && self.max_time > self.ramp.1,
+                self.ramp.0 >= 0.0
+                    && self.ramp.1 > self.ramp.0
+                    && self.max_time > self.ramp.1
+                    && finite(self.max_time),
                 "ramp",
                 self.ramp.1,
-                "0 <= start < end < max_time",
+                "0 <= start < end < max_time, finite",
             ),
             (
-                self.time_step_fraction > 0.0 && self.time_step_fraction <= 0.2 && self.skin > 0.0,
+                self.time_step_fraction > 0.0
+                    && self.time_step_fraction <= 0.2
+                    && self.skin > 0.0
+                    && finite(self.skin),
                 "time_step_fraction",
                 self.time_step_fraction,
                 "0 < f <= 0.2",
@@ -846,5 +885,68 @@ impl<'a> PourScene<'a> {
                 });
             }
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The field a rejected parameter set names.
+    fn rejected(p: PourParams) -> &'static str {
+        match p.validate() {
+            Err(PourError::InvalidParameter { field, .. }) => field,
+            other => panic!("expected a rejection, got {other:?}"),
+        }
+    }
+
+    /// Values no pour could finish with are refused by name before the
+    /// lattice is walked: an infinite die (its sites were walked without
+    /// end), an infinite lattice spacing (its grid's cell count
+    /// overflowed), an infinite time limit, and non-finite forces, speeds
+    /// and skins.
+    #[test]
+    fn infinite_and_vast_parameters_are_refused_by_name() {
+        let standard = PourParams::standard(1200.0, 1);
+        assert_eq!(standard.validate(), Ok(()));
+        let with = |f: fn(&mut PourParams)| {
+            let mut p = standard;
+            f(&mut p);
+            rejected(p)
+        };
+        assert_eq!(with(|p| p.die_radius = Real::INFINITY), "die_radius");
+        assert_eq!(
+            with(|p| p.die_radius = 2e4 * p.lattice_spacing),
+            "die_radius"
+        );
+        assert_eq!(
+            with(|p| p.lattice_spacing = Real::INFINITY),
+            "lattice_spacing"
+        );
+        assert_eq!(with(|p| p.lattice_spacing = Real::NAN), "lattice_spacing");
+        assert_eq!(with(|p| p.gravity_m_s2 = Real::INFINITY), "gravity_m_s2");
+        assert_eq!(with(|p| p.max_time = Real::INFINITY), "ramp");
+        assert_eq!(with(|p| p.skin = Real::INFINITY), "time_step_fraction");
+        assert_eq!(with(|p| p.initial_speed = Real::NAN), "initial_speed");
+        assert_eq!(with(|p| p.damping_max = Real::INFINITY), "damping_max");
+        assert_eq!(with(|p| p.rest_speed = 0.0), "rest_speed");
+        assert_eq!(with(|p| p.rest_kinetic_energy = Real::NAN), "rest_speed");
+        // The widest die accepted still validates (its layer is walked).
+        let mut wide = standard;
+        wide.die_radius = 1e3 * wide.lattice_spacing;
+        assert_eq!(wide.validate(), Ok(()));
+    }
+
+    /// A grid too large to count says so with `usize::MAX` instead of
+    /// overflowing.
+    #[test]
+    fn a_grid_too_large_to_count_saturates() {
+        let g = Grid {
+            cell: 1.0,
+            nxy: usize::MAX / 2,
+            nz: 3,
+            half_width: 1.0,
+        };
+        assert_eq!(g.cells(), usize::MAX);
     }
 }
