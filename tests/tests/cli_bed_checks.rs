@@ -550,3 +550,33 @@ fn the_summary_keeps_the_scene_exactly() {
     assert_eq!(scene.held_reprojection, f64::INFINITY);
     assert_eq!(scene.granules, 8);
 }
+
+/// A scene whose granules' own buffers exceed the machine's memory is
+/// refused by name before the pour (it was killed for want of memory after
+/// it, without a message): 100 000 granules of 32x8 need about 1.8 TB.
+#[test]
+fn a_scene_too_large_for_the_memory_is_refused_before_the_pour() {
+    let dir = out_dir("too-large");
+    let run = bed(&[
+        "--quiet",
+        "--granules",
+        "100000",
+        "--die-diameter-mm",
+        "200",
+        "--mesh",
+        "32x8",
+        "--out",
+        dir.to_str().unwrap(),
+    ]);
+    rejected(
+        &run,
+        &[
+            "`granules` = 100000 on the `mesh` 32x8 need at least",
+            "GB of memory: use fewer granules or a coarser mesh",
+        ],
+    );
+    assert!(
+        !dir.join("checkpoint.bin").exists() && !dir.join("packing.csv").exists(),
+        "nothing is poured or written"
+    );
+}

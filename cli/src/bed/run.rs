@@ -740,6 +740,35 @@ pub fn assembly_params(scene: &Scene, mesh: &OwnedReference) -> anyhow::Result<A
     Ok(params)
 }
 
+/// This machine's memory, bytes (Linux `/proc/meminfo` MemTotal), or
+/// `None` where it cannot be read.
+fn machine_memory_bytes() -> Option<u64> {
+    let info = std::fs::read_to_string("/proc/meminfo").ok()?;
+    let line = info.lines().find(|l| l.starts_with("MemTotal:"))?;
+    let kb: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
+    Some(kb.saturating_mul(1024))
+}
+
+/// Why `scene` cannot run on a machine of `total` bytes, if its granules'
+/// own buffers, `need` bytes ([`crate::model::GranuleStore::bytes_for`]
+/// each: a lower bound, the contact lists and outputs come on top — the
+/// published scene peaks at about 3.4 times it), do not fit: a scene of
+/// many granules on a fine mesh was killed for want of memory after its
+/// pour, without a message.
+fn memory_refusal(scene: &Scene, need: u64, total: u64) -> Option<String> {
+    (need > total).then(|| {
+        format!(
+            "`granules` = {} on the `mesh` {} need at least {:.1} GB for the granules' own \
+             buffers, more than this machine's {:.1} GB of memory: use fewer granules or a \
+             coarser mesh",
+            scene.granules,
+            scene.mesh,
+            need as f64 / 1e9,
+            total as f64 / 1e9
+        )
+    })
+}
+
 /// Runs `scene` from `control`'s checkpoint, else its packing, else a
 /// fresh pour, reporting to `observer`. Errors before the first step
 /// (pour failed, bad setup, packing or checkpoint unfit) are returned; an
@@ -753,6 +782,12 @@ pub fn run_bed(
     let radius = scene.radius_m();
     let mesh = scene.granule_mesh()?;
     let mut params = assembly_params(scene, &mesh)?;
+    let need = scene.granules as u64
+        * crate::model::GranuleStore::bytes_for(&mesh, params.elements.points_per_element());
+    if let Some(message) = machine_memory_bytes().and_then(|total| memory_refusal(scene, need, total))
+    {
+        return Err(crate::error::InputError(message).into());
+    }
     // Where the run starts: a fresh pour, or a checkpoint's state.
     let (die, placed, resumed, pour_wall_time_s) = match &control.resume {
         Some(c) => {

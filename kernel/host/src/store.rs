@@ -47,6 +47,37 @@ pub struct GranuleStore {
 }
 
 impl GranuleStore {
+    /// The bytes [`GranuleStore::new`] allocates for `mesh` with `points`
+    /// integration points per element, without allocating them: what a
+    /// host checks against its memory before it makes many granules.
+    pub fn bytes_for(mesh: &OwnedReference, points: usize) -> u64 {
+        use core::mem::size_of;
+        let nodes = mesh.positions.len() as u64;
+        let per_node = 7 * size_of::<[Real; 3]>() + 2 * size_of::<Real>() + size_of::<u8>();
+        let states = (mesh.hexes.len() as u64).saturating_mul(points as u64);
+        nodes
+            .saturating_mul(per_node as u64)
+            .saturating_add(states.saturating_mul(size_of::<[Real; 6]>() as u64))
+    }
+
+    /// The bytes its buffers hold (their lengths, as [`GranuleStore::new`]
+    /// makes them).
+    pub fn bytes(&self) -> u64 {
+        use core::mem::size_of_val;
+        let node_vectors = [
+            &self.x, &self.v, &self.v_star, &self.x_pred, &self.f_int, &self.f_c, &self.f_d,
+        ];
+        let bytes = node_vectors
+            .iter()
+            .map(|v| size_of_val(v.as_slice()))
+            .sum::<usize>()
+            + size_of_val(self.mass.as_slice())
+            + size_of_val(self.contact_mass.as_slice())
+            + size_of_val(self.fixed.as_slice())
+            + size_of_val(self.cp_inv.as_slice());
+        bytes as u64
+    }
+
     /// Zeroed buffers for `mesh` with `points` integration points per element
     /// (the kernel's scene or [`GranuleBuffers::reset`] initialises them).
     pub fn new(mesh: &OwnedReference, points: usize) -> Self {
@@ -196,6 +227,29 @@ impl PourStore {
             pairs_old: &mut self.pairs_old,
             head: &mut self.head,
             next: &mut self.next,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::mesh::MeshLevel;
+
+    /// What `bytes_for` predicts is what `new` allocates, for the one-point
+    /// element and F-bar's eight points, on two mesh levels.
+    #[test]
+    fn the_predicted_bytes_are_those_allocated() {
+        for level in [MeshLevel::new(4, 1), MeshLevel::STANDARD] {
+            let mesh = OwnedReference::sphere(0.5e-3, level, false).unwrap();
+            for points in [1, 8] {
+                let store = GranuleStore::new(&mesh, points);
+                assert_eq!(
+                    GranuleStore::bytes_for(&mesh, points),
+                    store.bytes(),
+                    "{level} with {points} points"
+                );
+            }
         }
     }
 }
