@@ -784,7 +784,8 @@ pub fn run_bed(
     let mut params = assembly_params(scene, &mesh)?;
     let need = scene.granules as u64
         * crate::model::GranuleStore::bytes_for(&mesh, params.elements.points_per_element());
-    if let Some(message) = machine_memory_bytes().and_then(|total| memory_refusal(scene, need, total))
+    if let Some(message) =
+        machine_memory_bytes().and_then(|total| memory_refusal(scene, need, total))
     {
         return Err(crate::error::InputError(message).into());
     }

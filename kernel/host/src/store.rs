@@ -65,7 +65,13 @@ impl GranuleStore {
     pub fn bytes(&self) -> u64 {
         use core::mem::size_of_val;
         let node_vectors = [
-            &self.x, &self.v, &self.v_star, &self.x_pred, &self.f_int, &self.f_c, &self.f_d,
+            &self.x,
+            &self.v,
+            &self.v_star,
+            &self.x_pred,
+            &self.f_int,
+            &self.f_c,
+            &self.f_d,
         ];
         let bytes = node_vectors
             .iter()
