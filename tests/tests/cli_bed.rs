@@ -692,6 +692,42 @@ fn the_rate_check_presses_the_same_bed_at_half_speed() {
         run.stderr
     );
     assert!(twin["unloading"]["half_speed_passed"].is_null());
+
+    // A twin an interrupt stopped goes on from its checkpoint when the run
+    // is resumed with the check, to the bits of the twin never stopped.
+    // The stopped twin is made as a run of the twin's scene, stopped at
+    // C = 0.1, into the twin's directory of a finished run.
+    let resumed = out_dir("rate_check_resumed");
+    bed(&resumed, "2", &[]);
+    bed(
+        &resumed.join("half_speed"),
+        "2",
+        &["--punch-speed-m-s", "0.025", "--stop-at-strain", "0.1"],
+    );
+    let run = cli(&[
+        "bed",
+        "-j",
+        "2",
+        "--resume",
+        resumed.to_str().unwrap(),
+        "--rate-check",
+    ]);
+    assert_eq!(run.code, 0, "{}", run.stderr);
+    assert!(
+        run.stderr.contains(
+            "rate check: its run at half the punch speed goes on from its checkpoint at C = 0.1"
+        ),
+        "{}",
+        run.stderr
+    );
+    for file in ["compression.csv", "unloading.csv"] {
+        let read = |d: &Path| std::fs::read_to_string(d.join("half_speed").join(file)).unwrap();
+        assert_eq!(read(&resumed), read(&dir), "the twin's {file}");
+    }
+    assert_eq!(
+        summary(&resumed)["quasi_static"]["rate_change_rel"],
+        s["quasi_static"]["rate_change_rel"]
+    );
 }
 
 /// Runs the bed of `args` twice, with `--<flag> true` and `--<flag>

@@ -508,7 +508,8 @@ pub struct BedArgs {
     /// twice the run's cost) and require P(C) to move by less than 5 %; a
     /// scene that unloads is withdrawn at half the speed too, and a change
     /// of its in-die elastic recovery of 5 % or more is a warning
-    /// (summary.json's unloading.half_speed_*).
+    /// (summary.json's unloading.half_speed_*). With --resume DIR, a
+    /// half-speed run an interrupt stopped goes on from its checkpoint.
     #[arg(long, conflicts_with_all = ["types", "stop_at_strain"])]
     pub rate_check: bool,
 
@@ -900,7 +901,8 @@ impl BedArgs {
     }
 
     /// `--rate-check`: the same scene (same pour) at half the punch speed
-    /// into `out/half_speed`; the change of P(C) goes into `result` and the
+    /// into `out/half_speed` (continued from its checkpoint there if an
+    /// interrupt stopped it); the change of P(C) goes into `result` and the
     /// outputs in `out` are written again with it.
     fn rate_check(
         &self,
@@ -917,7 +919,26 @@ impl BedArgs {
             ..scene.clone()
         };
         let dir = out.join(HALF_SPEED_DIR);
+        // A twin an interrupt stopped (its checkpoint holds this very scene
+        // at half speed) goes on from there: it takes about twice the run.
+        // Any other checkpoint there (another scene, unreadable) is
+        // replaced by a fresh twin.
+        let resume = checkpoint::Checkpoint::read(&dir)
+            .ok()
+            .filter(|c| c.progress.scene_toml == slow.to_toml());
+        if let Some(c) = &resume
+            && !self.quiet
+        {
+            writeln!(
+                streams.stderr,
+                "rate check: its run at half the punch speed goes on from its checkpoint at C = \
+                 {:.4} in `{}`",
+                c.progress.die.strain_at(c.state.time),
+                dir.display()
+            )?;
+        }
         let control = run::RunControl {
+            resume,
             checkpoint_dir: Some(dir.clone()),
             interrupt: Some(&crate::signal::INTERRUPT),
             ..run::RunControl::default()
@@ -932,8 +953,9 @@ impl BedArgs {
             return Err(anyhow::Error::new(crate::signal::Interrupted(format!(
                 "interrupted during the rate check's run at half the punch speed (its outputs \
                  so far are in `{}`); the run's own outputs in `{}` are complete, without the \
-                 rate check",
+                 rate check: `granbed-cli bed --resume {} --rate-check` continues it",
                 dir.display(),
+                out.display(),
                 out.display()
             ))));
         }
