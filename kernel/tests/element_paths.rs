@@ -14,7 +14,8 @@ use granbed_kernel::Real;
 use granbed_kernel::constitutive::UpdateError;
 use granbed_kernel::constitutive::update::{check_input, input_is_valid, trial};
 use granbed_kernel::element::batch::{
-    BATCH, ElementBatch, ElementPath, batch_count, has_avx2, one_point_elements, regroup, sink,
+    BATCH, ElementBatch, ElementPath, LoopError, batch_count, has_avx2, one_point_elements,
+    regroup, sink,
 };
 use granbed_kernel::element::force::HexForces;
 use granbed_kernel::element::reference::{HexReference, hex_reference};
@@ -62,7 +63,7 @@ fn bits(e: usize, out: &HexForces) -> Vec<u64> {
 }
 
 struct Pass {
-    result: Result<(), (usize, UpdateError)>,
+    result: Result<(), LoopError>,
     outputs: Vec<Vec<u64>>,
     plastic: usize,
 }
@@ -217,7 +218,7 @@ fn fails_alike(
         let mut cp = vec![VOIGT_IDENTITY; hexes.len()];
         let pass = run(path, hexes, refs, x, &mut cp);
         match &pass.result {
-            Err((element, error)) if expected(error) => {
+            Err(LoopError::Element(element, error)) if expected(error) => {
                 assert_eq!(*element, bad, "{path:?}: element {element}")
             }
             other => panic!("{path:?}: expected element {bad} to fail, got {other:?}"),
@@ -290,6 +291,48 @@ fn a_failing_element_is_reported_alike_and_leaves_the_same_states() {
     });
 }
 
+/// Buffers that do not fit the hexes are refused by name before any
+/// element is evaluated, on every path (they indexed out of bounds).
+#[test]
+fn buffers_that_do_not_fit_the_hexes_are_refused_by_name() {
+    let (mesh, refs) = first_elements();
+    let count = refs.len();
+    let hexes = &mesh.hexes[..count];
+    let x = mesh.positions.clone();
+    let mut cp = vec![VOIGT_IDENTITY; count];
+    for path in PATHS {
+        assert_eq!(
+            run(path, hexes, &refs[..count - 1], &x, &mut cp).result,
+            Err(LoopError::BufferLength {
+                buffer: "refs",
+                expected: count,
+                got: count - 1
+            })
+        );
+        let mut short = vec![VOIGT_IDENTITY; count + 1];
+        let pass = run(path, hexes, &refs, &x, &mut short);
+        assert_eq!(
+            pass.result,
+            Err(LoopError::BufferLength {
+                buffer: "cp_inv",
+                expected: count,
+                got: count + 1
+            })
+        );
+        assert!(pass.outputs.is_empty(), "{path:?}: nothing evaluated");
+        let id = hexes.as_flattened().iter().copied().max().unwrap();
+        let few = &x[..id as usize];
+        assert_eq!(
+            run(path, hexes, &refs, few, &mut cp).result,
+            Err(LoopError::NodeId {
+                id,
+                nodes: id as usize
+            })
+        );
+    }
+    assert!(cp.iter().all(|c| c == &VOIGT_IDENTITY), "no state touched");
+}
+
 /// A stored state that is valid (positive definite, det C_p⁻¹ = 1) but so
 /// stretched that the trial stress b = F C_p⁻¹ Fᵀ overflows fails its
 /// element as non-finite on every path, the states untouched: the batch
@@ -307,7 +350,11 @@ fn an_overflowing_trial_state_is_non_finite_on_every_path() {
         let mut cp = vec![VOIGT_IDENTITY; count];
         cp[bad] = stretched;
         let pass = run(path, hexes, &refs, &mesh.positions, &mut cp);
-        assert_eq!(pass.result, Err((bad, UpdateError::NonFinite)), "{path:?}");
+        assert_eq!(
+            pass.result,
+            Err(LoopError::Element(bad, UpdateError::NonFinite)),
+            "{path:?}"
+        );
         assert!(cp[..bad].iter().all(|c| *c == VOIGT_IDENTITY), "{path:?}");
         assert_eq!(cp[bad], stretched, "{path:?}");
     }

@@ -105,7 +105,7 @@ impl Grid {
     }
 }
 
-/// Scratch of [`build_pairs`]: one `head` entry per grid cell
+/// Scratch of the pour's candidate search (`build_pairs`): one `head` entry per grid cell
 /// ([`Grid::cells`]), one `next` entry per sphere.
 pub struct GridScratch<'a> {
     /// First sphere of each cell's chain.
@@ -118,7 +118,11 @@ pub struct GridScratch<'a> {
 /// sphere pairs closer than `range` (centre distance) and spheres closer
 /// than the skin `range − 2·radius` to the floor or the die wall. The
 /// tangential history of pairs present in `old` (sorted) is carried over.
-pub fn build_pairs(
+///
+/// Crate-private: it indexes `scratch.head` by `grid`'s cells and
+/// `scratch.next` by sphere without checking their lengths, which
+/// [`crate::dem::pour::PourScene`] checks once when it starts.
+pub(crate) fn build_pairs(
     grid: &Grid,
     x: &[[Real; 3]],
     radius: Real,

@@ -43,7 +43,7 @@
 //! kernel's only `unsafe` code (the workspace denies it elsewhere), allowed
 //! function by function: reading `cpuid`/`xgetbv` (`detect_avx2`), and
 //! declaring and calling the AVX2-compiled loop (`Job::batched_avx2`,
-//! [`one_point_elements`]), which is sound only once [`has_avx2`] said yes —
+//! `evaluate`, behind [`one_point_elements`]), which is sound only once [`has_avx2`] said yes —
 //! each block says so. Nothing inside the AVX2 loop may be inline assembly
 //! of legacy SSE (as `libm::sqrt` is on x86-64): it would pay the SSE/AVX
 //! transition penalty on every call.
@@ -297,7 +297,8 @@ pub fn regroup(elements: &[HexReference], out: &mut [ElementBatch]) -> Result<()
 /// hands the results to `sink` in element order: a full batch's at once
 /// ([`Sink::batch`]), an element evaluated alone (the remainder, a batch
 /// redone after a failing lane) by [`Sink::element`]. Stops at the first
-/// element whose update fails and returns its index with the error; the
+/// element whose update fails and returns its index with the error
+/// ([`LoopError::Element`]); the
 /// states of the elements before it are updated, the failing one's and
 /// those after it are not (as an element-by-element loop would leave them).
 ///
@@ -306,10 +307,72 @@ pub fn regroup(elements: &[HexReference], out: &mut [ElementBatch]) -> Result<()
 /// than `refs`, each batch gathers its lanes from `refs`, which costs time,
 /// not bits.
 ///
-/// Lengths: `refs` and `cp_inv` as `hexes`; node ids index `x`.
+/// Lengths: `refs` and `cp_inv` as `hexes`; node ids index `x`. Both are
+/// checked first ([`LoopError::BufferLength`], [`LoopError::NodeId`]);
+/// an element that fails is [`LoopError::Element`].
+#[allow(clippy::too_many_arguments)]
+pub fn one_point_elements<S: Sink + ?Sized>(
+    path: ElementPath,
+    mat: &Material,
+    opts: &UpdateOptions,
+    kappa: Real,
+    hexes: &[[u32; 8]],
+    refs: &[HexReference],
+    batches: &[ElementBatch],
+    x: &[[Real; 3]],
+    cp_inv: &mut [Voigt],
+    sink: &mut S,
+) -> Result<(), LoopError> {
+    for (buffer, got) in [("refs", refs.len()), ("cp_inv", cp_inv.len())] {
+        if got != hexes.len() {
+            return Err(LoopError::BufferLength {
+                buffer,
+                expected: hexes.len(),
+                got,
+            });
+        }
+    }
+    let id = hexes.as_flattened().iter().fold(0, |m, &i| m.max(i));
+    if !hexes.is_empty() && id as usize >= x.len() {
+        return Err(LoopError::NodeId { id, nodes: x.len() });
+    }
+    evaluate(
+        path, mat, opts, kappa, hexes, refs, batches, x, cp_inv, sink,
+    )
+    .map_err(|(element, error)| LoopError::Element(element, error))
+}
+
+/// Why [`one_point_elements`] stopped.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum LoopError {
+    /// `refs` or `cp_inv` is not as long as `hexes`; nothing was evaluated.
+    BufferLength {
+        /// The buffer.
+        buffer: &'static str,
+        /// Entries expected (one per hex).
+        expected: usize,
+        /// Entries given.
+        got: usize,
+    },
+    /// A hex names a node beyond `x`; nothing was evaluated.
+    NodeId {
+        /// The largest node id of the hexes.
+        id: u32,
+        /// Nodes in `x` (ids must be below this).
+        nodes: usize,
+    },
+    /// The update of this element failed (the states of the elements
+    /// before it are updated, its own and the later ones are not).
+    Element(usize, UpdateError),
+}
+
+/// [`one_point_elements`] without its checks, for a caller that has made
+/// them ([`crate::granule::forces::internal_forces_on`] checks the mesh's
+/// buffers and ids once per call, as `one_point_elements` would again):
+/// lengths or ids that do not fit panic here.
 #[allow(clippy::too_many_arguments)]
 #[allow(unsafe_code)]
-pub fn one_point_elements<S: Sink + ?Sized>(
+pub(crate) fn evaluate<S: Sink + ?Sized>(
     path: ElementPath,
     mat: &Material,
     opts: &UpdateOptions,

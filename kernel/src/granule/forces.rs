@@ -6,7 +6,7 @@ use core::fmt;
 
 use crate::Real;
 use crate::constitutive::{UpdateError, UpdateInfo, UpdateOptions};
-use crate::element::batch::{BATCH, BatchOutput, ElementPath, Sink, one_point_elements};
+use crate::element::batch::{BATCH, BatchOutput, ElementPath, Sink, evaluate};
 use crate::element::fbar::{fbar_elastic_energy, fbar_forces, fbar_stress};
 use crate::element::force::HexForces;
 use crate::element::hex8::HexCoords;
@@ -261,7 +261,8 @@ pub fn internal_forces_on(
     match settings.kind {
         ElementKind::OnePoint => {
             let mut sink = Assemble { f, summary: &mut s };
-            one_point_elements(
+            // The buffers and ids are checked above.
+            evaluate(
                 path,
                 mat,
                 &settings.update,
