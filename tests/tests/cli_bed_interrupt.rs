@@ -19,7 +19,7 @@ use std::path::{Path, PathBuf};
 use common::{Table, cli, number, summary};
 use granbed_cli::assembly::Assembly;
 use granbed_cli::bed::Scene;
-use granbed_cli::bed::checkpoint::{Checkpoint, FILE_NAME};
+use granbed_cli::bed::checkpoint::{Checkpoint, FILE_NAME, WITHDRAWAL_FILE_NAME};
 use granbed_cli::bed::run::{BedObserver, BedSample, CutShort, RunControl, pour, run_bed};
 use granbed_cli::model::OwnedReference;
 use granbed_cli::signal::INTERRUPT;
@@ -60,6 +60,21 @@ impl InterruptAfter {
     }
 }
 
+/// The wall time each withdrawal row was handed on at.
+struct WithdrawalTimes(Vec<f64>);
+
+impl BedObserver for WithdrawalTimes {
+    fn sample(&mut self, _: &BedSample, _: f64) {}
+
+    fn withdrawal(&mut self, _: &BedSample, elapsed_s: f64) {
+        self.0.push(elapsed_s);
+    }
+
+    fn snapshot(&mut self, _: f64, _: &Assembly<'_>, _: &OwnedReference) -> anyhow::Result<()> {
+        Ok(())
+    }
+}
+
 impl BedObserver for InterruptAfter {
     fn sample(&mut self, _: &BedSample, _: f64) {
         self.count(false);
@@ -74,9 +89,9 @@ impl BedObserver for InterruptAfter {
     }
 }
 
-/// Rewrites the format-10 checkpoint of `samples` output rows in `dir`,
-/// which holds no withdrawal, as format 6: without format 10's unloading
-/// flag (the last u64, 0), the die wall's normal forces of format 9 (one
+/// Rewrites the format-11 checkpoint of `samples` output rows in `dir`,
+/// which holds no withdrawal, as format 6: without format 11's withdrawal
+/// flag and format 10's unloading flag (the last two u64, 0), the die wall's normal forces of format 9 (one
 /// float for the window, one per row) and the phase times and counters of
 /// format 7 (a length-prefixed list of 3 floats, then 7 u64s), version 6,
 /// the checksum of the shorter payload. (Format 8 differs from 7 only in
@@ -84,13 +99,13 @@ impl BedObserver for InterruptAfter {
 fn downgrade_to_format_6(dir: &Path, samples: usize) {
     let path = dir.join(FILE_NAME);
     let bytes = std::fs::read(&path).unwrap();
-    assert_eq!(common::checkpoint_version(&bytes), 10);
+    assert_eq!(common::checkpoint_version(&bytes), 11);
     assert_eq!(
-        bytes[bytes.len() - 8..],
-        [0; 8],
-        "a checkpoint without a withdrawal"
+        bytes[bytes.len() - 16..],
+        [0; 16],
+        "a checkpoint without a withdrawal, done or in progress"
     );
-    let payload = &bytes[36..bytes.len() - 8 - (8 + 3 * 8 + 7 * 8) - 8 * (1 + samples)];
+    let payload = &bytes[36..bytes.len() - 16 - (8 + 3 * 8 + 7 * 8) - 8 * (1 + samples)];
     std::fs::write(&path, common::checkpoint_file(&bytes, 6, payload)).unwrap();
 }
 
@@ -365,12 +380,14 @@ fn an_interrupt_during_the_pour_stops_it_at_its_next_check() {
 
 /// An interrupt during the upper punch's withdrawal (scene `unload`, the
 /// published scene's) stops it after the step it is in: the run says it
-/// was interrupted, its withdrawal is cut short after the rows so far, and
-/// the checkpoint is the loading's end without it. Resumed, the finished
-/// run withdraws the punch afresh from there, to the rows and figures of
-/// a withdrawal never interrupted, bit for bit.
+/// was interrupted, its withdrawal is cut short after the rows so far, the
+/// checkpoint is the loading's end without it, and the withdrawal's own
+/// checkpoint (`withdrawal.bin`) holds it where it stopped. Resumed, the
+/// run goes on from there (the rows so far are handed on at once, at the
+/// withdrawal's wall time then), to the rows and figures of a withdrawal
+/// never interrupted, bit for bit, and the withdrawal's checkpoint goes.
 #[test]
-fn an_interrupted_withdrawal_runs_again_from_the_loading_end() {
+fn an_interrupted_withdrawal_goes_on_from_its_checkpoint() {
     static FLAG: AtomicBool = AtomicBool::new(false);
     let printed = cli(&[&["bed", "--print-scene"][..], &SMALL].concat());
     let scene = Scene::from_toml(&printed.stdout).unwrap();
@@ -410,6 +427,11 @@ fn an_interrupted_withdrawal_runs_again_from_the_loading_end() {
     let checkpoint = Checkpoint::read(&cut).unwrap();
     assert!(checkpoint.progress.unloading.is_none());
     assert_eq!(checkpoint.state.steps, run.steps, "the loading's end");
+    let saved = Checkpoint::read_from(&cut, WITHDRAWAL_FILE_NAME).unwrap();
+    let progress = saved.progress.withdrawal.as_ref().expect("a withdrawal");
+    assert_eq!(progress.turn_steps, run.steps);
+    assert_eq!(progress.rows, u.samples, "the rows so far");
+    assert!(saved.state.steps > run.steps, "the state where it stopped");
 
     let mut quiet = InterruptAfter {
         rows: usize::MAX,
@@ -418,6 +440,7 @@ fn an_interrupted_withdrawal_runs_again_from_the_loading_end() {
         withdrawal: true,
     };
     let straight = run_into(&whole, &mut quiet, None);
+    let mut seen = WithdrawalTimes(Vec::new());
     let resumed = pool
         .install(|| {
             run_bed(
@@ -427,11 +450,16 @@ fn an_interrupted_withdrawal_runs_again_from_the_loading_end() {
                     checkpoint_dir: Some(cut.clone()),
                     ..RunControl::default()
                 },
-                &mut quiet,
+                &mut seen,
             )
         })
         .unwrap();
     assert!(!resumed.interrupted);
+    // The two rows so far came from the withdrawal's checkpoint, before
+    // any step: at its wall time, both.
+    assert_eq!(seen.0[..2], [progress.wall_time_s; 2], "{:?}", seen.0);
+    assert!(seen.0[2] > progress.wall_time_s);
+    assert!(!cut.join(WITHDRAWAL_FILE_NAME).exists());
     let (a, b) = (
         resumed.unloading.expect("withdrawn again"),
         straight.unloading.expect("withdrawn"),

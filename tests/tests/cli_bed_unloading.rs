@@ -176,12 +176,12 @@ fn the_punch_withdraws_until_the_bed_lets_go() {
     assert!(summary(&plain)["unloading"].is_null());
     assert!(!plain.join("unloading.csv").exists());
     // Its checkpoint as a format-9 file (before the withdrawal: the last
-    // word, the unloading flag 0, cut), resumed with the withdrawal: it
-    // runs from the finished state.
+    // two words, the unloading and withdrawal flags 0, cut), resumed with
+    // the withdrawal: it runs from the finished state.
     let path = plain.join("checkpoint.bin");
     let bytes = std::fs::read(&path).unwrap();
-    assert_eq!(bytes[bytes.len() - 8..], [0; 8]);
-    let v9 = common::checkpoint_file(&bytes, 9, &bytes[36..bytes.len() - 8]);
+    assert_eq!(bytes[bytes.len() - 16..], [0; 16]);
+    let v9 = common::checkpoint_file(&bytes, 9, &bytes[36..bytes.len() - 16]);
     std::fs::write(&path, v9).unwrap();
     let plain_s = plain.to_str().unwrap();
     let run = cli(&["bed", "--quiet", "--resume", plain_s, "--unload", "true"]);

@@ -257,8 +257,15 @@ const COUNTER_BYTES: usize = 8 + 3 * 8 + 7 * 8;
 
 /// The offset of format 10's last word in the checkpoint file `bytes` of
 /// a run without a withdrawal: its unloading flag, 0 (cut from every older
-/// format).
+/// format), before format 11's last word.
 fn unloading_word(bytes: &[u8]) -> usize {
+    bytes.len() - 16
+}
+
+/// The offset of format 11's last word in the checkpoint file `bytes` of
+/// a run without a withdrawal in progress: its withdrawal flag, 0 (cut
+/// from every older format).
+fn withdrawal_word(bytes: &[u8]) -> usize {
     bytes.len() - 8
 }
 
@@ -301,7 +308,7 @@ fn older(bytes: &[u8], cut: &[usize], version: u32) -> Vec<u8> {
 /// are made from this build's own: two checkpoints of one state that
 /// differ only in a field differ only in its words, which are cut out.
 #[test]
-fn versions_2_to_9_checkpoints_read_with_the_fields_they_lack_at_their_defaults() {
+fn versions_2_to_10_checkpoints_read_with_the_fields_they_lack_at_their_defaults() {
     let (dir, _) = base_checkpoint();
     let mut ck = read(dir).unwrap();
     for g in &mut ck.state.granules {
@@ -376,29 +383,35 @@ fn versions_2_to_9_checkpoints_read_with_the_fields_they_lack_at_their_defaults(
         old
     };
     let counters = counter_words(&bytes);
-    let unloading = unloading_word(&bytes);
-    assert_eq!(bytes[unloading..], [0; 8], "no withdrawal: flag 0");
+    let (unloading, withdrawal) = (unloading_word(&bytes), withdrawal_word(&bytes));
+    assert_eq!(bytes[unloading..], [0; 16], "no withdrawal: flags 0");
     let cut_of = |parts: &[&Vec<usize>]| {
         let mut cut: Vec<usize> = parts
             .iter()
             .flat_map(|p| p.iter().copied())
             .chain(counters.iter().copied())
             .chain(die.iter().copied())
-            .chain([unloading])
+            .chain([unloading, withdrawal])
             .collect();
         cut.sort_unstable();
         cut
     };
 
+    // Version 10: all but the flag of a withdrawal in progress.
+    let v10 = older(&bytes, &[withdrawal], 10);
+    let v10_read = read(&write_checkpoint("version10", &v10))
+        .unwrap_or_else(|e| panic!("a version 10 checkpoint reads: {e}"));
+    assert_eq!(v10_read, ck, "version 10 reads as the same state");
+
     // Version 9: all but the unloading flag.
-    let v9 = older(&bytes, &[unloading], 9);
+    let v9 = older(&bytes, &[unloading, withdrawal], 9);
     let v9_read = read(&write_checkpoint("version9", &v9))
         .unwrap_or_else(|e| panic!("a version 9 checkpoint reads: {e}"));
     assert_eq!(v9_read, ck, "version 9 reads as the same state");
 
     // Version 8: all but the die-wall forces (the counters are kept).
     let mut v8_cut = die.clone();
-    v8_cut.push(unloading);
+    v8_cut.extend([unloading, withdrawal]);
     v8_cut.sort_unstable();
     let v8 = older(&bytes, &v8_cut, 8);
     let mut v8_read = read(&write_checkpoint("version8", &v8))
@@ -424,7 +437,7 @@ fn versions_2_to_9_checkpoints_read_with_the_fields_they_lack_at_their_defaults(
     begun.progress.window.time = 1e-4;
     begun.progress.window.die_normal = 0.5;
     let (mut die_begun, begun_bytes) = edited_words(&begun, flip_die);
-    die_begun.push(unloading_word(&begun_bytes));
+    die_begun.extend([unloading_word(&begun_bytes), withdrawal_word(&begun_bytes)]);
     let v8_begun = older(&begun_bytes, &die_begun, 8);
     let read_begun = read(&write_checkpoint("version8_begun", &v8_begun)).unwrap();
     assert_eq!(read_begun.progress.window.time, 1e-4);
@@ -488,9 +501,10 @@ fn a_withdrawal_in_a_checkpoint_reads_back() {
     ck.write(&d).unwrap();
     assert_eq!(read(&d).unwrap(), ck);
     // The flag is the word after the counters, where a file without a
-    // withdrawal ends; 1 here: make it 2.
+    // withdrawal ends but for the flag of one in progress; 1 here: make it
+    // 2.
     let (_, without) = base_checkpoint();
-    let flag = without.len() - 8;
+    let flag = unloading_word(without);
     let bytes = std::fs::read(d.join(FILE_NAME)).unwrap();
     assert_eq!(bytes[flag..flag + 8], 1u64.to_le_bytes());
     let mut payload = bytes[36..].to_vec();
@@ -498,6 +512,60 @@ fn a_withdrawal_in_a_checkpoint_reads_back() {
     let bytes = common::checkpoint_file(&bytes, common::checkpoint_version(&bytes), &payload);
     let e = read(&write_checkpoint("withdrawal_flag", &bytes)).unwrap_err();
     assert!(e.contains("unknown unloading flag 2"), "{e}");
+}
+
+/// A withdrawal in progress (format 11, the file `withdrawal.bin`) reads
+/// back to the same rows, window, next row and wall time, the rows' mean
+/// strains continuing from the loading's; a flag other than 0 or 1 is
+/// refused by name.
+#[test]
+fn a_withdrawal_in_progress_reads_back() {
+    use granbed_cli::bed::checkpoint::{WITHDRAWAL_FILE_NAME, WithdrawalProgress};
+    use granbed_cli::bed::run::{Window, set_mean_strains_after};
+    let (dir, _) = base_checkpoint();
+    let mut ck = read(dir).unwrap();
+    let last = *ck.progress.samples.last().unwrap();
+    let mut rows: Vec<_> = [1, 2, 3]
+        .map(|k| granbed_cli::bed::run::BedSample {
+            strain: last.strain - 1e-4 * f64::from(k),
+            steps: last.steps + 10 * u64::from(k as u8),
+            upper_force_n: 1.0 / f64::from(k),
+            die_normal_force_n: 0.25 * f64::from(k),
+            ..last
+        })
+        .to_vec();
+    set_mean_strains_after(Some(&last), &mut rows);
+    ck.progress.withdrawal = Some(WithdrawalProgress {
+        turn_steps: last.steps,
+        rows,
+        window: Window {
+            time: 2e-5,
+            impulse: [1e-5, 2e-5, -3e-7],
+            die_normal: 4e-6,
+            pairs: 1e-3,
+            walls: 2e-3,
+            min_j: 0.75,
+            max_speed: 0.125,
+        },
+        next_row: last.strain - 3.5e-4,
+        wall_time_s: 1.5,
+    });
+    let d = common::fresh_dir("fuzz_files", "withdrawal_in_progress");
+    std::fs::create_dir_all(&d).unwrap();
+    ck.write_as(&d, WITHDRAWAL_FILE_NAME).unwrap();
+    let back = Checkpoint::read_from(&d, WITHDRAWAL_FILE_NAME).unwrap();
+    assert_eq!(back, ck);
+    // The flag is the last word but for the rows, their forces and the
+    // fields before them; find it as the word after the unloading flag 0.
+    let bytes = std::fs::read(d.join(WITHDRAWAL_FILE_NAME)).unwrap();
+    let (_, without) = base_checkpoint();
+    let flag = withdrawal_word(without);
+    assert_eq!(bytes[flag..flag + 8], 1u64.to_le_bytes());
+    let mut payload = bytes[36..].to_vec();
+    payload[flag - 36] = 2;
+    let bytes = common::checkpoint_file(&bytes, common::checkpoint_version(&bytes), &payload);
+    let e = read(&write_checkpoint("withdrawal_progress_flag", &bytes)).unwrap_err();
+    assert!(e.contains("unknown withdrawal flag 2"), "{e}");
 }
 
 /// The payload property below only resumes the mutants that decode; this
@@ -512,8 +580,8 @@ fn a_checkpoint_with_a_nudged_float_decodes_and_resumes() {
     let resumed = (1..=64).find_map(|k| {
         let mut p = payload.to_vec();
         // Before the counters (a nudged counter only moves a cost figure)
-        // and format 10's unloading flag (the last word).
-        let at = p.len().checked_sub(8 + COUNTER_BYTES + 8 * k)?;
+        // and the unloading and withdrawal flags (the last two words).
+        let at = p.len().checked_sub(16 + COUNTER_BYTES + 8 * k)?;
         p[at] ^= 1;
         let b = common::checkpoint_file(bytes, common::checkpoint_version(bytes), &p);
         let dir = write_checkpoint("nudged", &b);

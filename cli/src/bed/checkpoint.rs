@@ -21,6 +21,10 @@ use crate::assembly::{AssemblyState, Energies, GranuleState, PhaseTimes};
 
 /// File name of the checkpoint in the output directory.
 pub const FILE_NAME: &str = "checkpoint.bin";
+/// File name of the checkpoint of a withdrawal in progress, beside
+/// [`FILE_NAME`] (which keeps the loading's end): written as the withdrawal
+/// goes and when an interrupt stops it, removed once it is done.
+pub const WITHDRAWAL_FILE_NAME: &str = "withdrawal.bin";
 /// Format version written and read.
 ///
 /// 2: samples gained the smallest Gauss-point Jacobian, the largest nodal
@@ -70,7 +74,15 @@ pub const FILE_NAME: &str = "checkpoint.bin";
 /// (as the samples, then each one's die-wall normal force, one f64 per
 /// row), its lift-off strain (f64, NaN: none) and its wall time (f64).
 /// Older files hold none: a finished run resumed with `unload` runs it.
-pub const VERSION: u32 = 10;
+///
+/// 11: the payload ends with a withdrawal in progress (the file
+/// [`WITHDRAWAL_FILE_NAME`], whose state is the assembly's in the middle of
+/// the withdrawal): a flag (u64, 0: none), then with 1 the loading's last
+/// step (u64), the strain of the next row (f64), the wall time so far
+/// (f64), the open window (as the loading's, with its die-wall impulse
+/// after it) and the rows so far (as the samples, then each one's die-wall
+/// normal force). Older files hold none.
+pub const VERSION: u32 = 11;
 /// The oldest version read.
 const OLDEST_VERSION: u32 = 2;
 /// Floats per held constraint: side (0: A, 1: B; plus 2 for a watch),
@@ -110,6 +122,25 @@ pub struct Progress {
     /// The withdrawal of a finished run (format 10; the state is still
     /// that of the loading's end).
     pub unloading: Option<Unloading>,
+    /// A withdrawal in progress (format 11; only in
+    /// [`WITHDRAWAL_FILE_NAME`], whose state is the withdrawal's).
+    pub withdrawal: Option<WithdrawalProgress>,
+}
+
+/// How far a withdrawal has gone: what it needs, besides the assembly's
+/// state and the loading's rows, to go on bit for bit.
+#[derive(Clone, Debug, PartialEq)]
+pub struct WithdrawalProgress {
+    /// The step the loading ended at, where the withdrawal turned.
+    pub turn_steps: u64,
+    /// Rows so far (their mean strains continue from the loading's).
+    pub rows: Vec<BedSample>,
+    /// The open averaging window.
+    pub window: Window,
+    /// Strain of the next row.
+    pub next_row: Real,
+    /// Wall time of the withdrawal so far, s.
+    pub wall_time_s: f64,
 }
 
 /// A checkpoint: progress and assembly state.
@@ -119,6 +150,33 @@ pub struct Checkpoint {
     pub progress: Progress,
     /// The assembly.
     pub state: AssemblyState,
+}
+
+/// A window's floats but its die-wall impulse, in the file's order.
+fn window_to(w: &Window) -> [f64; WINDOW_FLOATS] {
+    [
+        w.time,
+        w.impulse[0],
+        w.impulse[1],
+        w.impulse[2],
+        w.pairs,
+        w.walls,
+        w.min_j,
+        w.max_speed,
+    ]
+}
+
+/// [`window_to`]'s inverse, with the die-wall impulse `die_normal`.
+fn window_from(w: [f64; WINDOW_FLOATS], die_normal: f64) -> Window {
+    Window {
+        time: w[0],
+        impulse: [w[1], w[2], w[3]],
+        die_normal,
+        pairs: w[4],
+        walls: w[5],
+        min_j: w[6],
+        max_speed: w[7],
+    }
 }
 
 /// FNV-1a, 64 bits.
@@ -367,16 +425,7 @@ impl Checkpoint {
         ]);
         e.u64(p.snapshots_done as u64);
         let w = &p.window;
-        e.f64s(&[
-            w.time,
-            w.impulse[0],
-            w.impulse[1],
-            w.impulse[2],
-            w.pairs,
-            w.walls,
-            w.min_j,
-            w.max_speed,
-        ]);
+        e.f64s(&window_to(w));
         e.vecs(&p.samples.iter().map(sample_to).collect::<Vec<_>>());
         e.f64s(&[s.time, f64::from_bits(s.steps), s.dt[0], s.dt[1]]);
         e.f64s(&energies_to(&s.energies));
@@ -440,6 +489,21 @@ impl Checkpoint {
                 }
                 e.f64(u.lift_off_strain);
                 e.f64(u.wall_time_s);
+            }
+        }
+        match &p.withdrawal {
+            None => e.u64(0),
+            Some(w) => {
+                e.u64(1);
+                e.u64(w.turn_steps);
+                e.f64(w.next_row);
+                e.f64(w.wall_time_s);
+                e.f64s(&window_to(&w.window));
+                e.f64(w.window.die_normal);
+                e.vecs(&w.rows.iter().map(sample_to).collect::<Vec<_>>());
+                for row in &w.rows {
+                    e.f64(row.die_normal_force_n);
+                }
             }
         }
         e.0
@@ -621,6 +685,37 @@ impl Checkpoint {
                 other => bail!("unknown unloading flag {other}"),
             },
         };
+        let withdrawal = match version {
+            2..=10 => None,
+            _ => match d.u64()? {
+                0 => None,
+                1 => {
+                    let turn_steps = d.u64()?;
+                    let next_row = d.f64()?;
+                    let wall_time_s = d.f64()?;
+                    let w = <[f64; WINDOW_FLOATS]>::try_from(d.f64s()?)
+                        .map_err(|_| anyhow::anyhow!("bad withdrawal window"))?;
+                    let window = window_from(w, d.f64()?);
+                    let mut rows: Vec<BedSample> = d
+                        .vecs::<SAMPLE_FLOATS>()?
+                        .into_iter()
+                        .map(sample_from)
+                        .collect();
+                    for row in &mut rows {
+                        row.die_normal_force_n = d.f64()?;
+                    }
+                    set_mean_strains_after(samples.last(), &mut rows);
+                    Some(WithdrawalProgress {
+                        turn_steps,
+                        rows,
+                        window,
+                        next_row,
+                        wall_time_s,
+                    })
+                }
+                other => bail!("unknown withdrawal flag {other}"),
+            },
+        };
         if !d.0.is_empty() {
             bail!("checkpoint has {} bytes after its end", d.0.len());
         }
@@ -635,20 +730,13 @@ impl Checkpoint {
                 pour_wall_time_s,
                 compression_wall_time_s,
                 samples,
-                window: Window {
-                    time: w[0],
-                    impulse: [w[1], w[2], w[3]],
-                    die_normal,
-                    pairs: w[4],
-                    walls: w[5],
-                    min_j: w[6],
-                    max_speed: w[7],
-                },
+                window: window_from(w, die_normal),
                 next_output,
                 snapshots_done,
                 counters,
                 counters_from_step,
                 unloading,
+                withdrawal,
             },
             state: AssemblyState {
                 time: t[0],
@@ -669,9 +757,15 @@ impl Checkpoint {
     /// renamed over the old one (a crash leaves the old or the new file,
     /// never a torn one).
     pub fn write(&self, dir: &Path) -> anyhow::Result<PathBuf> {
+        self.write_as(dir, FILE_NAME)
+    }
+
+    /// [`Checkpoint::write`] to `dir/name` (the withdrawal's own file,
+    /// [`WITHDRAWAL_FILE_NAME`]).
+    pub fn write_as(&self, dir: &Path, name: &str) -> anyhow::Result<PathBuf> {
         let payload = self.payload();
-        let path = dir.join(FILE_NAME);
-        let tmp = dir.join(format!("{FILE_NAME}.tmp"));
+        let path = dir.join(name);
+        let tmp = dir.join(format!("{name}.tmp"));
         let mut file = std::fs::File::create(&tmp)
             .with_context(|| format!("cannot create `{}`", tmp.display()))?;
         let mut head = Vec::with_capacity(36);
@@ -692,7 +786,12 @@ impl Checkpoint {
     /// Reads `dir/checkpoint.bin`, checking the magic, the version and the
     /// checksum.
     pub fn read(dir: &Path) -> anyhow::Result<Self> {
-        let path = dir.join(FILE_NAME);
+        Self::read_from(dir, FILE_NAME)
+    }
+
+    /// [`Checkpoint::read`] of `dir/name`.
+    pub fn read_from(dir: &Path, name: &str) -> anyhow::Result<Self> {
+        let path = dir.join(name);
         let bytes = std::fs::read(&path)
             .with_context(|| format!("cannot read checkpoint `{}`", path.display()))?;
         let bad =

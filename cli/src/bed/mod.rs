@@ -1027,8 +1027,10 @@ impl BedArgs {
             return Err(anyhow::Error::new(crate::signal::Interrupted(format!(
                 "interrupted during the withdrawal of the rate check's run at half the punch \
                  speed (its outputs so far are in `{}`); the run's own outputs in `{}` are \
-                 complete, with the loading's rate check, without the unloading's",
+                 complete, with the loading's rate check, without the unloading's: \
+                 `granbed-cli bed --resume {} --rate-check` continues it",
                 dir.display(),
+                out.display(),
                 out.display()
             ))));
         }

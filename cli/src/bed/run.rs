@@ -20,7 +20,9 @@ use granbed_kernel::dem::pour::{PourError, PourParams, PourStatus};
 use super::checkpoint::{self, Checkpoint};
 use super::scene::Scene;
 use crate::assembly::die::{DieScene, placements, wall_index};
-use crate::assembly::{Assembly, AssemblyError, AssemblyParams, Energies, PhaseTimes};
+use crate::assembly::{
+    Assembly, AssemblyError, AssemblyParams, AssemblyState, Energies, PhaseTimes,
+};
 use crate::model::OwnedReference;
 use crate::pack::run::run_pour;
 
@@ -189,8 +191,9 @@ pub struct Unloading {
     /// Wall time of the withdrawal, s.
     pub wall_time_s: f64,
     /// Why the withdrawal stopped before lift-off or its limit; `None` if
-    /// it completed. A withdrawal cut short is not kept in the checkpoint:
-    /// a resume runs it again.
+    /// it completed. A withdrawal cut short is not kept in the loading's
+    /// checkpoint; its own ([`checkpoint::WITHDRAWAL_FILE_NAME`]), written
+    /// as it goes and at an interrupt, is where a resume goes on from.
     pub cut_short: Option<CutShort>,
 }
 
@@ -240,25 +243,57 @@ fn withdrawal_holds(then: &str, now: &Scene) -> bool {
 type SampleOf<'a> = dyn Fn(&mut Assembly<'_>, &Window, Option<&BedSample>, Real, ImposedCompression) -> BedSample
     + 'a;
 
+/// Removes `dir`'s checkpoint of a withdrawal in progress, if any.
+fn remove_withdrawal_checkpoint(dir: &std::path::Path) -> anyhow::Result<()> {
+    let path = dir.join(checkpoint::WITHDRAWAL_FILE_NAME);
+    match std::fs::remove_file(&path) {
+        Err(e) if e.kind() != std::io::ErrorKind::NotFound => {
+            Err(e).with_context(|| format!("cannot remove `{}`", path.display()))
+        }
+        _ => Ok(()),
+    }
+}
+
+/// Writes a withdrawal's checkpoint from the assembly and the progress.
+type SaveWithdrawal<'a> =
+    dyn Fn(&Assembly<'_>, checkpoint::WithdrawalProgress) -> anyhow::Result<()> + 'a;
+
+/// Where a withdrawal goes on from, and where it keeps its progress.
+struct WithdrawalStore<'a> {
+    /// A withdrawal an interrupt stopped: its progress and the assembly's
+    /// state then (from [`checkpoint::WITHDRAWAL_FILE_NAME`]).
+    resume: Option<(checkpoint::WithdrawalProgress, AssemblyState)>,
+    /// Writes the withdrawal's checkpoint (none: no checkpoints).
+    save: Option<&'a SaveWithdrawal<'a>>,
+    /// Wall time between the withdrawal's checkpoints, s.
+    every_s: f64,
+}
+
 /// Withdraws the upper punch of `asm`, which has just pressed the bed to
 /// the last of the rows `loading`, at the punch speed, with a row every
 /// 1/[`UNLOADING_ROWS_PER_INTERVAL`] of the scene's output interval, until
 /// a row's upper-punch force falls below [`LIFT_OFF_FORCE_FRACTION`] of
 /// the loading's largest (lift-off), or the punch has withdrawn
 /// [`MAX_WITHDRAWAL_STRAIN`], or `interrupt` is set, or a step fails.
-/// `observer` sees each row.
+/// `observer` sees each row. With `store.resume` it goes on from there,
+/// with the bits of a withdrawal never stopped; `store.save` keeps its
+/// progress every `store.every_s` and when the interrupt stops it.
 fn withdraw(
     asm: &mut Assembly<'_>,
     (die, scene): (&DieScene, &Scene),
     loading: &[BedSample],
     (interrupt, observer): (Option<&AtomicBool>, &mut dyn BedObserver),
     sample: &SampleOf<'_>,
-) -> Unloading {
+    store: WithdrawalStore<'_>,
+) -> anyhow::Result<Unloading> {
     let at_end = loading.last().copied().unwrap_or_default();
+    let turn_steps = asm.steps();
     let free_below_n =
         LIFT_OFF_FORCE_FRACTION * loading.iter().map(|s| s.upper_force_n).fold(0.0, Real::max);
     let start = Instant::now();
     let speed = die.punch_speed_m_s;
+    // At the turn, so that the punch's motion is the same whether the
+    // withdrawal goes on from a checkpoint or not.
     asm.withdraw_wall(wall_index::UPPER, speed);
     let interval = scene.output_strain_interval / Real::from(UNLOADING_ROWS_PER_INTERVAL);
     let limit = at_end.strain - MAX_WITHDRAWAL_STRAIN.min(at_end.strain);
@@ -268,6 +303,26 @@ fn withdraw(
     // the loading's last force, then each row's.
     let mut before = (at_end.strain, at_end.upper_force_n);
     let (mut samples, mut lift_off_strain, mut cut_short) = (Vec::new(), Real::NAN, None);
+    let mut wall_before = 0.0;
+    if let Some((progress, state)) = store.resume {
+        asm.restore(&state)?;
+        if die.strain_at_height(super::snapshots::die_geometry(asm).1)
+            < scene.exact_contact_from_strain
+        {
+            asm.set_exact_contact_from(Real::INFINITY);
+        }
+        for s in &progress.rows {
+            observer.withdrawal(s, progress.wall_time_s);
+        }
+        if let Some(&last) = progress.rows.last() {
+            previous = last;
+            before = (last.mean_strain, last.upper_force_n);
+        }
+        (samples, window, next) = (progress.rows, progress.window, progress.next_row);
+        wall_before = progress.wall_time_s;
+    }
+    let wall = || wall_before + start.elapsed().as_secs_f64();
+    let mut last_save = Instant::now();
     loop {
         if let Err(e) = asm.step() {
             cut_short = Some(CutShort::StepFailed(e.to_string()));
@@ -290,7 +345,7 @@ fn withdraw(
                 upper_velocity_m_s: speed,
             };
             let s = sample(asm, &window, Some(&previous), strain, imposed);
-            observer.withdrawal(&s, start.elapsed().as_secs_f64());
+            observer.withdrawal(&s, wall());
             samples.push(s);
             window = Window::new();
             while next >= strain - 1e-12 {
@@ -315,17 +370,33 @@ fn withdraw(
             previous = s;
             before = (s.mean_strain, s.upper_force_n);
         }
-        if interrupt.is_some_and(|f| f.load(Ordering::SeqCst)) {
+        let interrupted = interrupt.is_some_and(|f| f.load(Ordering::SeqCst));
+        if let Some(save) = store.save
+            && (interrupted || last_save.elapsed().as_secs_f64() >= store.every_s)
+        {
+            save(
+                asm,
+                checkpoint::WithdrawalProgress {
+                    turn_steps,
+                    rows: samples.clone(),
+                    window,
+                    next_row: next,
+                    wall_time_s: wall(),
+                },
+            )?;
+            last_save = Instant::now();
+        }
+        if interrupted {
             cut_short = Some(CutShort::Interrupted { strain });
             break;
         }
     }
-    Unloading {
+    Ok(Unloading {
         samples,
         lift_off_strain,
-        wall_time_s: start.elapsed().as_secs_f64(),
+        wall_time_s: wall(),
         cut_short,
-    }
+    })
 }
 
 /// What a run produced. A run stopped by a kernel error keeps the samples
@@ -959,6 +1030,7 @@ pub fn run_bed(
                     counters: counters_before + asm.times(),
                     counters_from_step,
                     unloading: kept.clone(),
+                    withdrawal: None,
                 },
                 state: asm.state(),
             }
@@ -1130,18 +1202,55 @@ pub fn run_bed(
             drop(last_good.take());
             let at_end_checkpoint =
                 dir.map(|_| make(&asm, &samples, &window, next, snapshots_done));
+            // A withdrawal an interrupt stopped goes on from its own
+            // checkpoint if it turned at this very step under a scene that
+            // withdraws alike; any other is stale and goes.
+            let resume = dir.and_then(|dir| {
+                let c = checkpoint::Checkpoint::read_from(dir, checkpoint::WITHDRAWAL_FILE_NAME)
+                    .ok()?;
+                let w = c.progress.withdrawal?;
+                (w.turn_steps == asm.steps()
+                    && c.progress.samples.len() == samples.len()
+                    && withdrawal_holds(&c.progress.scene_toml, scene))
+                .then_some((w, c.state))
+            });
+            if let Some(dir) = dir
+                && resume.is_none()
+            {
+                remove_withdrawal_checkpoint(dir)?;
+            }
+            let save = |asm: &Assembly<'_>, w: checkpoint::WithdrawalProgress| {
+                let (Some(dir), Some(c)) = (dir, &at_end_checkpoint) else {
+                    return Ok(());
+                };
+                Checkpoint {
+                    progress: checkpoint::Progress {
+                        withdrawal: Some(w),
+                        ..c.progress.clone()
+                    },
+                    state: asm.state(),
+                }
+                .write_as(dir, checkpoint::WITHDRAWAL_FILE_NAME)
+                .map(|_| ())
+            };
             let u = withdraw(
                 &mut asm,
                 (&die, scene),
                 &samples,
                 (control.interrupt, observer),
                 &sample,
-            );
+                WithdrawalStore {
+                    resume,
+                    save: dir.map(|_| &save as _),
+                    every_s,
+                },
+            )?;
             if let (Some(dir), Some(mut c)) = (dir, at_end_checkpoint)
                 && u.cut_short.is_none()
             {
                 c.progress.unloading = Some(u.clone());
                 c.write(dir)?;
+                remove_withdrawal_checkpoint(dir)?;
             }
             // Only a withdrawal the interrupt cut short counts: one that
             // completed in the step the signal came in is whole and kept.

@@ -196,7 +196,8 @@ pub fn warning(u: &Unloading) -> Option<String> {
     match &u.cut_short {
         Some(why) => Some(format!(
             "the upper punch's withdrawal stopped before it came free of the bed ({why}): \
-             unloading.csv has its rows so far; --resume runs it again"
+             unloading.csv has its rows so far; --resume goes on from its last checkpoint \
+             (withdrawal.bin; without one, from the loading's end)"
         )),
         None if !u.lift_off_strain.is_finite() => Some(format!(
             "the bed still pushed the upper punch with {} % or more of its largest force at \
