@@ -50,6 +50,7 @@ pub mod plot;
 pub mod point;
 pub mod progress;
 pub mod quasi_static;
+pub mod run_length;
 pub mod signal;
 pub mod study;
 pub mod vtk;

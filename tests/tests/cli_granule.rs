@@ -435,7 +435,7 @@ fn platens_carry_equal_forces() {
 fn bad_input_names_the_flag() {
     let dir = out_dir("bad");
     let out = dir.to_str().unwrap();
-    let cases: [(&[&str], &str); 17] = [
+    let cases: [(&[&str], &str); 18] = [
         (&["--strain", "0"], "--strain"),
         (
             &["--diameter-mm", "0"],
@@ -451,6 +451,17 @@ fn bad_input_names_the_flag() {
         (
             &["--output-strain", "1e-300"],
             "`--output-strain 1e-300` rejected (allowed: 1e-6 <= interval",
+        ),
+        // Each in range, together a wave speed 3·10⁵ times B2's: 10¹⁰
+        // steps.
+        (
+            &[
+                "--youngs-modulus-pa",
+                "1e12",
+                "--true-density-kg-m3",
+                "1e-2",
+            ],
+            "steps (a stable time step of",
         ),
         (&["--gravity"], "--gravity"),
         (&["--mesh", "3x1"], "--mesh"),

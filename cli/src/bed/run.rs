@@ -811,6 +811,40 @@ pub fn assembly_params(scene: &Scene, mesh: &OwnedReference) -> anyhow::Result<A
     Ok(params)
 }
 
+/// The most steps a bed run may take (about 10⁴ times the published
+/// scene's 8 369, which take 19 minutes on two cores; the slowest punch
+/// allowed, `MIN_PUNCH_SPEED_M_S`, with physical masses, about 2·10⁷).
+pub const MAX_STEPS: f64 = 1e8;
+
+/// An estimate of `scene`'s steps before its pour: the undeformed
+/// granule's element estimate of the stable step (which the run's global
+/// estimate exceeds by about a third, physics.md §4.2) with the masses'
+/// scaling, over the time the punch takes to the final strain of a bed at
+/// a packing fraction of 0.6 (poured beds: 0.55–0.64).
+fn run_length(
+    scene: &Scene,
+    mesh: &OwnedReference,
+    material: &granbed_kernel::material::Material,
+) -> crate::run_length::RunLength {
+    let wave_speed_m_s = granbed_kernel::granule::timestep::wave_speed(material);
+    let time_step_s = granbed_kernel::granule::timestep::element_time_step(
+        &mesh.view(),
+        material,
+        &mesh.positions,
+        scene.time_step_safety,
+    )
+    .map_or(Real::NAN, |dt| dt * scene.mass_scaling.sqrt());
+    let radius = scene.radius_m();
+    let die_radius = 0.5e-3 * scene.die_diameter_mm;
+    let solid = scene.granules as Real * 4.0 / 3.0 * core::f64::consts::PI * radius.powi(3);
+    let height = solid / (0.6 * core::f64::consts::PI * die_radius * die_radius);
+    crate::run_length::RunLength {
+        duration_s: scene.final_strain * height / scene.punch_speed_m_s,
+        time_step_s,
+        wave_speed_m_s,
+    }
+}
+
 /// This machine's memory, bytes (Linux `/proc/meminfo` MemTotal), or
 /// `None` where it cannot be read.
 fn machine_memory_bytes() -> Option<u64> {
@@ -858,6 +892,13 @@ pub fn run_bed(
     if let Some(message) =
         machine_memory_bytes().and_then(|total| memory_refusal(scene, need, total))
     {
+        return Err(crate::error::InputError(message).into());
+    }
+    if let Some(message) = run_length(scene, &mesh, &material).refusal(
+        MAX_STEPS,
+        "the `[material]` (youngs_modulus_pa, poisson_ratio, true_density_kg_m3, eta0), \
+         mass_scaling, punch_speed_m_s and final_strain",
+    ) {
         return Err(crate::error::InputError(message).into());
     }
     // Where the run starts: a fresh pour, or a checkpoint's state.
@@ -1407,5 +1448,31 @@ mod tests {
         };
         let p = assembly_params(&never, &mesh).unwrap();
         assert!(!p.contact.watch_beside && p.contact.reproject_slide.is_infinite());
+    }
+
+    /// The estimate before the pour is within a factor of two of the
+    /// published scene's 8 369 steps (BENCHMARKS.md, session 19's run; the
+    /// element estimate is the conservative one, so above), and a stiff,
+    /// light material is refused by its fields.
+    #[test]
+    fn the_published_scene_is_estimated_and_a_runaway_material_refused() {
+        let scene = Scene::published();
+        let mesh = scene.granule_mesh().unwrap();
+        let material = scene.material().unwrap();
+        let steps = run_length(&scene, &mesh, &material).steps();
+        assert!((8369.0..2.0 * 8369.0).contains(&steps), "{steps}");
+        assert!(
+            run_length(&scene, &mesh, &material)
+                .refusal(MAX_STEPS, "f")
+                .is_none()
+        );
+        let mut runaway = scene.clone();
+        runaway.material.youngs_modulus_pa = Some(1e13);
+        runaway.material.true_density_kg_m3 = Some(1e-3);
+        let material = runaway.material().unwrap();
+        let e = run_length(&runaway, &mesh, &material)
+            .refusal(MAX_STEPS, "the `[material]`")
+            .expect("refused");
+        assert!(e.contains("the `[material]` set them"), "{e}");
     }
 }

@@ -42,6 +42,10 @@ use summary::{RunSetup, Summary, symmetry_name};
 /// Radius of the simulated granule, m (the published 1 mm granule).
 pub const GRANULE_RADIUS_M: Real = 0.5e-3;
 
+/// The most steps a run may take (about 2·10⁴ times the standard run's
+/// 47 096; at its pace, some six hours for the octant).
+pub const MAX_STEPS: f64 = 1e9;
+
 /// The slowest `--speed-mm-s`, mm/s (a fiftieth of the standard 5 mm/s):
 /// the run's steps grow as 1/speed (at 10⁻⁶ mm/s about 10¹⁴ steps).
 pub const MIN_SPEED_MM_S: f64 = 0.1;
@@ -474,7 +478,23 @@ impl GranuleArgs {
             }
             .material()?;
             let params = self.params(material);
-            run::check(params, mesh).map_err(|e| self.scene_error(e))?;
+            let time_step_s = run::check(params, mesh).map_err(|e| self.scene_error(e))?;
+            let length = crate::run_length::RunLength {
+                duration_s: params.final_strain * 1e-3 * self.diameter_mm
+                    / params.approach_speed_m_s,
+                time_step_s,
+                wave_speed_m_s: granbed_kernel::granule::timestep::wave_speed(&material),
+            };
+            if let Some(message) = length.refusal(
+                MAX_STEPS,
+                "the material (`--youngs-modulus-pa`, `--poisson-ratio`, \
+                 `--true-density-kg-m3`, `--eta0`), `--mass-scaling`, `--speed-mm-s` and \
+                 `--strain`",
+            ) {
+                return Err(
+                    InputError(format!("granule {}: {message}", granule_type.name())).into(),
+                );
+            }
             let dir = if self.types.is_some() {
                 self.out.join(granule_type.name())
             } else {

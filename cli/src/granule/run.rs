@@ -42,12 +42,13 @@ pub struct RunResult {
 }
 
 /// Checks `params` against `mesh` the way a run would (the kernel's
-/// parameter validation and buffer checks), without stepping.
+/// parameter validation and buffer checks), without stepping; returns the
+/// run's first time step, s.
 ///
 /// Errors are those of [`PlatenScene::new`].
-pub fn check(params: PlatenParams, mesh: &OwnedReference) -> Result<(), SceneError> {
+pub fn check(params: PlatenParams, mesh: &OwnedReference) -> Result<Real, SceneError> {
     let mut store = PlatenStore::new(mesh, params.elements.points_per_element());
-    PlatenScene::new(params, mesh.view(), store.buffers()).map(drop)
+    PlatenScene::new(params, mesh.view(), store.buffers()).map(|s| s.time_step())
 }
 
 /// Runs the platen experiment `params` on `mesh` to its final strain.
