@@ -28,7 +28,7 @@ impl RunLength {
     /// inputs that set the step and the duration.
     pub fn refusal(&self, cap: f64, fields: &str) -> Option<String> {
         let steps = self.steps();
-        (!(steps <= cap)).then(|| {
+        (steps.is_nan() || steps > cap).then(|| {
             format!(
                 "the run would take about {} steps (a stable time step of {} s, the material's \
                  wave speed being {} m/s, over {} s of simulated time), more than the {} \
