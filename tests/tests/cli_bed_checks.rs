@@ -216,7 +216,10 @@ fn scene_fields_out_of_range_or_contradicting_are_named() {
 fn every_numeric_flag_takes_a_minus_and_names_its_range() {
     let cases: [(&str, &[&str]); 21] = [
         ("--granules", &["'--granules <N>'", "1..=100000"]),
-        ("--diameter-mm", &["`--diameter-mm -1`", "0.001 <= d < 2000"]),
+        (
+            "--diameter-mm",
+            &["`--diameter-mm -1`", "0.001 <= d < 2000"],
+        ),
         (
             "--punch-speed-m-s",
             &["`--punch-speed-m-s -1`", "1e-4 <= v <= 10 m/s"],

@@ -263,6 +263,14 @@ impl Enc {
         self.u64(b.len() as u64);
         self.0.extend_from_slice(b);
     }
+    /// A withdrawal's rows: as the samples, then each one's die-wall
+    /// normal force.
+    fn rows(&mut self, rows: &[BedSample]) {
+        self.vecs(&rows.iter().map(sample_to).collect::<Vec<_>>());
+        for row in rows {
+            self.f64(row.die_normal_force_n);
+        }
+    }
 }
 
 struct Dec<'a>(&'a [u8]);
@@ -306,6 +314,20 @@ impl Dec<'_> {
         let (head, rest) = self.0.split_at(n);
         self.0 = rest;
         Ok(head)
+    }
+    /// [`Enc::rows`]' rows, their mean strains continuing from the
+    /// loading's last row `after`.
+    fn rows_after(&mut self, after: Option<&BedSample>) -> anyhow::Result<Vec<BedSample>> {
+        let mut rows: Vec<BedSample> = self
+            .vecs::<SAMPLE_FLOATS>()?
+            .into_iter()
+            .map(sample_from)
+            .collect();
+        for row in &mut rows {
+            row.die_normal_force_n = self.f64()?;
+        }
+        set_mean_strains_after(after, &mut rows);
+        Ok(rows)
     }
 }
 
@@ -483,10 +505,7 @@ impl Checkpoint {
             None => e.u64(0),
             Some(u) => {
                 e.u64(1);
-                e.vecs(&u.samples.iter().map(sample_to).collect::<Vec<_>>());
-                for sample in &u.samples {
-                    e.f64(sample.die_normal_force_n);
-                }
+                e.rows(&u.samples);
                 e.f64(u.lift_off_strain);
                 e.f64(u.wall_time_s);
             }
@@ -500,10 +519,7 @@ impl Checkpoint {
                 e.f64(w.wall_time_s);
                 e.f64s(&window_to(&w.window));
                 e.f64(w.window.die_normal);
-                e.vecs(&w.rows.iter().map(sample_to).collect::<Vec<_>>());
-                for row in &w.rows {
-                    e.f64(row.die_normal_force_n);
-                }
+                e.rows(&w.rows);
             }
         }
         e.0
@@ -665,16 +681,7 @@ impl Checkpoint {
             _ => match d.u64()? {
                 0 => None,
                 1 => {
-                    let mut rows: Vec<BedSample> = d
-                        .vecs::<SAMPLE_FLOATS>()?
-                        .into_iter()
-                        .map(sample_from)
-                        .collect();
-                    for row in &mut rows {
-                        row.die_normal_force_n = d.f64()?;
-                    }
-                    // The rows' mean strains continue from the loading's.
-                    set_mean_strains_after(samples.last(), &mut rows);
+                    let rows = d.rows_after(samples.last())?;
                     Some(Unloading {
                         samples: rows,
                         lift_off_strain: d.f64()?,
@@ -696,15 +703,7 @@ impl Checkpoint {
                     let w = <[f64; WINDOW_FLOATS]>::try_from(d.f64s()?)
                         .map_err(|_| anyhow::anyhow!("bad withdrawal window"))?;
                     let window = window_from(w, d.f64()?);
-                    let mut rows: Vec<BedSample> = d
-                        .vecs::<SAMPLE_FLOATS>()?
-                        .into_iter()
-                        .map(sample_from)
-                        .collect();
-                    for row in &mut rows {
-                        row.die_normal_force_n = d.f64()?;
-                    }
-                    set_mean_strains_after(samples.last(), &mut rows);
+                    let rows = d.rows_after(samples.last())?;
                     Some(WithdrawalProgress {
                         turn_steps,
                         rows,
