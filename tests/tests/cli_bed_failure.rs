@@ -12,7 +12,8 @@
 //! * out-of-range factors are rejected by name;
 //! * a snapshot that cannot be written mid-run stops it with a checkpoint
 //!   of the step it failed at, from which `--resume` writes the snapshot
-//!   and finishes the run with the bits of a run never stopped.
+//!   (of that step, without the tables that need its contact forces) and
+//!   finishes the run with the bits of a run never stopped.
 
 mod common;
 
@@ -189,24 +190,27 @@ fn out_of_range_factors_are_rejected_by_name() {
     }
 }
 
-#[test]
-fn a_snapshot_that_cannot_be_written_keeps_the_run_for_resume() {
-    let dir = common::fresh_dir("cli_bed_failure", "snapshot");
+/// Runs the 1 % bed of `scene_file` with snapshots at 0 and `at` into
+/// `<dir>/reference`, then into `<dir>/out` with a directory where the
+/// snapshot at `at` goes, so that it cannot be written: the run stops with
+/// a checkpoint of that step; `--resume` writes the snapshot, at that
+/// step's state (the same file as the run never stopped), without its
+/// contact tables (the warning says so), and ends with the bits of the run
+/// never stopped.
+fn a_failed_snapshot_resumes(name: &str, at: &str) {
+    let dir = common::fresh_dir("cli_bed_failure", name);
     let scene = scene_file(&dir, 0.9, [2.0, 2000.0]);
     let text = std::fs::read_to_string(&scene).unwrap();
-    let text = text.replace(
-        "snapshot_strains = [0.0]",
-        "snapshot_strains = [0.0, 0.005]",
-    );
-    assert!(text.contains("snapshot_strains = [0.0, 0.005]"));
+    let list = format!("snapshot_strains = [0.0, {at}]");
+    let text = text.replace("snapshot_strains = [0.0]", &list);
+    assert!(text.contains(&list));
     std::fs::write(&scene, text).unwrap();
-    // The reference: the same run, never stopped.
     let reference = dir.join("reference");
     let r = run(&scene, &reference);
     assert_eq!(r.code, 0, "{}", r.stderr);
     // A directory where the second snapshot's file goes: a fresh run
     // removes old files only, so the snapshot at C = 0 is written and the
-    // one at 0.5 % cannot be.
+    // one at `at` cannot be.
     let out = dir.join("out");
     let blocker = out.join("vtk").join("bed_1.vtu");
     std::fs::create_dir_all(&blocker).unwrap();
@@ -220,18 +224,33 @@ fn a_snapshot_that_cannot_be_written_keeps_the_run_for_resume() {
         c.progress.snapshots_done, 1,
         "the checkpoint must leave the failed snapshot to do"
     );
+    let at: f64 = at.parse().unwrap();
     assert!(
-        c.state.steps > 0 && c.progress.die.strain_at(c.state.time) >= 0.005 - 1e-12,
+        c.state.steps > 0 && c.progress.die.strain_at(c.state.time) >= at - 1e-12,
         "the checkpoint must hold the step the snapshot failed at"
     );
     std::fs::remove_dir(&blocker).unwrap();
     let resumed = cli(&["bed", "--quiet", "--resume", out.to_str().unwrap()]);
     assert_eq!(resumed.code, 0, "resume failed:\n{}", resumed.stderr);
-    assert!(blocker.is_file(), "the resumed run writes the snapshot");
-    let csv = |d: &Path| std::fs::read_to_string(d.join("compression.csv")).unwrap();
+    let read = |d: &Path, f: &str| std::fs::read(d.join(f)).unwrap();
     assert_eq!(
-        csv(&out),
-        csv(&reference),
+        read(&out, "vtk/bed_1.vtu"),
+        read(&reference, "vtk/bed_1.vtu"),
+        "the snapshot is of the step it belongs to"
+    );
+    assert!(!out.join("vtk/contacts_1.csv").exists());
+    let warning = format!("the snapshot at C = {at} was written on --resume");
+    assert!(resumed.stderr.contains(&warning), "{}", resumed.stderr);
+    assert_eq!(
+        read(&out, "compression.csv"),
+        read(&reference, "compression.csv"),
         "the resumed run must give the bits of the run never stopped"
     );
+}
+
+#[test]
+fn a_snapshot_that_cannot_be_written_keeps_the_run_for_resume() {
+    // Mid-run, and at the final strain (where the resume takes no step).
+    a_failed_snapshot_resumes("snapshot_mid", "0.005");
+    a_failed_snapshot_resumes("snapshot_end", "0.01");
 }

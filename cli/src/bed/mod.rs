@@ -177,13 +177,16 @@ Output, in --out DIR (created if missing):
   checkpoint.bin   the state to continue from with --resume (every
                    checkpoint_interval_minutes and checkpoint_strain_interval,
                    and at the end)
+  withdrawal.bin   a withdrawal in progress (every checkpoint_interval_minutes
+                   and at an interrupt; removed when it is done)
 
 `--resume DIR` on a finished run takes no step of the loading and writes its
 outputs again: with --kawakita-min-strain or --heckel-min-strain it refits the
 run, and its checkpoint keeps the new windows. Its withdrawal is kept unless
 the scene changed what it would do; else (none in the checkpoint, or
 --unload true on a run without one, as for checkpoints before format 10,
-whose scenes read unload = false) the withdrawal runs from the finished state.
+whose scenes read unload = false) the withdrawal runs from the finished state,
+or goes on from withdrawal.bin where an interrupt stopped it.
 
 A series (--types, --seeds) keeps DIR/series.json (its members, scene and,
 for --types, its pour, exactly): `--resume DIR` on the series directory
@@ -782,7 +785,7 @@ impl BedArgs {
                 let withdrawal = match (scene.unload, &c.progress.unloading) {
                     (true, None) => {
                         "; the upper punch's withdrawal after it, which the checkpoint does not \
-                         hold, runs now"
+                         hold, runs now (or goes on from withdrawal.bin)"
                     }
                     (false, _) => " (without the withdrawal: scene unload = false)",
                     (true, Some(_)) => "",

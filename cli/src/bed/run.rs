@@ -897,7 +897,8 @@ pub fn run_bed(
     if let Some(message) = run_length(scene, &mesh, &material).refusal(
         MAX_STEPS,
         "the `[material]` (youngs_modulus_pa, poisson_ratio, true_density_kg_m3, eta0), \
-         mass_scaling, punch_speed_m_s and final_strain",
+         mass_scaling, time_step_safety, mesh, granules, diameter_mm, die_diameter_mm, \
+         punch_speed_m_s and final_strain",
     ) {
         return Err(crate::error::InputError(message).into());
     }
@@ -1045,8 +1046,25 @@ pub fn run_bed(
             (vec![first], Window::new(), scene.output_strain_interval, 0)
         }
     };
-    while snapshots.get(snapshots_done).is_some_and(|&c| c <= 0.0) {
-        observer.snapshot(0.0, &asm, &mesh)?;
+    // The snapshots due before the first step: at C = 0, and on a resume
+    // those a failed write left to do (the checkpoint is of the step they
+    // belong to; the tables that need its contact forces, which a
+    // checkpoint does not keep, cannot be written, and the run says so).
+    let mut warnings = Vec::new();
+    let strain_now = die.strain_at(asm.time());
+    while let Some(&c) = snapshots
+        .get(snapshots_done)
+        .filter(|&&c| c <= 0.0 || (resumed.is_some() && strain_now + 1e-12 >= c))
+    {
+        let c = c.max(0.0);
+        observer.snapshot(c, &asm, &mesh)?;
+        if c > 0.0 {
+            warnings.push(format!(
+                "the snapshot at C = {c} was written on --resume, at the state of the step it \
+                 belongs to but without its contacts, granules, network and stress tables \
+                 (they need that step's contact forces, which a checkpoint does not keep)"
+            ));
+        }
         snapshots_done += 1;
     }
     let dir = control.checkpoint_dir.as_deref();
@@ -1319,7 +1337,7 @@ pub fn run_bed(
         stopped,
         interrupted,
         resumed_past_end,
-        warnings: Vec::new(),
+        warnings,
         error,
         checkpoint_strain,
         rate_change_rel: None,

@@ -488,8 +488,8 @@ impl GranuleArgs {
             if let Some(message) = length.refusal(
                 MAX_STEPS,
                 "the material (`--youngs-modulus-pa`, `--poisson-ratio`, \
-                 `--true-density-kg-m3`, `--eta0`), `--mass-scaling`, `--speed-mm-s` and \
-                 `--strain`",
+                 `--true-density-kg-m3`, `--eta0`), `--mass-scaling`, `--time-step-safety`, \
+                 `--mesh`, `--speed-mm-s` and `--strain`",
             ) {
                 return Err(
                     InputError(format!("granule {}: {message}", granule_type.name())).into(),

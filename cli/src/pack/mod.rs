@@ -336,7 +336,7 @@ impl PackArgs {
                  of range (allowed: {allowed})"
             ),
             "friction" => format!("`--friction {value}` is out of range (allowed: {allowed})"),
-            "ramp" => format!(
+            "ramp" | "max_time" => format!(
                 "`--max-time-s {}` is out of range (allowed: finite and after the end of the \
                  dissipation ramp at {} s)",
                 self.max_time_s,

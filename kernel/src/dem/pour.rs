@@ -171,7 +171,7 @@ impl PourParams {
     fn validate(&self) -> Result<(), PourError> {
         let d = 2.0 * self.radius;
         let finite = |v: Real| v.is_finite();
-        let checks: [(bool, &'static str, Real, &'static str); 15] = [
+        let checks: [(bool, &'static str, Real, &'static str); 18] = [
             (
                 (1..=100_000).contains(&self.granules),
                 "granules",
@@ -244,13 +244,16 @@ impl PourParams {
                 ">= 0, finite",
             ),
             (
-                self.rest_speed > 0.0
-                    && finite(self.rest_speed)
-                    && self.rest_kinetic_energy > 0.0
-                    && finite(self.rest_kinetic_energy),
+                self.rest_speed > 0.0 && finite(self.rest_speed),
                 "rest_speed",
-                self.rest_speed.min(self.rest_kinetic_energy),
-                "rest speed and kinetic energy > 0, finite",
+                self.rest_speed,
+                "> 0, finite",
+            ),
+            (
+                self.rest_kinetic_energy > 0.0 && finite(self.rest_kinetic_energy),
+                "rest_kinetic_energy",
+                self.rest_kinetic_energy,
+                "> 0, finite",
             ),
             (
                 self.restitution_start > 0.0
@@ -262,22 +265,23 @@ impl PourParams {
                 "0 < e <= 1",
             ),
             (
-                self.ramp.0 >= 0.0
-                    && self.ramp.1 > self.ramp.0
-                    && self.max_time > self.ramp.1
-                    && finite(self.max_time),
+                self.ramp.0 >= 0.0 && self.ramp.1 > self.ramp.0 && self.max_time > self.ramp.1,
                 "ramp",
                 self.ramp.1,
-                "0 <= start < end < max_time, finite",
+                "0 <= start < end < max_time",
             ),
+            (finite(self.max_time), "max_time", self.max_time, "finite"),
             (
-                self.time_step_fraction > 0.0
-                    && self.time_step_fraction <= 0.2
-                    && self.skin > 0.0
-                    && finite(self.skin),
+                self.time_step_fraction > 0.0 && self.time_step_fraction <= 0.2,
                 "time_step_fraction",
                 self.time_step_fraction,
                 "0 < f <= 0.2",
+            ),
+            (
+                self.skin > 0.0 && finite(self.skin),
+                "skin",
+                self.skin,
+                "> 0, finite",
             ),
         ];
         for (ok, field, value, allowed) in checks {
@@ -925,13 +929,18 @@ mod tests {
         );
         assert_eq!(with(|p| p.lattice_spacing = Real::NAN), "lattice_spacing");
         assert_eq!(with(|p| p.gravity_m_s2 = Real::INFINITY), "gravity_m_s2");
-        assert_eq!(with(|p| p.max_time = Real::INFINITY), "ramp");
-        assert_eq!(with(|p| p.skin = Real::INFINITY), "time_step_fraction");
+        assert_eq!(with(|p| p.max_time = Real::INFINITY), "max_time");
+        assert_eq!(with(|p| p.skin = Real::INFINITY), "skin");
+        assert_eq!(with(|p| p.skin = 0.0), "skin");
         assert_eq!(with(|p| p.initial_speed = Real::NAN), "initial_speed");
         assert_eq!(with(|p| p.damping_max = Real::INFINITY), "damping_max");
         assert_eq!(with(|p| p.rest_speed = 0.0), "rest_speed");
-        assert_eq!(with(|p| p.rest_kinetic_energy = Real::NAN), "rest_speed");
-        // The widest die accepted still validates (its layer is walked).
+        assert_eq!(
+            with(|p| p.rest_kinetic_energy = Real::NAN),
+            "rest_kinetic_energy"
+        );
+        // A die of a thousand lattice spacings still validates (its layer
+        // is walked; the bound is ten times wider).
         let mut wide = standard;
         wide.die_radius = 1e3 * wide.lattice_spacing;
         assert_eq!(wide.validate(), Ok(()));
