@@ -728,6 +728,40 @@ fn the_rate_check_presses_the_same_bed_at_half_speed() {
         summary(&resumed)["quasi_static"]["rate_change_rel"],
         s["quasi_static"]["rate_change_rel"]
     );
+
+    // A stopped twin of another scene (another speed) is not gone on
+    // from, nor is a matching one by a fresh run: both get a fresh twin,
+    // with the bits of the twin above.
+    let other = out_dir("rate_check_other");
+    bed(&other, "2", &[]);
+    let plant = |speed: &str| {
+        bed(
+            &other.join("half_speed"),
+            "2",
+            &["--punch-speed-m-s", speed, "--stop-at-strain", "0.1"],
+        );
+    };
+    let fresh_twin = |run: common::Run| {
+        assert_eq!(run.code, 0, "{}", run.stderr);
+        assert!(!run.stderr.contains("goes on from"), "{}", run.stderr);
+        let read =
+            |d: &Path| std::fs::read_to_string(d.join("half_speed/compression.csv")).unwrap();
+        assert_eq!(read(&other), read(&dir), "a fresh twin");
+    };
+    plant("0.02");
+    fresh_twin(cli(&[
+        "bed",
+        "-j",
+        "2",
+        "--resume",
+        other.to_str().unwrap(),
+        "--rate-check",
+    ]));
+    plant("0.025");
+    let mut fresh = vec!["bed", "-j", "2", "--overwrite", "--rate-check", "--out"];
+    fresh.push(other.to_str().unwrap());
+    fresh.extend_from_slice(&SMALL);
+    fresh_twin(cli(&fresh));
 }
 
 /// Runs the bed of `args` twice, with `--<flag> true` and `--<flag>

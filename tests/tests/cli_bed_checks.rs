@@ -582,4 +582,27 @@ fn a_scene_too_large_for_the_memory_is_refused_before_the_pour() {
         !dir.join("checkpoint.bin").exists() && !dir.join("packing.csv").exists(),
         "nothing is poured or written"
     );
+    // A `--types` series, whose members share one pour, checks them
+    // before it.
+    let run = bed(&[
+        "--quiet",
+        "--types",
+        "A2,B2",
+        "--granules",
+        "100000",
+        "--die-diameter-mm",
+        "200",
+        "--mesh",
+        "32x8",
+        "--out",
+        dir.to_str().unwrap(),
+    ]);
+    rejected(
+        &run,
+        &["A2", "`granules` = 100000 on the `mesh` 32x8 need at least"],
+    );
+    assert!(
+        !dir.join("series.json").exists(),
+        "nothing is poured or written"
+    );
 }

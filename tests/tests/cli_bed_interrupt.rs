@@ -46,6 +46,9 @@ struct InterruptAfter {
     seen: usize,
     flag: &'static AtomicBool,
     withdrawal: bool,
+    /// A file copied (from, to) when the flag is set, before the step's
+    /// checkpoint: the checkpoint of the step before.
+    keep: Option<(PathBuf, PathBuf)>,
 }
 
 impl InterruptAfter {
@@ -54,6 +57,9 @@ impl InterruptAfter {
         if withdrawal == self.withdrawal {
             self.seen += 1;
             if self.seen == self.rows {
+                if let Some((from, to)) = &self.keep {
+                    std::fs::copy(from, to).unwrap();
+                }
                 self.flag.store(true, Ordering::SeqCst);
             }
         }
@@ -156,6 +162,7 @@ fn an_interrupted_run_keeps_its_work_and_resumes_to_the_same_bits() {
         seen: 0,
         flag: &FLAG,
         withdrawal: false,
+        keep: None,
     };
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(1)
@@ -382,16 +389,26 @@ fn an_interrupt_during_the_pour_stops_it_at_its_next_check() {
 /// published scene's) stops it after the step it is in: the run says it
 /// was interrupted, its withdrawal is cut short after the rows so far, the
 /// checkpoint is the loading's end without it, and the withdrawal's own
-/// checkpoint (`withdrawal.bin`) holds it where it stopped. Resumed, the
-/// run goes on from there (the rows so far are handed on at once, at the
-/// withdrawal's wall time then), to the rows and figures of a withdrawal
-/// never interrupted, bit for bit, and the withdrawal's checkpoint goes.
+/// checkpoint (`withdrawal.bin`, written here every step) holds it where it
+/// stopped. Resumed, the run goes on from there (the rows so far are
+/// handed on at once, at the withdrawal's wall time then), to the rows and
+/// figures of a withdrawal never interrupted, bit for bit, and the
+/// withdrawal's checkpoint goes. So does a resume from the checkpoint of a
+/// step between two rows (its averaging window open), kept as the second
+/// row came; a withdrawal checkpoint of another loading (one row's force
+/// changed in its last bit) is not used but removed, and the withdrawal
+/// runs from the loading's end, to the same bits.
 #[test]
 fn an_interrupted_withdrawal_goes_on_from_its_checkpoint() {
     static FLAG: AtomicBool = AtomicBool::new(false);
     let printed = cli(&[&["bed", "--print-scene"][..], &SMALL].concat());
-    let scene = Scene::from_toml(&printed.stdout).unwrap();
+    let mut scene = Scene::from_toml(&printed.stdout).unwrap();
     assert!(scene.unload, "the published scene unloads");
+    // A checkpoint every step (the interval changes no bit), and physical
+    // masses: steps short enough that a row of the withdrawal takes
+    // several (with the published ×20, one).
+    scene.checkpoint_interval_minutes = 1e-9;
+    scene.mass_scaling = 1.0;
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(1)
         .build()
@@ -407,11 +424,17 @@ fn an_interrupted_withdrawal_goes_on_from_its_checkpoint() {
         pool.install(|| run_bed(&scene, &control, observer))
             .unwrap()
     };
+    let between = out_dir("withdrawal_between_rows");
+    std::fs::create_dir_all(&between).unwrap();
     let mut observer = InterruptAfter {
         rows: 2,
         seen: 0,
         flag: &FLAG,
         withdrawal: true,
+        keep: Some((
+            cut.join(WITHDRAWAL_FILE_NAME),
+            between.join(WITHDRAWAL_FILE_NAME),
+        )),
     };
     let run = run_into(&cut, &mut observer, Some(&FLAG));
     let u = run.unloading.as_ref().expect("a withdrawal");
@@ -432,40 +455,67 @@ fn an_interrupted_withdrawal_goes_on_from_its_checkpoint() {
     assert_eq!(progress.turn_steps, run.steps);
     assert_eq!(progress.rows, u.samples, "the rows so far");
     assert!(saved.state.steps > run.steps, "the state where it stopped");
+    // The step before the second row's: one row, the window open.
+    let open = Checkpoint::read_from(&between, WITHDRAWAL_FILE_NAME).unwrap();
+    let open_progress = open.progress.withdrawal.as_ref().unwrap();
+    assert_eq!(open_progress.rows, u.samples[..1]);
+    assert!(open_progress.window.time > 0.0, "an open window");
+    assert_eq!(open.state.steps + 1, saved.state.steps);
+    // Another loading's withdrawal: a row's force moved by one bit.
+    let stale = out_dir("withdrawal_stale");
+    std::fs::create_dir_all(&stale).unwrap();
+    let mut other = saved.clone();
+    let f = &mut other.progress.samples[1].upper_force_n;
+    *f = f64::from_bits(f.to_bits() ^ 1);
+    other.write_as(&stale, WITHDRAWAL_FILE_NAME).unwrap();
 
     let mut quiet = InterruptAfter {
         rows: usize::MAX,
         seen: 0,
         flag: &FLAG,
         withdrawal: true,
+        keep: None,
     };
     let straight = run_into(&whole, &mut quiet, None);
-    let mut seen = WithdrawalTimes(Vec::new());
-    let resumed = pool
-        .install(|| {
-            run_bed(
-                &scene,
-                &RunControl {
-                    resume: Some(checkpoint),
-                    checkpoint_dir: Some(cut.clone()),
-                    ..RunControl::default()
-                },
-                &mut seen,
-            )
-        })
-        .unwrap();
-    assert!(!resumed.interrupted);
-    // The two rows so far came from the withdrawal's checkpoint, before
-    // any step: at its wall time, both.
-    assert_eq!(seen.0[..2], [progress.wall_time_s; 2], "{:?}", seen.0);
-    assert!(seen.0[2] > progress.wall_time_s);
-    assert!(!cut.join(WITHDRAWAL_FILE_NAME).exists());
-    let (a, b) = (
-        resumed.unloading.expect("withdrawn again"),
-        straight.unloading.expect("withdrawn"),
-    );
-    assert!(a.cut_short.is_none() && a.lift_off_strain.is_finite());
-    assert_eq!(a.samples, b.samples);
-    assert_eq!(a.lift_off_strain.to_bits(), b.lift_off_strain.to_bits());
-    assert!(Checkpoint::read(&cut).unwrap().progress.unloading.is_some());
+    let straight = straight.unloading.expect("withdrawn");
+    // Resumes `dir` from the loading's checkpoint `loading`: the
+    // withdrawal's rows and the wall times they were handed on at.
+    let resume = |dir: &Path, loading: Checkpoint| {
+        let mut seen = WithdrawalTimes(Vec::new());
+        let resumed = pool
+            .install(|| {
+                run_bed(
+                    &scene,
+                    &RunControl {
+                        resume: Some(loading),
+                        checkpoint_dir: Some(dir.to_path_buf()),
+                        ..RunControl::default()
+                    },
+                    &mut seen,
+                )
+            })
+            .unwrap();
+        assert!(!resumed.interrupted);
+        assert!(!dir.join(WITHDRAWAL_FILE_NAME).exists());
+        assert!(Checkpoint::read(dir).unwrap().progress.unloading.is_some());
+        let u = resumed.unloading.expect("withdrawn");
+        assert!(u.cut_short.is_none() && u.lift_off_strain.is_finite());
+        assert_eq!(u.samples, straight.samples);
+        assert_eq!(
+            u.lift_off_strain.to_bits(),
+            straight.lift_off_strain.to_bits()
+        );
+        seen.0
+    };
+    // The rows so far came from the withdrawal's checkpoint, before any
+    // step: at its wall time.
+    let seen = resume(&cut, checkpoint.clone());
+    assert_eq!(seen[..2], [progress.wall_time_s; 2], "{seen:?}");
+    assert!(seen[2] > progress.wall_time_s);
+    let seen = resume(&between, checkpoint.clone());
+    assert_eq!(seen[0], open_progress.wall_time_s, "{seen:?}");
+    assert!(seen[1] > open_progress.wall_time_s);
+    // The stale one is not used: every row comes from a step.
+    let seen = resume(&stale, checkpoint);
+    assert!(seen[0] < seen[1], "{seen:?}");
 }

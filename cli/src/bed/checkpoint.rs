@@ -152,6 +152,17 @@ pub struct Checkpoint {
     pub state: AssemblyState,
 }
 
+/// Whether the rows `a` and `b` hold the same numbers to the bit, NaN
+/// included (the mean strains are derived from the rest).
+pub fn same_rows(a: &[BedSample], b: &[BedSample]) -> bool {
+    let bits = |s: &BedSample| {
+        let mut v = sample_to(s).map(f64::to_bits).to_vec();
+        v.push(s.die_normal_force_n.to_bits());
+        v
+    };
+    a.len() == b.len() && a.iter().zip(b).all(|(x, y)| bits(x) == bits(y))
+}
+
 /// A window's floats but its die-wall impulse, in the file's order.
 fn window_to(w: &Window) -> [f64; WINDOW_FLOATS] {
     [

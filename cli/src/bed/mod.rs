@@ -922,12 +922,14 @@ impl BedArgs {
             ..scene.clone()
         };
         let dir = out.join(HALF_SPEED_DIR);
-        // A twin an interrupt stopped (its checkpoint holds this very scene
-        // at half speed) goes on from there: it takes about twice the run.
-        // Any other checkpoint there (another scene, unreadable) is
-        // replaced by a fresh twin.
-        let resume = checkpoint::Checkpoint::read(&dir)
-            .ok()
+        // With --resume, a twin an interrupt stopped (its checkpoint holds
+        // this very scene at half speed) goes on from there: it takes about
+        // twice the run. A fresh run, and any other checkpoint there
+        // (another scene, unreadable), get a fresh twin.
+        let resume = self
+            .resume
+            .as_ref()
+            .and_then(|_| checkpoint::Checkpoint::read(&dir).ok())
             .filter(|c| c.progress.scene_toml == slow.to_toml());
         if let Some(c) = &resume
             && !self.quiet
@@ -1058,6 +1060,8 @@ impl BedArgs {
             .collect();
         for m in &members {
             m.scene.validate().with_context(|| m.name.clone())?;
+            // Before the one pour the types share.
+            run::check_feasible(&m.scene).with_context(|| m.name.clone())?;
             self.keep_unfinished(&m.dir)?;
         }
         let scenes: Vec<Scene> = members.iter().map(|m| m.scene.clone()).collect();

@@ -207,6 +207,10 @@ pub enum CutShort {
     },
     /// A step failed (the assembly's error, as text).
     StepFailed(String),
+    /// Its checkpoint could not be written (the error, as text): it stops
+    /// there rather than go on unkept, and the loading's outputs are
+    /// written as they are.
+    CheckpointFailed(String),
 }
 
 impl core::fmt::Display for CutShort {
@@ -214,6 +218,7 @@ impl core::fmt::Display for CutShort {
         match self {
             Self::Interrupted { strain } => write!(f, "interrupted at C = {strain:.4}"),
             Self::StepFailed(e) => write!(f, "a step failed: {e}"),
+            Self::CheckpointFailed(e) => write!(f, "its checkpoint could not be written: {e}"),
         }
     }
 }
@@ -305,7 +310,13 @@ fn withdraw(
     let (mut samples, mut lift_off_strain, mut cut_short) = (Vec::new(), Real::NAN, None);
     let mut wall_before = 0.0;
     if let Some((progress, state)) = store.resume {
-        asm.restore(&state)?;
+        asm.restore(&state).with_context(|| {
+            format!(
+                "cannot go on from {}: remove it, and --resume runs the withdrawal from the \
+                 loading's end",
+                checkpoint::WITHDRAWAL_FILE_NAME
+            )
+        })?;
         if die.strain_at_height(super::snapshots::die_geometry(asm).1)
             < scene.exact_contact_from_strain
         {
@@ -374,16 +385,17 @@ fn withdraw(
         if let Some(save) = store.save
             && (interrupted || last_save.elapsed().as_secs_f64() >= store.every_s)
         {
-            save(
-                asm,
-                checkpoint::WithdrawalProgress {
-                    turn_steps,
-                    rows: samples.clone(),
-                    window,
-                    next_row: next,
-                    wall_time_s: wall(),
-                },
-            )?;
+            let progress = checkpoint::WithdrawalProgress {
+                turn_steps,
+                rows: samples.clone(),
+                window,
+                next_row: next,
+                wall_time_s: wall(),
+            };
+            if let Err(e) = save(asm, progress) {
+                cut_short = Some(CutShort::CheckpointFailed(format!("{e:#}")));
+                break;
+            }
             last_save = Instant::now();
         }
         if interrupted {
@@ -811,6 +823,42 @@ pub fn assembly_params(scene: &Scene, mesh: &OwnedReference) -> anyhow::Result<A
     Ok(params)
 }
 
+/// Refuses `scene` (a usage error naming its fields) if it could not
+/// finish: its granules' own buffers exceed the machine's memory
+/// ([`memory_refusal`]), or it would take more than [`MAX_STEPS`]
+/// ([`run_length`]). `run_bed` checks this before its pour; a `--types`
+/// series checks every member before the one pour they share.
+pub fn check_feasible(scene: &Scene) -> anyhow::Result<()> {
+    let mesh = scene.granule_mesh()?;
+    let points = scene.element_settings()?.points_per_element();
+    check_feasible_on(scene, &mesh, &scene.material()?, points)
+}
+
+/// [`check_feasible`] with the mesh, material and integration points per
+/// element already made.
+fn check_feasible_on(
+    scene: &Scene,
+    mesh: &OwnedReference,
+    material: &granbed_kernel::material::Material,
+    points: usize,
+) -> anyhow::Result<()> {
+    let need = scene.granules as u64 * crate::model::GranuleStore::bytes_for(mesh, points);
+    if let Some(message) =
+        machine_memory_bytes().and_then(|total| memory_refusal(scene, need, total))
+    {
+        return Err(crate::error::InputError(message).into());
+    }
+    if let Some(message) = run_length(scene, mesh, material).refusal(
+        MAX_STEPS,
+        "the `[material]` (youngs_modulus_pa, poisson_ratio, true_density_kg_m3, eta0), \
+         mass_scaling, time_step_safety, mesh, granules, diameter_mm, die_diameter_mm, \
+         punch_speed_m_s and final_strain",
+    ) {
+        return Err(crate::error::InputError(message).into());
+    }
+    Ok(())
+}
+
 /// The most steps a bed run may take (about 10⁴ times the published
 /// scene's 8 369, which take 19 minutes on two cores; the slowest punch
 /// allowed, `MIN_PUNCH_SPEED_M_S`, with physical masses, about 2·10⁷).
@@ -887,21 +935,12 @@ pub fn run_bed(
     let radius = scene.radius_m();
     let mesh = scene.granule_mesh()?;
     let mut params = assembly_params(scene, &mesh)?;
-    let need = scene.granules as u64
-        * crate::model::GranuleStore::bytes_for(&mesh, params.elements.points_per_element());
-    if let Some(message) =
-        machine_memory_bytes().and_then(|total| memory_refusal(scene, need, total))
-    {
-        return Err(crate::error::InputError(message).into());
-    }
-    if let Some(message) = run_length(scene, &mesh, &material).refusal(
-        MAX_STEPS,
-        "the `[material]` (youngs_modulus_pa, poisson_ratio, true_density_kg_m3, eta0), \
-         mass_scaling, time_step_safety, mesh, granules, diameter_mm, die_diameter_mm, \
-         punch_speed_m_s and final_strain",
-    ) {
-        return Err(crate::error::InputError(message).into());
-    }
+    check_feasible_on(
+        scene,
+        &mesh,
+        &material,
+        params.elements.points_per_element(),
+    )?;
     // Where the run starts: a fresh pour, or a checkpoint's state.
     let (die, placed, resumed, pour_wall_time_s) = match &control.resume {
         Some(c) => {
@@ -1068,6 +1107,12 @@ pub fn run_bed(
         snapshots_done += 1;
     }
     let dir = control.checkpoint_dir.as_deref();
+    // A fresh run leaves no withdrawal of an earlier run beside its own.
+    if let Some(dir) = dir
+        && control.resume.is_none()
+    {
+        remove_withdrawal_checkpoint(dir)?;
+    }
     // The withdrawal of a finished run resumed without a step: its
     // checkpoints (rewritten for a changed scene) keep it.
     let kept = resumed
@@ -1262,14 +1307,16 @@ pub fn run_bed(
             let at_end_checkpoint =
                 dir.map(|_| make(&asm, &samples, &window, next, snapshots_done));
             // A withdrawal an interrupt stopped goes on from its own
-            // checkpoint if it turned at this very step under a scene that
+            // checkpoint if it turned at this very step of this very
+            // loading (the die and every row to the bit) under a scene that
             // withdraws alike; any other is stale and goes.
             let resume = dir.and_then(|dir| {
                 let c = checkpoint::Checkpoint::read_from(dir, checkpoint::WITHDRAWAL_FILE_NAME)
                     .ok()?;
                 let w = c.progress.withdrawal?;
                 (w.turn_steps == asm.steps()
-                    && c.progress.samples.len() == samples.len()
+                    && c.progress.die == die
+                    && checkpoint::same_rows(&c.progress.samples, &samples)
                     && withdrawal_holds(&c.progress.scene_toml, scene))
                 .then_some((w, c.state))
             });
