@@ -825,8 +825,8 @@ pub fn assembly_params(scene: &Scene, mesh: &OwnedReference) -> anyhow::Result<A
 
 /// Refuses `scene` (a usage error naming its fields) if it could not
 /// finish: its granules' own buffers exceed the machine's memory
-/// ([`memory_refusal`]), or it would take more than [`MAX_STEPS`]
-/// ([`run_length`]). `run_bed` checks this before its pour; a `--types`
+/// (`memory_refusal`), or it would take more than [`MAX_STEPS`]
+/// (`run_length`). `run_bed` checks this before its pour; a `--types`
 /// series checks every member before the one pour they share.
 pub fn check_feasible(scene: &Scene) -> anyhow::Result<()> {
     let mesh = scene.granule_mesh()?;
