@@ -560,7 +560,8 @@ fn the_summary_keeps_the_scene_exactly() {
 #[test]
 fn a_scene_too_large_for_the_memory_is_refused_before_the_pour() {
     let dir = out_dir("too-large");
-    let run = bed(&[
+    let out = dir.to_str().unwrap();
+    let huge = [
         "--quiet",
         "--granules",
         "100000",
@@ -569,10 +570,10 @@ fn a_scene_too_large_for_the_memory_is_refused_before_the_pour() {
         "--mesh",
         "32x8",
         "--out",
-        dir.to_str().unwrap(),
-    ]);
+        out,
+    ];
     rejected(
-        &run,
+        &bed(&huge),
         &[
             "`granules` = 100000 on the `mesh` 32x8 need at least",
             "GB of memory: use fewer granules or a coarser mesh",
@@ -584,21 +585,9 @@ fn a_scene_too_large_for_the_memory_is_refused_before_the_pour() {
     );
     // A `--types` series, whose members share one pour, checks them
     // before it.
-    let run = bed(&[
-        "--quiet",
-        "--types",
-        "A2,B2",
-        "--granules",
-        "100000",
-        "--die-diameter-mm",
-        "200",
-        "--mesh",
-        "32x8",
-        "--out",
-        dir.to_str().unwrap(),
-    ]);
+    let series = [&huge[..], &["--types", "A2,B2"]].concat();
     rejected(
-        &run,
+        &bed(&series),
         &["A2", "`granules` = 100000 on the `mesh` 32x8 need at least"],
     );
     assert!(

@@ -470,25 +470,36 @@ fn versions_2_to_10_checkpoints_read_with_the_fields_they_lack_at_their_defaults
     read(&write_checkpoint("version2as3", &v2)).expect_err("flags missing");
 }
 
+/// `n` rows of a withdrawal after the loading's last row `last`: the strain
+/// falling by 10⁻⁴ a row over 10 steps, distinct forces, the mean strains
+/// continuing from `last`'s.
+fn withdrawal_rows(
+    last: &granbed_cli::bed::run::BedSample,
+    n: u32,
+) -> Vec<granbed_cli::bed::run::BedSample> {
+    let mut rows: Vec<_> = (1..=n)
+        .map(|k| granbed_cli::bed::run::BedSample {
+            strain: last.strain - 1e-4 * f64::from(k),
+            steps: last.steps + 10 * u64::from(k),
+            upper_force_n: 1.0 / f64::from(k),
+            die_normal_force_n: 0.25 * f64::from(k),
+            ..*last
+        })
+        .collect();
+    granbed_cli::bed::run::set_mean_strains_after(Some(last), &mut rows);
+    rows
+}
+
 /// A checkpoint with a withdrawal (format 10) reads back to the same
 /// rows, lift-off and wall time, the rows' mean strains continuing from
 /// the loading's last row; a flag other than 0 or 1 is refused by name.
 #[test]
 fn a_withdrawal_in_a_checkpoint_reads_back() {
-    use granbed_cli::bed::run::{Unloading, set_mean_strains_after};
+    use granbed_cli::bed::run::Unloading;
     let (dir, _) = base_checkpoint();
     let mut ck = read(dir).unwrap();
     let last = *ck.progress.samples.last().unwrap();
-    let mut rows: Vec<_> = [1, 2]
-        .map(|k| granbed_cli::bed::run::BedSample {
-            strain: last.strain - 1e-4 * f64::from(k),
-            steps: last.steps + 10 * u64::from(k as u8),
-            upper_force_n: 1.0 / f64::from(k),
-            die_normal_force_n: 0.25 * f64::from(k),
-            ..last
-        })
-        .to_vec();
-    set_mean_strains_after(Some(&last), &mut rows);
+    let rows = withdrawal_rows(&last, 2);
     assert!(rows[0].mean_strain < last.strain && rows[0].mean_strain > rows[0].strain);
     ck.progress.unloading = Some(Unloading {
         samples: rows,
@@ -521,20 +532,11 @@ fn a_withdrawal_in_a_checkpoint_reads_back() {
 #[test]
 fn a_withdrawal_in_progress_reads_back() {
     use granbed_cli::bed::checkpoint::{WITHDRAWAL_FILE_NAME, WithdrawalProgress};
-    use granbed_cli::bed::run::{Window, set_mean_strains_after};
+    use granbed_cli::bed::run::Window;
     let (dir, _) = base_checkpoint();
     let mut ck = read(dir).unwrap();
     let last = *ck.progress.samples.last().unwrap();
-    let mut rows: Vec<_> = [1, 2, 3]
-        .map(|k| granbed_cli::bed::run::BedSample {
-            strain: last.strain - 1e-4 * f64::from(k),
-            steps: last.steps + 10 * u64::from(k as u8),
-            upper_force_n: 1.0 / f64::from(k),
-            die_normal_force_n: 0.25 * f64::from(k),
-            ..last
-        })
-        .to_vec();
-    set_mean_strains_after(Some(&last), &mut rows);
+    let rows = withdrawal_rows(&last, 3);
     ck.progress.withdrawal = Some(WithdrawalProgress {
         turn_steps: last.steps,
         rows,
