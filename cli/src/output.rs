@@ -127,6 +127,16 @@ pub fn write_json(path: &Path, value: &impl serde::Serialize) -> anyhow::Result<
     finish_file(w, path)
 }
 
+/// The field `key` (with its colon) of a Linux `/proc` file of `kB`
+/// lines, such as `/proc/meminfo` or `/proc/self/status`, in bytes; `None`
+/// where the file or the field cannot be read.
+pub fn proc_kib_field(path: &str, key: &str) -> Option<u64> {
+    let text = std::fs::read_to_string(path).ok()?;
+    let line = text.lines().find(|l| l.starts_with(key))?;
+    let kib: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
+    Some(kib.saturating_mul(1024))
+}
+
 /// `num / den`, or `None` (JSON `null`) if that is not a finite number.
 pub fn finite_ratio(num: f64, den: f64) -> Option<f64> {
     let r = num / den;
@@ -169,5 +179,24 @@ pub fn all_failures(
             others.len() + 1,
             others.join("; ")
         )))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_proc_field_reads_in_bytes_and_a_missing_one_is_none() {
+        let dir = std::env::temp_dir().join(format!("granbed-proc-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let path = dir.join("meminfo");
+        std::fs::write(&path, "MemTotal:       24576 kB\nMemFree:  12 kB\n").unwrap();
+        let path = path.to_str().unwrap();
+        assert_eq!(proc_kib_field(path, "MemTotal:"), Some(24576 * 1024));
+        assert_eq!(proc_kib_field(path, "MemFree:"), Some(12 * 1024));
+        assert_eq!(proc_kib_field(path, "VmHWM:"), None);
+        assert_eq!(proc_kib_field("/no/such/file", "MemTotal:"), None);
+        std::fs::remove_dir_all(&dir).unwrap();
     }
 }

@@ -14,12 +14,13 @@ use granbed_kernel::Real;
 use granbed_kernel::constitutive::UpdateError;
 use granbed_kernel::constitutive::update::{check_input, input_is_valid, trial};
 use granbed_kernel::element::batch::{
-    BATCH, ElementBatch, ElementPath, LoopError, batch_count, has_avx2, one_point_elements,
-    regroup, sink,
+    BATCH, ElementBatch, ElementPath, batch_count, has_avx2, one_point_elements, regroup, sink,
 };
 use granbed_kernel::element::force::HexForces;
 use granbed_kernel::element::reference::{HexReference, hex_reference};
-use granbed_kernel::granule::forces::{ElementKind, ElementSettings, internal_forces_on};
+use granbed_kernel::granule::forces::{
+    ElementFailure, ElementKind, ElementSettings, ForcesError, internal_forces_on,
+};
 use granbed_kernel::material::GranuleType;
 use granbed_kernel::mesh::reference::ReferenceMesh;
 use granbed_kernel::mesh::sphere::SphereMeshParams;
@@ -63,7 +64,7 @@ fn bits(e: usize, out: &HexForces) -> Vec<u64> {
 }
 
 struct Pass {
-    result: Result<(), LoopError>,
+    result: Result<(), ForcesError>,
     outputs: Vec<Vec<u64>>,
     plastic: usize,
 }
@@ -218,7 +219,7 @@ fn fails_alike(
         let mut cp = vec![VOIGT_IDENTITY; hexes.len()];
         let pass = run(path, hexes, refs, x, &mut cp);
         match &pass.result {
-            Err(LoopError::Element(element, error)) if expected(error) => {
+            Err(ForcesError::Element(ElementFailure { element, error })) if expected(error) => {
                 assert_eq!(*element, bad, "{path:?}: element {element}")
             }
             other => panic!("{path:?}: expected element {bad} to fail, got {other:?}"),
@@ -303,7 +304,7 @@ fn buffers_that_do_not_fit_the_hexes_are_refused_by_name() {
     for path in PATHS {
         assert_eq!(
             run(path, hexes, &refs[..count - 1], &x, &mut cp).result,
-            Err(LoopError::BufferLength {
+            Err(ForcesError::BufferLength {
                 buffer: "refs",
                 expected: count,
                 got: count - 1
@@ -313,7 +314,7 @@ fn buffers_that_do_not_fit_the_hexes_are_refused_by_name() {
         let pass = run(path, hexes, &refs, &x, &mut short);
         assert_eq!(
             pass.result,
-            Err(LoopError::BufferLength {
+            Err(ForcesError::BufferLength {
                 buffer: "cp_inv",
                 expected: count,
                 got: count + 1
@@ -324,7 +325,7 @@ fn buffers_that_do_not_fit_the_hexes_are_refused_by_name() {
         let few = &x[..id as usize];
         assert_eq!(
             run(path, hexes, &refs, few, &mut cp).result,
-            Err(LoopError::NodeId {
+            Err(ForcesError::NodeId {
                 id,
                 nodes: id as usize
             })
@@ -352,7 +353,10 @@ fn an_overflowing_trial_state_is_non_finite_on_every_path() {
         let pass = run(path, hexes, &refs, &mesh.positions, &mut cp);
         assert_eq!(
             pass.result,
-            Err(LoopError::Element(bad, UpdateError::NonFinite)),
+            Err(ForcesError::Element(ElementFailure {
+                element: bad,
+                error: UpdateError::NonFinite
+            })),
             "{path:?}"
         );
         assert!(cp[..bad].iter().all(|c| *c == VOIGT_IDENTITY), "{path:?}");

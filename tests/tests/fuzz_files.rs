@@ -512,17 +512,21 @@ fn a_withdrawal_in_a_checkpoint_reads_back() {
     ck.write(&d).unwrap();
     assert_eq!(read(&d).unwrap(), ck);
     // The flag is the word after the counters, where a file without a
-    // withdrawal ends but for the flag of one in progress; 1 here: make it
-    // 2.
+    // withdrawal ends but for the flag of one in progress.
     let (_, without) = base_checkpoint();
-    let flag = unloading_word(without);
     let bytes = std::fs::read(d.join(FILE_NAME)).unwrap();
+    let e = with_flag_2(&bytes, unloading_word(without), "withdrawal_flag");
+    assert!(e.contains("unknown unloading flag 2"), "{e}");
+}
+
+/// The checkpoint file `bytes` with its flag word at `flag`, 1, set to 2
+/// under a valid checksum: the error reading it (written as `name`).
+fn with_flag_2(bytes: &[u8], flag: usize, name: &str) -> String {
     assert_eq!(bytes[flag..flag + 8], 1u64.to_le_bytes());
     let mut payload = bytes[36..].to_vec();
     payload[flag - 36] = 2;
-    let bytes = common::checkpoint_file(&bytes, common::checkpoint_version(&bytes), &payload);
-    let e = read(&write_checkpoint("withdrawal_flag", &bytes)).unwrap_err();
-    assert!(e.contains("unknown unloading flag 2"), "{e}");
+    let bytes = common::checkpoint_file(bytes, common::checkpoint_version(bytes), &payload);
+    read(&write_checkpoint(name, &bytes)).unwrap_err()
 }
 
 /// A withdrawal in progress (format 11, the file `withdrawal.bin`) reads
@@ -557,16 +561,11 @@ fn a_withdrawal_in_progress_reads_back() {
     ck.write_as(&d, WITHDRAWAL_FILE_NAME).unwrap();
     let back = Checkpoint::read_from(&d, WITHDRAWAL_FILE_NAME).unwrap();
     assert_eq!(back, ck);
-    // The flag is the last word but for the rows, their forces and the
-    // fields before them; find it as the word after the unloading flag 0.
+    // The flag is the word after the unloading flag 0, where a file
+    // without a withdrawal in progress ends.
     let bytes = std::fs::read(d.join(WITHDRAWAL_FILE_NAME)).unwrap();
     let (_, without) = base_checkpoint();
-    let flag = withdrawal_word(without);
-    assert_eq!(bytes[flag..flag + 8], 1u64.to_le_bytes());
-    let mut payload = bytes[36..].to_vec();
-    payload[flag - 36] = 2;
-    let bytes = common::checkpoint_file(&bytes, common::checkpoint_version(&bytes), &payload);
-    let e = read(&write_checkpoint("withdrawal_progress_flag", &bytes)).unwrap_err();
+    let e = with_flag_2(&bytes, withdrawal_word(without), "withdrawal_progress_flag");
     assert!(e.contains("unknown withdrawal flag 2"), "{e}");
 }
 

@@ -479,10 +479,7 @@ pub struct Summary<'a> {
 /// Peak resident set size of this process (Linux `/proc/self/status`
 /// VmHWM), bytes.
 pub fn peak_memory_bytes() -> Option<u64> {
-    let status = std::fs::read_to_string("/proc/self/status").ok()?;
-    let line = status.lines().find(|l| l.starts_with("VmHWM:"))?;
-    let kb: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
-    Some(kb * 1024)
+    crate::output::proc_kib_field("/proc/self/status", "VmHWM:")
 }
 
 /// The Kawakita fit of the samples with C ≥ `min_strain`, each pressure

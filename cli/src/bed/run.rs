@@ -896,10 +896,7 @@ fn run_length(
 /// This machine's memory, bytes (Linux `/proc/meminfo` MemTotal), or
 /// `None` where it cannot be read.
 fn machine_memory_bytes() -> Option<u64> {
-    let info = std::fs::read_to_string("/proc/meminfo").ok()?;
-    let line = info.lines().find(|l| l.starts_with("MemTotal:"))?;
-    let kb: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
-    Some(kb.saturating_mul(1024))
+    crate::output::proc_kib_field("/proc/meminfo", "MemTotal:")
 }
 
 /// Why `scene` cannot run on a machine of `total` bytes, if its granules'

@@ -61,6 +61,7 @@ use crate::element::force::{
     ElementGeometry, HexForces, hex_forces, mean_gradient_rows, nodal_forces_into,
 };
 use crate::element::reference::HexReference;
+use crate::granule::forces::{ElementFailure, ForcesError};
 use crate::lanes::{Lanes, Num};
 use crate::material::Material;
 use crate::tensor::{Rows, Voigt};
@@ -298,7 +299,7 @@ pub fn regroup(elements: &[HexReference], out: &mut [ElementBatch]) -> Result<()
 /// ([`Sink::batch`]), an element evaluated alone (the remainder, a batch
 /// redone after a failing lane) by [`Sink::element`]. Stops at the first
 /// element whose update fails and returns its index with the error
-/// ([`LoopError::Element`]); the
+/// ([`ForcesError::Element`]); the
 /// states of the elements before it are updated, the failing one's and
 /// those after it are not (as an element-by-element loop would leave them).
 ///
@@ -308,8 +309,9 @@ pub fn regroup(elements: &[HexReference], out: &mut [ElementBatch]) -> Result<()
 /// not bits.
 ///
 /// Lengths: `refs` and `cp_inv` as `hexes`; node ids index `x`. Both are
-/// checked first ([`LoopError::BufferLength`], [`LoopError::NodeId`]);
-/// an element that fails is [`LoopError::Element`].
+/// checked first, nothing evaluated if they do not fit
+/// ([`ForcesError::BufferLength`], [`ForcesError::NodeId`], the element
+/// pass's errors); an element that fails is [`ForcesError::Element`].
 #[allow(clippy::too_many_arguments)]
 pub fn one_point_elements<S: Sink + ?Sized>(
     path: ElementPath,
@@ -322,10 +324,10 @@ pub fn one_point_elements<S: Sink + ?Sized>(
     x: &[[Real; 3]],
     cp_inv: &mut [Voigt],
     sink: &mut S,
-) -> Result<(), LoopError> {
+) -> Result<(), ForcesError> {
     for (buffer, got) in [("refs", refs.len()), ("cp_inv", cp_inv.len())] {
         if got != hexes.len() {
-            return Err(LoopError::BufferLength {
+            return Err(ForcesError::BufferLength {
                 buffer,
                 expected: hexes.len(),
                 got,
@@ -334,36 +336,12 @@ pub fn one_point_elements<S: Sink + ?Sized>(
     }
     let id = hexes.as_flattened().iter().fold(0, |m, &i| m.max(i));
     if !hexes.is_empty() && id as usize >= x.len() {
-        return Err(LoopError::NodeId { id, nodes: x.len() });
+        return Err(ForcesError::NodeId { id, nodes: x.len() });
     }
     evaluate(
         path, mat, opts, kappa, hexes, refs, batches, x, cp_inv, sink,
     )
-    .map_err(|(element, error)| LoopError::Element(element, error))
-}
-
-/// Why [`one_point_elements`] stopped.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub enum LoopError {
-    /// `refs` or `cp_inv` is not as long as `hexes`; nothing was evaluated.
-    BufferLength {
-        /// The buffer.
-        buffer: &'static str,
-        /// Entries expected (one per hex).
-        expected: usize,
-        /// Entries given.
-        got: usize,
-    },
-    /// A hex names a node beyond `x`; nothing was evaluated.
-    NodeId {
-        /// The largest node id of the hexes.
-        id: u32,
-        /// Nodes in `x` (ids must be below this).
-        nodes: usize,
-    },
-    /// The update of this element failed (the states of the elements
-    /// before it are updated, its own and the later ones are not).
-    Element(usize, UpdateError),
+    .map_err(|(element, error)| ForcesError::Element(ElementFailure { element, error }))
 }
 
 /// [`one_point_elements`] without its checks, for a caller that has made

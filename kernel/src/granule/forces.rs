@@ -91,7 +91,9 @@ impl core::error::Error for ElementFailure {}
 pub enum ForcesError {
     /// A buffer's length does not match the mesh: `x` and `f` hold one
     /// entry per node, `cp_inv` one per integration point, the mesh's
-    /// `elements` one per hex.
+    /// `elements` one per hex (for
+    /// [`crate::element::batch::one_point_elements`]: `refs` and `cp_inv`
+    /// one per hex).
     BufferLength {
         /// The buffer.
         buffer: &'static str,
