@@ -1322,20 +1322,21 @@ pub fn run_bed(
             {
                 remove_withdrawal_checkpoint(dir)?;
             }
-            let save = |asm: &Assembly<'_>, w: checkpoint::WithdrawalProgress| {
-                let (Some(dir), Some(c)) = (dir, &at_end_checkpoint) else {
-                    return Ok(());
-                };
-                Checkpoint {
-                    progress: checkpoint::Progress {
-                        withdrawal: Some(w),
-                        ..c.progress.clone()
-                    },
-                    state: asm.state(),
+            // The withdrawal's checkpoint: the loading's end's progress
+            // with the withdrawal's, and the state then.
+            let save = dir.zip(at_end_checkpoint.as_ref()).map(|(dir, c)| {
+                move |asm: &Assembly<'_>, w: checkpoint::WithdrawalProgress| {
+                    Checkpoint {
+                        progress: checkpoint::Progress {
+                            withdrawal: Some(w),
+                            ..c.progress.clone()
+                        },
+                        state: asm.state(),
+                    }
+                    .write_as(dir, checkpoint::WITHDRAWAL_FILE_NAME)
+                    .map(|_| ())
                 }
-                .write_as(dir, checkpoint::WITHDRAWAL_FILE_NAME)
-                .map(|_| ())
-            };
+            });
             let u = withdraw(
                 &mut asm,
                 (&die, scene),
@@ -1344,7 +1345,7 @@ pub fn run_bed(
                 &sample,
                 WithdrawalStore {
                     resume,
-                    save: dir.map(|_| &save as _),
+                    save: save.as_ref().map(|f| f as &SaveWithdrawal<'_>),
                     every_s,
                 },
             )?;
