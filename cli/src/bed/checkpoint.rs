@@ -7,7 +7,7 @@
 //! progress ([`Progress`]) and the assembly state. Floats are stored as
 //! their bits, so nothing is rounded.
 
-use std::io::Write as _;
+use std::io::{Seek as _, Write as _};
 use std::path::{Path, PathBuf};
 
 use anyhow::{Context as _, bail};
@@ -91,6 +91,10 @@ const CONSTRAINT_FLOATS: usize = 11;
 /// Granule flag: still a rigid body.
 const FLAG_RIGID: u64 = 1;
 const MAGIC: &[u8; 16] = b"GRANBED-CKPT\0\0\0\0";
+/// Bytes before the payload: the magic, the version, the length, the checksum.
+const HEAD_BYTES: usize = 36;
+/// Where the header's payload length starts (the checksum follows it).
+const LENGTH_AT: u64 = 20;
 
 /// A bed run's progress besides the assembly state.
 #[derive(Clone, Debug, PartialEq)]
@@ -192,7 +196,15 @@ fn window_from(w: [f64; WINDOW_FLOATS], die_normal: f64) -> Window {
 
 /// FNV-1a, 64 bits.
 fn fnv1a(bytes: &[u8]) -> u64 {
-    bytes.iter().fold(0xcbf2_9ce4_8422_2325, |h, &b| {
+    fnv1a_on(FNV1A_START, bytes)
+}
+
+/// FNV-1a 64's hash before any byte.
+const FNV1A_START: u64 = 0xcbf2_9ce4_8422_2325;
+
+/// FNV-1a 64 of `bytes` continued from the hash `h` of the bytes before.
+fn fnv1a_on(h: u64, bytes: &[u8]) -> u64 {
+    bytes.iter().fold(h, |h, &b| {
         (h ^ u64::from(b)).wrapping_mul(0x0000_0100_0000_01b3)
     })
 }
@@ -246,12 +258,64 @@ fn constraint_from(v: [f64; CONSTRAINT_FLOATS]) -> anyhow::Result<Constraint> {
     })
 }
 
-#[derive(Default)]
-struct Enc(Vec<u8>);
+/// The payload's encoder: streams its bytes to `out` in blocks of
+/// [`Enc::BLOCK`], keeping their length and FNV-1a 64 checksum, so that a
+/// checkpoint is written without a copy of the whole payload in memory (for
+/// the published scene about 170 MB, on top of the state it encodes). The
+/// first write error is kept and every later write skipped.
+struct Enc<'w> {
+    block: Vec<u8>,
+    out: &'w mut dyn std::io::Write,
+    len: u64,
+    sum: u64,
+    error: Option<std::io::Error>,
+}
 
-impl Enc {
+impl<'w> Enc<'w> {
+    /// Bytes gathered before they are hashed and written.
+    const BLOCK: usize = 1 << 20;
+
+    fn new(out: &'w mut dyn std::io::Write) -> Self {
+        Self {
+            block: Vec::with_capacity(Self::BLOCK),
+            out,
+            len: 0,
+            sum: FNV1A_START,
+            error: None,
+        }
+    }
+
+    fn put(&mut self, b: &[u8]) {
+        self.block.extend_from_slice(b);
+        if self.block.len() >= Self::BLOCK {
+            self.spill();
+        }
+    }
+
+    /// Hashes, counts and writes the gathered bytes.
+    fn spill(&mut self) {
+        self.sum = fnv1a_on(self.sum, &self.block);
+        self.len += self.block.len() as u64;
+        if self.error.is_none()
+            && let Err(e) = self.out.write_all(&self.block)
+        {
+            self.error = Some(e);
+        }
+        self.block.clear();
+    }
+
+    /// The payload's length and checksum once every byte is written, or the
+    /// first write error.
+    fn finish(mut self) -> std::io::Result<(u64, u64)> {
+        self.spill();
+        match self.error {
+            Some(e) => Err(e),
+            None => Ok((self.len, self.sum)),
+        }
+    }
+
     fn u64(&mut self, v: u64) {
-        self.0.extend_from_slice(&v.to_le_bytes());
+        self.put(&v.to_le_bytes());
     }
     fn f64(&mut self, v: f64) {
         self.u64(v.to_bits());
@@ -272,7 +336,7 @@ impl Enc {
     }
     fn bytes(&mut self, b: &[u8]) {
         self.u64(b.len() as u64);
-        self.0.extend_from_slice(b);
+        self.put(b);
     }
     /// A withdrawal's rows: as the samples, then each one's die-wall
     /// normal force.
@@ -444,9 +508,9 @@ fn sample_from(v: [f64; SAMPLE_FLOATS]) -> BedSample {
 }
 
 impl Checkpoint {
-    fn payload(&self) -> Vec<u8> {
+    /// Encodes the payload into `e`.
+    fn encode(&self, e: &mut Enc<'_>) {
         let (p, s) = (&self.progress, &self.state);
-        let mut e = Enc::default();
         e.bytes(p.scene_toml.as_bytes());
         e.f64s(&[
             p.die.die_radius_m,
@@ -533,7 +597,6 @@ impl Checkpoint {
                 e.rows(&w.rows);
             }
         }
-        e.0
     }
 
     fn from_payload(bytes: &[u8], version: u32) -> anyhow::Result<Self> {
@@ -772,21 +835,28 @@ impl Checkpoint {
 
     /// [`Checkpoint::write`] to `dir/name` (the withdrawal's own file,
     /// [`WITHDRAWAL_FILE_NAME`]).
+    ///
+    /// The payload is streamed after a header whose length and checksum are
+    /// filled in once it is written ([`Enc`]).
     pub fn write_as(&self, dir: &Path, name: &str) -> anyhow::Result<PathBuf> {
-        let payload = self.payload();
         let path = dir.join(name);
         let tmp = dir.join(format!("{name}.tmp"));
         let mut file = std::fs::File::create(&tmp)
             .with_context(|| format!("cannot create `{}`", tmp.display()))?;
-        let mut head = Vec::with_capacity(36);
+        let mut head = Vec::with_capacity(HEAD_BYTES);
         head.extend_from_slice(MAGIC);
         head.extend_from_slice(&VERSION.to_le_bytes());
-        head.extend_from_slice(&(payload.len() as u64).to_le_bytes());
-        head.extend_from_slice(&fnv1a(&payload).to_le_bytes());
-        file.write_all(&head)
-            .and_then(|()| file.write_all(&payload))
-            .and_then(|()| file.sync_all())
-            .with_context(|| format!("cannot write `{}`", tmp.display()))?;
+        head.resize(HEAD_BYTES, 0);
+        let written = file.write_all(&head).and_then(|()| {
+            let mut e = Enc::new(&mut file);
+            self.encode(&mut e);
+            let (len, sum) = e.finish()?;
+            file.seek(std::io::SeekFrom::Start(LENGTH_AT))?;
+            file.write_all(&len.to_le_bytes())?;
+            file.write_all(&sum.to_le_bytes())?;
+            file.sync_all()
+        });
+        written.with_context(|| format!("cannot write `{}`", tmp.display()))?;
         drop(file);
         std::fs::rename(&tmp, &path)
             .with_context(|| format!("cannot move the checkpoint to `{}`", path.display()))?;
@@ -806,7 +876,7 @@ impl Checkpoint {
             .with_context(|| format!("cannot read checkpoint `{}`", path.display()))?;
         let bad =
             |why: &str| anyhow::anyhow!("`{}` is not a usable checkpoint: {why}", path.display());
-        if bytes.len() < 36 || &bytes[..16] != MAGIC {
+        if bytes.len() < HEAD_BYTES || &bytes[..16] != MAGIC {
             return Err(bad("no granbed checkpoint header"));
         }
         let version = u32::from_le_bytes(bytes[16..20].try_into().unwrap_or_default());
@@ -817,7 +887,7 @@ impl Checkpoint {
         }
         let len = u64::from_le_bytes(bytes[20..28].try_into().unwrap_or_default());
         let sum = u64::from_le_bytes(bytes[28..36].try_into().unwrap_or_default());
-        let payload = &bytes[36..];
+        let payload = &bytes[HEAD_BYTES..];
         if (payload.len() as u64) < len {
             return Err(bad(&format!(
                 "truncated ({} of its {len} payload bytes)",
@@ -840,6 +910,52 @@ impl Checkpoint {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The encoder writes exactly the bytes it is given, in order, across
+    /// the boundaries of its blocks, and returns their length and FNV-1a
+    /// checksum, which the reader checks against the whole payload.
+    #[test]
+    fn the_encoder_streams_what_it_counts_and_hashes() {
+        let floats: Vec<f64> = (0..400_000).map(|k| f64::from(k) * 0.37 - 5.0).collect();
+        let text = b"granules = 30";
+        let mut out = Vec::new();
+        let mut e = Enc::new(&mut out);
+        e.bytes(text);
+        e.f64s(&floats);
+        e.u64(7);
+        let (len, sum) = e.finish().unwrap();
+        let mut expected = (text.len() as u64).to_le_bytes().to_vec();
+        expected.extend_from_slice(text);
+        expected.extend_from_slice(&(floats.len() as u64).to_le_bytes());
+        for x in &floats {
+            expected.extend_from_slice(&x.to_bits().to_le_bytes());
+        }
+        expected.extend_from_slice(&7u64.to_le_bytes());
+        assert!(expected.len() > 3 * Enc::BLOCK, "crosses block boundaries");
+        assert_eq!(out, expected);
+        assert_eq!(len, expected.len() as u64);
+        assert_eq!(sum, fnv1a(&expected));
+    }
+
+    /// A write that fails is returned by `finish`, not lost, whatever was
+    /// encoded after it.
+    #[test]
+    fn the_encoder_returns_its_first_write_error() {
+        struct Full;
+        impl std::io::Write for Full {
+            fn write(&mut self, _: &[u8]) -> std::io::Result<usize> {
+                Err(std::io::Error::other("disk full"))
+            }
+            fn flush(&mut self) -> std::io::Result<()> {
+                Ok(())
+            }
+        }
+        let mut out = Full;
+        let mut e = Enc::new(&mut out);
+        e.f64s(&vec![1.0; 300_000]);
+        e.u64(1);
+        assert_eq!(e.finish().unwrap_err().to_string(), "disk full");
+    }
 
     /// A held constraint reads back as written, its floats to the bit, on
     /// either side, ordinary or a watch; another side value is refused.
