@@ -32,7 +32,7 @@ pub struct ExportMeshArgs {
     #[arg(long)]
     pub octant: bool,
     /// Granule diameter, mm (0.001 ≤ d ≤ 1000).
-    #[arg(long, default_value_t = 1.0, allow_negative_numbers = true)]
+    #[arg(value_parser = crate::numbers::real, long, default_value_t = 1.0, allow_negative_numbers = true)]
     pub diameter_mm: f64,
     /// Length unit of the node coordinates.
     #[arg(long, value_enum, default_value = "m")]

@@ -28,42 +28,42 @@ pub struct MaterialArgs {
     pub granule_type: GranuleType,
 
     /// Young's modulus E of the granule skeleton, Pa (1e-3 ≤ E ≤ 1e13).
-    #[arg(long, value_name = "PA", allow_negative_numbers = true)]
+    #[arg(value_parser = crate::numbers::real, long, value_name = "PA", allow_negative_numbers = true)]
     pub youngs_modulus_pa: Option<f64>,
 
     /// Poisson's ratio ν, dimensionless (−1 < ν < 0.5).
-    #[arg(long, value_name = "NU", allow_negative_numbers = true)]
+    #[arg(value_parser = crate::numbers::real, long, value_name = "NU", allow_negative_numbers = true)]
     pub poisson_ratio: Option<f64>,
 
     /// Yield stress σy of the solid (Kirchhoff measure), Pa (≥ 1e-3; `inf`
     /// makes the material purely elastic).
-    #[arg(long, value_name = "PA", allow_negative_numbers = true)]
+    #[arg(value_parser = crate::numbers::real, long, value_name = "PA", allow_negative_numbers = true)]
     pub yield_stress_pa: Option<f64>,
 
     /// Initial relative density η0 (solid fraction), dimensionless
     /// (ηc < η0 ≤ 1).
-    #[arg(long, value_name = "ETA", allow_negative_numbers = true)]
+    #[arg(value_parser = crate::numbers::real, long, value_name = "ETA", allow_negative_numbers = true)]
     pub eta0: Option<f64>,
 
     /// Yield-surface pressure constant cp of a1(η) = cp(1 − η²),
     /// dimensionless (0 ≤ cp ≤ 1e3).
-    #[arg(long, value_name = "CP", allow_negative_numbers = true)]
+    #[arg(value_parser = crate::numbers::real, long, value_name = "CP", allow_negative_numbers = true)]
     pub cp: Option<f64>,
 
     /// Critical relative density ηc where the yield surface vanishes,
     /// dimensionless (0 ≤ ηc < 1, and below η0).
-    #[arg(long, value_name = "ETA", allow_negative_numbers = true)]
+    #[arg(value_parser = crate::numbers::real, long, value_name = "ETA", allow_negative_numbers = true)]
     pub eta_c: Option<f64>,
 
     /// True (solid) density of the granule material, kg/m³
     /// (1e-3 ≤ ρ ≤ 1e5);
     /// the granule's density is η0 times this.
-    #[arg(long, value_name = "KG_M3", allow_negative_numbers = true)]
+    #[arg(value_parser = crate::numbers::real, long, value_name = "KG_M3", allow_negative_numbers = true)]
     pub true_density_kg_m3: Option<f64>,
 
     /// Coulomb friction coefficient of the granule surface, dimensionless
     /// (finite, ≥ 0).
-    #[arg(long, value_name = "MU", allow_negative_numbers = true)]
+    #[arg(value_parser = crate::numbers::real, long, value_name = "MU", allow_negative_numbers = true)]
     pub friction: Option<f64>,
 }
 

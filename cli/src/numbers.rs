@@ -1,7 +1,10 @@
 //! Whole-number flags (`--granules`, `--seed`, `-j`, …): a value parser
 //! whose rejection says what is allowed, where the standard integer
 //! parsers say "invalid digit found in string" for `-3`, `1.5` or `1e3`;
-//! and the comma lists of distinct values of `--types` and `--seeds`.
+//! the number flags' parser ([`real`]), which refuses what the standard
+//! one reads as something else (`1e400` as infinity, `1e-400` as 0) and
+//! says how to write a number it cannot read (`1mm`, `0,5`); and the comma
+//! lists of distinct values of `--types` and `--seeds`.
 
 /// A clap value parser of whole numbers `lo..=hi` written in digits; a
 /// rejection (clap prefixes the flag and the value) gives the range.
@@ -23,6 +26,52 @@ where
             .and_then(|n| T::try_from(n).ok())
             .ok_or_else(|| format!("out of range ({allowed})"))
     }
+}
+
+/// The clap value parser of every number flag (`--diameter-mm`,
+/// `--yield-stress-pa`, …). It reads what Rust's `f64` parser reads —
+/// `inf` and `nan` included, which each flag's own check then allows or
+/// refuses with its range — but refuses a written number the double cannot
+/// hold instead of reading it as another: one beyond about 1.8e308 (read as
+/// infinity) or a nonzero one below about 4.9e-324 (read as 0). A value it
+/// cannot read gets a hint: a decimal comma (`0,5`) or a unit after the
+/// number (`1mm`, `30kPa`: the unit is in the flag's name).
+pub fn real(text: &str) -> Result<f64, String> {
+    let t = text.trim();
+    let Ok(x) = t.parse::<f64>() else {
+        let number_part = t.trim_end_matches(|c: char| c.is_alphabetic() || c == '%' || c == ' ');
+        return Err(
+            if t.contains(',') && t.replacen(',', ".", 1).parse::<f64>().is_ok() {
+                format!(
+                    "not a number: write a decimal point, not a comma (`{}`)",
+                    t.replacen(',', ".", 1)
+                )
+            } else if number_part != t
+                && !number_part.is_empty()
+                && number_part.parse::<f64>().is_ok()
+            {
+                format!(
+                    "not a number: write the number alone (`{number_part}`); the flag's name gives its unit"
+                )
+            } else {
+                "not a number (write e.g. 0.5, 2e-3 or 30000)".to_owned()
+            },
+        );
+    };
+    let mantissa = t.split(['e', 'E']).next().unwrap_or(t);
+    let spelled_infinite = t
+        .trim_start_matches(['+', '-'])
+        .to_ascii_lowercase()
+        .starts_with("inf");
+    if x.is_infinite() && !spelled_infinite {
+        return Err(
+            "beyond the largest double (about 1.8e308); it would be read as infinity".to_owned(),
+        );
+    }
+    if x == 0.0 && mantissa.chars().any(|c| ('1'..='9').contains(&c)) {
+        return Err("below the smallest double (about 4.9e-324); it would be read as 0".to_owned());
+    }
+    Ok(x)
 }
 
 /// The comma list `text` parsed item by item (items trimmed) with
@@ -70,6 +119,41 @@ mod tests {
         }
         assert_eq!(significant(0.5, 0), "0.5");
         assert_eq!(significant(2.0 / 3.0, 2), "0.67");
+    }
+
+    /// Numbers are read as Rust reads them, `inf` and `nan` included; a
+    /// written number the double cannot hold is refused, not read as
+    /// infinity or 0; a unit or a decimal comma gets a hint.
+    #[test]
+    fn real_refuses_what_a_double_would_misread() {
+        for (text, x) in [
+            ("0.5", 0.5),
+            (" 30000 ", 30_000.0),
+            ("2e-3", 2e-3),
+            ("-0", -0.0),
+            ("0e5", 0.0),
+            ("0.000", 0.0),
+            ("1e308", 1e308),
+            ("5e-324", 5e-324),
+            ("inf", f64::INFINITY),
+            ("-Infinity", f64::NEG_INFINITY),
+        ] {
+            assert_eq!(real(text).map(f64::to_bits), Ok(x.to_bits()), "{text}");
+        }
+        assert!(real("nan").unwrap().is_nan());
+        let refused = |text: &str, says: &str| {
+            let e = real(text).unwrap_err();
+            assert!(e.contains(says), "{text}: {e}");
+        };
+        refused("1e400", "largest double");
+        refused("-2e309", "largest double");
+        refused("1e-400", "smallest double");
+        refused("0,5", "decimal point, not a comma (`0.5`)");
+        refused("1mm", "the number alone (`1`)");
+        refused("30 kPa", "the number alone (`30`)");
+        refused("12%", "the number alone (`12`)");
+        refused("abc", "not a number (write");
+        refused("", "not a number (write");
     }
 
     #[test]

@@ -135,7 +135,7 @@ pub struct PointArgs {
     /// on --path: hydrostatic = volume reduction 1 − J, uniaxial-* = axial
     /// nominal strain, shear = shear strain γ. Allowed open ranges:
     /// −10 < strain < 1 (hydrostatic, uniaxial-*), −10 < γ < 10 (shear).
-    #[arg(long, default_value_t = 0.3, allow_negative_numbers = true)]
+    #[arg(value_parser = crate::numbers::real, long, default_value_t = 0.3, allow_negative_numbers = true)]
     pub strain: f64,
 
     /// Number of equal strain increments (1 to 10000000); the CSV has

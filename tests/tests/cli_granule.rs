@@ -435,8 +435,22 @@ fn platens_carry_equal_forces() {
 fn bad_input_names_the_flag() {
     let dir = out_dir("bad");
     let out = dir.to_str().unwrap();
-    let cases: [(&[&str], &str); 18] = [
+    let cases: [(&[&str], &str); 21] = [
         (&["--strain", "0"], "--strain"),
+        // Numbers a double would misread, and a unit: refused by the
+        // number flags' parser with the flag named by clap.
+        (
+            &["--yield-stress-pa", "1e400"],
+            "'1e400' for '--yield-stress-pa <PA>': beyond the largest double",
+        ),
+        (
+            &["--youngs-modulus-pa", "1e-400"],
+            "'1e-400' for '--youngs-modulus-pa <PA>': below the smallest double",
+        ),
+        (
+            &["--diameter-mm", "1mm"],
+            "'1mm' for '--diameter-mm <MM>': not a number: write the number alone (`1`)",
+        ),
         (
             &["--diameter-mm", "0"],
             "`--diameter-mm 0` is out of range (allowed: 0.001 <= d <= 1000 mm)",

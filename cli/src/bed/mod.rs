@@ -303,7 +303,7 @@ pub struct BedArgs {
     /// Override: final axial strain (0 < C ≤ 0.9, at least the scene's
     /// output_strain_interval); the scene's snapshot strains beyond it are
     /// dropped. With --resume, a run already past it takes no step.
-    #[arg(long, value_name = "C", allow_negative_numbers = true)]
+    #[arg(value_parser = crate::numbers::real, long, value_name = "C", allow_negative_numbers = true)]
     pub strain: Option<f64>,
 
     /// Override: seed of the pour and the rotations (a whole number
@@ -313,18 +313,18 @@ pub struct BedArgs {
     pub seed: Option<u64>,
 
     /// Override: die diameter, mm (more than 4 granule diameters).
-    #[arg(long, value_name = "MM", allow_negative_numbers = true)]
+    #[arg(value_parser = crate::numbers::real, long, value_name = "MM", allow_negative_numbers = true)]
     pub die_diameter_mm: Option<f64>,
 
     /// Override: granule diameter, mm (0.001 ≤ d < 2000; the die must stay
     /// more than 4 granule diameters wide).
-    #[arg(long, value_name = "MM", allow_negative_numbers = true)]
+    #[arg(value_parser = crate::numbers::real, long, value_name = "MM", allow_negative_numbers = true)]
     pub diameter_mm: Option<f64>,
 
     /// Override: upper-punch speed, m/s (1e-4 ≤ v ≤ 10; published 0.05). A
     /// slower punch brings a run closer to quasi-static at the cost of
     /// proportionally more steps.
-    #[arg(long, value_name = "M_S", allow_negative_numbers = true)]
+    #[arg(value_parser = crate::numbers::real, long, value_name = "M_S", allow_negative_numbers = true)]
     pub punch_speed_m_s: Option<f64>,
 
     /// Override: element formulation (one-point, or fbar for verification:
@@ -334,7 +334,7 @@ pub struct BedArgs {
 
     /// Override: hourglass coefficient κ of the one-point element
     /// (0 ≤ κ ≤ 1).
-    #[arg(long, value_name = "KAPPA", allow_negative_numbers = true)]
+    #[arg(value_parser = crate::numbers::real, long, value_name = "KAPPA", allow_negative_numbers = true)]
     pub hourglass_kappa: Option<f64>,
 
     /// Override: after the final strain the upper punch withdraws at the
@@ -368,14 +368,14 @@ pub struct BedArgs {
     /// deeper than this fraction of the element size is left (0 < t ≤ 0.1;
     /// the published scene's is 0.01, 0.005 leaves half the overlap for a
     /// quarter more sweeps). Allowed with --resume.
-    #[arg(long, value_name = "T", allow_negative_numbers = true)]
+    #[arg(value_parser = crate::numbers::real, long, value_name = "T", allow_negative_numbers = true)]
     pub sweep_tolerance: Option<f64>,
 
     /// Override: skin of the contact search's per-node face lists as a
     /// fraction of the mean surface-face diagonal (0 ≤ s ≤ 1, 0: none;
     /// default 0.05). Only the speed depends on it, so it may be given with
     /// --resume.
-    #[arg(long, value_name = "S", allow_negative_numbers = true)]
+    #[arg(value_parser = crate::numbers::real, long, value_name = "S", allow_negative_numbers = true)]
     pub face_list_skin: Option<f64>,
 
     /// Override: the contact search runs every N steps (1..=10); the steps
@@ -393,7 +393,7 @@ pub struct BedArgs {
     /// front of a face are held with the contacts, so that the steps
     /// between two searches (--contact-search-interval) see them close.
     /// Allowed with --resume.
-    #[arg(long, value_name = "C", allow_negative_numbers = true)]
+    #[arg(value_parser = crate::numbers::real, long, value_name = "C", allow_negative_numbers = true)]
     pub contact_capture: Option<f64>,
 
     /// Override: where a pair re-measures the contacts it holds (later
@@ -402,7 +402,7 @@ pub struct BedArgs {
     /// element size is projected on the face afresh, and (with a capture
     /// distance) nodes just beside a face are watched (0 < S ≤ 1, or inf:
     /// neither; published 0.05). Allowed with --resume.
-    #[arg(long, value_name = "S", allow_negative_numbers = true)]
+    #[arg(value_parser = crate::numbers::real, long, value_name = "S", allow_negative_numbers = true)]
     pub held_reprojection: Option<f64>,
 
     /// Override: a node behind faces it projects inside is held against
@@ -417,13 +417,13 @@ pub struct BedArgs {
     /// (--exact-contact-from-strain) on, as a fraction of the element size
     /// (0 < t ≤ 0.1; published 0.005, scene files without the field:
     /// --sweep-tolerance's). Allowed with --resume.
-    #[arg(long, value_name = "T", allow_negative_numbers = true)]
+    #[arg(value_parser = crate::numbers::real, long, value_name = "T", allow_negative_numbers = true)]
     pub exact_sweep_tolerance: Option<f64>,
 
     /// Override: from this axial strain on every contact sweep searches,
     /// as with --hold-constraints false --contact-search-interval 1
     /// (0 ≤ C ≤ 1, 1: never; published 0.3). Allowed with --resume.
-    #[arg(long, value_name = "C", allow_negative_numbers = true)]
+    #[arg(value_parser = crate::numbers::real, long, value_name = "C", allow_negative_numbers = true)]
     pub exact_contact_from_strain: Option<f64>,
 
     /// Override: the Kawakita fit of summary.json takes the output rows
@@ -431,14 +431,14 @@ pub struct BedArgs {
     /// which its averaged pressure belongs (0 ≤ C ≤ 0.9; published 0.25,
     /// physics.md). Allowed
     /// with --resume: on a finished run it refits without a step.
-    #[arg(long, value_name = "C", allow_negative_numbers = true)]
+    #[arg(value_parser = crate::numbers::real, long, value_name = "C", allow_negative_numbers = true)]
     pub kawakita_min_strain: Option<f64>,
 
     /// Override: the Heckel fit of summary.json (ln(1/(1 - D)) against P)
     /// takes the output rows with C ≥ this, C the row's interval mean
     /// strain, as for --kawakita-min-strain (0 ≤ C ≤ 0.9; published 0.25).
     /// Allowed with --resume: on a finished run it refits without a step.
-    #[arg(long, value_name = "C", allow_negative_numbers = true)]
+    #[arg(value_parser = crate::numbers::real, long, value_name = "C", allow_negative_numbers = true)]
     pub heckel_min_strain: Option<f64>,
 
     /// Continue the run whose checkpoint is in DIR (its `checkpoint.bin`),
@@ -457,7 +457,7 @@ pub struct BedArgs {
 
     /// Write a checkpoint and stop once the strain reaches C (continue
     /// later with --resume; 0 < C ≤ the final strain).
-    #[arg(long, value_name = "C", allow_negative_numbers = true)]
+    #[arg(value_parser = crate::numbers::real, long, value_name = "C", allow_negative_numbers = true)]
     pub stop_at_strain: Option<f64>,
 
     /// Override: mass scaling F ≥ 1 for quasi-static runs (the stable step
@@ -466,7 +466,7 @@ pub struct BedArgs {
     /// --selective-mass-ratio); 1 gives physical masses; 10 takes 40 % more
     /// steps than 20, 30 a fifth fewer (and fails the certificate narrowly
     /// on the published scene; 1 ≤ F ≤ 1e6).
-    #[arg(long, value_name = "F", allow_negative_numbers = true)]
+    #[arg(value_parser = crate::numbers::real, long, value_name = "F", allow_negative_numbers = true)]
     pub mass_scaling: Option<f64>,
 
     /// Override: the mass scaling acts on the granules' deformational modes,
@@ -482,13 +482,13 @@ pub struct BedArgs {
     /// inertia (the published scene's R is 10; inf: G = 1 for any F). Above
     /// 10 the contacts of a granule pressed on a punch can inject energy (the
     /// summary's contact loss and certificate show it).
-    #[arg(long, value_name = "R", allow_negative_numbers = true)]
+    #[arg(value_parser = crate::numbers::real, long, value_name = "R", allow_negative_numbers = true)]
     pub selective_mass_ratio: Option<f64>,
 
     /// Override: safety factor on the stable time step 2/ω_max
     /// (0 < C ≤ 2; default 0.9; above 1 the run is unstable). Allowed with
     /// --resume, e.g. to continue a run that failed with a smaller step.
-    #[arg(long, value_name = "C", allow_negative_numbers = true)]
+    #[arg(value_parser = crate::numbers::real, long, value_name = "C", allow_negative_numbers = true)]
     pub time_step_safety: Option<f64>,
 
     /// Override: variable mass scaling — a granule whose stable step falls
@@ -498,12 +498,12 @@ pub struct BedArgs {
     /// (a scene file without the field: 0). The summary reports the
     /// granules scaled and the mass added. Allowed with --resume (masses
     /// already added stay).
-    #[arg(long, value_name = "R", allow_negative_numbers = true)]
+    #[arg(value_parser = crate::numbers::real, long, value_name = "R", allow_negative_numbers = true)]
     pub time_step_floor: Option<f64>,
 
     /// Override: the largest factor K variable mass scaling puts on a
     /// granule's masses (1 ≤ K ≤ 1e6; default 4).
-    #[arg(long, value_name = "K", allow_negative_numbers = true)]
+    #[arg(value_parser = crate::numbers::real, long, value_name = "K", allow_negative_numbers = true)]
     pub max_mass_factor: Option<f64>,
 
     /// The quasi-static certificate's rate check: after the run, press the

@@ -239,7 +239,7 @@ pub struct GranuleArgs {
     /// approach / d. A granule of k × d at the same platen speed in mm/s
     /// is the same experiment scaled (the same stresses at each strain,
     /// forces × k²) as long as there is no gravity.
-    #[arg(
+    #[arg(value_parser = crate::numbers::real,
         long,
         value_name = "MM",
         default_value_t = 1.0,
@@ -256,12 +256,12 @@ pub struct GranuleArgs {
     pub element: ElementArg,
 
     /// Final strain: platen approach / granule diameter (0 < strain ≤ 0.9).
-    #[arg(long, default_value_t = 0.4, allow_negative_numbers = true)]
+    #[arg(value_parser = crate::numbers::real, long, default_value_t = 0.4, allow_negative_numbers = true)]
     pub strain: f64,
 
     /// Speed at which the platens approach each other, mm/s
     /// (0.1 ≤ speed ≤ 10000); each platen moves at half of it.
-    #[arg(
+    #[arg(value_parser = crate::numbers::real,
         long,
         value_name = "MM_S",
         default_value_t = 5.0,
@@ -271,7 +271,7 @@ pub struct GranuleArgs {
 
     /// Fraction ξ of critical damping of the granule's lowest
     /// deformational mode (0 ≤ ξ ≤ 2).
-    #[arg(
+    #[arg(value_parser = crate::numbers::real,
         long,
         value_name = "XI",
         default_value_t = 0.5,
@@ -281,7 +281,7 @@ pub struct GranuleArgs {
 
     /// Hourglass stiffness coefficient κ of the one-point hexes
     /// (0 ≤ κ ≤ 1).
-    #[arg(
+    #[arg(value_parser = crate::numbers::real,
         long,
         value_name = "KAPPA",
         default_value_t = 0.05,
@@ -295,7 +295,7 @@ pub struct GranuleArgs {
 
     /// Strain between samples (CSV rows); the platen forces are averaged
     /// over each interval (10⁻⁶ ≤ interval ≤ --strain).
-    #[arg(
+    #[arg(value_parser = crate::numbers::real,
         long,
         value_name = "STRAIN",
         default_value_t = 0.005,
@@ -308,7 +308,7 @@ pub struct GranuleArgs {
     pub time_step_method: TimeStepArg,
 
     /// Safety factor C of the time-step estimate (0 < C ≤ 1).
-    #[arg(
+    #[arg(value_parser = crate::numbers::real,
         long,
         value_name = "C",
         default_value_t = 0.9,
@@ -324,7 +324,7 @@ pub struct GranuleArgs {
     /// stable step grows by √F. Check `quasi_static` in summary.json, and
     /// note that F > 1 raises σ_est of soft granules (A3: +1.1 % at ×4,
     /// +2.4 % at ×10; BENCHMARKS.md).
-    #[arg(
+    #[arg(value_parser = crate::numbers::real,
         long,
         value_name = "F",
         default_value_t = STANDARD_MASS_SCALING,

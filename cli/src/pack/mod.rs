@@ -139,18 +139,18 @@ pub struct PackMaterialArgs {
 
     /// Initial relative density η0 (solid fraction) of the granules,
     /// dimensionless (ηc < η0 ≤ 1, ηc = 0.2 in every preset).
-    #[arg(long, value_name = "ETA", allow_negative_numbers = true)]
+    #[arg(value_parser = crate::numbers::real, long, value_name = "ETA", allow_negative_numbers = true)]
     pub eta0: Option<f64>,
 
     /// True (solid) density of the granule material, kg/m³
     /// (1e-3 ≤ ρ ≤ 1e5);
     /// the spheres' density is η0 times this.
-    #[arg(long, value_name = "KG_M3", allow_negative_numbers = true)]
+    #[arg(value_parser = crate::numbers::real, long, value_name = "KG_M3", allow_negative_numbers = true)]
     pub true_density_kg_m3: Option<f64>,
 
     /// Coulomb friction coefficient of the sphere–sphere and the
     /// sphere–wall (floor and die) contacts, dimensionless (finite, ≥ 0).
-    #[arg(long, value_name = "MU", allow_negative_numbers = true)]
+    #[arg(value_parser = crate::numbers::real, long, value_name = "MU", allow_negative_numbers = true)]
     pub friction: Option<f64>,
 }
 
@@ -255,7 +255,7 @@ pub struct PackArgs {
     /// Give up (exit status 1, outputs still written) if the spheres are not
     /// at rest after this simulated time, s (finite, after the end of the
     /// dissipation ramp at 0.30 s).
-    #[arg(
+    #[arg(value_parser = crate::numbers::real,
         long,
         value_name = "S",
         default_value_t = 3.0,

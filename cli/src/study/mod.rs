@@ -103,12 +103,12 @@ pub struct WorkPrecisionArgs {
 
     /// bed-small: die diameter, mm (more than 4 and at most 1000 granule
     /// diameters; default 5.65; 4.2 with --quick).
-    #[arg(long, value_name = "MM", allow_negative_numbers = true)]
+    #[arg(value_parser = crate::numbers::real, long, value_name = "MM", allow_negative_numbers = true)]
     pub die_diameter_mm: Option<f64>,
 
     /// bed-small: final axial strain (0 < C ≤ 0.9; default 0.3, with
     /// --quick too).
-    #[arg(long, value_name = "C", allow_negative_numbers = true)]
+    #[arg(value_parser = crate::numbers::real, long, value_name = "C", allow_negative_numbers = true)]
     pub strain: Option<f64>,
 
     /// bed-small: mesh level of the granules (default 4x1).
@@ -171,7 +171,7 @@ pub struct StabilityArgs {
     pub mesh: MeshLevel,
 
     /// Die diameter, mm (more than 4 and at most 1000 granule diameters).
-    #[arg(
+    #[arg(value_parser = crate::numbers::real,
         long,
         value_name = "MM",
         default_value_t = 5.0,
@@ -180,7 +180,7 @@ pub struct StabilityArgs {
     pub die_diameter_mm: f64,
 
     /// Final axial strain of the beds (0 < C ≤ 0.9).
-    #[arg(
+    #[arg(value_parser = crate::numbers::real,
         long,
         value_name = "C",
         default_value_t = 0.6,
@@ -193,7 +193,7 @@ pub struct StabilityArgs {
     pub granule_mesh: MeshLevel,
 
     /// Final platen strain x/d of the single granules (0 < C ≤ 0.9).
-    #[arg(
+    #[arg(value_parser = crate::numbers::real,
         long,
         value_name = "C",
         default_value_t = 0.7,
@@ -209,22 +209,22 @@ pub struct StabilityArgs {
 
     /// Override the beds' speed watchdog (× punch speed; default: the
     /// published scene's; 1 ≤ r ≤ 1e9).
-    #[arg(long, value_name = "R", allow_negative_numbers = true)]
+    #[arg(value_parser = crate::numbers::real, long, value_name = "R", allow_negative_numbers = true)]
     pub watchdog_speed_ratio: Option<f64>,
 
     /// Override the beds' contact-sweep tolerance (fraction of the element
     /// size, 0 < t ≤ 0.1; default: the published scene's).
-    #[arg(long, value_name = "T", allow_negative_numbers = true)]
+    #[arg(value_parser = crate::numbers::real, long, value_name = "T", allow_negative_numbers = true)]
     pub sweep_tolerance: Option<f64>,
 
     /// Override the beds' mass scaling, 1 ≤ F ≤ 1e6 (default: the
     /// published scene's, selective with its ratio limit).
-    #[arg(long, value_name = "F", allow_negative_numbers = true)]
+    #[arg(value_parser = crate::numbers::real, long, value_name = "F", allow_negative_numbers = true)]
     pub mass_scaling: Option<f64>,
 
     /// Override the beds' time-step floor of variable mass scaling,
     /// 0 ≤ r ≤ 1 (0: off; default: the published scene's).
-    #[arg(long, value_name = "R", allow_negative_numbers = true)]
+    #[arg(value_parser = crate::numbers::real, long, value_name = "R", allow_negative_numbers = true)]
     pub time_step_floor: Option<f64>,
 
     /// Override the beds' rule for a node behind several faces (default:
