@@ -50,8 +50,11 @@ pub enum Command {
     /// Kawakita fit. Without arguments it runs the published scene.
     // Boxed: its options are most of the enum's size.
     Bed(Box<BedArgs>),
-    /// Studies of the code itself: `work-precision` measures what each
-    /// numerical setting costs and how far it moves the answer.
+    /// Studies of the code itself: `work-precision` (what each numerical
+    /// setting costs and how far it moves the answer), `stability` (every
+    /// granule type far past 30 % strain), `compare` (how far one bed run
+    /// lies from another) and `element-time` (the element's time per
+    /// element-step on a checkpoint's state).
     Study(StudyArgs),
 }
 

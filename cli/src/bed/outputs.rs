@@ -798,14 +798,23 @@ fn not_quasi_static(scene: &Scene, run: &BedRun, q: &QuasiStatic) -> Option<Stri
     let judged = granbed_kernel::analysis::quasi_static::judged(&run.samples);
     let from = judged.first().map_or(Real::NAN, |s| s.strain);
     let to = judged.last().map_or(Real::NAN, |s| s.strain);
+    // Lighter masses are advice only where they are scaled up: 1 is the
+    // physical mass and the smallest allowed.
+    let lighter = if scene.mass_scaling > 1.0 {
+        format!(
+            " or lighter masses (--mass-scaling, now {})",
+            scene.mass_scaling
+        )
+    } else {
+        String::new()
+    };
     Some(format!(
         "NOT quasi-static over C = {from:.3} to {to:.3} (the second half of the output rows, \
          which the certificate judges): {}. Inertia is in these figures: a slower punch \
-         (--punch-speed-m-s, now {} m/s) or lighter masses (--mass-scaling, now {}) reduce \
-         it; a bed of few granules rearranges by jumps whatever the speed",
+         (--punch-speed-m-s, now {} m/s){lighter} reduces it; a bed of few granules \
+         rearranges by jumps whatever the speed",
         q.figures(),
         scene.punch_speed_m_s,
-        scene.mass_scaling,
     ))
 }
 
@@ -1240,6 +1249,40 @@ mod tests {
             min_strain: 0.25,
         };
         assert!(kawakita_doubts(&none).is_empty());
+    }
+
+    /// The warning of a failed certificate advises lighter masses only
+    /// where the masses are scaled up; at the physical mass (1, the
+    /// smallest allowed) only a slower punch.
+    #[test]
+    fn lighter_masses_are_advised_only_above_the_physical_mass() {
+        use crate::bed::run::{BedRun, BedSample};
+        let run = BedRun::of_samples(vec![BedSample::default(); 4]);
+        let failed = QuasiStatic {
+            max_kinetic_to_internal: Some(0.5),
+            max_relative_kinetic_to_internal: None,
+            force_imbalance_rel: Some(0.01),
+            rate_change_rel: None,
+            passed: false,
+        };
+        let mut scene = Scene::published();
+        let scaled = not_quasi_static(&scene, &run, &failed).unwrap();
+        assert!(
+            scaled.contains("a slower punch (--punch-speed-m-s, now 0.05 m/s) or lighter masses (--mass-scaling, now 20) reduces it"),
+            "{scaled}"
+        );
+        scene.mass_scaling = 1.0;
+        let physical = not_quasi_static(&scene, &run, &failed).unwrap();
+        assert!(
+            physical.contains("a slower punch (--punch-speed-m-s, now 0.05 m/s) reduces it"),
+            "{physical}"
+        );
+        assert!(!physical.contains("lighter"), "{physical}");
+        let passed = QuasiStatic {
+            passed: true,
+            ..failed
+        };
+        assert_eq!(not_quasi_static(&scene, &run, &passed), None);
     }
 
     /// The R² rule of both fits: 0.9 and above is linear, below it and NaN
