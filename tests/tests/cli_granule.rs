@@ -804,3 +804,34 @@ fn kernel_failure_keeps_partial_results() {
     assert!(html.contains("<p><strong>The run stopped early:</strong>"));
     assert!(!html.contains("<img"));
 }
+
+/// A coarse output interval keeps the unloaded state out of σ_est, and the
+/// notes say what the fit covered: sampled every 0.2 the fit starts at the
+/// 0.2 sample (half an interval at the low end would have reached down to
+/// strain 0 and fitted the unloaded state, 34 % low with samples every
+/// 0.4); every 0.4 there is one sample in 0.1–0.4 and no σ_est.
+#[test]
+fn a_coarse_output_interval_keeps_the_unloaded_state_out_of_sigma_est() {
+    let dir = out_dir("coarse_interval");
+    let run = granule_ok(&dir, &["--mesh", "4x1", "--output-strain", "0.2"]);
+    let s = summary(&dir);
+    let range = &s["sigma_est_strain_range"];
+    let first = range[0].as_f64().unwrap();
+    assert!((0.2..0.2001).contains(&first), "{range}");
+    assert_eq!(number(&s, "fit_points"), 2.0);
+    let note = s["notes"][0].as_str().unwrap();
+    assert!(
+        note.contains("not 0.1 to 0.4: the output interval 0.2 places no sample near 0.1"),
+        "{note}"
+    );
+    assert!(run.stderr.contains(note), "{}", run.stderr);
+    let dir = out_dir("coarse_interval_04");
+    granule_ok(&dir, &["--mesh", "4x1", "--output-strain", "0.4"]);
+    let s = summary(&dir);
+    assert_eq!(s["sigma_est_pa"], Value::Null, "{s}");
+    let note = s["notes"][0].as_str().unwrap();
+    assert!(
+        note.contains("the output interval 0.4 places fewer there"),
+        "{note}"
+    );
+}

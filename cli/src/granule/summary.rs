@@ -111,10 +111,10 @@ pub struct Summary {
     pub sigma_est_pa: Option<Real>,
     /// Strain range the fit actually covered, x/d: the first and the last
     /// sample within [`FIT_STRAIN_RANGE`], each end widened by half an
-    /// output interval ([`granbed_kernel::analysis::granule::fit_window`]: a sample lies up to a step past its
+    /// output interval, at most 0.05 ([`granbed_kernel::analysis::granule::fit_window`]: a sample lies up to a step past its
     /// nominal strain, so the 40 % sample is 0.4000019) (narrower when the run ends
-    /// before 0.4, which `notes` and stderr then say); `null` without a
-    /// fit.
+    /// before 0.4, or when an interval above 0.1 places no sample near
+    /// 0.1, which `notes` and stderr then say); `null` without a fit.
     pub sigma_est_strain_range: Option<[Real; 2]>,
     /// σ_y,eff0 = √a2(η0)·σ_y, Pa.
     pub sigma_eff0_pa: Real,
@@ -180,13 +180,26 @@ impl Summary {
         let fit = sigma_est.map(|s| (s.sigma_pa, s.fit));
         let mut notes = Vec::new();
         match fitted_range {
-            None => notes.push(format!(
+            None if final_strain < hi => notes.push(format!(
                 "sigma_est needs at least two samples with {lo} <= strain <= {hi}; the run \
                  ended at strain {final_strain}"
+            )),
+            None => notes.push(format!(
+                "sigma_est needs at least two samples with {lo} <= strain <= {hi}; the output \
+                 interval {} places fewer there",
+                p.output_strain_interval
             )),
             Some([a, b]) if final_strain < hi => notes.push(format!(
                 "sigma_est was fitted over strain {a} to {b} only, not {lo} to {hi}: the run \
                  ended at strain {final_strain}"
+            )),
+            // The first sample more than a quarter interval above 10 %: none
+            // was written nominally at 10 % (a sample lies at most a step
+            // past its nominal strain).
+            Some([a, b]) if a > lo + 0.25 * p.output_strain_interval => notes.push(format!(
+                "sigma_est was fitted over strain {a} to {b} only, not {lo} to {hi}: the \
+                 output interval {} places no sample near {lo}",
+                p.output_strain_interval
             )),
             Some(_) => {}
         }

@@ -15,14 +15,20 @@ pub const FIT_STRAIN_RANGE: [Real; 2] = [0.1, 0.4];
 
 /// The window of x/d that the σ_est fit takes from samples written every
 /// `interval` of strain: [`FIT_STRAIN_RANGE`] widened by half an interval
-/// at each end. A sample lies up to one time step past its nominal strain
-/// (a run stops once it has reached 40 %, at 0.4000019 for the standard
-/// granule), so the nominal bounds would drop the 40 % sample; the half
-/// interval takes the samples nominally at 10 % and 40 % and no others.
-/// `interval` must be positive (the scene's `output_strain_interval`).
+/// at each end, but by at most half of its lower bound (5 %). A sample lies
+/// up to one time step past its nominal strain (a run stops once it has
+/// reached 40 %, at 0.4000019 for the standard granule), so the nominal
+/// bounds would drop the 40 % sample; the half interval takes the samples
+/// nominally at 10 % and 40 % and no others. The cap keeps the unloaded
+/// state (strain 0) and samples far below 10 % out of the fit when the
+/// interval is coarse: every 0.2, half an interval would reach down to 0
+/// and fit the unloaded state too (a σ_est 34 % low was measured with
+/// samples every 0.4). `interval` must be positive (the scene's
+/// `output_strain_interval`).
 pub fn fit_window(interval: Real) -> [Real; 2] {
     let [lo, hi] = FIT_STRAIN_RANGE;
-    [lo - 0.5 * interval, hi + 0.5 * interval]
+    let widen = (0.5 * interval).min(0.5 * lo);
+    [lo - widen, hi + widen]
 }
 
 /// Estimated granule yield stress from the platen force: the least-squares
@@ -116,5 +122,22 @@ mod tests {
                 .points,
             60
         );
+    }
+
+    /// A coarse interval does not bring the unloaded state into the fit:
+    /// sampled every 0.2 (0, 0.2, 0.4) the fit takes 0.2 and 0.4; every 0.4
+    /// (0, 0.4) it has one sample and no fit. Half an interval at each end
+    /// would have reached down to 0 in both.
+    #[test]
+    fn a_coarse_interval_keeps_strain_0_out_of_the_fit() {
+        let d = 1e-3;
+        assert_eq!(fit_window(0.2), [0.05, 0.45]);
+        let line = |c: Real| (c * d, 1.0 + c);
+        let fit = yield_stress_estimate([0.0, 0.2, 0.4].map(line).into_iter(), d, 0.05, 0.45);
+        assert_eq!(fit.unwrap().1.points, 2);
+        let [lo, hi] = fit_window(0.4);
+        assert!(lo > 0.0 && hi < 0.8, "{lo} {hi}");
+        let samples = [0.0, 0.4].map(line);
+        assert!(yield_stress_estimate(samples.into_iter(), d, lo, hi).is_none());
     }
 }
