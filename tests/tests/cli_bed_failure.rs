@@ -254,3 +254,47 @@ fn a_snapshot_that_cannot_be_written_keeps_the_run_for_resume() {
     a_failed_snapshot_resumes("snapshot_mid", "0.005");
     a_failed_snapshot_resumes("snapshot_end", "0.01");
 }
+
+/// A withdrawal whose step fails is a run gone wrong: exit status 1 with
+/// the step's error (granule, step, element), after the loading's outputs
+/// and the withdrawal's rows so far are written. A punch at 10 m/s (the
+/// most allowed) on a 30-granule coarse bed moves C ≈ 0.08 per step: the
+/// loading folds elements, and the withdrawal's second step inverts one
+/// (user review, session 55: it exited 0 with only a warning).
+#[test]
+fn a_withdrawal_that_inverts_an_element_exits_with_status_1() {
+    let dir = common::fresh_dir("cli_bed_failure", "withdrawal_fails");
+    let run = cli(&[
+        "bed",
+        "--granules",
+        "30",
+        "--die-diameter-mm",
+        "5",
+        "--mesh",
+        "4x1",
+        "--strain",
+        "0.1",
+        "--punch-speed-m-s",
+        "10",
+        "-j",
+        "2",
+        "--quiet",
+        "--out",
+        dir.to_str().unwrap(),
+    ]);
+    assert_eq!(run.code, 1, "{}", run.stderr);
+    let error = run
+        .stderr
+        .lines()
+        .find(|l| l.starts_with("error: "))
+        .unwrap_or_else(|| panic!("no error line:\n{}", run.stderr));
+    assert!(
+        error.contains("withdrawal stopped before it came free of the bed (a step failed: granule")
+            && error.contains("inverted element"),
+        "{error}"
+    );
+    for file in ["compression.csv", "unloading.csv", "summary.json"] {
+        assert!(dir.join(file).is_file(), "{file} not written");
+    }
+    assert!(number(&summary(&dir), "final_strain") >= 0.1);
+}

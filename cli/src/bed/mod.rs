@@ -839,6 +839,19 @@ impl BedArgs {
                 out.display()
             )));
         }
+        // A withdrawal whose step failed (an inverted element) or whose
+        // checkpoint could not be written is a run gone wrong too: exit
+        // status 1, after the loading's outputs and the withdrawal's rows
+        // so far were written (an interrupt's is the status above).
+        if let Some(why) = result.unloading.as_ref().and_then(|u| u.cut_short.as_ref())
+            && !matches!(why, run::CutShort::Interrupted { .. })
+        {
+            anyhow::bail!(
+                "the upper punch's withdrawal stopped before it came free of the bed ({why}); \
+                 the loading's outputs and the withdrawal's rows so far are in `{}`",
+                out.display()
+            );
+        }
         Ok(())
     }
 
