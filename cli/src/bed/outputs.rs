@@ -854,6 +854,12 @@ pub fn fit_linear(r_squared: Real) -> bool {
     r_squared >= FIT_MIN_R_SQUARED
 }
 
+/// A poured bed shallower than this many granule diameters is warned
+/// about as a layer (the published scene's is about 9.6 diameters deep;
+/// 100 granules in its 11.3 mm die pour to about 1.26, the CI-sized bed of
+/// 30 in a 5 mm die to about 1.9).
+pub const SHALLOW_BED_DIAMETERS: Real = 1.5;
+
 /// The summary's warnings: `run.warnings`, then those its figures call
 /// for.
 fn warnings(
@@ -864,6 +870,19 @@ fn warnings(
     max_penetration_rel: Option<Real>,
 ) -> Vec<String> {
     let mut w = run.warnings.clone();
+    let diameter_m = scene.diameter_mm * 1e-3;
+    if run.bed_height_m < SHALLOW_BED_DIAMETERS * diameter_m {
+        w.push(format!(
+            "the poured bed is {:.3} mm deep, less than {SHALLOW_BED_DIAMETERS} granule \
+             diameters ({} mm): its granules touch mostly the punches, a layer rather than a \
+             bed, and its figures are not a bed's; a narrower die (--die-diameter-mm, now {}) \
+             or more granules (--granules, now {}) make it deeper",
+            run.bed_height_m * 1e3,
+            scene.diameter_mm,
+            scene.die_diameter_mm,
+            scene.granules
+        ));
+    }
     if run.interrupted {
         w.push(format!(
             "interrupted (SIGINT/SIGTERM) at C = {:.4}, step {}: the figures cover the run so \
@@ -1283,6 +1302,45 @@ mod tests {
             ..failed
         };
         assert_eq!(not_quasi_static(&scene, &run, &passed), None);
+    }
+
+    /// A bed poured less than 1.5 granule diameters deep is warned about
+    /// as a layer, naming its depth and what deepens it; a deeper one is
+    /// not.
+    #[test]
+    fn a_bed_shallower_than_two_diameters_is_warned_about() {
+        use crate::bed::run::{BedRun, BedSample};
+        let scene = Scene::published();
+        let mut run = BedRun::of_samples(vec![BedSample::default(); 4]);
+        let kawakita = KawakitaSummary {
+            a: None,
+            inv_b_pa: None,
+            r_squared: None,
+            points: 0,
+            min_strain: 0.25,
+        };
+        let heckel = HeckelSummary {
+            yield_pressure_pa: None,
+            k_per_pa: None,
+            a: None,
+            d_a: None,
+            r_squared: None,
+            points: 0,
+            min_strain: 0.25,
+        };
+        let fits = (&kawakita, &heckel);
+        let layer = |w: &[String]| w.iter().any(|w| w.contains("a layer rather than a bed"));
+        run.bed_height_m = 1.26e-3;
+        let w = warnings(&scene, &run, fits, 0.0, None);
+        assert!(layer(&w), "{w:?}");
+        assert!(
+            w.iter().any(|w| w.starts_with(
+                "the poured bed is 1.260 mm deep, less than 1.5 granule diameters (1 mm)"
+            )),
+            "{w:?}"
+        );
+        run.bed_height_m = 1.51e-3;
+        assert!(!layer(&warnings(&scene, &run, fits, 0.0, None)));
     }
 
     /// The R² rule of both fits: 0.9 and above is linear, below it and NaN
