@@ -543,6 +543,34 @@ fn detect_listed_reports_list_ids_outside_the_bodies() {
         used: &[0],
     };
     assert_eq!(short(run(&past)), ("face lists (faces)", 7, 1));
+    // Used quads repeated, more of them than the master has quads (they
+    // overran the scratch: an index panic, session 55's API review), or
+    // descending: refused by index.
+    let repeated: Vec<u32> = vec![0; b.quads.len() + 1];
+    let overrun = FaceLists {
+        nodes: &[first],
+        starts: &[0, 1],
+        faces: &[0],
+        used: &repeated,
+    };
+    assert_eq!(
+        field(run(&overrun)),
+        "face lists (used): index of an id not above the one before"
+    );
+    let descending = FaceLists {
+        nodes: &[first],
+        starts: &[0, 1],
+        faces: &[0],
+        used: &[3, 2],
+    };
+    assert!(
+        matches!(
+            run(&descending),
+            Err(ContactError::InvalidParameter { value, .. }) if value == 1.0
+        ),
+        "{:?}",
+        run(&descending)
+    );
     assert!(few.faces_of(5).is_empty() && past.faces_of(0).is_empty());
     assert_eq!(bad_face.faces_of(0), &[888_888]);
     assert!(slot.iter().all(|&s| s == u32::MAX), "slot restored");

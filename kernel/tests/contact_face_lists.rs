@@ -206,6 +206,47 @@ fn both_with(s: &Scene, d: Real, settings: PairSettings) -> (Vec<Constraint>, Ve
     full_and_listed((&a, &b), &settings, anchors, d)
 }
 
+/// A drift or window fraction that is NaN, negative or infinite is
+/// refused by name (with a NaN drift the lists came out empty and the
+/// listed detection missed the contact without an error).
+#[test]
+fn build_refuses_a_drift_or_window_that_is_not_a_length() {
+    use granbed_kernel::contact::pair::ContactError;
+    let s = scene(3, 0.05e-3, 0.0);
+    let anchors = s.anchor.each_ref().map(|x| AnchorSurface {
+        x: &x[s.first..],
+        first_surface: s.first,
+        quads: &s.mesh.quads[..],
+    });
+    let n = anchors[0].x.len();
+    let (mut nodes, mut starts) = (vec![0; n], vec![0; n + 1]);
+    let (mut faces, mut used) = (vec![0; 1 << 16], vec![0; s.mesh.quads.len()]);
+    let mut scratch = vec![ReachBox::default(); s.mesh.quads.len()];
+    let mut run = |f: Real, d: Real| {
+        let out = FaceListsMut {
+            nodes: &mut nodes,
+            starts: &mut starts,
+            faces: &mut faces,
+            used: &mut used,
+        };
+        build(&anchors[0], &anchors[1], f, d, &mut scratch, out)
+    };
+    let listed = run(0.25, 1e-6).unwrap();
+    assert!(listed.faces > 0, "the overlapping pair lists faces");
+    for (f, d, name) in [
+        (0.25, Real::NAN, "drift"),
+        (0.25, -1e-3, "drift"),
+        (0.25, Real::INFINITY, "drift"),
+        (Real::NAN, 1e-6, "window_fraction"),
+        (-0.1, 1e-6, "window_fraction"),
+    ] {
+        match run(f, d) {
+            Err(ContactError::InvalidParameter { field, .. }) => assert_eq!(field, name),
+            other => panic!("f = {f}, drift = {d}: {other:?}"),
+        }
+    }
+}
+
 /// Bit patterns of a constraint list, so −0.0 ≠ 0.0 and NaN = NaN.
 fn bits(c: &[Constraint]) -> Vec<(u8, u32, u32, Vec<u64>)> {
     c.iter()

@@ -71,14 +71,17 @@ impl<'a> FaceLists<'a> {
     }
 
     /// Checks the layout: one offset per node and one more, non-decreasing,
-    /// the last within `faces` — what [`build`] writes. (The detection
-    /// checks the node and used-quad ids where it reads them; a listed face
-    /// id outside the master's quads is no candidate.)
+    /// the last within `faces`, and `used` strictly ascending — what
+    /// [`build`] writes. (The detection checks the node and used-quad ids
+    /// where it reads them; a listed face id outside the master's quads is
+    /// no candidate. Ascending ids below the master's quad count are at
+    /// most that many, which the detection's scratch holds.)
     ///
     /// Errors: `starts` not one longer than `nodes`, or `faces` shorter
     /// than the last offset ([`ContactError::BufferLength`]); an offset
-    /// below the one before ([`ContactError::InvalidParameter`], with the
-    /// offset's index in `starts` as the value).
+    /// below the one before, or a used id not above the one before
+    /// ([`ContactError::InvalidParameter`], with the index in `starts` or
+    /// `used` as the value).
     pub fn check(&self) -> Result<(), ContactError> {
         if self.starts.len() != self.nodes.len() + 1 {
             return Err(ContactError::BufferLength {
@@ -92,6 +95,13 @@ impl<'a> FaceLists<'a> {
                 field: "face lists (starts): index of a decreasing offset",
                 value: (k + 1) as Real,
                 allowed: "non-decreasing offsets",
+            });
+        }
+        if let Some(k) = self.used.windows(2).position(|w| w[1] <= w[0]) {
+            return Err(ContactError::InvalidParameter {
+                field: "face lists (used): index of an id not above the one before",
+                value: (k + 1) as Real,
+                allowed: "strictly ascending quad ids",
             });
         }
         match self.starts.last() {
@@ -151,10 +161,13 @@ impl Default for ReachBox {
 }
 
 /// Builds the lists of the pass `slave` → `master` on their anchors, valid
-/// while no surface node of either body is farther than `drift` (m, > 0)
-/// from its anchor. `window_fraction` is the pair's f (g_max = f × face
-/// diagonal). `scratch` needs one entry per master quad. A full `faces`
-/// buffer is [`ContactError::Capacity`] (grow it and call again).
+/// while no surface node of either body is farther than `drift` (m, finite,
+/// ≥ 0) from its anchor. `window_fraction` is the pair's f (g_max = f ×
+/// face diagonal; finite, ≥ 0). `scratch` needs one entry per master quad.
+/// A full `faces` buffer is [`ContactError::Capacity`] (grow it and call
+/// again); a NaN, negative or infinite `drift` or `window_fraction` is
+/// [`ContactError::InvalidParameter`] (with a NaN the lists came out empty
+/// and the detection through them missed every contact without a word).
 pub fn build(
     slave: &AnchorSurface<'_>,
     master: &AnchorSurface<'_>,
@@ -163,6 +176,15 @@ pub fn build(
     scratch: &mut [ReachBox],
     out: FaceListsMut<'_>,
 ) -> Result<ListLengths, ContactError> {
+    for (field, value) in [("drift", drift), ("window_fraction", window_fraction)] {
+        if !(value >= 0.0 && value.is_finite()) {
+            return Err(ContactError::InvalidParameter {
+                field,
+                value,
+                allowed: "finite, >= 0",
+            });
+        }
+    }
     check_len("scratch", scratch.len(), master.quads.len())?;
     check_len("nodes", out.nodes.len(), slave.x.len())?;
     check_len("starts", out.starts.len(), slave.x.len() + 1)?;
