@@ -22,7 +22,7 @@ fn dropped_sphere_rebounds_to_e_squared_h() {
         p.max_time = 12.0;
         p.friction_wall = 0.0;
         let h = 5e-3;
-        let mut store = PourStore::new(&p);
+        let mut store = PourStore::new(&p).unwrap();
         store.x[0] = [0.0, 0.0, p.radius + h];
         store.v[0] = [0.0; 3];
         let mut scene = PourScene::from_state(p, store.buffers()).unwrap();
@@ -64,7 +64,7 @@ fn settle(
 ) {
     let mut p = PourParams::standard(1200.0, seed);
     p.granules = granules;
-    let mut store = PourStore::new(&p);
+    let mut store = PourStore::new(&p).unwrap();
     let mut scene = PourScene::new(p, store.buffers()).unwrap();
     let status = scene
         .run_to_rest(5000, &mut |_| ControlFlow::Continue(()))
@@ -90,7 +90,7 @@ fn settled_bed_balances_its_weight_and_is_deterministic() {
     let early = |seed: u64| {
         let mut p = PourParams::standard(1200.0, seed);
         p.granules = 100;
-        let mut store = PourStore::new(&p);
+        let mut store = PourStore::new(&p).unwrap();
         let mut scene = PourScene::new(p, store.buffers()).unwrap();
         for _ in 0..20_000 {
             scene.step().unwrap();
@@ -121,7 +121,7 @@ fn settled_bed_balances_its_weight_and_is_deterministic() {
 fn published_bed_on_a_fixed_seed() {
     use granbed_cli::pack::measures::{Region, bed_height, packing_fraction};
     let p = PourParams::standard(1200.0, 1);
-    let mut store = PourStore::new(&p);
+    let mut store = PourStore::new(&p).unwrap();
     let mut scene = PourScene::new(p, store.buffers()).unwrap();
     let s = scene
         .run_to_rest(5000, &mut |_| ControlFlow::Continue(()))
@@ -157,14 +157,14 @@ fn a_stopped_pour_goes_on_to_the_same_bits() {
     p.granules = 30;
     let check = 2000;
     let never_stopped = {
-        let mut store = PourStore::new(&p);
+        let mut store = PourStore::new(&p).unwrap();
         let mut scene = PourScene::new(p, store.buffers()).unwrap();
         let s = scene
             .run_to_rest(check, &mut |_| ControlFlow::Continue(()))
             .unwrap();
         (scene.positions().to_vec(), s.steps)
     };
-    let mut store = PourStore::new(&p);
+    let mut store = PourStore::new(&p).unwrap();
     let mut scene = PourScene::new(p, store.buffers()).unwrap();
     let mut checks = 0;
     let stopped = scene.run_to_rest(check, &mut |_| {

@@ -84,7 +84,7 @@ pub fn run_pour(
     params: PourParams,
     on_check: &mut dyn FnMut(&PourStatus, f64) -> ControlFlow<()>,
 ) -> Result<PourResult, PourError> {
-    let mut store = PourStore::new(&params);
+    let mut store = PourStore::new(&params)?;
     let start = Instant::now();
     let mut scene = PourScene::new(params, store.buffers())?;
     let outcome = scene.run_to_rest(CHECK_EVERY, &mut |s| {

@@ -6,7 +6,7 @@ use alloc::vec::Vec;
 
 use granbed_kernel::Real;
 use granbed_kernel::dem::neighbors::Pair;
-use granbed_kernel::dem::pour::{PourBuffers, PourParams};
+use granbed_kernel::dem::pour::{PourBuffers, PourError, PourParams};
 use granbed_kernel::granule::dynamics::GranuleBuffers;
 use granbed_kernel::granule::timestep::PowerIterationBuffers;
 use granbed_kernel::scene::platens::PlatenBuffers;
@@ -177,12 +177,16 @@ pub struct PourStore {
 }
 
 impl PourStore {
-    /// Buffers for `params`, with room for 12 candidate pairs per sphere.
-    pub fn new(params: &PourParams) -> Self {
+    /// Buffers for `params`, with room for 12 candidate pairs per sphere;
+    /// the parameters are checked first ([`PourParams::validate`]), since
+    /// the grid of parameters the pour refuses can have too many cells to
+    /// allocate.
+    pub fn new(params: &PourParams) -> Result<Self, PourError> {
+        params.validate()?;
         let n = params.granules;
         let z = [0.0; 3];
         let empty = Pair { i: 0, j: 0, xi: z };
-        Self {
+        Ok(Self {
             x: vec![z; n],
             v: vec![z; n],
             omega: vec![z; n],
@@ -193,7 +197,7 @@ impl PourStore {
             pairs_old: vec![empty; 12 * n],
             head: vec![0; params.grid().cells()],
             next: vec![0; n],
-        }
+        })
     }
 
     /// The kernel's borrowed view.
@@ -244,6 +248,37 @@ mod tests {
             + size_of_val(contact_mass.as_slice())
             + size_of_val(fixed.as_slice())
             + size_of_val(cp_inv.as_slice())) as u64
+    }
+
+    /// Pour parameters the kernel refuses are refused before the buffers
+    /// are sized from their grid (a lattice spacing of 0 made the grid's
+    /// lattice walk without end, an infinite die a grid too large to
+    /// allocate): by the field's name.
+    #[test]
+    fn pour_buffers_are_refused_for_refused_parameters() {
+        let standard = PourParams::standard(1200.0, 1);
+        assert!(PourStore::new(&standard).is_ok());
+        for (p, name) in [
+            (
+                PourParams {
+                    lattice_spacing: 0.0,
+                    ..standard
+                },
+                "lattice_spacing",
+            ),
+            (
+                PourParams {
+                    die_radius: Real::INFINITY,
+                    ..standard
+                },
+                "die_radius",
+            ),
+        ] {
+            match PourStore::new(&p) {
+                Err(PourError::InvalidParameter { field, .. }) => assert_eq!(field, name),
+                other => panic!("{name}: {:?}", other.map(|_| ())),
+            }
+        }
     }
 
     /// What `bytes_for` predicts is what `new` allocates, for the one-point

@@ -116,10 +116,14 @@ impl PourParams {
     }
 
     /// Lattice sites per layer: the square-lattice points whose jittered
-    /// sphere stays inside the die.
+    /// sphere stays inside the die. At most [`MAX_DIE_LATTICE_SPACINGS`]
+    /// spacings from the axis: [`Self::validate`] refuses a wider die, and
+    /// the cut keeps [`Self::fill_height`] and [`Self::grid`] finite for
+    /// parameters it refuses (a lattice spacing of 0 or an infinite die
+    /// made them walk 2¹²⁸ sites).
     fn sites(&self) -> impl Iterator<Item = [Real; 2]> + '_ {
         let reach = self.die_radius - self.radius - self.jitter * core::f64::consts::SQRT_2;
-        let k = libm::floor(reach / self.lattice_spacing) as i64;
+        let k = libm::floor(reach / self.lattice_spacing).min(MAX_DIE_LATTICE_SPACINGS) as i64;
         (-k..=k)
             .flat_map(move |j| {
                 (-k..=k).map(move |i| {
@@ -143,7 +147,10 @@ impl PourParams {
             + self.jitter
     }
 
-    /// The neighbour grid (its `cells()` sizes the `head` buffer).
+    /// The neighbour grid (its `cells()` sizes the `head` buffer). Check
+    /// the parameters with [`Self::validate`] first: for parameters it
+    /// refuses the grid still comes back, but its cell count can be vast
+    /// (it saturates at `usize::MAX`).
     pub fn grid(&self) -> Grid {
         Grid::new(
             self.die_radius,
@@ -168,7 +175,10 @@ impl PourParams {
         )
     }
 
-    fn validate(&self) -> Result<(), PourError> {
+    /// Checks every parameter's range (what [`pour`] checks first):
+    /// [`PourError::InvalidParameter`] naming the first field out of its
+    /// range. Call it before sizing buffers from [`Self::grid`].
+    pub fn validate(&self) -> Result<(), PourError> {
         let d = 2.0 * self.radius;
         let finite = |v: Real| v.is_finite();
         let checks: [(bool, &'static str, Real, &'static str); 18] = [
@@ -944,6 +954,42 @@ mod tests {
         let mut wide = standard;
         wide.die_radius = 1e3 * wide.lattice_spacing;
         assert_eq!(wide.validate(), Ok(()));
+    }
+
+    /// The grid and the fill height come back for parameters `validate`
+    /// refuses, as a host sizing its buffers before the pour asks for them
+    /// (a lattice spacing of 0 or 1 nm, or an infinite die, walked the
+    /// lattice without end: the kernel API review of session 55).
+    #[test]
+    fn the_grid_of_refused_parameters_comes_back() {
+        let standard = PourParams::standard(1200.0, 1);
+        for (p, field) in [
+            (
+                PourParams {
+                    lattice_spacing: 0.0,
+                    ..standard
+                },
+                "lattice_spacing",
+            ),
+            (
+                PourParams {
+                    lattice_spacing: 1e-9,
+                    ..standard
+                },
+                "lattice_spacing",
+            ),
+            (
+                PourParams {
+                    die_radius: Real::INFINITY,
+                    ..standard
+                },
+                "die_radius",
+            ),
+        ] {
+            assert_eq!(rejected(p), field);
+            let _ = p.grid().cells();
+            assert!(p.fill_height() > 0.0, "{field}");
+        }
     }
 
     /// A grid too large to count says so with `usize::MAX` instead of
