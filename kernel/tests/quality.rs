@@ -144,3 +144,42 @@ fn a_folded_element_and_a_nan_are_found() {
         assert!(hexes[w.element].contains(&hexes[7][3]));
     });
 }
+
+/// Positions shorter than the mesh (or a hex naming a node past them) give
+/// a NaN ratio at the first element that reads a missing node, as a
+/// position that is not finite does, instead of an index panic (the
+/// kernel API review of session 55); the reference table of such a mesh
+/// holds NaN rows.
+#[test]
+fn a_node_the_positions_lack_is_reported_as_nan() {
+    check(|mesh, dets, x0| {
+        let hexes = mesh.mesh.hexes;
+        let short = &x0[..10];
+        let first = hexes
+            .iter()
+            .position(|h| h.iter().any(|&n| n as usize >= short.len()))
+            .unwrap();
+        for w in [
+            worst_element(mesh, short),
+            worst_element_against(mesh, dets, short),
+        ] {
+            let w = w.expect("elements");
+            assert!(w.ratio.is_nan(), "ratio {}", w.ratio);
+            assert_eq!(w.element, first);
+        }
+        let mut bad_hexes = hexes.to_vec();
+        bad_hexes[3][5] = 1_000_000;
+        let bad = ReferenceMesh {
+            mesh: MeshView {
+                hexes: &bad_hexes,
+                ..mesh.mesh
+            },
+            ..*mesh
+        };
+        let mut table = vec![[0.0; 8]; hexes.len()];
+        reference_gauss_dets(&bad, &mut table).unwrap();
+        assert!(table[3].iter().all(|d| d.is_nan()));
+        assert!(table[2].iter().all(|d| d.is_finite()));
+        assert_eq!(worst_element(&bad, x0).map(|w| w.element), Some(3));
+    });
+}

@@ -18,10 +18,14 @@ pub struct WorstElement {
     pub element: usize,
 }
 
-/// det J_g at the Gauss points of the hex `hex` with node positions `x`.
+/// det J_g at the Gauss points of the hex `hex` with node positions `x`. A
+/// node id past `x` (positions shorter than the mesh, or a hex naming a
+/// node it does not have) counts as a position that is not finite: NaN
+/// determinants, which the ratios report, instead of an index panic.
 #[inline]
 fn gauss_dets(x: &[[Real; 3]], hex: &[u32; 8]) -> [Real; 8] {
-    gauss_determinants(&core::array::from_fn(|i| x[hex[i] as usize]))
+    let node = |i: usize| x.get(hex[i] as usize).copied().unwrap_or([Real::NAN; 3]);
+    gauss_determinants(&core::array::from_fn(node))
 }
 
 /// det J_g(X) of every element of `mesh` at its 2×2×2 Gauss points (in
@@ -42,7 +46,8 @@ pub fn reference_gauss_dets(mesh: &ReferenceMesh<'_>, out: &mut [[Real; 8]]) -> 
 /// The smallest Gauss-point Jacobian ratio of the granule at positions `x`
 /// (one per mesh node, m) against the reference mesh, with its element;
 /// `None` for a mesh without elements. A NaN ratio wins (it is reported,
-/// not skipped). [`worst_element_against`] with the reference determinants
+/// not skipped): a position that is not finite, or a node `x` does not
+/// have, gives one. [`worst_element_against`] with the reference determinants
 /// taken on the way.
 pub fn worst_element(mesh: &ReferenceMesh<'_>, x: &[[Real; 3]]) -> Option<WorstElement> {
     worst_element_against(mesh, &[], x)
