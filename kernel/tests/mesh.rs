@@ -302,6 +302,31 @@ fn ids_out_of_range_are_errors_not_panics() {
         })
     ));
     assert_eq!(area_and_volume(&m.positions, &quads), None);
+    // A quad naming an interior node: refused by check, and so by the
+    // octant's extraction, which indexes its per-node surface table from
+    // the first surface node (it overflowed: the kernel API review of
+    // session 55).
+    let first_surface = n - m.size.surface_nodes;
+    let mut inward = m.quads.clone();
+    inward[7][2] = 0;
+    let bad_surface = view(&m.hexes, &inward, m.size.surface_nodes);
+    let expected = Err(MeshError::NotSurfaceNode {
+        quad: 7,
+        id: 0,
+        first_surface,
+    });
+    assert_eq!(bad_surface.check(), expected);
+    let mut out = MeshBuffers {
+        positions: &mut [],
+        hexes: &mut [],
+        quads: &mut [],
+        node_quads: &mut [],
+        scratch: &mut [],
+    };
+    assert_eq!(
+        granbed_kernel::mesh::octant::extract_octant(&bad_surface, &mut out).map(|_| ()),
+        expected
+    );
     let too_many = view(&m.hexes, &m.quads, n + 1);
     assert!(matches!(
         octant_size(&too_many),

@@ -22,7 +22,10 @@ pub struct MeshView<'a> {
 
 impl MeshView<'_> {
     /// [`MeshError::NodeOutOfRange`] if a hex or quad names a node beyond
-    /// `positions`, or `surface_nodes` exceeds the node count; what every
+    /// `positions`, or `surface_nodes` exceeds the node count;
+    /// [`MeshError::NotSurfaceNode`] if a quad names a node before the last
+    /// `surface_nodes` (per-node surface tables are indexed from the first
+    /// surface node: [`extract_octant`] overflowed on one). What every
     /// routine that indexes positions by these ids checks first.
     pub fn check(&self) -> Result<(), MeshError> {
         let nodes = self.positions.len();
@@ -46,12 +49,25 @@ impl MeshView<'_> {
                     })
             })
         };
-        match bad("hexes", &mut self.hexes.iter().map(|h| &h[..]))
+        if let Some(e) = bad("hexes", &mut self.hexes.iter().map(|h| &h[..]))
             .or_else(|| bad("quads", &mut self.quads.iter().map(|q| &q[..])))
         {
-            Some(e) => Err(e),
-            None => Ok(()),
+            return Err(e);
         }
+        let first_surface = nodes - self.surface_nodes;
+        self.quads
+            .iter()
+            .enumerate()
+            .find_map(|(quad, q)| {
+                q.iter()
+                    .find(|&&id| (id as usize) < first_surface)
+                    .map(|&id| MeshError::NotSurfaceNode {
+                        quad,
+                        id: id as usize,
+                        first_surface,
+                    })
+            })
+            .map_or(Ok(()), Err)
     }
 }
 

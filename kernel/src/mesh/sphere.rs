@@ -151,6 +151,17 @@ pub enum MeshError {
         /// Nodes in the mesh.
         nodes: usize,
     },
+    /// A surface quad names a node that is not a surface node (an id below
+    /// the first of the last `surface_nodes` nodes, which every per-node
+    /// surface table is indexed from).
+    NotSurfaceNode {
+        /// Index of the quad.
+        quad: usize,
+        /// The node id.
+        id: usize,
+        /// The first surface node's id.
+        first_surface: usize,
+    },
     /// An element has a corner with det J ≤ 0 (bad placement parameters).
     InvertedElement {
         /// Element index.
@@ -188,6 +199,15 @@ impl fmt::Display for MeshError {
             } => write!(
                 f,
                 "mesh `{buffer}` entry {index} names node {id}, but there are {nodes} nodes (ids 0..{nodes})"
+            ),
+            Self::NotSurfaceNode {
+                quad,
+                id,
+                first_surface,
+            } => write!(
+                f,
+                "mesh `quads` entry {quad} names node {id}, which is not a surface node (those are \
+                 ids {first_surface} on)"
             ),
             Self::InvertedElement { element, corner } => {
                 write!(f, "mesh element {element} is inverted at corner {corner}")
