@@ -27,20 +27,38 @@ pub struct Pair {
     pub xi: [Real; 3],
 }
 
-/// The pair list outgrew the buffer it was given.
+/// Partners (spheres j > i within range) one sphere can have in the pair
+/// search's on-stack list.
+pub const MAX_PARTNERS: usize = 64;
+
+/// The pair list outgrew the buffer it was given, or one sphere's partners
+/// outgrew [`MAX_PARTNERS`].
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct PairOverflow {
-    /// Capacity of the pair buffer.
+    /// Capacity of the pair buffer, or [`MAX_PARTNERS`] if `per_sphere`.
     pub capacity: usize,
+    /// One sphere had more than [`MAX_PARTNERS`] partners: a larger pair
+    /// buffer does not help (spheres overlap far more than a pour allows,
+    /// or the search range is too long for the radius).
+    pub per_sphere: bool,
 }
 
 impl fmt::Display for PairOverflow {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        write!(
-            f,
-            "contact pair list overflow: more than {} candidate pairs",
-            self.capacity
-        )
+        if self.per_sphere {
+            write!(
+                f,
+                "contact pair list overflow: a sphere has more than {} partners within the \
+                 search range (deeply overlapping spheres, or a skin longer than the radius)",
+                self.capacity
+            )
+        } else {
+            write!(
+                f,
+                "contact pair list overflow: more than {} candidate pairs",
+                self.capacity
+            )
+        }
     }
 }
 
@@ -142,6 +160,11 @@ pub(crate) fn build_pairs(
     let wall_gap = range - 2.0 * radius; // the skin
     let overflow = PairOverflow {
         capacity: out.len(),
+        per_sphere: false,
+    };
+    let crowded = PairOverflow {
+        capacity: MAX_PARTNERS,
+        per_sphere: true,
     };
     let mut count = 0;
     let mut o = 0; // merge cursor in `old`
@@ -151,7 +174,7 @@ pub(crate) fn build_pairs(
         // Collect this sphere's partners j > i in increasing order: scan the
         // 27 neighbour cells (each chain is sorted) and insert-sort a small
         // on-stack buffer.
-        let mut partners: heapless::Vec<u32, 64> = heapless::Vec::new();
+        let mut partners: heapless::Vec<u32, MAX_PARTNERS> = heapless::Vec::new();
         for dz in -1i64..=1 {
             for dy in -1i64..=1 {
                 for dx in -1i64..=1 {
@@ -177,7 +200,7 @@ pub(crate) fn build_pairs(
                                     .iter()
                                     .position(|&k| k > j)
                                     .unwrap_or(partners.len());
-                                partners.insert(at, j).map_err(|_| overflow)?;
+                                partners.insert(at, j).map_err(|_| crowded)?;
                             }
                         }
                         j = next[j as usize];
@@ -209,4 +232,54 @@ pub(crate) fn build_pairs(
         }
     }
     Ok(count)
+}
+
+#[cfg(test)]
+mod tests {
+    extern crate std;
+    use super::*;
+    use std::vec;
+    use std::vec::Vec;
+
+    const NO_PAIR: Pair = Pair {
+        i: 0,
+        j: 0,
+        xi: [0.0; 3],
+    };
+
+    /// Spheres crowded at one point give one sphere more partners than the
+    /// search holds: an overflow marked per sphere (a larger pair buffer
+    /// does not help), where a short pair buffer alone is not.
+    #[test]
+    fn a_crowded_sphere_is_told_from_a_short_buffer() {
+        let (radius, range) = (0.5e-3, 1.2e-3);
+        let grid = Grid::new(5e-3, 5e-3, range);
+        let (mut head, mut next) = (vec![0; grid.cells()], vec![0; 80]);
+        let mut scratch = GridScratch {
+            head: &mut head,
+            next: &mut next,
+        };
+        let crowded: Vec<[Real; 3]> = (0..80).map(|k| [1e-6 * k as Real, 0.0, 2e-3]).collect();
+        let mut out = vec![NO_PAIR; 100_000];
+        let e = build_pairs(&grid, &crowded, radius, range, &mut scratch, &[], &mut out);
+        assert_eq!(
+            e,
+            Err(PairOverflow {
+                capacity: MAX_PARTNERS,
+                per_sphere: true
+            })
+        );
+        let apart: Vec<[Real; 3]> = (0..10)
+            .map(|k| [1e-3 * (k % 3) as Real, 1e-3 * (k / 3) as Real, 2e-3])
+            .collect();
+        let mut short = vec![NO_PAIR; 2];
+        let e = build_pairs(&grid, &apart, radius, range, &mut scratch, &[], &mut short);
+        assert_eq!(
+            e,
+            Err(PairOverflow {
+                capacity: 2,
+                per_sphere: false
+            })
+        );
+    }
 }

@@ -287,11 +287,16 @@ impl PourParams {
                 self.time_step_fraction,
                 "0 < f <= 0.2",
             ),
+            // At most the radius: the centres within 2r + skin ≤ 3r of a
+            // sphere's are those of spheres inside a ball of 4r, at most
+            // 0.7405 · 4³ ≈ 47 of them unless they overlap deeply, within
+            // the 64 partners per sphere the pair search holds
+            // (`neighbors::MAX_PARTNERS`).
             (
-                self.skin > 0.0 && finite(self.skin),
+                self.skin > 0.0 && self.skin <= self.radius && finite(self.skin),
                 "skin",
                 self.skin,
-                "> 0, finite",
+                "> 0 and <= radius",
             ),
         ];
         for (ok, field, value, allowed) in checks {
@@ -335,7 +340,10 @@ pub enum PourError {
         /// Entries given.
         got: usize,
     },
-    /// The candidate-pair buffers are too small.
+    /// The candidate-pair buffer is too small (grow it and call again), or
+    /// a sphere has more partners than the search holds
+    /// ([`PairOverflow::per_sphere`]: spheres overlapping far more than a
+    /// pour lets them, which a larger buffer does not cure).
     Pairs(PairOverflow),
     /// The spheres did not come to rest within `max_time`.
     NotSettled {
@@ -942,6 +950,7 @@ mod tests {
         assert_eq!(with(|p| p.max_time = Real::INFINITY), "max_time");
         assert_eq!(with(|p| p.skin = Real::INFINITY), "skin");
         assert_eq!(with(|p| p.skin = 0.0), "skin");
+        assert_eq!(with(|p| p.skin = 1.01 * p.radius), "skin");
         assert_eq!(with(|p| p.initial_speed = Real::NAN), "initial_speed");
         assert_eq!(with(|p| p.damping_max = Real::INFINITY), "damping_max");
         assert_eq!(with(|p| p.rest_speed = 0.0), "rest_speed");
