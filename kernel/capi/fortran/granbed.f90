@@ -323,13 +323,19 @@ contains
     ierr = c_granbed_node_face_force(c, weight, friction, dt_squared, force)
   end subroutine granbed_face_force
 
-  !> props(1:8) of the standard granule type name ('A1' ... 'C3').
+  !> props(1:8) of the standard granule type name ('A1' ... 'C3'); for an
+  !> unknown name ierr is the C function's error and props are zero (the C
+  !> struct was not written).
   subroutine granbed_preset_props(name, props, ierr)
     character(len=*), intent(in) :: name
     real(c_double), intent(out) :: props(GRANBED_VUMAT_NPROPS)
     integer(c_int32_t), intent(out) :: ierr
     type(granbed_material_params) :: p
     ierr = c_granbed_material_preset(trim(name)//c_null_char, p)
+    if (ierr /= GRANBED_OK) then
+      props = 0.0_c_double
+      return
+    end if
     props = [p%youngs_modulus_pa, p%poisson_ratio, p%yield_stress_pa, p%eta0, p%cp, p%eta_c, &
          p%true_density_kg_m3, p%friction]
   end subroutine granbed_preset_props

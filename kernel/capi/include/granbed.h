@@ -294,7 +294,9 @@ int32_t granbed_node_face_force(const struct GranbedNodeFace *c,
 //   (−,−,−), 1 (+,−,−), 2 (+,+,−), 3 (−,+,−), then 4–7 the same at +ζ).
 // * `reference`: out, n×`GRANBED_HEX_REFERENCE_LEN`.
 // * `element_status`: out, n codes (`GRANBED_ERR_DEGENERATE` for a hex
-//   with a non-positive Gauss-point Jacobian, `GRANBED_ERR_NON_FINITE`).
+//   with a non-positive Gauss-point Jacobian, `GRANBED_ERR_NON_FINITE`
+//   for a non-finite coordinate or a record that would overflow, e.g. a
+//   hex so large that its volume does; a failed hex's record is zeroed).
 //
 // Returns `GRANBED_OK`, `GRANBED_ERR_POINT_FAILED` (some hex failed: see
 // its `element_status`) or an argument error.
@@ -316,8 +318,10 @@ int32_t granbed_hex_reference(size_t n,
 //   (`GRANBED_DEFAULT_HOURGLASS_KAPPA` = 0.05).
 // * `reference`: in, n×66 from `granbed_hex_reference`. An element whose
 //   record has a non-finite entry, V0 ≤ 0, a hourglass geometry factor
-//   < 0 or a node volume ≤ 0 fails with `GRANBED_ERR_INVALID_ARGUMENT`
-//   (a corrupt record: what `granbed_hex_reference` writes passes).
+//   ≤ 0 (or below about 1e-153 m, where its stiffening overflows) or a
+//   node volume ≤ 0 fails with `GRANBED_ERR_INVALID_ARGUMENT` (a corrupt
+//   record: what `granbed_hex_reference` writes with `GRANBED_OK`
+//   passes).
 // * `x`: in, n×24, current node coordinates, `[element][node][xyz]`, m.
 // * `cp_inv`: in/out, n×6, the element's C_p⁻¹ (kept on failure).
 // * `f`: out, n×24, nodal forces `[element][node][xyz]`, N (zero on
@@ -382,6 +386,9 @@ int32_t granbed_material_derived(const struct GranbedMaterialParams *params,
 
 // Writes the initial plastic state C_p⁻¹ = identity of `n` points to
 // `cp_inv` (n×6, Voigt xx yy zz yz xz xy).
+//
+// Returns `GRANBED_OK`, `GRANBED_ERR_NULL_POINTER` (`cp_inv` NULL with
+// n > 0) or `GRANBED_ERR_SIZE` (6n doubles overflow the address space).
 //
 // # Safety
 // `cp_inv` points to 6n writable doubles (may be NULL if n = 0).

@@ -37,15 +37,13 @@ fn encode(r: &HexReference, out: &mut [f64; GRANBED_HEX_REFERENCE_LEN]) {
     }
 }
 
-/// True if `v` can be a reference record of `granbed_hex_reference`: every
-/// entry finite, V0 > 0, the hourglass geometry factor ≥ 0 and every node
-/// volume > 0 (B0 and γ0 only finite: their ranges depend on the shape).
+/// True if `v` can be a reference record of `granbed_hex_reference`:
+/// the kernel's [`HexReference::usable`] (every entry finite, V0 > 0,
+/// every node volume > 0, a hourglass geometry factor > 0 whose
+/// stiffening stays finite; B0 and γ0 only finite: their ranges depend on
+/// the shape).
 fn reference_ok(v: &[f64; GRANBED_HEX_REFERENCE_LEN]) -> bool {
-    let r = decode(v);
-    v.iter().all(|x| x.is_finite())
-        && r.volume > 0.0
-        && r.hourglass_geometry >= 0.0
-        && r.node_volume.iter().all(|&n| n > 0.0)
+    decode(v).usable()
 }
 
 fn decode(v: &[f64; GRANBED_HEX_REFERENCE_LEN]) -> HexReference {
@@ -77,7 +75,9 @@ fn coords(x: &[f64; 24]) -> [[f64; 3]; 8] {
 ///   (−,−,−), 1 (+,−,−), 2 (+,+,−), 3 (−,+,−), then 4–7 the same at +ζ).
 /// * `reference`: out, n×`GRANBED_HEX_REFERENCE_LEN`.
 /// * `element_status`: out, n codes (`GRANBED_ERR_DEGENERATE` for a hex
-///   with a non-positive Gauss-point Jacobian, `GRANBED_ERR_NON_FINITE`).
+///   with a non-positive Gauss-point Jacobian, `GRANBED_ERR_NON_FINITE`
+///   for a non-finite coordinate or a record that would overflow, e.g. a
+///   hex so large that its volume does; a failed hex's record is zeroed).
 ///
 /// Returns `GRANBED_OK`, `GRANBED_ERR_POINT_FAILED` (some hex failed: see
 /// its `element_status`) or an argument error.
@@ -104,7 +104,14 @@ pub unsafe extern "C" fn granbed_hex_reference(
                 GRANBED_ERR_NON_FINITE
             } else if let Some(r) = hex_reference(&coords(x)) {
                 encode(&r, o);
-                GRANBED_OK
+                // Finite coordinates whose volume or geometry factor
+                // overflows (a side of 1e103 m): no record the forces
+                // could use.
+                if r.usable() {
+                    GRANBED_OK
+                } else {
+                    GRANBED_ERR_NON_FINITE
+                }
             } else {
                 GRANBED_ERR_DEGENERATE
             };
@@ -131,8 +138,10 @@ pub unsafe extern "C" fn granbed_hex_reference(
 ///   (`GRANBED_DEFAULT_HOURGLASS_KAPPA` = 0.05).
 /// * `reference`: in, n×66 from `granbed_hex_reference`. An element whose
 ///   record has a non-finite entry, V0 ≤ 0, a hourglass geometry factor
-///   < 0 or a node volume ≤ 0 fails with `GRANBED_ERR_INVALID_ARGUMENT`
-///   (a corrupt record: what `granbed_hex_reference` writes passes).
+///   ≤ 0 (or below about 1e-153 m, where its stiffening overflows) or a
+///   node volume ≤ 0 fails with `GRANBED_ERR_INVALID_ARGUMENT` (a corrupt
+///   record: what `granbed_hex_reference` writes with `GRANBED_OK`
+///   passes).
 /// * `x`: in, n×24, current node coordinates, `[element][node][xyz]`, m.
 /// * `cp_inv`: in/out, n×6, the element's C_p⁻¹ (kept on failure).
 /// * `f`: out, n×24, nodal forces `[element][node][xyz]`, N (zero on
@@ -272,6 +281,10 @@ mod tests {
             (0, -1.0),
             (57, f64::NAN),
             (57, -1.0),
+            // A factor of 0, or one whose stiffening 1/(32 (0.1 hg)²)
+            // overflows: the forces were NaN with GRANBED_OK.
+            (57, 0.0),
+            (57, 1e-160),
             (30, f64::INFINITY),
             (60, 0.0),
         ] {
@@ -301,5 +314,23 @@ mod tests {
             );
             assert_eq!(f, [0.0; 24]);
         }
+    }
+
+    /// A hex of finite coordinates whose volume overflows gets
+    /// `GRANBED_ERR_NON_FINITE` and a zeroed record, not `GRANBED_OK` with
+    /// a record `granbed_hex_forces` refuses.
+    #[test]
+    fn a_hex_whose_volume_overflows_is_non_finite() {
+        let huge = CUBE.map(|c| c * 1e103);
+        let mut r = [1.0; GRANBED_HEX_REFERENCE_LEN];
+        let mut st = [0i32; 1];
+        // SAFETY: arrays of the documented lengths.
+        let code =
+            unsafe { granbed_hex_reference(1, huge.as_ptr(), r.as_mut_ptr(), st.as_mut_ptr()) };
+        assert_eq!(
+            (code, st[0]),
+            (GRANBED_ERR_POINT_FAILED, GRANBED_ERR_NON_FINITE)
+        );
+        assert_eq!(r, [0.0; GRANBED_HEX_REFERENCE_LEN]);
     }
 }

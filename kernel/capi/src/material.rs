@@ -233,6 +233,9 @@ pub unsafe extern "C" fn granbed_material_derived(
 /// Writes the initial plastic state C_p⁻¹ = identity of `n` points to
 /// `cp_inv` (n×6, Voigt xx yy zz yz xz xy).
 ///
+/// Returns `GRANBED_OK`, `GRANBED_ERR_NULL_POINTER` (`cp_inv` NULL with
+/// n > 0) or `GRANBED_ERR_SIZE` (6n doubles overflow the address space).
+///
 /// # Safety
 /// `cp_inv` points to 6n writable doubles (may be NULL if n = 0).
 #[unsafe(no_mangle)]

@@ -35,6 +35,29 @@ pub struct HexReference {
     pub node_volume: [Real; 8],
 }
 
+impl HexReference {
+    /// Whether the element forces can use this record: every entry
+    /// finite, V0 > 0, every node volume > 0, and a hourglass geometry
+    /// factor > 0 whose stiffening term 1/(32 (a·factor)²) (a =
+    /// [`crate::element::force::HOURGLASS_STIFFENING_AMPLITUDE`]) is finite
+    /// — a factor of 0, or one below about 10⁻¹⁵³ m, made it infinite and
+    /// the forces NaN. What [`hex_reference`] returns for a hex of
+    /// reasonable size passes; a hex whose coordinates are so large that
+    /// its volume overflows does not.
+    pub fn usable(&self) -> bool {
+        let a = crate::element::force::HOURGLASS_STIFFENING_AMPLITUDE * self.hourglass_geometry;
+        let stiffening = 1.0 / (32.0 * a * a);
+        self.volume > 0.0
+            && self.volume.is_finite()
+            && self.hourglass_geometry > 0.0
+            && stiffening.is_finite()
+            && self.node_volume.iter().all(|&v| v > 0.0 && v.is_finite())
+            && self.b0.as_flattened().iter().all(|v| v.is_finite())
+            && self.gamma0.as_flattened().iter().all(|v| v.is_finite())
+            && self.hourglass_geometry.is_finite()
+    }
+}
+
 /// The volume Σ_g det J_g of a hex at node positions `x` (m³, [`hex8`]
 /// order) by 2×2×2 Gauss quadrature, exact for the trilinear map — the
 /// [`HexReference::volume`] of [`hex_reference`] to the bit, without the
