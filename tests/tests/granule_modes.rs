@@ -677,4 +677,41 @@ fn heavier_masses_lengthen_the_global_step_by_the_square_root() {
     let mut element = TimeStepControl::new(TimeStepMethod::Element, 0.9);
     assert!(!element.scale_masses(k));
     assert!(!control.scale_masses(Real::NAN) && !control.scale_masses(0.0));
+    // A safety factor outside (0, 2] gives no step (it gave a negative,
+    // NaN or vast one), and power buffers of the wrong length give none
+    // (a short state copy panicked): the kernel API review of session 55.
+    let at = Linearisation {
+        mass: &store.mass,
+        x: &store.x,
+        cp_inv: &store.cp_inv,
+    };
+    for (m, safety) in [
+        (TimeStepMethod::Element, -1.0),
+        (TimeStepMethod::Element, Real::NAN),
+        (method, 1e300),
+        (method, 0.0),
+    ] {
+        let mut mode = vec![[0.0; 3]; n];
+        power_start(&mut mode);
+        let mut scratch = PowerScratch::new(mode, store.cp_inv.len());
+        let step = TimeStepControl::new(m, safety).estimate(
+            &view,
+            &mat,
+            &settings(0.05),
+            &at,
+            &mut scratch.buffers(),
+        );
+        assert_eq!(step, None, "safety {safety}");
+    }
+    let mut mode = vec![[0.0; 3]; n];
+    power_start(&mut mode);
+    let mut short = PowerScratch::new(mode, store.cp_inv.len() - 1);
+    let step = TimeStepControl::new(method, 0.9).estimate(
+        &view,
+        &mat,
+        &settings(0.05),
+        &at,
+        &mut short.buffers(),
+    );
+    assert_eq!(step, None);
 }

@@ -44,6 +44,11 @@ pub fn element_time_step(
     Some(safety * min_element_length(mesh, x)? / wave_speed(mat))
 }
 
+/// The largest safety factor [`TimeStepControl::estimate`] takes: twice
+/// the stability limit, what a test that provokes an instability uses (the
+/// bed scene's `time_step_safety` allows it for that).
+pub const MAX_SAFETY: Real = 2.0;
+
 /// Scratch buffers of [`max_frequency`]: node buffers have one entry per
 /// node, `cp_scratch` as many entries as the granule's `cp_inv`.
 pub struct PowerIterationBuffers<'a> {
@@ -74,7 +79,9 @@ pub struct Linearisation<'a> {
 /// Largest angular frequency ω_max (rad/s) of the granule linearised at
 /// `at`, by `iterations` power iterations on M⁻¹K with matrix-free products
 /// K·u ≈ [f(x + hu) − f(x − hu)]/(2h). The stable central-difference step
-/// is 2/ω_max. `None` if an element fails at a perturbed configuration.
+/// is 2/ω_max. `None` if an element fails at a perturbed configuration,
+/// or a buffer's length is not the granule's (`mass` and every node buffer
+/// one entry per position, `cp_scratch` one per state).
 pub fn max_frequency(
     mesh: &ReferenceMesh<'_>,
     mat: &Material,
@@ -84,6 +91,20 @@ pub fn max_frequency(
     iterations: u32,
 ) -> Option<Real> {
     let (mass, x, cp_inv) = (at.mass, at.x, at.cp_inv);
+    let nodes = x.len();
+    if [
+        mass.len(),
+        buf.mode.len(),
+        buf.x_pert.len(),
+        buf.f_plus.len(),
+    ]
+    .into_iter()
+    .chain([buf.f_minus.len()])
+    .any(|n| n != nodes)
+        || buf.cp_scratch.len() != cp_inv.len()
+    {
+        return None;
+    }
     let size = crate::math::max(min_element_length(mesh, x)?, Real::MIN_POSITIVE);
     let mut lambda = 0.0;
     for _ in 0..iterations {
@@ -215,7 +236,9 @@ impl TimeStepControl {
         global && usable
     }
 
-    /// A policy with safety factor `safety` (0 < C ≤ 1).
+    /// A policy with safety factor `safety`: 0 < C ≤ 1 for a stable step;
+    /// up to [`MAX_SAFETY`] to provoke an instability on purpose (a test of
+    /// the watchdogs); [`Self::estimate`] gives no step outside (0, 2].
     pub fn new(method: TimeStepMethod, safety: Real) -> Self {
         Self {
             method,
@@ -227,7 +250,8 @@ impl TimeStepControl {
     }
 
     /// The stable step for the granule at `at`, s; `None` if an element is
-    /// inverted or the motion is not finite. `power` is scratch for the
+    /// inverted, the motion is not finite, the safety factor is not in
+    /// (0, [`MAX_SAFETY`]] or a buffer of `power` has the wrong length. `power` is scratch for the
     /// global method (its `mode` is kept as the warm start between calls;
     /// fill it with any non-zero field before the first call).
     pub fn estimate(
@@ -238,6 +262,9 @@ impl TimeStepControl {
         at: &Linearisation<'_>,
         power: &mut PowerIterationBuffers<'_>,
     ) -> Option<Real> {
+        if !(self.safety > 0.0 && self.safety <= MAX_SAFETY) {
+            return None;
+        }
         let length = min_element_length(mesh, at.x)?;
         let TimeStepMethod::Global {
             power_interval,
@@ -248,7 +275,7 @@ impl TimeStepControl {
         };
         if self.global_dt == 0.0 || self.since_power >= power_interval {
             let iterations = if self.global_dt == 0.0 {
-                10 * power_iterations
+                power_iterations.saturating_mul(10)
             } else {
                 power_iterations
             };
