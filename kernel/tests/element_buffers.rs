@@ -297,4 +297,19 @@ fn a_step_checks_its_buffers_and_step_sizes() {
             }
         );
     }
+    // A position buffer one node short: reset fills what both hold (it
+    // panicked in copy_from_slice), and the step refuses the buffers.
+    let (mut short_x, mut full_v) = (vec![z; n - 1], vec![z; n]);
+    let mut b = GranuleBuffers {
+        x: &mut short_x,
+        v: &mut full_v,
+        ..b
+    };
+    b.reset(&reference, &mat);
+    assert_eq!(b.x, &reference.mesh.positions[..n - 1]);
+    let r = predict(&reference, &mat, &one_point, &mut b, good, &loads);
+    assert!(
+        matches!(r, Err(ForcesError::BufferLength { .. })),
+        "{r:?}"
+    );
 }

@@ -70,9 +70,16 @@ impl RigidMotion {
 }
 
 /// The mass-orthogonal projection of velocities `v` onto the six rigid modes
-/// of nodes at `x` with masses `mass` (kg). All slices have one entry per node.
+/// of nodes at `x` with masses `mass` (kg). All slices have one entry per
+/// node; a node `v` lacks counts as a NaN velocity (a NaN motion, not a
+/// panic).
 pub fn rigid_motion(mass: &[Real], x: &[[Real; 3]], v: &[[Real; 3]]) -> RigidMotion {
-    rigid_motion_of(mass, x, |i| v[i])
+    rigid_motion_of(mass, x, velocity_of(v))
+}
+
+/// Node `i`'s velocity of `v`, NaN for a node past it.
+fn velocity_of(v: &[[Real; 3]]) -> impl Fn(usize) -> [Real; 3] + '_ {
+    |i| v.get(i).copied().unwrap_or([Real::NAN; 3])
 }
 
 /// [`rigid_motion`] of the velocity field `v(I)` given node by node (for a
@@ -397,7 +404,7 @@ pub fn damping_forces_in(
     f_d: &mut [[Real; 3]],
 ) {
     let rigid = match frame {
-        Some(frame) => frame.motion(mass, x, |i| v[i]),
+        Some(frame) => frame.motion(mass, x, velocity_of(v)),
         None => RigidMotion::REST,
     };
     damping_forces_of(&rigid, mass, x, v, c, f_d);
@@ -406,6 +413,8 @@ pub fn damping_forces_in(
 /// [`damping_forces_in`] with the rigid part of `v` taken by the caller:
 /// `rigid` is the frame's `motion(mass, x, |i| v[i])`, or
 /// [`RigidMotion::REST`] when the rigid modes are held; the same bits.
+/// Entries of `f_d` past the shortest of `mass`, `x` and `v` are NaN (they
+/// kept stale forces).
 pub fn damping_forces_of(
     rigid: &RigidMotion,
     mass: &[Real],
@@ -419,6 +428,10 @@ pub fn damping_forces_of(
         for a in 0..3 {
             fi[a] = -c * m * (vi[a] - r[a]);
         }
+    }
+    let nodes = mass.len().min(x.len()).min(v.len());
+    for fi in f_d.iter_mut().skip(nodes) {
+        *fi = [Real::NAN; 3];
     }
 }
 
@@ -441,6 +454,26 @@ mod tests {
         let mass = core::array::from_fn(|_| rng.uniform(1e-10, 3e-10));
         let x = core::array::from_fn(|_| core::array::from_fn(|_| rng.uniform(-5e-4, 6e-4)));
         (mass, x)
+    }
+
+    /// Velocities shorter than the masses and positions give a NaN motion
+    /// and NaN damping forces past them, not an index panic or stale forces
+    /// (the kernel API review of session 55).
+    #[test]
+    fn short_velocities_are_nan_not_a_panic() {
+        let (mass, x) = cloud(3);
+        let v = [[1e-3, 0.0, 0.0]; N];
+        let short = &v[..N / 2];
+        assert!(rigid_motion(&mass, &x, short).velocity[0].is_nan());
+        assert!(selective_kinetic_excess(&mass, &x, short, 10.0).is_nan());
+        for rigid_modes in [true, false] {
+            let mut f_d = [[7.0; 3]; N];
+            damping_forces(&mass, &x, short, 5.0, rigid_modes, &mut f_d);
+            assert!(f_d[N / 2..].iter().flatten().all(|f| f.is_nan()));
+            if !rigid_modes {
+                assert!(f_d[..N / 2].iter().flatten().all(|f| f.is_finite()));
+            }
+        }
     }
 
     /// The six-entry sum of the frame gives the bits of the full nine-entry

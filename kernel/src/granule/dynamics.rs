@@ -85,9 +85,14 @@ impl GranuleBuffers<'_> {
     }
 
     /// The virgin state on `mesh`: x = X, v = 0, C_p⁻¹ = 1, masses ρ0 × the
-    /// lumped volumes, nothing fixed. Lengths must be right.
+    /// lumped volumes, nothing fixed. Lengths must be right (one entry per
+    /// mesh node; [`Self::wrong_length`] names a mismatch, and the step
+    /// functions refuse one): a buffer shorter or longer than the mesh is
+    /// filled as far as both go, without a panic.
     pub fn reset(&mut self, mesh: &ReferenceMesh<'_>, mat: &Material) {
-        self.x.copy_from_slice(mesh.mesh.positions);
+        for (x, p) in self.x.iter_mut().zip(mesh.mesh.positions) {
+            *x = *p;
+        }
         self.v.fill([0.0; 3]);
         self.cp_inv.fill(VOIGT_IDENTITY);
         self.fixed.fill(0);
