@@ -17,22 +17,25 @@ use crate::Real;
 /// [`MaterialParams::validate`] to obtain the [`Material`] the kernel uses.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct MaterialParams {
-    /// Young's modulus E of the granule skeleton, Pa. Range: finite, > 0.
+    /// Young's modulus E of the granule skeleton, Pa. Range:
+    /// [`YOUNGS_MODULUS_RANGE_PA`], 1e-3 ≤ E ≤ 1e13.
     pub youngs_modulus_pa: Real,
     /// Poisson's ratio ν. Range: −1 < ν < 0.5.
     pub poisson_ratio: Real,
     /// Yield stress σ_y of the solid (Kirchhoff measure), Pa.
-    /// Range: > 0; `+∞` makes the material purely elastic.
+    /// Range: ≥ [`MIN_YIELD_STRESS_PA`] (1e-3); `+∞` makes the material
+    /// purely elastic.
     pub yield_stress_pa: Real,
     /// Initial relative density η0 (solid fraction). Range: η_c < η0 ≤ 1.
     pub eta0: Real,
-    /// Yield-surface constant c_p of a1(η) = c_p(1 − η²). Range: finite, ≥ 0.
+    /// Yield-surface constant c_p of a1(η) = c_p(1 − η²). Range:
+    /// 0 ≤ c_p ≤ [`MAX_CP`] (1e3).
     pub cp: Real,
     /// Critical relative density η_c where the yield surface vanishes.
     /// Range: 0 ≤ η_c < 1.
     pub eta_c: Real,
     /// True (solid) density, kg/m³; the granule's density is η0 times this.
-    /// Range: finite, > 0.
+    /// Range: [`DENSITY_RANGE_KG_M3`], 1e-3 ≤ ρ ≤ 1e5.
     pub true_density_kg_m3: Real,
     /// Coulomb friction coefficient of the granule surface. Range: finite, ≥ 0.
     pub friction: Real,

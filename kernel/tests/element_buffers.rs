@@ -308,8 +308,5 @@ fn a_step_checks_its_buffers_and_step_sizes() {
     b.reset(&reference, &mat);
     assert_eq!(b.x, &reference.mesh.positions[..n - 1]);
     let r = predict(&reference, &mat, &one_point, &mut b, good, &loads);
-    assert!(
-        matches!(r, Err(ForcesError::BufferLength { .. })),
-        "{r:?}"
-    );
+    assert!(matches!(r, Err(ForcesError::BufferLength { .. })), "{r:?}");
 }

@@ -44,7 +44,9 @@ impl ContactLaw {
         }
     }
 
-    /// Two identical spheres (radius `r`, mass `m`) of an isotropic solid (E, ν).
+    /// Two identical spheres (radius `r`, m; mass `m`, kg) of an isotropic
+    /// solid (Young's modulus `youngs`, Pa; Poisson's ratio `poisson`),
+    /// with Coulomb `friction` (dimensionless).
     pub fn sphere_sphere(youngs: Real, poisson: Real, r: Real, m: Real, friction: Real) -> Self {
         let g = youngs / (2.0 * (1.0 + poisson));
         Self::new(
@@ -56,7 +58,8 @@ impl ContactLaw {
         )
     }
 
-    /// A sphere against a rigid flat wall.
+    /// A sphere (radius `r`, m; mass `m`, kg; `youngs`, Pa; `poisson`)
+    /// against a rigid flat wall, with Coulomb `friction`.
     pub fn sphere_wall(youngs: Real, poisson: Real, r: Real, m: Real, friction: Real) -> Self {
         let g = youngs / (2.0 * (1.0 + poisson));
         Self::new(

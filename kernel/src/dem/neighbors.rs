@@ -78,8 +78,8 @@ pub struct Grid {
 }
 
 impl Grid {
-    /// A grid over a die of radius `die_radius` up to `height` with cells of
-    /// at least `range`.
+    /// A grid over a die of radius `die_radius` (m) up to `height` (m) with
+    /// cells of at least `range` (m).
     pub fn new(die_radius: Real, height: Real, range: Real) -> Self {
         let nxy = crate::math::max(1.0, libm::floor(2.0 * die_radius / range)) as usize;
         let cell = 2.0 * die_radius / nxy as Real;

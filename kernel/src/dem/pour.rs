@@ -26,7 +26,7 @@ pub const MAX_DIE_LATTICE_SPACINGS: Real = 1.0e4;
 pub struct PourParams {
     /// Number of spheres; 1 ≤ N ≤ 100 000.
     pub granules: usize,
-    /// Sphere radius, m; > 0.
+    /// Sphere radius, m; 0 < r < 1.
     pub radius: Real,
     /// Sphere density, kg/m³ (η0 × true density); > 0.
     pub density: Real,
@@ -35,9 +35,9 @@ pub struct PourParams {
     pub youngs_modulus_pa: Real,
     /// Contact Poisson's ratio; −1 < ν < 0.5.
     pub poisson_ratio: Real,
-    /// Sphere–sphere friction; ≥ 0.
+    /// Sphere–sphere friction; ≥ 0 (`+∞`: no sliding).
     pub friction_particle: Real,
-    /// Sphere–wall friction; ≥ 0.
+    /// Sphere–wall friction; ≥ 0 (`+∞`: no sliding).
     pub friction_wall: Real,
     /// Die radius, m; > 2·radius and ≤ [`MAX_DIE_LATTICE_SPACINGS`] ×
     /// `lattice_spacing`.
@@ -46,27 +46,30 @@ pub struct PourParams {
     pub gravity_m_s2: Real,
     /// Spacing of the initial square lattice, m; ≥ 2·radius + 2·jitter.
     pub lattice_spacing: Real,
-    /// Random jitter of the initial positions, ± m per component.
+    /// Random jitter of the initial positions, ± m per component; ≥ 0 (and
+    /// within the lattice spacing's room, above).
     pub jitter: Real,
-    /// Random initial velocity, ± m/s per component.
+    /// Random initial velocity, ± m/s per component; finite, ≥ 0.
     pub initial_speed: Real,
     /// Coefficient of restitution before the dissipation ramp; (0, 1].
     pub restitution_start: Real,
     /// Coefficient of restitution after the ramp; (0, 1].
     pub restitution_end: Real,
-    /// Global damping coefficient after the ramp, 1/s (0 before it).
+    /// Global damping coefficient after the ramp, 1/s (0 before it); finite,
+    /// ≥ 0.
     pub damping_max: Real,
-    /// Ramp start and end times, s.
+    /// Ramp start and end times, s; 0 ≤ start < end < `max_time`.
     pub ramp: (Real, Real),
-    /// At rest when every speed is below this, m/s.
+    /// At rest when every speed is below this, m/s; finite, > 0.
     pub rest_speed: Real,
-    /// … and the kinetic energy per sphere below this, J.
+    /// … and the kinetic energy per sphere below this, J; finite, > 0.
     pub rest_kinetic_energy: Real,
-    /// Give up (error) after this simulated time, s.
+    /// Give up (error) after this simulated time, s; finite, past the ramp.
     pub max_time: Real,
-    /// Time step as a fraction of the Hertz contact time at 0.1 m/s.
+    /// Time step as a fraction of the Hertz contact time at 0.1 m/s;
+    /// 0 < f ≤ 0.2.
     pub time_step_fraction: Real,
-    /// Neighbour-list skin, m.
+    /// Neighbour-list skin, m; > 0 and ≤ `radius` (see [`Self::validate`]).
     pub skin: Real,
     /// Random seed.
     pub seed: u64,
@@ -175,7 +178,7 @@ impl PourParams {
         )
     }
 
-    /// Checks every parameter's range (what [`pour`] checks first):
+    /// Checks every parameter's range (what [`PourScene::new`] checks first):
     /// [`PourError::InvalidParameter`] naming the first field out of its
     /// range. Call it before sizing buffers from [`Self::grid`].
     pub fn validate(&self) -> Result<(), PourError> {

@@ -312,6 +312,9 @@ pub fn regroup(elements: &[HexReference], out: &mut [ElementBatch]) -> Result<()
 /// checked first, nothing evaluated if they do not fit
 /// ([`ForcesError::BufferLength`], [`ForcesError::NodeId`], the element
 /// pass's errors); an element that fails is [`ForcesError::Element`].
+/// Not checked here, as in [`hex_forces`]: `kappa` (0 ≤ κ ≤ 1; a NaN gives
+/// NaN forces) and `opts`' tolerances — [`crate::granule::forces::internal_forces`]
+/// checks them with the element settings ([`crate::granule::forces::ElementSettings::check`]).
 #[allow(clippy::too_many_arguments)]
 pub fn one_point_elements<S: Sink + ?Sized>(
     path: ElementPath,

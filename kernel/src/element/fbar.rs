@@ -133,7 +133,8 @@ fn kinematics(x_ref: &HexCoords, x: &HexCoords) -> Result<Kinematics, UpdateErro
 }
 
 /// Forces of one F-bar element with reference coordinates `x_ref` at current
-/// positions `x` (m); `cp_inv[g]` is the C_p⁻¹ of Gauss point g (in/out).
+/// positions `x` (m); `cp_inv[g]` is the C_p⁻¹ of Gauss point g (in/out), in
+/// [`crate::element::hex8::gauss_points`] order.
 pub fn fbar_forces(
     mat: &Material,
     opts: &UpdateOptions,

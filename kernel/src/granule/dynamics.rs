@@ -56,7 +56,8 @@ pub struct GranuleBuffers<'a> {
     pub mass: &'a mut [Real],
     /// Per node, bit a set if velocity component a is held at 0.
     pub fixed: &'a mut [u8],
-    /// Per integration point, C_p⁻¹ (Voigt), element by element.
+    /// Per integration point, C_p⁻¹ (Voigt), element by element (F-bar's
+    /// eight in [`crate::element::hex8::gauss_points`] order).
     pub cp_inv: &'a mut [Voigt],
 }
 

@@ -217,7 +217,8 @@ pub struct ForceSummary {
 /// Evaluates all elements at positions `x` (`[node][xyz]`, m) and writes the
 /// assembled internal + hourglass force into `f` (`[node][xyz]`, N, zeroed
 /// first). `cp_inv` holds [`ElementSettings::points_per_element`] C_p⁻¹ per
-/// element, element by element (in/out). The one-point element runs on the
+/// element, element by element (in/out; F-bar's eight in
+/// [`crate::element::hex8::gauss_points`] order). The one-point element runs on the
 /// fastest [`ElementPath`] of the processor (all paths give the same bits).
 ///
 /// Lengths: `x`, `f` = nodes; `cp_inv` = hexes × points per element; the
