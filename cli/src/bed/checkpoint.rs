@@ -837,7 +837,7 @@ impl Checkpoint {
     /// [`WITHDRAWAL_FILE_NAME`]).
     ///
     /// The payload is streamed after a header whose length and checksum are
-    /// filled in once it is written ([`Enc`]).
+    /// filled in once it is written (in 1 MiB blocks, hashed as they go).
     pub fn write_as(&self, dir: &Path, name: &str) -> anyhow::Result<PathBuf> {
         let path = dir.join(name);
         let tmp = dir.join(format!("{name}.tmp"));
