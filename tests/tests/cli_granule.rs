@@ -31,7 +31,7 @@ fn granule_ok(dir: &Path, args: &[&str]) -> Run {
 /// The header `force_displacement.csv` must have, in this order.
 const FORCE_HEADER: &str = "time_s,displacement_m,strain,force_n,force_upper_n,force_lower_n,\
                             kinetic_j,internal_work_j,elastic_j,plastic_j,hourglass_j,damping_j,\
-                            contact_work_j,gravity_work_j,platen_work_j,min_j,dt_s,steps";
+                            contact_work_j,gravity_work_j,platen_work_j,min_jacobian,dt_s,steps";
 
 /// Keys `summary.json` must have.
 const SUMMARY_KEYS: [&str; 46] = [
@@ -143,7 +143,7 @@ fn outputs_exist_and_parse() {
         "{range:?}"
     );
     assert_eq!(fitted.len(), number(&s, "fit_points") as usize);
-    assert_eq!(s["format_version"], 2);
+    assert_eq!(s["format_version"], 3);
     assert!(
         run.stderr.lines().any(|l| l
             .starts_with("warning: granule B2: sigma_est was fitted over strain")
@@ -333,7 +333,9 @@ fn summary_is_consistent_with_the_csv() {
     );
     assert_eq!(
         number(&s, "min_jacobian"),
-        col("min_j").into_iter().fold(f64::INFINITY, f64::min)
+        col("min_jacobian")
+            .into_iter()
+            .fold(f64::INFINITY, f64::min)
     );
     assert_eq!(number(&s, "dt_s"), col("dt_s")[0]);
     let contact = col("contact_work_j")[last];

@@ -521,9 +521,13 @@ impl Scene {
 
     /// Parses and validates a scene file's text.
     pub fn from_toml(text: &str) -> anyhow::Result<Self> {
+        // One message: the parser's, with its line, column and excerpt (as
+        // the cause under a context of its own it was printed twice).
         let mut scene: Scene = toml::from_str(text).map_err(|e| {
-            anyhow::Error::new(InputError(format!("invalid scene: {}", e.message())))
-                .context(e.to_string())
+            anyhow::Error::new(InputError(format!(
+                "invalid scene: {}",
+                e.to_string().trim_end()
+            )))
         })?;
         scene.validate()?;
         // The type as it is spelt everywhere else (`b2` → `B2`): the
@@ -953,6 +957,19 @@ pub struct OmittedField {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A scene the TOML parser refuses is an input error whose message —
+    /// the whole chain, as the CLI prints it — holds the parser's text,
+    /// with its line and excerpt, once (it was printed twice: as a context
+    /// and again as its cause).
+    #[test]
+    fn a_scene_parse_error_is_said_once() {
+        let e = Scene::from_toml("version = 1\ngranuels = 30\n").unwrap_err();
+        assert!(e.downcast_ref::<InputError>().is_some(), "{e:#}");
+        let text = format!("{e:#}");
+        assert!(text.starts_with("invalid scene: TOML parse error at line 2"), "{text}");
+        assert_eq!(text.matches("unknown field `granuels`").count(), 1, "{text}");
+    }
 
     /// A scene file without the ratio has none (∞), and ∞ survives the
     /// TOML a checkpoint stores.

@@ -91,7 +91,7 @@ Output, in --out DIR (created if missing; with --types in DIR/<TYPE>/ per type):
     kinetic_j internal_work_j elastic_j plastic_j hourglass_j damping_j
     contact_work_j gravity_work_j platen_work_j
                           energy ledger of the whole granule, J
-    min_j                 smallest element volume ratio J of the last step
+    min_jacobian          smallest element volume ratio J of the last step
     dt_s                  current time step, s
     steps                 time steps so far
   summary.json            every input, sigma_est (4/(pi d) dF/dx fitted over

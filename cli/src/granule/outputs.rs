@@ -77,7 +77,7 @@ pub const FORCE_COLUMNS: [(&str, &str); 18] = [
     ("gravity_work_j", "work of gravity, J"),
     ("platen_work_j", "work of the moving platens, J"),
     (
-        "min_j",
+        "min_jacobian",
         "smallest element volume ratio J of the sample's last step",
     ),
     ("dt_s", "time step, s"),

@@ -22,7 +22,10 @@ pub const FORMAT: &str = "granbed-granule-summary";
 ///
 /// 2: `sigma_est_strain_range` is the strain range the fit covered (null
 /// without a fit), no longer always the nominal [0.1, 0.4].
-pub const FORMAT_VERSION: u32 = 2;
+/// 3: `element` is spelt as the `--element` flag (`fbar`, was `f-bar`),
+/// and `force_displacement.csv`'s `min_j` is `min_jacobian`, as in the
+/// bed's tables (`_j` is the joule columns' suffix).
+pub const FORMAT_VERSION: u32 = 3;
 
 pub use granbed_kernel::analysis::granule::FIT_STRAIN_RANGE;
 
@@ -78,7 +81,7 @@ pub struct Summary {
     #[serde(flatten)]
     pub material: MaterialSummary,
 
-    /// Element formulation: `one-point` (production) or `f-bar`.
+    /// Element formulation: `one-point` (production) or `fbar`.
     pub element: &'static str,
     /// Requested final strain (platen approach / d).
     pub target_strain: Real,
@@ -220,7 +223,7 @@ impl Summary {
             },
             element: match p.elements.kind {
                 ElementKind::OnePoint => "one-point",
-                ElementKind::FBar => "f-bar",
+                ElementKind::FBar => "fbar",
             },
             target_strain: p.final_strain,
             approach_speed_m_s: p.approach_speed_m_s,

@@ -461,7 +461,7 @@ pub const SAMPLE_COLUMNS: [&str; 18] = [
     "contact_work_j",
     "gravity_work_j",
     "platen_work_j",
-    "min_j",
+    "min_jacobian",
     "dt_s",
     "steps",
 ];
