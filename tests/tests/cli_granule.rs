@@ -837,3 +837,16 @@ fn a_coarse_output_interval_keeps_the_unloaded_state_out_of_sigma_est() {
         "{note}"
     );
 }
+
+/// The summary spells the element as its flag does (`fbar`; format 3).
+#[test]
+fn the_summary_names_the_element_as_the_flag_does() {
+    let dir = out_dir("fbar_name");
+    granule_ok(
+        &dir,
+        &["--mesh", "4x1", "--element", "fbar", "--strain", "0.02"],
+    );
+    let s = summary(&dir);
+    assert_eq!(s["element"], "fbar", "{s}");
+    assert_eq!(s["format_version"], 3);
+}
