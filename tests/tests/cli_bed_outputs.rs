@@ -396,6 +396,9 @@ fn snapshots_plots_and_report() {
         "<td>version</td><td class=\"value\" title=\"{0}\">{0}</td>",
         s["version"].as_str().unwrap()
     )));
+    // Named and versioned as the granule's and the pour's summaries are.
+    assert_eq!(s["format"], "granbed-bed-summary");
+    assert_eq!(s["format_version"], 1);
     for line in [
         "granules = 20",
         "mesh = &quot;4x1&quot;",

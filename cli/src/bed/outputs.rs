@@ -240,6 +240,14 @@ fn row(s: &BedSample, run: &BedRun) -> [Field; 32] {
     ]
 }
 
+/// `format` of a bed run's `summary.json`, as the granule's and the pour's
+/// summaries name theirs.
+pub const FORMAT: &str = "granbed-bed-summary";
+/// Version of the bed's `summary.json` format; bumped when a field changes
+/// meaning or disappears (adding a field does not bump it). 1: the format
+/// as it was when these two fields were added (session 55).
+pub const FORMAT_VERSION: u32 = 1;
+
 /// The Kawakita fit of `summary.json`.
 #[derive(Clone, Copy, Debug, Serialize)]
 pub struct KawakitaSummary {
@@ -310,6 +318,10 @@ pub fn quasi_static(samples: &[BedSample], rate_change_rel: Option<Real>) -> Qua
 /// The fields of `summary.json`.
 #[derive(Debug, Serialize)]
 pub struct Summary<'a> {
+    /// Always [`FORMAT`].
+    pub format: &'static str,
+    /// [`FORMAT_VERSION`].
+    pub format_version: u32,
     /// granbed version.
     pub version: &'static str,
     /// The scene as run. (JSON has no infinity: a field set to ∞ reads
@@ -689,6 +701,8 @@ pub fn summary<'a>(scene: &'a Scene, run: &BedRun) -> Summary<'a> {
     let unloading = run.unloading.as_ref().map(|u| UnloadingSummary::of(run, u));
     warnings.extend(unloading.as_ref().and_then(super::unloading::rate_warning));
     Summary {
+        format: FORMAT,
+        format_version: FORMAT_VERSION,
         version: env!("CARGO_PKG_VERSION"),
         scene,
         scene_toml: scene.to_toml(),

@@ -30,7 +30,7 @@ pub const REPORT_FILE: &str = "report.html";
 /// meaning; any other field follows (nested objects such as `kawakita` and
 /// `heckel` are flattened to `kawakita.<field>`; the scene, `scene` and
 /// `scene_toml`, is shown as TOML instead).
-const FIELDS: [(&str, &str); 116] = [
+const FIELDS: [(&str, &str); 118] = [
     ("kawakita_a", "Kawakita a (limiting strain)"),
     ("kawakita_inv_b_pa", "Kawakita 1/b, Pa"),
     (
@@ -344,6 +344,8 @@ const FIELDS: [(&str, &str); 116] = [
     ),
     ("error", "error that stopped the run early"),
     ("version", "granbed version"),
+    ("format", "name of this file's format"),
+    ("format_version", "version of this file's format"),
     // Shown in the fields above already, or above the table.
     ("kawakita.a", ""),
     ("kawakita.inv_b_pa", ""),

@@ -967,8 +967,15 @@ mod tests {
         let e = Scene::from_toml("version = 1\ngranuels = 30\n").unwrap_err();
         assert!(e.downcast_ref::<InputError>().is_some(), "{e:#}");
         let text = format!("{e:#}");
-        assert!(text.starts_with("invalid scene: TOML parse error at line 2"), "{text}");
-        assert_eq!(text.matches("unknown field `granuels`").count(), 1, "{text}");
+        assert!(
+            text.starts_with("invalid scene: TOML parse error at line 2"),
+            "{text}"
+        );
+        assert_eq!(
+            text.matches("unknown field `granuels`").count(),
+            1,
+            "{text}"
+        );
     }
 
     /// A scene file without the ratio has none (∞), and ∞ survives the
