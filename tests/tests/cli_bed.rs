@@ -504,6 +504,36 @@ fn a_stopped_run_resumes_to_the_same_bits() {
         refused.stderr
     );
     assert_eq!(std::fs::read(parts.join("checkpoint.bin")).unwrap(), ck);
+    // So is a granule or a pour into it, whose summary and report would
+    // replace the run's (user review, session 55).
+    let summary_before = std::fs::read(parts.join("summary.json")).unwrap();
+    for argv in [
+        vec![
+            "granule", "--mesh", "4x1", "--strain", "0.01", "--out", parts_s,
+        ],
+        vec![
+            "pack",
+            "--granules",
+            "20",
+            "--die-diameter-mm",
+            "5",
+            "--out",
+            parts_s,
+        ],
+    ] {
+        let refused = cli(&argv);
+        assert_eq!(refused.code, 2, "{argv:?}: {}", refused.stderr);
+        assert!(
+            refused.stderr.contains("holds an unfinished bed run")
+                && refused.stderr.contains(&format!("--resume {parts_s}")),
+            "{}",
+            refused.stderr
+        );
+    }
+    assert_eq!(
+        std::fs::read(parts.join("summary.json")).unwrap(),
+        summary_before
+    );
     // With --overwrite (on a copy of it) the fresh run goes ahead.
     let over = out_dir("overwrite");
     std::fs::create_dir_all(&over).unwrap();

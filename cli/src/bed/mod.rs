@@ -1302,27 +1302,53 @@ impl BedArgs {
     /// directory without a checkpoint and an unreadable checkpoint (which
     /// no resume could use) are no reason to stop.
     fn keep_unfinished(&self, dir: &std::path::Path) -> anyhow::Result<()> {
-        if self.overwrite || !dir.join(checkpoint::FILE_NAME).is_file() {
+        if self.overwrite {
             return Ok(());
         }
-        let Ok(c) = checkpoint::Checkpoint::read(dir) else {
+        let Some((reached, last)) = unfinished_run(dir) else {
             return Ok(());
         };
-        let Ok(scene) = Scene::from_toml(&c.progress.scene_toml) else {
-            return Ok(());
-        };
-        if c.state.time >= c.progress.die.time_of_strain(scene.final_strain) {
-            return Ok(());
-        }
         Err(crate::error::input_error(format!(
-            "`{}` holds an unfinished run (checkpoint at C = {:.4} of {}): `granbed-cli bed \
-             --resume {}` continues it; choose another --out, or pass --overwrite to start \
-             afresh there and lose it",
+            "`{}` holds an unfinished run (checkpoint at C = {reached:.4} of {last}): \
+             `granbed-cli bed --resume {}` continues it; choose another --out, or pass \
+             --overwrite to start afresh there and lose it",
             dir.display(),
-            c.progress.die.strain_at(c.state.time),
-            scene.final_strain,
             dir.display()
         )))
+    }
+}
+
+/// The strain an unfinished bed run in `dir` has reached and its final
+/// strain: `Some` when `dir` holds a readable `checkpoint.bin` whose scene
+/// parses and whose state is short of its final strain. A finished run, a
+/// directory without a checkpoint and an unreadable checkpoint (which no
+/// resume could use) give `None`.
+pub fn unfinished_run(
+    dir: &std::path::Path,
+) -> Option<(granbed_kernel::Real, granbed_kernel::Real)> {
+    if !dir.join(checkpoint::FILE_NAME).is_file() {
+        return None;
+    }
+    let c = checkpoint::Checkpoint::read(dir).ok()?;
+    let scene = Scene::from_toml(&c.progress.scene_toml).ok()?;
+    (c.state.time < c.progress.die.time_of_strain(scene.final_strain))
+        .then(|| (c.progress.die.strain_at(c.state.time), scene.final_strain))
+}
+
+/// Refuses a `command` (`granule`, `pack`) whose outputs would go into a
+/// directory holding an unfinished bed run: its `summary.json` and
+/// `report.html` would replace the run's, beside the checkpoint that
+/// `--resume` continues from.
+pub fn refuse_unfinished(dir: &std::path::Path, command: &str) -> anyhow::Result<()> {
+    match unfinished_run(dir) {
+        None => Ok(()),
+        Some((reached, last)) => Err(crate::error::input_error(format!(
+            "`{}` holds an unfinished bed run (checkpoint at C = {reached:.4} of {last}), whose \
+             summary and report this {command} run would replace: choose another --out \
+             (`granbed-cli bed --resume {}` continues that run)",
+            dir.display(),
+            dir.display()
+        ))),
     }
 }
 

@@ -600,6 +600,7 @@ impl GranuleArgs {
                 writeln!(streams.stderr, "warning: {w}")?;
             }
         }
+        crate::bed::refuse_unfinished(&self.out, "granule")?;
         for dir in core::iter::once(&self.out).chain(jobs.iter().map(|j| &j.dir)) {
             crate::output::create_out_dir(dir)?;
         }

@@ -447,6 +447,7 @@ impl PackArgs {
         let material = self.material.material()?;
         let params = self.params(&material);
         self.check(&params)?;
+        crate::bed::refuse_unfinished(&self.out, "pack")?;
         crate::output::create_out_dir(&self.out)?;
         let bar = progress::Progress::new(self.quiet, params.granules, params.max_time);
         // No stop: `pack` keeps the default SIGINT handling (it has no
