@@ -34,18 +34,20 @@ where
 /// refuses with its range — but refuses a written number the double cannot
 /// hold instead of reading it as another: one beyond about 1.8e308 (read as
 /// infinity) or a nonzero one below about 4.9e-324 (read as 0). A value it
-/// cannot read gets a hint: a decimal comma (`0,5`) or a unit after the
-/// number (`1mm`, `30kPa`: the unit is in the flag's name).
+/// cannot read gets a hint: a comma (`0,5`, `30,000`: a decimal point, no
+/// thousands separators) or a unit after the number (`1mm`, `30kPa`: the
+/// unit is in the flag's name).
 pub fn real(text: &str) -> Result<f64, String> {
     let t = text.trim();
     let Ok(x) = t.parse::<f64>() else {
         let number_part = t.trim_end_matches(|c: char| c.is_alphabetic() || c == '%' || c == ' ');
         return Err(
-            if t.contains(',') && t.replacen(',', ".", 1).parse::<f64>().is_ok() {
-                format!(
-                    "not a number: write a decimal point, not a comma (`{}`)",
-                    t.replacen(',', ".", 1)
-                )
+            if t.contains(',') && t.replace(',', "").parse::<f64>().is_ok() {
+                // `0,5` or `30,000`: which one the comma meant is not ours
+                // to guess.
+                "not a number: no commas, a decimal point for a fraction (`0.5`) and no \
+                 thousands separators (`30000`)"
+                    .to_owned()
             } else if number_part != t
                 && !number_part.is_empty()
                 && number_part.parse::<f64>().is_ok()
@@ -148,7 +150,8 @@ mod tests {
         refused("1e400", "largest double");
         refused("-2e309", "largest double");
         refused("1e-400", "smallest double");
-        refused("0,5", "decimal point, not a comma (`0.5`)");
+        refused("0,5", "no commas, a decimal point for a fraction (`0.5`)");
+        refused("30,000", "no thousands separators (`30000`)");
         refused("1mm", "the number alone (`1`)");
         refused("30 kPa", "the number alone (`30`)");
         refused("12%", "the number alone (`12`)");

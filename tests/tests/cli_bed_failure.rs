@@ -289,12 +289,50 @@ fn a_withdrawal_that_inverts_an_element_exits_with_status_1() {
         .find(|l| l.starts_with("error: "))
         .unwrap_or_else(|| panic!("no error line:\n{}", run.stderr));
     assert!(
-        error.contains("withdrawal stopped before it came free of the bed (a step failed: granule")
-            && error.contains("inverted element"),
+        error.contains("the upper punch's withdrawal failed"),
         "{error}"
     );
+    // Where it failed, said once: in the warning (the error points to it).
+    let said = run
+        .stderr
+        .matches("withdrawal stopped before it came free of the bed (a step failed: granule")
+        .count();
+    assert_eq!(said, 1, "{}", run.stderr);
+    assert!(run.stderr.contains("inverted element"), "{}", run.stderr);
     for file in ["compression.csv", "unloading.csv", "summary.json"] {
         assert!(dir.join(file).is_file(), "{file} not written");
     }
     assert!(number(&summary(&dir), "final_strain") >= 0.1);
+    // In a series (`--types`) too: each member's failed withdrawal named.
+    let dir = common::fresh_dir("cli_bed_failure", "withdrawal_fails_series");
+    let run = cli(&[
+        "bed",
+        "--types",
+        "A2,B2",
+        "--granules",
+        "30",
+        "--die-diameter-mm",
+        "5",
+        "--mesh",
+        "4x1",
+        "--strain",
+        "0.1",
+        "--punch-speed-m-s",
+        "10",
+        "-j",
+        "2",
+        "--quiet",
+        "--out",
+        dir.to_str().unwrap(),
+    ]);
+    assert_eq!(run.code, 1, "{}", run.stderr);
+    for member in ["A2", "B2"] {
+        assert!(
+            run.stderr.contains(&format!(
+                "granule type {member}: the upper punch's withdrawal failed"
+            )),
+            "{}",
+            run.stderr
+        );
+    }
 }

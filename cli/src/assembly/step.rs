@@ -240,7 +240,9 @@ pub(super) fn validate(p: &AssemblyParams) -> Result<(), AssemblyError> {
             "> 0 m",
         ),
         (
-            p.time_step_safety > 0.0 && p.time_step_safety <= 2.0 && p.time_step_interval >= 1,
+            p.time_step_safety > 0.0
+                && p.time_step_safety <= granbed_kernel::granule::timestep::MAX_SAFETY
+                && p.time_step_interval >= 1,
             "time_step_safety",
             p.time_step_safety,
             "0 < C <= 2 (and an interval >= 1)",

@@ -856,8 +856,13 @@ impl Checkpoint {
             file.write_all(&sum.to_le_bytes())?;
             file.sync_all()
         });
-        written.with_context(|| format!("cannot write `{}`", tmp.display()))?;
         drop(file);
+        if let Err(e) = written {
+            // A half-written file (up to the state's size) is of no use to
+            // a resume: not left behind.
+            let _ = std::fs::remove_file(&tmp);
+            return Err(anyhow::Error::new(e).context(format!("cannot write `{}`", tmp.display())));
+        }
         std::fs::rename(&tmp, &path)
             .with_context(|| format!("cannot move the checkpoint to `{}`", path.display()))?;
         Ok(path)
@@ -879,14 +884,15 @@ impl Checkpoint {
         if bytes.len() < HEAD_BYTES || &bytes[..16] != MAGIC {
             return Err(bad("no granbed checkpoint header"));
         }
-        let version = u32::from_le_bytes(bytes[16..20].try_into().unwrap_or_default());
+        let at = LENGTH_AT as usize;
+        let version = u32::from_le_bytes(bytes[16..at].try_into().unwrap_or_default());
         if !(OLDEST_VERSION..=VERSION).contains(&version) {
             return Err(bad(&format!(
                 "format version {version}, this build reads {OLDEST_VERSION} to {VERSION}"
             )));
         }
-        let len = u64::from_le_bytes(bytes[20..28].try_into().unwrap_or_default());
-        let sum = u64::from_le_bytes(bytes[28..36].try_into().unwrap_or_default());
+        let len = u64::from_le_bytes(bytes[at..at + 8].try_into().unwrap_or_default());
+        let sum = u64::from_le_bytes(bytes[at + 8..HEAD_BYTES].try_into().unwrap_or_default());
         let payload = &bytes[HEAD_BYTES..];
         if (payload.len() as u64) < len {
             return Err(bad(&format!(
@@ -938,23 +944,31 @@ mod tests {
     }
 
     /// A write that fails is returned by `finish`, not lost, whatever was
-    /// encoded after it.
+    /// encoded after it, and nothing more is written after it.
     #[test]
     fn the_encoder_returns_its_first_write_error() {
-        struct Full;
+        /// Fails its first write ("disk full"), and any later one
+        /// differently; counts the calls.
+        struct Full(usize);
         impl std::io::Write for Full {
             fn write(&mut self, _: &[u8]) -> std::io::Result<usize> {
-                Err(std::io::Error::other("disk full"))
+                self.0 += 1;
+                Err(std::io::Error::other(if self.0 == 1 {
+                    "disk full"
+                } else {
+                    "written after a failure"
+                }))
             }
             fn flush(&mut self) -> std::io::Result<()> {
                 Ok(())
             }
         }
-        let mut out = Full;
+        let mut out = Full(0);
         let mut e = Enc::new(&mut out);
         e.f64s(&vec![1.0; 300_000]);
         e.u64(1);
         assert_eq!(e.finish().unwrap_err().to_string(), "disk full");
+        assert_eq!(out.0, 1, "writes after the first failure");
     }
 
     /// A held constraint reads back as written, its floats to the bit, on

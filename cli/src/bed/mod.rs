@@ -812,7 +812,7 @@ impl BedArgs {
         if result.interrupted {
             return Err(interrupted(&result, &out, &out, ""));
         }
-        if self.rate_check && result.error.is_none() {
+        if self.rate_check && result.error.is_none() && withdrawal_failure(&result).is_none() {
             self.rate_check(&pool, &scene, &out, &mut result, streams)?;
         }
         if result.stopped && !self.quiet {
@@ -843,12 +843,10 @@ impl BedArgs {
         // checkpoint could not be written is a run gone wrong too: exit
         // status 1, after the loading's outputs and the withdrawal's rows
         // so far were written (an interrupt's is the status above).
-        if let Some(why) = result.unloading.as_ref().and_then(|u| u.cut_short.as_ref())
-            && !matches!(why, run::CutShort::Interrupted { .. })
-        {
+        if withdrawal_failure(&result).is_some() {
             anyhow::bail!(
-                "the upper punch's withdrawal stopped before it came free of the bed ({why}); \
-                 the loading's outputs and the withdrawal's rows so far are in `{}`",
+                "the upper punch's withdrawal failed (the warning above says where); the \
+                 loading's outputs and the withdrawal's rows so far are in `{}`",
                 out.display()
             );
         }
@@ -1259,19 +1257,40 @@ impl BedArgs {
     }
 }
 
-/// The runs of a series the kernel stopped, each named with its strain and
-/// directory (the others ran on): all reported, or `Ok`.
+/// Why a run's punch withdrawal stopped short, if it failed: a step that
+/// failed or a checkpoint that could not be written (an interrupt is not a
+/// failure: its run is resumable).
+fn withdrawal_failure(r: &run::BedRun) -> Option<&run::CutShort> {
+    r.unloading
+        .as_ref()
+        .and_then(|u| u.cut_short.as_ref())
+        .filter(|why| !matches!(why, run::CutShort::Interrupted { .. }))
+}
+
+/// The runs of a series the kernel stopped, or whose withdrawal failed,
+/// each named with its strain and directory (the others ran on): all
+/// reported, or `Ok`.
 fn series_failures(series: &[SeriesRun<'_>], runs: Vec<run::BedRun>) -> anyhow::Result<()> {
     let failed = series.iter().zip(runs).filter_map(|(item, r)| {
         let strain = r.samples.last().map_or(0.0, |s| s.strain);
-        r.error.map(|e| {
-            anyhow::Error::new(e).context(format!(
-                "{}: the bed compression stopped early after C = {strain:.4} (outputs so far and \
-                 the last checkpoint in `{}`)",
+        let withdrawal = withdrawal_failure(&r).map(|why| {
+            anyhow::anyhow!(
+                "{}: the upper punch's withdrawal failed ({why}); the loading's outputs and the \
+                 withdrawal's rows so far are in `{}`",
                 item.name,
                 item.dir.display()
-            ))
-        })
+            )
+        });
+        r.error
+            .map(|e| {
+                anyhow::Error::new(e).context(format!(
+                    "{}: the bed compression stopped early after C = {strain:.4} (outputs so \
+                     far and the last checkpoint in `{}`)",
+                    item.name,
+                    item.dir.display()
+                ))
+            })
+            .or(withdrawal)
     });
     crate::output::all_failures(failed, "stopped early")
 }

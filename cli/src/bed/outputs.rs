@@ -482,7 +482,8 @@ pub struct Summary<'a> {
     /// a final strain past the target, overlaps above 1 % of the element,
     /// a Kawakita fit outside the law's regime, cost figures over part of
     /// the run, scene fields left at pre-publication values, an
-    /// interruption.
+    /// interruption, a bed poured less than [`SHALLOW_BED_DIAMETERS`]
+    /// granule diameters deep.
     pub warnings: Vec<String>,
     /// The error that stopped the run early, if any.
     pub error: Option<String>,
@@ -884,6 +885,13 @@ fn warnings(
     max_penetration_rel: Option<Real>,
 ) -> Vec<String> {
     let mut w = run.warnings.clone();
+    if run.interrupted {
+        w.push(format!(
+            "interrupted (SIGINT/SIGTERM) at C = {:.4}, step {}: the figures cover the run so \
+             far; `granbed-cli bed --resume DIR` continues it from its checkpoint",
+            run.strain_reached, run.steps
+        ));
+    }
     let diameter_m = scene.diameter_mm * 1e-3;
     if run.bed_height_m < SHALLOW_BED_DIAMETERS * diameter_m {
         w.push(format!(
@@ -895,13 +903,6 @@ fn warnings(
             scene.diameter_mm,
             scene.die_diameter_mm,
             scene.granules
-        ));
-    }
-    if run.interrupted {
-        w.push(format!(
-            "interrupted (SIGINT/SIGTERM) at C = {:.4}, step {}: the figures cover the run so \
-             far; `granbed-cli bed --resume DIR` continues it from its checkpoint",
-            run.strain_reached, run.steps
         ));
     }
     if let [.., before, last] = run.samples.as_slice() {
@@ -1322,7 +1323,7 @@ mod tests {
     /// as a layer, naming its depth and what deepens it; a deeper one is
     /// not.
     #[test]
-    fn a_bed_shallower_than_two_diameters_is_warned_about() {
+    fn a_bed_shallower_than_one_and_a_half_diameters_is_warned_about() {
         use crate::bed::run::{BedRun, BedSample};
         let scene = Scene::published();
         let mut run = BedRun::of_samples(vec![BedSample::default(); 4]);

@@ -97,7 +97,8 @@ Output, in --out DIR (created if missing; with --types in DIR/<TYPE>/ per type):
   summary.json            every input, sigma_est (4/(pi d) dF/dx fitted over
                           strain 0.1 to 0.4; null with fewer than two samples
                           there), sigma_est_strain_range (the strains fitted:
-                          less than 0.1-0.4 when the run ends before 0.4, which
+                          less than 0.1-0.4 when the run ends before 0.4 or
+                          --output-strain places no sample near 0.1, which
                           notes and stderr say), sigma_eff0, fit, energy checks, the
                           quasi-static certificate (kinetic/internal work over
                           the second half, with --symmetry full the platen force

@@ -116,8 +116,9 @@ pub struct Summary {
     /// sample within [`FIT_STRAIN_RANGE`], each end widened by half an
     /// output interval, at most 0.05 ([`granbed_kernel::analysis::granule::fit_window`]: a sample lies up to a step past its
     /// nominal strain, so the 40 % sample is 0.4000019) (narrower when the run ends
-    /// before 0.4, or when an interval above 0.1 places no sample near
-    /// 0.1, which `notes` and stderr then say); `null` without a fit.
+    /// before 0.4, or when the output interval places no sample nominally
+    /// near 0.1 (its multiples miss 0.1 by more than a quarter interval),
+    /// which `notes` and stderr then say); `null` without a fit.
     pub sigma_est_strain_range: Option<[Real; 2]>,
     /// σ_y,eff0 = √a2(η0)·σ_y, Pa.
     pub sigma_eff0_pa: Real,
@@ -196,14 +197,20 @@ impl Summary {
                 "sigma_est was fitted over strain {a} to {b} only, not {lo} to {hi}: the run \
                  ended at strain {final_strain}"
             )),
-            // The first sample more than a quarter interval above 10 %: none
-            // was written nominally at 10 % (a sample lies at most a step
-            // past its nominal strain).
-            Some([a, b]) if a > lo + 0.25 * p.output_strain_interval => notes.push(format!(
-                "sigma_est was fitted over strain {a} to {b} only, not {lo} to {hi}: the \
-                 output interval {} places no sample near {lo}",
-                p.output_strain_interval
-            )),
+            // The first fitted sample's nominal strain (the interval's
+            // multiple below it: a sample lies up to a step past its nominal
+            // strain, never before) more than a quarter interval above 10 %:
+            // none was written nominally near 10 %.
+            Some([a, b])
+                if nominal_at_or_below(a, p.output_strain_interval)
+                    > lo + 0.25 * p.output_strain_interval =>
+            {
+                notes.push(format!(
+                    "sigma_est was fitted over strain {a} to {b} only, not {lo} to {hi}: the \
+                     output interval {} places no sample near {lo}",
+                    p.output_strain_interval
+                ));
+            }
             Some(_) => {}
         }
         let e = last.map(|s| s.energy).unwrap_or_default();
@@ -299,5 +306,29 @@ impl Summary {
             self.steps,
             self.wall_time_s
         )
+    }
+}
+/// The multiple of `interval` at or just below the strain `c` (a sample's
+/// nominal strain: samples lie up to a step past it, never before; 10⁻⁹ of
+/// an interval of round-off taken as on it).
+fn nominal_at_or_below(c: Real, interval: Real) -> Real {
+    (c / interval + 1e-9).floor() * interval
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A sample's nominal strain is the interval's multiple at or below it,
+    /// however far a step carried it past (up to a whole interval): the
+    /// default interval's 10 % sample stays at 10 % at a fast platen, and
+    /// an interval of 0.06 puts the first sample past 10 % at 12 %.
+    #[test]
+    fn a_sample_past_its_nominal_strain_keeps_it() {
+        let close = |a: Real, b: Real| (a - b).abs() < 1e-12;
+        assert!(close(nominal_at_or_below(0.100_010_7, 0.005), 0.1));
+        assert!(close(nominal_at_or_below(0.103_8, 0.005), 0.1));
+        assert!(close(nominal_at_or_below(0.120_000_4, 0.06), 0.12));
+        assert!(close(nominal_at_or_below(0.2, 0.2), 0.2));
     }
 }

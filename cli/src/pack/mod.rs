@@ -99,9 +99,9 @@ impl<const EXP: i32> FromStr for Scaled<EXP> {
 
     fn from_str(s: &str) -> Result<Self, Self::Err> {
         let text = s.trim();
-        let given: f64 = text
-            .parse()
-            .map_err(|_| format!("`{text}` is not a number"))?;
+        // The number flags' parser: `1e400` refused rather than read as
+        // infinity, hints for a unit or a comma.
+        let given = crate::numbers::real(text)?;
         // Shift the decimal exponent of the text itself, then parse once.
         let (mantissa, exp) = match text.find(['e', 'E']) {
             Some(at) => (&text[..at], text[at + 1..].parse::<i32>().ok()),
@@ -532,13 +532,18 @@ mod tests {
         assert_eq!(inf.si, f64::INFINITY);
         assert!("abc".parse::<Millimetres>().is_err());
         assert_eq!(mm.to_string(), "11.3");
+        // A number a double cannot hold is refused, not read as 0 or ∞
+        // (the number flags' parser), with a hint for a unit.
+        for text in ["1e-2147483648", "1e2147483647", "1e400"] {
+            assert!(text.parse::<Megapascals>().is_err(), "{text}");
+        }
+        let e = "1mm".parse::<Millimetres>().unwrap_err();
+        assert!(e.contains("the number alone (`1`)"), "{e}");
         // An exponent at the end of i32's range is shifted without
         // overflow (the test profile checks overflow): the value is then
-        // scaled in floating point, 0 and ∞ here.
-        let tiny: Millimetres = "1e-2147483648".parse().unwrap();
-        assert_eq!(tiny.si, 0.0);
-        let huge: Megapascals = "1e2147483647".parse().unwrap();
-        assert_eq!(huge.si, f64::INFINITY);
+        // scaled in floating point.
+        let zero: Megapascals = "0e2147483647".parse().unwrap();
+        assert_eq!(zero.si, 0.0);
     }
 
     #[test]

@@ -126,7 +126,12 @@ impl PourParams {
     /// made them walk 2¹²⁸ sites).
     fn sites(&self) -> impl Iterator<Item = [Real; 2]> + '_ {
         let reach = self.die_radius - self.radius - self.jitter * core::f64::consts::SQRT_2;
-        let k = libm::floor(reach / self.lattice_spacing).min(MAX_DIE_LATTICE_SPACINGS) as i64;
+        // NaN (a NaN radius or spacing): no sites, as `as i64` gave before
+        // the cut (`min` would take the bound).
+        let k = match libm::floor(reach / self.lattice_spacing) {
+            k if k.is_nan() => 0,
+            k => k.min(MAX_DIE_LATTICE_SPACINGS) as i64,
+        };
         (-k..=k)
             .flat_map(move |j| {
                 (-k..=k).map(move |i| {
