@@ -5,7 +5,12 @@
  * except in granbed_vumat, which takes Abaqus' order [11, 22, 33, 12, 23, 31].
  * Every function but granbed_version and granbed_status_message returns a
  * GRANBED_* status (granbed_status_message names it); none aborts on bad
- * numbers.
+ * numbers. An argument error is GRANBED_ERR_NULL_POINTER (a required pointer
+ * is NULL) or GRANBED_ERR_SIZE (an array's byte size overflows size_t), in
+ * every function that takes arrays or pointers.
+ * Built in this workspace the library targets x86-64-v3 (AVX2): on an
+ * older x86-64 processor it stops with SIGILL; rebuild it with
+ * GRANBED_TARGET_CPU=x86-64 (install.sh) or RUSTFLAGS="-C target-cpu=x86-64".
  */
 
 #ifndef GRANBED_H
@@ -361,7 +366,7 @@ int32_t granbed_material_preset(const char *name, struct GranbedMaterialParams *
 // Checks every field of `params` against its range (NaN always fails).
 // On failure returns `GRANBED_ERR_INVALID_PARAMETER` and, if `error` is
 // not NULL, writes the first rejected field, its value and the allowed
-// range there.
+// range there; `GRANBED_ERR_NULL_POINTER` if `params` is NULL.
 //
 // # Safety
 // `params` is NULL or points to a `GranbedMaterialParams`; `error` is

@@ -156,7 +156,7 @@ pub unsafe extern "C" fn granbed_material_preset(
 /// Checks every field of `params` against its range (NaN always fails).
 /// On failure returns `GRANBED_ERR_INVALID_PARAMETER` and, if `error` is
 /// not NULL, writes the first rejected field, its value and the allowed
-/// range there.
+/// range there; `GRANBED_ERR_NULL_POINTER` if `params` is NULL.
 ///
 /// # Safety
 /// `params` is NULL or points to a `GranbedMaterialParams`; `error` is
