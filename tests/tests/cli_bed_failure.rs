@@ -255,16 +255,12 @@ fn a_snapshot_that_cannot_be_written_keeps_the_run_for_resume() {
     a_failed_snapshot_resumes("snapshot_end", "0.01");
 }
 
-/// A withdrawal whose step fails is a run gone wrong: exit status 1 with
-/// the step's error (granule, step, element), after the loading's outputs
-/// and the withdrawal's rows so far are written. A punch at 10 m/s (the
-/// most allowed) on a 30-granule coarse bed moves C ≈ 0.08 per step: the
-/// loading folds elements, and the withdrawal's second step inverts one
-/// (user review, session 55: it exited 0 with only a warning).
-#[test]
-fn a_withdrawal_that_inverts_an_element_exits_with_status_1() {
-    let dir = common::fresh_dir("cli_bed_failure", "withdrawal_fails");
-    let run = cli(&[
+/// A 30-granule coarse bed pressed to 10 % by a punch at 10 m/s (the most
+/// allowed) into a fresh directory `name`, with `extra` arguments: its
+/// directory and the run.
+fn fast_punch(name: &str, extra: &[&str]) -> (std::path::PathBuf, common::Run) {
+    let dir = common::fresh_dir("cli_bed_failure", name);
+    let mut argv = vec![
         "bed",
         "--granules",
         "30",
@@ -281,7 +277,21 @@ fn a_withdrawal_that_inverts_an_element_exits_with_status_1() {
         "--quiet",
         "--out",
         dir.to_str().unwrap(),
-    ]);
+    ];
+    argv.extend_from_slice(extra);
+    let run = cli(&argv);
+    (dir, run)
+}
+
+/// A withdrawal whose step fails is a run gone wrong: exit status 1 with
+/// the step's error (granule, step, element), after the loading's outputs
+/// and the withdrawal's rows so far are written. A punch at 10 m/s (the
+/// most allowed) on a 30-granule coarse bed moves C ≈ 0.08 per step: the
+/// loading folds elements, and the withdrawal's second step inverts one
+/// (user review, session 55: it exited 0 with only a warning).
+#[test]
+fn a_withdrawal_that_inverts_an_element_exits_with_status_1() {
+    let (dir, run) = fast_punch("withdrawal_fails", &[]);
     assert_eq!(run.code, 1, "{}", run.stderr);
     let error = run
         .stderr
@@ -304,27 +314,7 @@ fn a_withdrawal_that_inverts_an_element_exits_with_status_1() {
     }
     assert!(number(&summary(&dir), "final_strain") >= 0.1);
     // In a series (`--types`) too: each member's failed withdrawal named.
-    let dir = common::fresh_dir("cli_bed_failure", "withdrawal_fails_series");
-    let run = cli(&[
-        "bed",
-        "--types",
-        "A2,B2",
-        "--granules",
-        "30",
-        "--die-diameter-mm",
-        "5",
-        "--mesh",
-        "4x1",
-        "--strain",
-        "0.1",
-        "--punch-speed-m-s",
-        "10",
-        "-j",
-        "2",
-        "--quiet",
-        "--out",
-        dir.to_str().unwrap(),
-    ]);
+    let (_, run) = fast_punch("withdrawal_fails_series", &["--types", "A2,B2"]);
     assert_eq!(run.code, 1, "{}", run.stderr);
     for member in ["A2", "B2"] {
         assert!(
