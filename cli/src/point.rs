@@ -171,11 +171,17 @@ struct Summary {
     pressure_pa: f64,
     /// Relative density of the last row.
     eta: f64,
+    /// The first step and path strain at which η reached 1 (the pores
+    /// closed: from there the solid itself is compressed).
+    dense_from: Option<(u32, f64)>,
 }
 
 impl Summary {
-    fn add(&mut self, n: u32, s: &PointSample) {
+    fn add(&mut self, n: u32, strain: f64, s: &PointSample) {
         self.steps = n;
+        if s.info.eta >= 1.0 && self.dense_from.is_none() {
+            self.dense_from = Some((n, strain));
+        }
         self.plastic += u32::from(s.info.plastic);
         self.max_iterations = self.max_iterations.max(s.info.iterations);
         self.pressure_pa = tensor::pressure(&s.tau);
@@ -275,7 +281,7 @@ impl PointArgs {
             match point.step_to(strain) {
                 Ok(sample) => {
                     csv.write_row(&row(n, &sample)).with_context(write_err)?;
-                    summary.add(n, &sample);
+                    summary.add(n, strain, &sample);
                 }
                 Err(e) => {
                     let rows = csv.rows();
@@ -296,6 +302,14 @@ impl PointArgs {
             "point: type {} on {} to strain {}: {summary}",
             self.material.granule_type, self.path, self.strain
         )?;
+        if let Some((n, strain)) = summary.dense_from {
+            writeln!(
+                streams.stderr,
+                "note: eta reached 1 at step {n} (strain {strain}): the pores are closed and \
+                 from there the solid itself is compressed (eta = eta0/J counts its elastic \
+                 volume change; the yield surface is von Mises's)"
+            )?;
+        }
         Ok(())
     }
 }

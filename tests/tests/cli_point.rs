@@ -365,3 +365,46 @@ fn negative_values_in_any_spelling_reach_the_flag() {
     assert_eq!(run.code, 2);
     assert!(run.stderr.contains("--strain"), "{}", run.stderr);
 }
+
+/// A path that closes the pores says where: η = η0/J reaches 1 and the
+/// note names the step and strain (B2, η0 = 0.8: J = 0.8 at a hydrostatic
+/// strain of 0.2, so the first step at or past it); a path that stays
+/// porous has no note.
+#[test]
+fn a_path_past_full_density_says_where_the_pores_closed() {
+    let run = point_ok(&[
+        "--type",
+        "B2",
+        "--path",
+        "hydrostatic",
+        "--strain",
+        "0.3",
+        "--steps",
+        "30",
+    ]);
+    let note = run
+        .stderr
+        .lines()
+        .find(|l| l.starts_with("note: eta reached 1 at step "))
+        .unwrap_or_else(|| panic!("no note:\n{}", run.stderr));
+    // The first of the steps 0.01 apart at or past 0.2 (0.2 itself may
+    // round either side of 1).
+    let strain: f64 = note
+        .split("(strain ")
+        .nth(1)
+        .and_then(|t| t.split(')').next())
+        .and_then(|t| t.parse().ok())
+        .unwrap_or_else(|| panic!("{note}"));
+    assert!((0.2..=0.21).contains(&strain), "{note}");
+    let run = point_ok(&[
+        "--type",
+        "B2",
+        "--path",
+        "hydrostatic",
+        "--strain",
+        "0.05",
+        "--steps",
+        "10",
+    ]);
+    assert!(!run.stderr.contains("eta reached 1"), "{}", run.stderr);
+}
