@@ -61,10 +61,13 @@ impl Num for Real {
 
 /// Whether bit `l` of a lane mask is set: the masks of the lane solvers
 /// (`u64`, bit l for lane l, so at most 64 lanes) that say which lanes are
-/// still iterating.
+/// still iterating. `false` for `l` ≥ 64 (a shift that far overflowed).
 #[inline(always)]
 pub fn lane_bit(bits: u64, l: usize) -> bool {
-    bits >> l & 1 == 1
+    u32::try_from(l)
+        .ok()
+        .and_then(|l| bits.checked_shr(l))
+        .is_some_and(|b| b & 1 == 1)
 }
 
 /// `W` values operated on lane by lane.
@@ -191,6 +194,17 @@ mod tests {
         for (l, x) in v.iter().enumerate() {
             assert_eq!(lanes.0[l].to_bits(), x.to_bits(), "lane {l}");
         }
+    }
+
+    /// A lane mask's bits read in order, and a lane past the mask's 64 is
+    /// not set (its shift overflowed).
+    #[test]
+    fn lane_bits_past_the_mask_are_unset() {
+        let bits = 0b1011u64 | 1 << 63;
+        let set: [bool; 5] = core::array::from_fn(|l| lane_bit(bits, l));
+        assert_eq!(set, [true, true, false, true, false]);
+        assert!(lane_bit(bits, 63));
+        assert!(!lane_bit(u64::MAX, 64) && !lane_bit(u64::MAX, usize::MAX));
     }
 
     /// Lane l of every operation equals the scalar operation on lane l.

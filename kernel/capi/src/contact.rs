@@ -37,7 +37,8 @@ pub struct GranbedQuadProjection {
 /// the normal points out) by Newton's method on the closest-point problem.
 ///
 /// Returns `GRANBED_OK`, `GRANBED_ERR_NON_FINITE`, or
-/// `GRANBED_ERR_DEGENERATE` (zero-length edge vectors or zero normal).
+/// `GRANBED_ERR_DEGENERATE` (zero-length edge vectors or zero normal, or
+/// finite corners so far apart that the normal's length overflows).
 ///
 /// # Safety
 /// `p` points to 3 doubles, `quad` to 12, `out` to a writable

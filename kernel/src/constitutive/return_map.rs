@@ -291,6 +291,9 @@ fn damping(eps: Real, delta: Real, de: Real, dd: Real) -> Real {
 
 impl<const W: usize> ReturnMapSystem<Lanes<W>> {
     /// The system of lane `l`.
+    ///
+    /// # Panics
+    /// If `l` ≥ `W` (an index into the lanes, as `Num::lane`'s).
     #[inline(always)]
     pub fn lane(&self, l: usize) -> ReturnMapSystem {
         ReturnMapSystem {

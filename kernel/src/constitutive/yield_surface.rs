@@ -73,6 +73,9 @@ pub struct CoefficientLanes<const W: usize> {
 
 impl<const W: usize> CoefficientLanes<W> {
     /// Lane `l`'s coefficients.
+    ///
+    /// # Panics
+    /// If `l` ≥ `W`.
     #[inline(always)]
     pub fn lane(&self, l: usize) -> YieldCoefficients {
         YieldCoefficients {

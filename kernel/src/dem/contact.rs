@@ -252,6 +252,9 @@ impl<const L: usize> ContactLanes<L> {
     };
 
     /// Sets lane `l`'s law.
+    ///
+    /// # Panics
+    /// If `l` ≥ `L`.
     #[inline(always)]
     pub fn set_law(&mut self, l: usize, law: &ContactLaw) {
         self.r_star[l] = law.r_star;

@@ -193,6 +193,9 @@ pub struct BatchOutput<'a> {
 
 impl BatchOutput<'_> {
     /// Lane `l` as one element's output.
+    ///
+    /// # Panics
+    /// If `l` ≥ [`BATCH`].
     #[inline(always)]
     pub fn lane(&self, l: usize) -> ElementOutput {
         let mut out = HexForces {

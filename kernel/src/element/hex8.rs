@@ -114,6 +114,9 @@ const fn gauss_point(i: usize) -> [Real; 3] {
 /// Scaled Jacobian at corner `i`: the determinant of the three unit edge
 /// vectors leaving node `i` along +ξ, +η, +ζ (sign-corrected), in [−1, 1];
 /// 1 for a cube corner, ≤ 0 for an inverted corner.
+///
+/// # Panics
+/// If `i` ≥ 8 (a hex has eight corners).
 pub fn corner_scaled_jacobian(x: &HexCoords, i: usize) -> Real {
     let j = jacobian(x, NODE_SIGNS[i]);
     let mut n = [0.0; 3];
