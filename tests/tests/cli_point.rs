@@ -372,16 +372,19 @@ fn negative_values_in_any_spelling_reach_the_flag() {
 /// porous has no note.
 #[test]
 fn a_path_past_full_density_says_where_the_pores_closed() {
-    let run = point_ok(&[
-        "--type",
-        "B2",
-        "--path",
-        "hydrostatic",
-        "--strain",
-        "0.3",
-        "--steps",
-        "30",
-    ]);
+    let b2_hydrostatic = |strain: &str, steps: &str| {
+        point_ok(&[
+            "--type",
+            "B2",
+            "--path",
+            "hydrostatic",
+            "--strain",
+            strain,
+            "--steps",
+            steps,
+        ])
+    };
+    let run = b2_hydrostatic("0.3", "30");
     let note = run
         .stderr
         .lines()
@@ -396,15 +399,6 @@ fn a_path_past_full_density_says_where_the_pores_closed() {
         .and_then(|t| t.parse().ok())
         .unwrap_or_else(|| panic!("{note}"));
     assert!((0.2..=0.21).contains(&strain), "{note}");
-    let run = point_ok(&[
-        "--type",
-        "B2",
-        "--path",
-        "hydrostatic",
-        "--strain",
-        "0.05",
-        "--steps",
-        "10",
-    ]);
+    let run = b2_hydrostatic("0.05", "10");
     assert!(!run.stderr.contains("eta reached 1"), "{}", run.stderr);
 }
