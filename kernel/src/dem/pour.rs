@@ -1004,7 +1004,8 @@ mod tests {
             ),
         ] {
             assert_eq!(rejected(p), field);
-            let _ = p.grid().cells();
+            // A hang here is the failure; the figures are what they can be.
+            assert!(p.grid().cells() >= 1, "{field}");
             assert!(p.fill_height() > 0.0, "{field}");
         }
     }
