@@ -14,6 +14,7 @@ use granbed_kernel::tensor::{self, XX, XY, XZ, YY, YZ, ZZ};
 use crate::csv::{CsvWriter, Field};
 use crate::error::input_error;
 use crate::material_args::MaterialArgs;
+use crate::numbers::Shown as _;
 use crate::output::{Output, Streams};
 
 /// Largest `--steps`.
@@ -194,7 +195,12 @@ impl fmt::Display for Summary {
         write!(
             f,
             "{} steps, {} plastic, max {} iterations, final pressure {:.6e} Pa, final eta {:.6}",
-            self.steps, self.plastic, self.max_iterations, self.pressure_pa, self.eta
+            self.steps,
+            self.plastic,
+            self.max_iterations,
+            // + 0.0: a pressure of -0 (no stress) is said as 0.
+            self.pressure_pa + 0.0,
+            self.eta
         )
     }
 }
@@ -300,14 +306,17 @@ impl PointArgs {
         writeln!(
             streams.stderr,
             "point: type {} on {} to strain {}: {summary}",
-            self.material.granule_type, self.path, self.strain
+            self.material.granule_type,
+            self.path,
+            self.strain.shown()
         )?;
         if let Some((n, strain)) = summary.dense_from {
             writeln!(
                 streams.stderr,
-                "note: eta reached 1 at step {n} (strain {strain}): the pores are closed and \
+                "note: eta reached 1 at step {n} (strain {}): the pores are closed and \
                  from there the solid itself is compressed (eta = eta0/J counts its elastic \
-                 volume change; the yield surface is von Mises's)"
+                 volume change; the yield surface is von Mises's)",
+                strain.shown()
             )?;
         }
         Ok(())

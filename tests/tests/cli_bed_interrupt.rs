@@ -194,6 +194,8 @@ fn an_interrupted_run_keeps_its_work_and_resumes_to_the_same_bits() {
     assert_eq!(r.code, 130, "{}", r.stderr);
     assert!(
         r.stderr.contains("interrupted at C =")
+            // Between two rows: the message says where the outputs end.
+            && r.stderr.contains("(the outputs' last row: C = ")
             && r.stderr
                 .contains(&format!("granbed-cli bed --resume {parts_s}")),
         "{}",

@@ -402,3 +402,25 @@ fn a_path_past_full_density_says_where_the_pores_closed() {
     let run = b2_hydrostatic("0.05", "10");
     assert!(!run.stderr.contains("eta reached 1"), "{}", run.stderr);
 }
+
+/// The closing line says the strain short and an unstressed point's
+/// pressure as 0: a strain of 1e-300 was printed with 300 digits, and the
+/// pressure of no stress, −tr τ/3 of zeros, as -0.
+#[test]
+fn the_closing_line_says_a_tiny_strain_short_and_no_pressure_as_zero() {
+    let run = point_ok(&[
+        "--path",
+        "hydrostatic",
+        "--strain",
+        "1e-300",
+        "--steps",
+        "3",
+    ]);
+    let line = run
+        .stderr
+        .lines()
+        .find(|l| l.starts_with("point: "))
+        .unwrap_or_else(|| panic!("no closing line:\n{}", run.stderr));
+    assert!(line.contains("to strain 1e-300:"), "{line}");
+    assert!(line.contains("final pressure 0.000000e0 Pa"), "{line}");
+}

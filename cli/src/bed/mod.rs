@@ -1305,10 +1305,9 @@ fn interrupted(
     what: &str,
 ) -> anyhow::Error {
     anyhow::Error::new(crate::signal::Interrupted(format!(
-        "interrupted at C = {:.4}, step {}{what}: the checkpoint and the outputs so far are in \
-         `{}`; continue with: granbed-cli bed --resume {}",
-        result.strain_reached,
-        result.steps,
+        "interrupted at {}{what}: the checkpoint and the outputs so far are in `{}`; continue \
+         with: granbed-cli bed --resume {}",
+        result.stopped_at(),
         dir.display(),
         resume_dir.display()
     )))

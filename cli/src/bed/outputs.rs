@@ -887,9 +887,9 @@ fn warnings(
     let mut w = run.warnings.clone();
     if run.interrupted {
         w.push(format!(
-            "interrupted (SIGINT/SIGTERM) at C = {:.4}, step {}: the figures cover the run so \
-             far; `granbed-cli bed --resume DIR` continues it from its checkpoint",
-            run.strain_reached, run.steps
+            "interrupted (SIGINT/SIGTERM) at {}: the figures cover the run so far; \
+             `granbed-cli bed --resume DIR` continues it from its checkpoint",
+            run.stopped_at()
         ));
     }
     let diameter_m = scene.diameter_mm * 1e-3;

@@ -524,6 +524,22 @@ pub struct HiddenOverlap {
     pub wall_time_s: f64,
 }
 
+impl BedRun {
+    /// Where an interrupted run stopped, for its messages: the strain and
+    /// step of its last step, and the strain of its outputs' last row when
+    /// that is an earlier one (rows are written every output interval, so
+    /// the summary and the CSVs end there, not at the step).
+    pub fn stopped_at(&self) -> String {
+        let mut at = format!("C = {:.4}, step {}", self.strain_reached, self.steps);
+        if let Some(last) = self.samples.last()
+            && last.strain < self.strain_reached
+        {
+            at.push_str(&format!(" (the outputs' last row: C = {:.4})", last.strain));
+        }
+        at
+    }
+}
+
 #[cfg(test)]
 impl BedRun {
     /// A finished run with these `samples` of one granule of one hex in a
