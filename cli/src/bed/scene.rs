@@ -472,6 +472,11 @@ fn default_hourglass_kappa() -> f64 {
     granbed_kernel::element::force::DEFAULT_HOURGLASS_KAPPA
 }
 
+/// The allowed `granule_type`s, for messages.
+const GRANULE_TYPES: &str = "A1, A2, A3, B1 ... C3";
+/// The allowed `element`s, for messages.
+const ELEMENTS: &str = "one-point, fbar";
+
 /// The scene's name of the one-point element.
 pub const ELEMENT_ONE_POINT: &str = "one-point";
 /// The scene's name of the F-bar element.
@@ -524,10 +529,27 @@ impl Scene {
         // One message: the parser's, with its line, column and excerpt (as
         // the cause under a context of its own it was printed twice).
         let mut scene: Scene = toml::from_str(text).map_err(|e| {
-            anyhow::Error::new(InputError(format!(
-                "invalid scene: {}",
-                e.to_string().trim_end()
-            )))
+            let problems = refused_fields(text);
+            // The parser's located message, unless it is a missing field's
+            // (located at the file's first line); then every field the
+            // scene's types refuse, with the allowed ranges the parser
+            // does not know.
+            let located = problems.is_empty() || !e.message().starts_with("missing field");
+            let mut message = if located {
+                format!("invalid scene: {}", e.to_string().trim_end())
+            } else {
+                "invalid scene".to_owned()
+            };
+            // The list, unless it would only say again the one refusal
+            // the located message says.
+            if !located || problems.len() > 1 || problems.iter().any(|p| p.1) {
+                message.push_str("\nevery field refused, with what it allows:");
+                for p in &problems {
+                    message.push_str("\n  - ");
+                    message.push_str(&p.0);
+                }
+            }
+            anyhow::Error::new(InputError(message))
         })?;
         scene.validate()?;
         // The type as it is spelt everywhere else (`b2` → `B2`): the
@@ -550,194 +572,8 @@ impl Scene {
         self.granule_type()?;
         self.mesh_level()?;
         self.element_kind()?;
-        let exact_sweep_tolerance = self.exact_sweep_tolerance();
-        let d = self.diameter_mm;
-        let die_range = format!(
-            "more than 4 and at most {} granule diameters: {} < D <= {} mm for granules of \
-             diameter_mm = {}",
-            MAX_DIE_DIAMETERS.shown(),
-            (4.0 * d).shown(),
-            (MAX_DIE_DIAMETERS * d).shown(),
-            d.shown()
-        );
-        let checks: [(bool, &str, f64, &str); 28] = [
-            (
-                self.sweep_tolerance > 0.0 && self.sweep_tolerance <= 0.1,
-                "sweep_tolerance",
-                self.sweep_tolerance,
-                "0 < t <= 0.1",
-            ),
-            (
-                exact_sweep_tolerance > 0.0 && exact_sweep_tolerance <= 0.1,
-                "exact_sweep_tolerance",
-                exact_sweep_tolerance,
-                "0 < t <= 0.1",
-            ),
-            (
-                (0.0..=1.0).contains(&self.face_list_skin),
-                "face_list_skin",
-                self.face_list_skin,
-                "0 <= s <= 1 (0: no face lists)",
-            ),
-            (
-                (0.0..=1.0).contains(&self.hourglass_kappa),
-                "hourglass_kappa",
-                self.hourglass_kappa,
-                "0 <= kappa <= 1",
-            ),
-            (
-                // Above 1 only to provoke an instability on purpose; the
-                // kernel's estimate takes up to MAX_SAFETY (2).
-                self.time_step_safety > 0.0
-                    && self.time_step_safety <= granbed_kernel::granule::timestep::MAX_SAFETY,
-                "time_step_safety",
-                self.time_step_safety,
-                "0 < C <= 2",
-            ),
-            (
-                (1.0..=1e9).contains(&self.watchdog_energy_ratio),
-                "watchdog_energy_ratio",
-                self.watchdog_energy_ratio,
-                "1 <= r <= 1e9",
-            ),
-            (
-                (1.0..=1e9).contains(&self.watchdog_speed_ratio),
-                "watchdog_speed_ratio",
-                self.watchdog_speed_ratio,
-                "1 <= r <= 1e9",
-            ),
-            (
-                (1.0..=1e6).contains(&self.mass_scaling),
-                "mass_scaling",
-                self.mass_scaling,
-                "1 <= F <= 1e6",
-            ),
-            (
-                self.selective_mass_ratio >= 1.0,
-                "selective_mass_ratio",
-                self.selective_mass_ratio,
-                ">= 1 (inf: physical rigid modes)",
-            ),
-            (
-                (0.0..=1.0).contains(&self.time_step_floor),
-                "time_step_floor",
-                self.time_step_floor,
-                "0 <= r <= 1 (0: off)",
-            ),
-            (
-                (1.0..=1e6).contains(&self.max_mass_factor),
-                "max_mass_factor",
-                self.max_mass_factor,
-                "1 <= k <= 1e6",
-            ),
-            (
-                self.checkpoint_interval_minutes > 0.0,
-                "checkpoint_interval_minutes",
-                self.checkpoint_interval_minutes,
-                "> 0",
-            ),
-            (
-                self.checkpoint_strain_interval >= MIN_STRAIN_INTERVAL,
-                "checkpoint_strain_interval",
-                self.checkpoint_strain_interval,
-                ">= 1e-6",
-            ),
-            (
-                (1..=MAX_GRANULES).contains(&self.granules),
-                "granules",
-                self.granules as f64,
-                "1..=100000",
-            ),
-            (
-                self.diameter_mm >= MIN_DIAMETER_MM && self.diameter_mm < 2000.0,
-                "diameter_mm",
-                self.diameter_mm,
-                "0.001 <= d < 2000",
-            ),
-            (
-                self.die_diameter_mm > 4.0 * self.diameter_mm
-                    && self.die_diameter_mm <= MAX_DIE_DIAMETERS * self.diameter_mm,
-                "die_diameter_mm",
-                self.die_diameter_mm,
-                &die_range,
-            ),
-            (
-                (MIN_PUNCH_SPEED_M_S..=MAX_PUNCH_SPEED_M_S).contains(&self.punch_speed_m_s),
-                "punch_speed_m_s",
-                self.punch_speed_m_s,
-                "1e-4 <= v <= 10 m/s (10: the platen speed limit of `granbed-cli granule`)",
-            ),
-            (
-                self.final_strain > 0.0 && self.final_strain <= MAX_FINAL_STRAIN,
-                "final_strain",
-                self.final_strain,
-                "0 < C <= 0.9",
-            ),
-            (
-                (0.0..=MAX_FINAL_STRAIN).contains(&self.kawakita_min_strain),
-                "kawakita_min_strain",
-                self.kawakita_min_strain,
-                "0 <= C <= 0.9",
-            ),
-            (
-                (0.0..=MAX_FINAL_STRAIN).contains(&self.heckel_min_strain),
-                "heckel_min_strain",
-                self.heckel_min_strain,
-                "0 <= C <= 0.9",
-            ),
-            (
-                self.output_strain_interval >= MIN_STRAIN_INTERVAL
-                    && self.output_strain_interval <= self.final_strain,
-                "output_strain_interval",
-                self.output_strain_interval,
-                "1e-6 <= interval <= final_strain",
-            ),
-            (
-                (0.0..=2.0).contains(&self.damping_ratio),
-                "damping_ratio",
-                self.damping_ratio,
-                "0 <= xi <= 2",
-            ),
-            (
-                (1..=MAX_CONTACT_SEARCH_INTERVAL).contains(&self.contact_search_interval),
-                "contact_search_interval",
-                f64::from(self.contact_search_interval),
-                "1..=10",
-            ),
-            (
-                (0.0..=0.1).contains(&self.contact_capture),
-                "contact_capture",
-                self.contact_capture,
-                "0 <= c <= 0.1",
-            ),
-            (
-                (self.held_reprojection > 0.0 && self.held_reprojection <= 1.0)
-                    || self.held_reprojection == f64::INFINITY,
-                "held_reprojection",
-                self.held_reprojection,
-                "0 < s <= 1, or inf (never)",
-            ),
-            (
-                (0.0..=1.0).contains(&self.exact_contact_from_strain),
-                "exact_contact_from_strain",
-                self.exact_contact_from_strain,
-                "0 <= C <= 1 (1: never)",
-            ),
-            (
-                self.contact_search_interval == 1 || self.hold_constraints,
-                "contact_search_interval",
-                f64::from(self.contact_search_interval),
-                "1 unless hold_constraints = true",
-            ),
-            (
-                (1..=50).contains(&self.contact_sweeps),
-                "contact_sweeps",
-                f64::from(self.contact_sweeps),
-                "1..=50",
-            ),
-        ];
-        if let Some((_, field, value, allowed)) = checks.into_iter().find(|c| !c.0) {
-            bail!(invalid(field, value, allowed));
+        if let Some((_, field, value, allowed)) = self.range_checks().into_iter().find(|c| !c.0) {
+            bail!(invalid(field, value, &allowed));
         }
         if let Some(c) = self
             .snapshot_strains
@@ -763,11 +599,203 @@ impl Scene {
         Ok(())
     }
 
+    /// The numeric fields' range checks: (passes, field, value, the
+    /// allowed range), in the order [`Scene::validate`] reports them.
+    fn range_checks(&self) -> [(bool, &'static str, f64, String); 28] {
+        let exact_sweep_tolerance = self.exact_sweep_tolerance();
+        let d = self.diameter_mm;
+        let die_range = format!(
+            "more than 4 and at most {} granule diameters: {} < D <= {} mm for granules of \
+             diameter_mm = {}",
+            MAX_DIE_DIAMETERS.shown(),
+            (4.0 * d).shown(),
+            (MAX_DIE_DIAMETERS * d).shown(),
+            d.shown()
+        );
+        [
+            (
+                self.sweep_tolerance > 0.0 && self.sweep_tolerance <= 0.1,
+                "sweep_tolerance",
+                self.sweep_tolerance,
+                "0 < t <= 0.1".to_owned(),
+            ),
+            (
+                exact_sweep_tolerance > 0.0 && exact_sweep_tolerance <= 0.1,
+                "exact_sweep_tolerance",
+                exact_sweep_tolerance,
+                "0 < t <= 0.1".to_owned(),
+            ),
+            (
+                (0.0..=1.0).contains(&self.face_list_skin),
+                "face_list_skin",
+                self.face_list_skin,
+                "0 <= s <= 1 (0: no face lists)".to_owned(),
+            ),
+            (
+                (0.0..=1.0).contains(&self.hourglass_kappa),
+                "hourglass_kappa",
+                self.hourglass_kappa,
+                "0 <= kappa <= 1".to_owned(),
+            ),
+            (
+                // Above 1 only to provoke an instability on purpose; the
+                // kernel's estimate takes up to MAX_SAFETY (2).
+                self.time_step_safety > 0.0
+                    && self.time_step_safety <= granbed_kernel::granule::timestep::MAX_SAFETY,
+                "time_step_safety",
+                self.time_step_safety,
+                "0 < C <= 2".to_owned(),
+            ),
+            (
+                (1.0..=1e9).contains(&self.watchdog_energy_ratio),
+                "watchdog_energy_ratio",
+                self.watchdog_energy_ratio,
+                "1 <= r <= 1e9".to_owned(),
+            ),
+            (
+                (1.0..=1e9).contains(&self.watchdog_speed_ratio),
+                "watchdog_speed_ratio",
+                self.watchdog_speed_ratio,
+                "1 <= r <= 1e9".to_owned(),
+            ),
+            (
+                (1.0..=1e6).contains(&self.mass_scaling),
+                "mass_scaling",
+                self.mass_scaling,
+                "1 <= F <= 1e6".to_owned(),
+            ),
+            (
+                self.selective_mass_ratio >= 1.0,
+                "selective_mass_ratio",
+                self.selective_mass_ratio,
+                ">= 1 (inf: physical rigid modes)".to_owned(),
+            ),
+            (
+                (0.0..=1.0).contains(&self.time_step_floor),
+                "time_step_floor",
+                self.time_step_floor,
+                "0 <= r <= 1 (0: off)".to_owned(),
+            ),
+            (
+                (1.0..=1e6).contains(&self.max_mass_factor),
+                "max_mass_factor",
+                self.max_mass_factor,
+                "1 <= k <= 1e6".to_owned(),
+            ),
+            (
+                self.checkpoint_interval_minutes > 0.0,
+                "checkpoint_interval_minutes",
+                self.checkpoint_interval_minutes,
+                "> 0".to_owned(),
+            ),
+            (
+                self.checkpoint_strain_interval >= MIN_STRAIN_INTERVAL,
+                "checkpoint_strain_interval",
+                self.checkpoint_strain_interval,
+                ">= 1e-6".to_owned(),
+            ),
+            (
+                (1..=MAX_GRANULES).contains(&self.granules),
+                "granules",
+                self.granules as f64,
+                "1..=100000".to_owned(),
+            ),
+            (
+                self.diameter_mm >= MIN_DIAMETER_MM && self.diameter_mm < 2000.0,
+                "diameter_mm",
+                self.diameter_mm,
+                "0.001 <= d < 2000".to_owned(),
+            ),
+            (
+                self.die_diameter_mm > 4.0 * self.diameter_mm
+                    && self.die_diameter_mm <= MAX_DIE_DIAMETERS * self.diameter_mm,
+                "die_diameter_mm",
+                self.die_diameter_mm,
+                die_range,
+            ),
+            (
+                (MIN_PUNCH_SPEED_M_S..=MAX_PUNCH_SPEED_M_S).contains(&self.punch_speed_m_s),
+                "punch_speed_m_s",
+                self.punch_speed_m_s,
+                "1e-4 <= v <= 10 m/s (10: the platen speed limit of `granbed-cli granule`)"
+                    .to_owned(),
+            ),
+            (
+                self.final_strain > 0.0 && self.final_strain <= MAX_FINAL_STRAIN,
+                "final_strain",
+                self.final_strain,
+                "0 < C <= 0.9".to_owned(),
+            ),
+            (
+                (0.0..=MAX_FINAL_STRAIN).contains(&self.kawakita_min_strain),
+                "kawakita_min_strain",
+                self.kawakita_min_strain,
+                "0 <= C <= 0.9".to_owned(),
+            ),
+            (
+                (0.0..=MAX_FINAL_STRAIN).contains(&self.heckel_min_strain),
+                "heckel_min_strain",
+                self.heckel_min_strain,
+                "0 <= C <= 0.9".to_owned(),
+            ),
+            (
+                self.output_strain_interval >= MIN_STRAIN_INTERVAL
+                    && self.output_strain_interval <= self.final_strain,
+                "output_strain_interval",
+                self.output_strain_interval,
+                "1e-6 <= interval <= final_strain".to_owned(),
+            ),
+            (
+                (0.0..=2.0).contains(&self.damping_ratio),
+                "damping_ratio",
+                self.damping_ratio,
+                "0 <= xi <= 2".to_owned(),
+            ),
+            (
+                (1..=MAX_CONTACT_SEARCH_INTERVAL).contains(&self.contact_search_interval),
+                "contact_search_interval",
+                f64::from(self.contact_search_interval),
+                "1..=10".to_owned(),
+            ),
+            (
+                (0.0..=0.1).contains(&self.contact_capture),
+                "contact_capture",
+                self.contact_capture,
+                "0 <= c <= 0.1".to_owned(),
+            ),
+            (
+                (self.held_reprojection > 0.0 && self.held_reprojection <= 1.0)
+                    || self.held_reprojection == f64::INFINITY,
+                "held_reprojection",
+                self.held_reprojection,
+                "0 < s <= 1, or inf (never)".to_owned(),
+            ),
+            (
+                (0.0..=1.0).contains(&self.exact_contact_from_strain),
+                "exact_contact_from_strain",
+                self.exact_contact_from_strain,
+                "0 <= C <= 1 (1: never)".to_owned(),
+            ),
+            (
+                self.contact_search_interval == 1 || self.hold_constraints,
+                "contact_search_interval",
+                f64::from(self.contact_search_interval),
+                "1 unless hold_constraints = true".to_owned(),
+            ),
+            (
+                (1..=50).contains(&self.contact_sweeps),
+                "contact_sweeps",
+                f64::from(self.contact_sweeps),
+                "1..=50".to_owned(),
+            ),
+        ]
+    }
+
     /// The granule type.
     pub fn granule_type(&self) -> anyhow::Result<GranuleType> {
         self.granule_type
             .parse()
-            .map_err(|_| invalid("granule_type", &self.granule_type, "A1, A2, A3, B1 ... C3"))
+            .map_err(|_| invalid("granule_type", &self.granule_type, GRANULE_TYPES))
     }
 
     /// The element formulation.
@@ -775,7 +803,7 @@ impl Scene {
         match self.element.as_str() {
             ELEMENT_ONE_POINT => Ok(ElementKind::OnePoint),
             ELEMENT_FBAR => Ok(ElementKind::FBar),
-            other => Err(invalid("element", other, "one-point, fbar")),
+            other => Err(invalid("element", other, ELEMENTS)),
         }
     }
 
@@ -942,6 +970,109 @@ impl Scene {
     }
 }
 
+/// What the scene's types refuse in the scene file `text`, every field at
+/// once, with its allowed range where one is known: serde stops at the
+/// first wrong or missing field and names only its Rust type ("expected
+/// usize"). Each field of the file is put alone into the published scene
+/// (a `[material]` field alone into its table), which is then read: a
+/// field so refused has the wrong type or is unknown. A field of the
+/// published scene that the file leaves out is required if the published
+/// scene without it is refused. Each refusal is said with whether it
+/// states an allowed range. Empty if `text` is not TOML.
+fn refused_fields(text: &str) -> Vec<(String, bool)> {
+    let (Ok(given), Ok(published)) = (
+        toml::from_str::<toml::Table>(text),
+        toml::from_str::<toml::Table>(DEFAULT_SCENE),
+    ) else {
+        return Vec::new();
+    };
+    let refusal = |table: toml::Table| {
+        toml::Value::Table(table)
+            .try_into::<Scene>()
+            .err()
+            .map(|e| e.message().to_owned())
+    };
+    let mut problems = Vec::new();
+    let mut try_field = |name: String, value: &toml::Value, table: toml::Table| {
+        if let Some(why) = refusal(table) {
+            let allowed = allowed_range(&name);
+            let ranged = allowed.is_some();
+            let allowed = allowed.map_or(String::new(), |a| format!("; allowed: {a}"));
+            problems.push((
+                format!("`{name}` = {value}: {}{allowed}", plain_types(&why)),
+                ranged,
+            ));
+        }
+    };
+    for (field, value) in &given {
+        match (value, published.get(field)) {
+            (toml::Value::Table(own), Some(toml::Value::Table(base))) => {
+                for (inner, v) in own {
+                    let mut table = published.clone();
+                    let mut sub = base.clone();
+                    sub.insert(inner.clone(), v.clone());
+                    table.insert(field.clone(), toml::Value::Table(sub));
+                    try_field(format!("{field}.{inner}"), v, table);
+                }
+            }
+            _ => {
+                let mut table = published.clone();
+                table.insert(field.clone(), value.clone());
+                try_field(field.clone(), value, table);
+            }
+        }
+    }
+    for field in published.keys().filter(|f| !given.contains_key(*f)) {
+        let mut table = published.clone();
+        table.remove(field);
+        if refusal(table).is_some() {
+            let allowed = allowed_range(field).map_or(String::new(), |a| format!(" ({a})"));
+            problems.push((
+                format!("`{field}` is missing: it is required{allowed}"),
+                true,
+            ));
+        }
+    }
+    problems
+}
+
+/// The allowed values of a top-level scene field, as
+/// [`Scene::validate`] states them (a range that depends on another field
+/// is stated for the published scene's), or `None`.
+fn allowed_range(field: &str) -> Option<String> {
+    match field {
+        "granule_type" => Some(GRANULE_TYPES.to_owned()),
+        "element" => Some(ELEMENTS.to_owned()),
+        "mesh" => Some("a level NxM such as \"8x2\"".to_owned()),
+        _ => Scene::published()
+            .range_checks()
+            .into_iter()
+            .find(|c| c.1 == field)
+            .map(|c| c.3),
+    }
+}
+
+/// Serde's refusal of a value in a user's words: what was expected (the
+/// value itself is shown beside it), without the names of Rust types.
+fn plain_types(message: &str) -> String {
+    let expected = match message.split_once(", expected ") {
+        Some((_, what)) if message.starts_with("invalid ") => format!("expected {what}"),
+        _ => message.to_owned(),
+    };
+    [
+        ("expected usize", "expected a whole number"),
+        ("expected u32", "expected a whole number up to 4294967295"),
+        (
+            "expected u64",
+            "expected a whole number up to 18446744073709551615",
+        ),
+        ("expected f64", "expected a number"),
+        ("expected a sequence", "expected a list [...]"),
+    ]
+    .iter()
+    .fold(expected, |m, (rust, plain)| m.replace(rust, plain))
+}
+
 /// A field a scene file omits whose value then differs from the published
 /// scene's ([`Scene::omitted_fields`]).
 #[derive(Clone, Debug, PartialEq, Eq)]
@@ -971,10 +1102,63 @@ mod tests {
             text.starts_with("invalid scene: TOML parse error at line 2"),
             "{text}"
         );
+        // Once located, and once more in the list of every refusal (the
+        // file lacks the required fields too).
+        let (located, list) = text
+            .split_once("\nevery field refused")
+            .unwrap_or_else(|| panic!("no list:\n{text}"));
+        for part in [located, list] {
+            assert_eq!(
+                part.matches("unknown field `granuels`").count(),
+                1,
+                "{text}"
+            );
+        }
+        // A file whose one refusal the located message says has no list.
+        let text = format!(
+            "{:#}",
+            Scene::from_toml(&format!("{DEFAULT_SCENE}\nx = 1\n")).unwrap_err()
+        );
+        assert_eq!(text.matches("unknown field `x`").count(), 1, "{text}");
+    }
+
+    /// A scene file with several fields of the wrong type or missing is
+    /// refused with every one of them named, and its allowed range where
+    /// the validation states one; serde alone named the first and its
+    /// Rust type ("expected usize").
+    #[test]
+    fn every_refused_field_is_named_with_its_range() {
+        let text = DEFAULT_SCENE
+            .lines()
+            .filter(|l| !l.starts_with("seed =") && !l.starts_with("mesh ="))
+            .map(|l| match l.split_once(" = ") {
+                Some(("granules", _)) => "granules = -5".to_owned(),
+                Some(("contact_sweeps", _)) => "contact_sweeps = 99999999999".to_owned(),
+                Some(("friction", _)) => "friction = \"high\"".to_owned(),
+                _ => l.to_owned(),
+            })
+            .collect::<Vec<_>>()
+            .join("\n");
+        let e = Scene::from_toml(&text).unwrap_err();
+        assert!(e.downcast_ref::<InputError>().is_some(), "{e:#}");
+        let text = format!("{e:#}");
+        for line in [
+            "  - `granules` = -5: expected a whole number; allowed: 1..=100000",
+            "  - `contact_sweeps` = 99999999999: expected a whole number up to 4294967295; \
+             allowed: 1..=50",
+            "  - `material.friction` = \"high\": expected a number",
+            "  - `seed` is missing: it is required",
+            "  - `mesh` is missing: it is required (a level NxM such as \"8x2\")",
+        ] {
+            assert!(text.lines().any(|l| l == line), "{line:?} not in\n{text}");
+        }
+        // Only missing fields: no excerpt of the file's first line.
+        let only_missing = DEFAULT_SCENE.replace("\nseed =", "\n# seed =");
+        let text = format!("{:#}", Scene::from_toml(&only_missing).unwrap_err());
         assert_eq!(
-            text.matches("unknown field `granuels`").count(),
-            1,
-            "{text}"
+            text,
+            "invalid scene\nevery field refused, with what it allows:\n  - `seed` is missing: \
+             it is required"
         );
     }
 
