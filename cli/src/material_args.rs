@@ -62,7 +62,7 @@ pub struct MaterialArgs {
     pub true_density_kg_m3: Option<f64>,
 
     /// Coulomb friction coefficient of the granule surface, dimensionless
-    /// (finite, ≥ 0).
+    /// (0 ≤ μ ≤ 10).
     #[arg(value_parser = crate::numbers::real, long, value_name = "MU", allow_negative_numbers = true)]
     pub friction: Option<f64>,
 }

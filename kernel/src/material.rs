@@ -37,7 +37,8 @@ pub struct MaterialParams {
     /// True (solid) density, kg/m³; the granule's density is η0 times this.
     /// Range: [`DENSITY_RANGE_KG_M3`], 1e-3 ≤ ρ ≤ 1e5.
     pub true_density_kg_m3: Real,
-    /// Coulomb friction coefficient of the granule surface. Range: finite, ≥ 0.
+    /// Coulomb friction coefficient of the granule surface. Range:
+    /// 0 ≤ μ ≤ [`MAX_FRICTION`] (10).
     pub friction: Real,
 }
 
@@ -130,6 +131,13 @@ pub const DENSITY_RANGE_KG_M3: [Real; 2] = [1e-3, 1e5];
 /// [`DENSITY_RANGE_KG_M3`] as an error names it.
 const DENSITY_ALLOWED: &str = "1e-3 <= rho <= 1e5 kg/m3";
 
+/// The largest Coulomb friction coefficient (the standard types use 0.1).
+/// The platen experiment's own friction has the same range, so that the
+/// browser, which gives it the granule's, names one range for μ.
+pub const MAX_FRICTION: Real = 10.0;
+/// [`MAX_FRICTION`] as an error names it.
+pub(crate) const FRICTION_ALLOWED: &str = "0 <= mu <= 10";
+
 impl MaterialParams {
     /// Checks every field against its documented range (NaN is always
     /// rejected) and derives the elastic constants.
@@ -174,10 +182,10 @@ impl MaterialParams {
             DENSITY_ALLOWED,
         )?;
         check(
-            p.friction.is_finite() && p.friction >= 0.0,
+            (0.0..=MAX_FRICTION).contains(&p.friction),
             "friction",
             p.friction,
-            "finite and >= 0",
+            FRICTION_ALLOWED,
         )?;
         let (e, nu) = (p.youngs_modulus_pa, p.poisson_ratio);
         let lambda = e * nu / ((1.0 + nu) * (1.0 - 2.0 * nu));

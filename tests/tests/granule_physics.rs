@@ -373,3 +373,44 @@ fn a_bad_yield_tolerance_is_refused_by_name() {
         }
     }
 }
+
+/// A granule so soft that its stable time step would carry the platens
+/// past the final strain in one step (E = 1e-3 Pa, the smallest allowed:
+/// its waves travel at about 1 mm/s, slower than the platens) is stepped
+/// at most `MAX_STRAIN_PER_STEP` at a time: it ends within one such step
+/// of its final strain, with a sample every output interval. Before, one
+/// step took it from 0 to 56 % strain.
+#[test]
+fn a_granule_softer_than_the_platens_are_fast_still_gives_a_curve() {
+    use granbed_kernel::scene::platens::MAX_STRAIN_PER_STEP;
+    let mut params = GranuleType::B2.params();
+    params.youngs_modulus_pa = 1e-3;
+    let mat = params.validate().unwrap();
+    let m = mesh(MeshLevel::new(4, 1), true);
+    let p = PlatenParams::standard(mat);
+    let mut store = PlatenStore::new(&m, 1);
+    let mut scene = PlatenScene::new(p, m.view(), store.buffers()).unwrap();
+    let mut samples = 0;
+    while !scene.finished() {
+        if scene.step().unwrap().is_some() {
+            samples += 1;
+        }
+    }
+    let overshoot = scene.strain() - p.final_strain;
+    assert!(
+        (0.0..=MAX_STRAIN_PER_STEP * (1.0 + 1e-9)).contains(&overshoot),
+        "ended at strain {} for a final strain of {}",
+        scene.strain(),
+        p.final_strain
+    );
+    let rows = (p.final_strain / p.output_strain_interval).round() as usize;
+    assert!(
+        samples + 1 >= rows,
+        "{samples} samples for {rows} output intervals"
+    );
+    assert!(
+        scene.steps() as Real >= p.final_strain / MAX_STRAIN_PER_STEP,
+        "{} steps",
+        scene.steps()
+    );
+}

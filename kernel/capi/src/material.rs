@@ -29,7 +29,7 @@ pub struct GranbedMaterialParams {
     pub eta_c: f64,
     /// True (solid) density, kg/m³. Range: 1e-3 ≤ ρ ≤ 1e5.
     pub true_density_kg_m3: f64,
-    /// Coulomb friction coefficient. Range: finite, ≥ 0.
+    /// Coulomb friction coefficient. Range: 0 ≤ μ ≤ 10.
     pub friction: f64,
 }
 

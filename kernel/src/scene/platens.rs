@@ -160,10 +160,10 @@ impl PlatenParams {
                 "0 < v <= 10 m/s",
             ),
             (
-                self.friction >= 0.0 && self.friction <= 10.0,
+                (0.0..=crate::material::MAX_FRICTION).contains(&self.friction),
                 "friction",
                 self.friction,
-                "0 <= mu <= 10",
+                crate::material::FRICTION_ALLOWED,
             ),
             (
                 self.final_strain > 0.0 && self.final_strain <= MAX_FINAL_STRAIN,
@@ -591,6 +591,24 @@ pub struct PlatenScene<'a> {
     element_steps: u64,
 }
 
+/// The largest strain the platens may add in one step: a step of the
+/// standard granule at 5 mm/s adds about 10⁻⁵.
+pub const MAX_STRAIN_PER_STEP: Real = 1e-3;
+
+/// The time step `dt` (s) limited so that the platens approach by at most
+/// [`MAX_STRAIN_PER_STEP`] × the granule `diameter` (m) per step. The
+/// stable step of a granule so soft that its waves are slower than the
+/// platens (E of a few Pa or less at 5 mm/s) would otherwise carry the run
+/// past its final strain in a single step, with no curve between; for any
+/// usual granule the stable step is two orders of magnitude shorter and
+/// this leaves it unchanged.
+fn capped_step(dt: Real, params: &PlatenParams, diameter: Real) -> Real {
+    crate::math::min(
+        dt,
+        MAX_STRAIN_PER_STEP * diameter / params.approach_speed_m_s,
+    )
+}
+
 fn check_len(buffer: &'static str, got: usize, expected: usize) -> Result<(), SceneError> {
     if got == expected {
         Ok(())
@@ -695,6 +713,7 @@ impl<'a> PlatenScene<'a> {
         };
         let dt = time_step
             .estimate(&mesh, &mat, &params.elements, &at, &mut power)
+            .map(|dt| capped_step(dt, &params, 2.0 * radius))
             .ok_or_else(|| SceneError::Unstable {
                 step: 0,
                 strain: 0.0,
@@ -889,6 +908,7 @@ impl<'a> PlatenScene<'a> {
                     &at,
                     &mut self.power,
                 )
+                .map(|dt| capped_step(dt, &self.params, self.diameter))
                 .ok_or_else(|| self.unstable(strain))?;
         }
         let sizes = StepSizes {
