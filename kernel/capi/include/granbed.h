@@ -11,6 +11,30 @@
  * Built in this workspace the library targets x86-64-v3 (AVX2): on an
  * older x86-64 processor it stops with SIGILL; rebuild it with
  * GRANBED_TARGET_CPU=x86-64 (install.sh) or RUSTFLAGS="-C target-cpu=x86-64".
+ * No function keeps global state: calls on separate buffers may run on
+ * several threads at once.
+ *
+ * The material (a porous granule; the model of granbed's design note
+ * physics.md, section 1, which is not installed with the library):
+ * F = F^e F^p. The state of a point is C_p^-1 = F^-1 b^e F^-T (6 values,
+ * Voigt order, no factor 2 on the shear terms), the identity in the
+ * virgin state, so b^e = F C_p^-1 F^T and J^e = sqrt(det b^e). The F
+ * passed in is always the TOTAL deformation gradient from the
+ * configuration where the state was initialised, never a step increment:
+ * the relative density is eta = eta0 / det F.
+ *   energy  psi = mu/2 (tr b^e - 3) + lambda/2 (J^e - 1)^2 - mu ln J^e
+ *   stress  tau = mu b^e + (lambda J^e (J^e - 1) - mu) 1   (Kirchhoff)
+ *   yield   phi = |dev tau|^2 + (a1/3) (tr tau)^2 - (2/3) a2 sigma_y^2
+ *           a1 = c_p (1 - eta^2), a2 = (eta^2 - eta_c^2) / (1 - eta_c^2)
+ *           for eta < 1; a1 = 0, a2 = 1 (von Mises) for eta >= 1
+ * with lambda, mu from E and nu (granbed_material_derived). The flow is
+ * associative, so a compressive pressure compacts the granule. The
+ * plastic corrector is the published return map; with volume_fix = 1
+ * (recommended) it then resets the spherical part of b^e so that
+ * det b^e = (J^e)^2, and with volume_fix = 0 it is the published
+ * algorithm literally, under which a spurious elastic dilatation builds
+ * up in shear (a tension of the order of sigma_y after a shear of 1).
+ * The update is for explicit codes: no consistent tangent is provided.
  */
 
 #ifndef GRANBED_H
@@ -109,7 +133,12 @@
 
 // Where a point projects on a bilinear quad.
 typedef struct GranbedQuadProjection {
-  // Local coordinate ξ* of the closest point (the face is [−1, 1]²).
+  // Local coordinate ξ* of the closest point on the bilinear surface
+  // extended beyond the face (the face is [−1, 1]²): not clamped, so a
+  // point beside the face gives |ξ*| > 1 and `inside` = 0, and its
+  // weights then lie outside [0, 1], which `granbed_node_face_force`
+  // refuses. Which face or edge such a node is held against is the
+  // host's choice.
   double xi;
   // Local coordinate η*.
   double eta;
@@ -130,14 +159,20 @@ typedef struct GranbedQuadProjection {
 // contact), their masses, and the projection of the predicted node on the
 // predicted face (from `granbed_project_node_on_quad`).
 typedef struct GranbedNodeFace {
-  // Slave node mass, kg (> 0; divide by the node's contact count for
-  // the mass sharing of physics.md §5.3).
+  // Slave node mass, kg (> 0). For several constraints on one node in
+  // a step, the mass sharing of physics.md §5.3 divides each node's mass
+  // (slave and master corners alike) by the number of constraints it
+  // takes part in.
   double slave_mass;
   // Slave node position at the start of the step, m.
   double slave_x_n[3];
   // Slave node predicted position, m.
   double slave_x_pred[3];
-  // Master corner masses, kg (> 0, also where the corner's weight is 0).
+  // Master corner masses, kg (> 0, also where the corner's weight is 0;
+  // shared as `slave_mass` is). A rigid master surface (a wall) is not
+  // given an infinite mass, which is refused: a mass many orders above
+  // the slave's, such as 1e20 kg, gives its limit, the force that moves
+  // only the slave.
   double master_mass[4];
   // Master corners at the start of the step, `[corner][xyz]`, m.
   double master_x_n[4][3];
@@ -186,7 +221,7 @@ typedef struct GranbedMaterialParams {
   double eta_c;
   // True (solid) density, kg/m³. Range: 1e-3 ≤ ρ ≤ 1e5.
   double true_density_kg_m3;
-  // Coulomb friction coefficient. Range: finite, ≥ 0.
+  // Coulomb friction coefficient. Range: 0 ≤ μ ≤ 10.
   double friction;
 } GranbedMaterialParams;
 
@@ -196,11 +231,17 @@ typedef struct GranbedPointInfo {
   double j;
   // Relative density η = η0/J after the step.
   double eta;
-  // Plastic dissipation of the step per unit reference volume, J/m³.
+  // Plastic dissipation of the step per unit reference volume, J/m³:
+  // Δγ τ:∂φ/∂τ at the returned stress (0 for an elastic step). The
+  // return map is not exactly work-conjugate, so the stress work less
+  // the change of ψ (the header's energy) and the summed dissipation
+  // leave a gap, a few per cent of the work for the standard types with
+  // `volume_fix` = 1 and more without; a host that needs an exact
+  // balance takes the dissipation as that difference instead.
   double dissipation_density;
   // Hourglass energy (k/2) Σ|q|² stored in the element, J
-  // (`granbed_hex_forces`; 0 for a material point): with the internal
-  // and plastic work it closes a host's energy balance.
+  // (`granbed_hex_forces`; 0 for a material point), for a host's energy
+  // balance (with the same gap as `dissipation_density`).
   double hourglass_energy;
   // 1 if the step was plastic, else 0.
   int32_t plastic;
@@ -335,9 +376,18 @@ int32_t granbed_hex_reference(size_t n,
 // * `tau`: out, n×6 Kirchhoff stress, Pa, or NULL.
 // * `info`: out, n records, or NULL.
 // * `element_status`: out, n codes (`GRANBED_ERR_INVALID_ARGUMENT` for a
-//   corrupt reference record, else the constitutive update's code).
+//   corrupt reference record, else the constitutive update's code, as
+//   `granbed_update_points` writes them).
 //
-// Returns `GRANBED_OK`, `GRANBED_ERR_POINT_FAILED` or an argument error.
+// Only det F̄ of the element's mean deformation gradient is checked
+// (`GRANBED_ERR_INVERTED` when ≤ 0): a tangled hex whose Jacobian changes
+// sign at a corner while det F̄ stays positive passes. A host whose mesh
+// can tangle checks its corner Jacobians itself.
+//
+// Returns `GRANBED_OK`, `GRANBED_ERR_POINT_FAILED`,
+// `GRANBED_ERR_INVALID_PARAMETER` (`params` fails
+// `granbed_material_check`), `GRANBED_ERR_INVALID_ARGUMENT` (`volume_fix`
+// not 0 or 1, κ outside [0, 1]) or an argument error.
 //
 // # Safety
 // Pointers to arrays of the documented lengths, outputs not overlapping.
@@ -407,19 +457,30 @@ const char *granbed_status_message(int32_t code);
 // Updates `n` integration points to their end-of-step deformation
 // gradients.
 //
-// * `params`: the material (validated on each call).
-// * `volume_fix`: 1 (recommended) or 0, see the kernel's `UpdateOptions`.
-// * `f`: in, n×9, F_{n+1} of each point, row-major (F11 F12 F13 F21 … F33).
+// * `params`: the material (validated on each call, every field, the
+//   friction and true density included).
+// * `volume_fix`: 1 (recommended) or 0, the published return map
+//   literally (see the header's first comment).
+// * `f`: in, n×9, F_{n+1} of each point, row-major (F11 F12 F13 F21 … F33):
+//   the total deformation gradient from the configuration where the
+//   point's state was initialised, not the step's increment.
 // * `cp_inv`: in/out, n×6, C_p⁻¹ of each point (Voigt xx yy zz yz xz xy;
-//   start with `granbed_state_init`). A failed point keeps its state.
+//   start with `granbed_state_init`). A failed point keeps its state. An
+//   all-zero state is not positive definite: `GRANBED_ERR_INVALID_STATE`
+//   (only `granbed_vumat` reads zeros as the virgin state).
 // * `stress_measure`: `GRANBED_STRESS_KIRCHHOFF` or
 //   `GRANBED_STRESS_CAUCHY`.
 // * `stress`: out, n×6, Pa, Voigt order (zero for a failed point).
 // * `info`: out, n records, or NULL.
-// * `point_status`: out, n status codes (`GRANBED_OK` or the point's error).
+// * `point_status`: out, n status codes: `GRANBED_OK`, or the point's
+//   `GRANBED_ERR_NON_FINITE`, `GRANBED_ERR_INVERTED` (det F ≤ 0),
+//   `GRANBED_ERR_INVALID_STATE` or `GRANBED_ERR_NO_CONVERGENCE`.
 //
-// Returns `GRANBED_OK`, `GRANBED_ERR_POINT_FAILED` if any point failed, or
-// an argument error (then nothing is written).
+// Returns `GRANBED_OK`, `GRANBED_ERR_POINT_FAILED` if any point failed,
+// `GRANBED_ERR_INVALID_PARAMETER` (`params` fails
+// `granbed_material_check`), `GRANBED_ERR_INVALID_ARGUMENT` (`volume_fix`
+// not 0 or 1, an unknown `stress_measure`) or an argument error; on any
+// but the first two nothing is written.
 //
 // # Safety
 // Every non-NULL pointer points to an array of the documented length;
@@ -451,7 +512,10 @@ int32_t granbed_update_points(const struct GranbedMaterialParams *params,
 // * `point_status(nblock)`: out, one code per point; a failed point gets
 //   zero stress and `state_new` = `state_old`.
 //
-// Returns `GRANBED_OK`, `GRANBED_ERR_POINT_FAILED`, or an argument error.
+// Returns `GRANBED_OK`, `GRANBED_ERR_POINT_FAILED`,
+// `GRANBED_ERR_INVALID_PARAMETER` (`props` fails `granbed_material_check`),
+// `GRANBED_ERR_INVALID_ARGUMENT` (`nprops` < 8 or `nstatev` < 6) or an
+// argument error.
 //
 // # Safety
 // Every pointer points to an array of the documented size; outputs do not

@@ -16,7 +16,12 @@ pub const GRANBED_INSIDE_TOLERANCE: f64 = 1e-6;
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct GranbedQuadProjection {
-    /// Local coordinate ξ* of the closest point (the face is [−1, 1]²).
+    /// Local coordinate ξ* of the closest point on the bilinear surface
+    /// extended beyond the face (the face is [−1, 1]²): not clamped, so a
+    /// point beside the face gives |ξ*| > 1 and `inside` = 0, and its
+    /// weights then lie outside [0, 1], which `granbed_node_face_force`
+    /// refuses. Which face or edge such a node is held against is the
+    /// host's choice.
     pub xi: f64,
     /// Local coordinate η*.
     pub eta: f64,
@@ -84,14 +89,20 @@ pub unsafe extern "C" fn granbed_project_node_on_quad(
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct GranbedNodeFace {
-    /// Slave node mass, kg (> 0; divide by the node's contact count for
-    /// the mass sharing of physics.md §5.3).
+    /// Slave node mass, kg (> 0). For several constraints on one node in
+    /// a step, the mass sharing of physics.md §5.3 divides each node's mass
+    /// (slave and master corners alike) by the number of constraints it
+    /// takes part in.
     pub slave_mass: f64,
     /// Slave node position at the start of the step, m.
     pub slave_x_n: [f64; 3],
     /// Slave node predicted position, m.
     pub slave_x_pred: [f64; 3],
-    /// Master corner masses, kg (> 0, also where the corner's weight is 0).
+    /// Master corner masses, kg (> 0, also where the corner's weight is 0;
+    /// shared as `slave_mass` is). A rigid master surface (a wall) is not
+    /// given an infinite mass, which is refused: a mass many orders above
+    /// the slave's, such as 1e20 kg, gives its limit, the force that moves
+    /// only the slave.
     pub master_mass: [f64; 4],
     /// Master corners at the start of the step, `[corner][xyz]`, m.
     pub master_x_n: [[f64; 3]; 4],

@@ -149,9 +149,18 @@ pub unsafe extern "C" fn granbed_hex_reference(
 /// * `tau`: out, n×6 Kirchhoff stress, Pa, or NULL.
 /// * `info`: out, n records, or NULL.
 /// * `element_status`: out, n codes (`GRANBED_ERR_INVALID_ARGUMENT` for a
-///   corrupt reference record, else the constitutive update's code).
+///   corrupt reference record, else the constitutive update's code, as
+///   `granbed_update_points` writes them).
 ///
-/// Returns `GRANBED_OK`, `GRANBED_ERR_POINT_FAILED` or an argument error.
+/// Only det F̄ of the element's mean deformation gradient is checked
+/// (`GRANBED_ERR_INVERTED` when ≤ 0): a tangled hex whose Jacobian changes
+/// sign at a corner while det F̄ stays positive passes. A host whose mesh
+/// can tangle checks its corner Jacobians itself.
+///
+/// Returns `GRANBED_OK`, `GRANBED_ERR_POINT_FAILED`,
+/// `GRANBED_ERR_INVALID_PARAMETER` (`params` fails
+/// `granbed_material_check`), `GRANBED_ERR_INVALID_ARGUMENT` (`volume_fix`
+/// not 0 or 1, κ outside [0, 1]) or an argument error.
 ///
 /// # Safety
 /// Pointers to arrays of the documented lengths, outputs not overlapping.

@@ -23,11 +23,17 @@ pub struct GranbedPointInfo {
     pub j: f64,
     /// Relative density η = η0/J after the step.
     pub eta: f64,
-    /// Plastic dissipation of the step per unit reference volume, J/m³.
+    /// Plastic dissipation of the step per unit reference volume, J/m³:
+    /// Δγ τ:∂φ/∂τ at the returned stress (0 for an elastic step). The
+    /// return map is not exactly work-conjugate, so the stress work less
+    /// the change of ψ (the header's energy) and the summed dissipation
+    /// leave a gap, a few per cent of the work for the standard types with
+    /// `volume_fix` = 1 and more without; a host that needs an exact
+    /// balance takes the dissipation as that difference instead.
     pub dissipation_density: f64,
     /// Hourglass energy (k/2) Σ|q|² stored in the element, J
-    /// (`granbed_hex_forces`; 0 for a material point): with the internal
-    /// and plastic work it closes a host's energy balance.
+    /// (`granbed_hex_forces`; 0 for a material point), for a host's energy
+    /// balance (with the same gap as `dissipation_density`).
     pub hourglass_energy: f64,
     /// 1 if the step was plastic, else 0.
     pub plastic: i32,
@@ -88,19 +94,30 @@ pub(crate) fn update_one(
 /// Updates `n` integration points to their end-of-step deformation
 /// gradients.
 ///
-/// * `params`: the material (validated on each call).
-/// * `volume_fix`: 1 (recommended) or 0, see the kernel's `UpdateOptions`.
-/// * `f`: in, n×9, F_{n+1} of each point, row-major (F11 F12 F13 F21 … F33).
+/// * `params`: the material (validated on each call, every field, the
+///   friction and true density included).
+/// * `volume_fix`: 1 (recommended) or 0, the published return map
+///   literally (see the header's first comment).
+/// * `f`: in, n×9, F_{n+1} of each point, row-major (F11 F12 F13 F21 … F33):
+///   the total deformation gradient from the configuration where the
+///   point's state was initialised, not the step's increment.
 /// * `cp_inv`: in/out, n×6, C_p⁻¹ of each point (Voigt xx yy zz yz xz xy;
-///   start with `granbed_state_init`). A failed point keeps its state.
+///   start with `granbed_state_init`). A failed point keeps its state. An
+///   all-zero state is not positive definite: `GRANBED_ERR_INVALID_STATE`
+///   (only `granbed_vumat` reads zeros as the virgin state).
 /// * `stress_measure`: `GRANBED_STRESS_KIRCHHOFF` or
 ///   `GRANBED_STRESS_CAUCHY`.
 /// * `stress`: out, n×6, Pa, Voigt order (zero for a failed point).
 /// * `info`: out, n records, or NULL.
-/// * `point_status`: out, n status codes (`GRANBED_OK` or the point's error).
+/// * `point_status`: out, n status codes: `GRANBED_OK`, or the point's
+///   `GRANBED_ERR_NON_FINITE`, `GRANBED_ERR_INVERTED` (det F ≤ 0),
+///   `GRANBED_ERR_INVALID_STATE` or `GRANBED_ERR_NO_CONVERGENCE`.
 ///
-/// Returns `GRANBED_OK`, `GRANBED_ERR_POINT_FAILED` if any point failed, or
-/// an argument error (then nothing is written).
+/// Returns `GRANBED_OK`, `GRANBED_ERR_POINT_FAILED` if any point failed,
+/// `GRANBED_ERR_INVALID_PARAMETER` (`params` fails
+/// `granbed_material_check`), `GRANBED_ERR_INVALID_ARGUMENT` (`volume_fix`
+/// not 0 or 1, an unknown `stress_measure`) or an argument error; on any
+/// but the first two nothing is written.
 ///
 /// # Safety
 /// Every non-NULL pointer points to an array of the documented length;

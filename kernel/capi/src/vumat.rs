@@ -59,7 +59,10 @@ fn set(a: &mut [f64], nblock: usize, i: usize, k: usize, v: f64) {
 /// * `point_status(nblock)`: out, one code per point; a failed point gets
 ///   zero stress and `state_new` = `state_old`.
 ///
-/// Returns `GRANBED_OK`, `GRANBED_ERR_POINT_FAILED`, or an argument error.
+/// Returns `GRANBED_OK`, `GRANBED_ERR_POINT_FAILED`,
+/// `GRANBED_ERR_INVALID_PARAMETER` (`props` fails `granbed_material_check`),
+/// `GRANBED_ERR_INVALID_ARGUMENT` (`nprops` < 8 or `nstatev` < 6) or an
+/// argument error.
 ///
 /// # Safety
 /// Every pointer points to an array of the documented size; outputs do not
