@@ -202,17 +202,7 @@ mod tests {
     }
 }
 
-/// `x` short, for messages: Rust's shortest round-trip decimal, or the
-/// same digits in scientific notation where that is more than three
-/// characters shorter (`1e300`, not 301 digits; `0.001` and `100000` stay).
-pub fn short(x: f64) -> String {
-    let (plain, scientific) = (x.to_string(), format!("{x:e}"));
-    if scientific.len() + 3 < plain.len() {
-        scientific
-    } else {
-        plain
-    }
-}
+pub use granbed_host::text::short;
 
 /// `x` rounded to `digits` significant digits (at least 1) for a table a
 /// reader scans: plain decimals for 10⁻³ ≤ |x| < 10⁶ (`0.3000`, `123.5`,
@@ -286,19 +276,8 @@ shown_as_displayed!(
 
 #[cfg(test)]
 mod short_tests {
-    use super::short;
-
     #[test]
-    fn long_numbers_go_scientific() {
-        assert_eq!(short(0.5), "0.5");
-        assert_eq!(short(1e300), "1e300");
-        assert_eq!(short(1e-12), "1e-12");
-        assert_eq!(short(-2.5e-9), "-2.5e-9");
-        assert_eq!(short(f64::NAN), "NaN");
-        assert_eq!(short(1234.5678), "1234.5678");
-        assert_eq!(short(0.001), "0.001");
-        assert_eq!(short(100000.0), "100000");
-        assert_eq!(short(1e6), "1e6");
+    fn a_value_is_shown_short() {
         assert_eq!(super::Shown::shown(&&1e300), "1e300");
         assert_eq!(super::Shown::shown("one-point"), "one-point");
     }

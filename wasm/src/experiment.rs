@@ -156,8 +156,9 @@ impl Error {
     pub fn invalid(field: &'static str, value: Real, allowed: &'static str) -> Self {
         Self {
             message: format!(
-                "{} = {value} is not allowed: the allowed range is {allowed} (field `{field}`)",
-                field_label(field)
+                "{} = {} is not allowed: the allowed range is {allowed} (field `{field}`)",
+                field_label(field),
+                granbed_host::text::short(value)
             ),
             field: Some(field),
             value: Some(value),

@@ -15,6 +15,7 @@
 //! - [`store`]: a granule's node and integration-point buffers, the time
 //!   step's power-iteration scratch, the platen experiment's pair of them,
 //!   and the discrete-element pour's buffers.
+//! - [`text`]: numbers as messages show them (`1e300`, not 301 digits).
 
 #![no_std]
 
@@ -22,6 +23,7 @@ extern crate alloc;
 
 pub mod mesh;
 pub mod store;
+pub mod text;
 
 pub use mesh::{MeshLevel, OwnedReference, regrouped};
 pub use store::{GranuleStore, PlatenStore, PourStore, PowerStore};
