@@ -35,8 +35,8 @@ pub struct MaterialArgs {
     #[arg(value_parser = crate::numbers::real, long, value_name = "NU", allow_negative_numbers = true)]
     pub poisson_ratio: Option<f64>,
 
-    /// Yield stress σy of the solid (Kirchhoff measure), Pa (≥ 1e-3; `inf`
-    /// makes the material purely elastic).
+    /// Yield stress σy of the solid (Kirchhoff measure), Pa (≥ 1e-3 and
+    /// ≥ 1e-6 E; `inf` makes the material purely elastic).
     #[arg(value_parser = crate::numbers::real, long, value_name = "PA", allow_negative_numbers = true)]
     pub yield_stress_pa: Option<f64>,
 

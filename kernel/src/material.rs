@@ -23,7 +23,8 @@ pub struct MaterialParams {
     /// Poisson's ratio ν. Range: −1 < ν < 0.5.
     pub poisson_ratio: Real,
     /// Yield stress σ_y of the solid (Kirchhoff measure), Pa.
-    /// Range: ≥ [`MIN_YIELD_STRESS_PA`] (1e-3); `+∞` makes the material
+    /// Range: ≥ [`MIN_YIELD_STRESS_PA`] (1e-3) and ≥
+    /// [`MIN_YIELD_TO_MODULUS`] × E (1e-6 E); `+∞` makes the material
     /// purely elastic.
     pub yield_stress_pa: Real,
     /// Initial relative density η0 (solid fraction). Range: η_c < η0 ≤ 1.
@@ -117,8 +118,15 @@ const YOUNGS_MODULUS_ALLOWED: &str = "1e-3 <= E <= 1e13 Pa";
 /// must stay a normal `f64` (a σ_y of 1e-300 made the first step's motion
 /// non-finite).
 pub const MIN_YIELD_STRESS_PA: Real = 1e-3;
-/// [`MIN_YIELD_STRESS_PA`] as an error names it.
-const YIELD_STRESS_ALLOWED: &str = ">= 1e-3 Pa (+inf for a purely elastic material)";
+/// The smallest ratio σ_y/E. Below about 1e-7 the return map cannot reach
+/// its tolerance in double precision (the trial stress exceeds the yield
+/// scale by more than the digits it has): a granule of B2's E with σ_y =
+/// 0.1 Pa, or of E = 1e13 Pa with B2's σ_y, stopped with "no
+/// convergence" within a few per cent of strain (session 56).
+pub const MIN_YIELD_TO_MODULUS: Real = 1e-6;
+/// [`MIN_YIELD_STRESS_PA`] and [`MIN_YIELD_TO_MODULUS`] as an error names
+/// them.
+const YIELD_STRESS_ALLOWED: &str = ">= 1e-3 Pa and >= 1e-6 E (+inf for a purely elastic material)";
 
 /// The largest compaction coefficient c_p (a1 = c_p(1 − η²); the standard
 /// types use 0.3).
@@ -157,7 +165,8 @@ impl MaterialParams {
             "-1 < nu < 0.5",
         )?;
         check(
-            p.yield_stress_pa >= MIN_YIELD_STRESS_PA,
+            p.yield_stress_pa >= MIN_YIELD_STRESS_PA
+                && p.yield_stress_pa >= MIN_YIELD_TO_MODULUS * p.youngs_modulus_pa,
             "yield_stress_pa",
             p.yield_stress_pa,
             YIELD_STRESS_ALLOWED,
@@ -304,7 +313,10 @@ mod tests {
     fn the_range_texts_name_the_constants() {
         let texts: [(&str, &[Real]); 4] = [
             (YOUNGS_MODULUS_ALLOWED, &YOUNGS_MODULUS_RANGE_PA),
-            (YIELD_STRESS_ALLOWED, &[MIN_YIELD_STRESS_PA]),
+            (
+                YIELD_STRESS_ALLOWED,
+                &[MIN_YIELD_STRESS_PA, MIN_YIELD_TO_MODULUS],
+            ),
             (CP_ALLOWED, &[MAX_CP]),
             (DENSITY_ALLOWED, &DENSITY_RANGE_KG_M3),
         ];
@@ -397,5 +409,24 @@ mod tests {
             assert_eq!(p.validate().unwrap_err().field, field);
         }
         assert_eq!("D1".parse::<GranuleType>(), Err(UnknownGranuleType));
+    }
+
+    /// σ_y below 1e-6 E is refused, naming σ_y, whatever E is (the
+    /// return map loses the yield surface in round-off below about 1e-7);
+    /// 1e-6 E itself and a purely elastic material pass.
+    #[test]
+    fn a_yield_stress_too_small_for_the_modulus_is_refused() {
+        let stiff = |e: Real, sy: Real| MaterialParams {
+            youngs_modulus_pa: e,
+            yield_stress_pa: sy,
+            ..GranuleType::B2.params()
+        };
+        for (e, sy) in [(1e13, 30e3), (1e6, 0.5), (1e6, 1e-3)] {
+            let err = stiff(e, sy).validate().unwrap_err();
+            assert_eq!(err.field, "yield_stress_pa", "E {e}, sigma_y {sy}");
+        }
+        for (e, sy) in [(1e13, 1e7), (1e6, 1.0), (1e13, Real::INFINITY)] {
+            assert!(stiff(e, sy).validate().is_ok(), "E {e}, sigma_y {sy}");
+        }
     }
 }

@@ -1548,6 +1548,8 @@ mod tests {
         let mut runaway = scene.clone();
         runaway.material.youngs_modulus_pa = Some(1e13);
         runaway.material.true_density_kg_m3 = Some(1e-3);
+        // Elastic (σ_y ≥ 1e-6 E would be 10 MPa).
+        runaway.material.yield_stress_pa = Some(f64::INFINITY);
         let material = runaway.material().unwrap();
         let e = run_length(&runaway, &mesh, &material)
             .refusal(MAX_STEPS, "the `[material]`")

@@ -211,7 +211,8 @@ typedef struct GranbedMaterialParams {
   double youngs_modulus_pa;
   // Poisson's ratio ν. Range: −1 < ν < 0.5.
   double poisson_ratio;
-  // Yield stress σ_y, Pa. Range: ≥ 1e-3 (+inf: purely elastic).
+  // Yield stress σ_y, Pa. Range: ≥ 1e-3 and ≥ 1e-6 E (+inf: purely
+  // elastic).
   double yield_stress_pa;
   // Initial relative density η0. Range: η_c < η0 ≤ 1.
   double eta0;

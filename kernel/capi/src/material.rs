@@ -19,7 +19,8 @@ pub struct GranbedMaterialParams {
     pub youngs_modulus_pa: f64,
     /// Poisson's ratio ν. Range: −1 < ν < 0.5.
     pub poisson_ratio: f64,
-    /// Yield stress σ_y, Pa. Range: ≥ 1e-3 (+inf: purely elastic).
+    /// Yield stress σ_y, Pa. Range: ≥ 1e-3 and ≥ 1e-6 E (+inf: purely
+    /// elastic).
     pub yield_stress_pa: f64,
     /// Initial relative density η0. Range: η_c < η0 ≤ 1.
     pub eta0: f64,
