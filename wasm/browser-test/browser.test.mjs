@@ -1,8 +1,10 @@
 // The page in Debian's headless chromium: run B2, compare the shown σ_est
 // with granbed-cli's, download the CSV (the CLI's bytes, named by the inputs
 // that ran), cancel a run (the inputs locked while it goes), provoke bad
-// inputs (ν = 0.6, a decimal comma, two at once, 1e400), mark results
-// stale when the inputs change, and lay the page out at a phone's width. Screenshots go to out/.
+// inputs (ν = 0.6, a decimal comma, two at once, 1e400), show a failed and
+// a not quasi-static run as such, mark results stale when the inputs
+// change, lay the page out at a phone's width, and open it as a file.
+// Screenshots go to out/.
 import { test, before, after } from 'node:test';
 import assert from 'node:assert/strict';
 import { mkdirSync, readFileSync } from 'node:fs';
@@ -94,6 +96,8 @@ test('Cancel stops a run and the page can run again', async () => {
   assert.equal(await page.textContent('#sigma-est'), '–');
   // The status keeps saying that the run was cancelled, and where.
   assert.match(await page.textContent('#status'), /^cancelled at strain \d+\.\d % \(the curve so far is shown\); ready$/);
+  // The plot's description is the cancelled run's, not "no run yet".
+  assert.match(await page.getAttribute('#plot', 'aria-label'), /of a run cancelled at strain \d+\.\d %: \d+ points, not saved$/);
   assert.deepEqual(problems, []);
 });
 
@@ -108,6 +112,8 @@ test('nu = 0.6 gives a readable error naming the field and its range', async () 
   assert.match(text, /poisson_ratio/);
   assert.equal(await page.getAttribute('#poisson_ratio', 'aria-invalid'), 'true');
   assert.equal(await page.isEnabled('#run'), true);
+  // The status line says nothing ran, not an earlier run's result.
+  assert.equal(await page.textContent('#status'), 'not run: an input was refused (see the message below)');
   await page.screenshot({ path: join(OUT, 'error.png') });
   assert.deepEqual(problems, []);
 });
@@ -122,18 +128,42 @@ test('a decimal comma is refused with its fix, not read as another number', asyn
   assert.equal(await page.getAttribute('#friction', 'aria-invalid'), 'true');
   assert.equal(await page.isEnabled('#run'), true);
   await page.fill('#friction', '0.3');
+  // A comma before three digits may separate thousands: both readings are
+  // offered (the fix offered for 30,000 Pa was once 30.000, i.e. 30 Pa).
+  await page.fill('#yield_stress_pa', '30,000');
+  await page.click('#run');
+  await page.waitForSelector('#results[data-state="rejected"]');
+  assert.match(await page.textContent('#error'), /σy: “30,000” has a comma: write 30000 if it separates thousands, or 30\.000 if/);
+  await page.fill('#yield_stress_pa', '30000');
   await page.uncheck('#custom');
   assert.deepEqual(problems, []);
 });
 
-test('a run without the fit window says why sigma_est is missing', async () => {
-  // E = 1 mPa: the stable step is so long that one step passes 40 %.
+test('a run an error stops shows no fit as its result, and says why', async () => {
+  // σy = 10 Pa on the coarse mesh: an element inverts past 10 % strain,
+  // where a fit of the curve so far gives a negative "σ_est".
   await page.check('#custom');
+  await page.selectOption('#mesh', '4x1');
+  await page.fill('#yield_stress_pa', '10');
+  await page.click('#run');
+  await page.waitForSelector('#results[data-state="failed"]', { timeout: 60_000 });
+  for (const id of ['#sigma-est', '#ratio', '#slope', '#r2']) {
+    assert.match(await page.textContent(id), /^n\/a: the run stopped by an error at strain \d+\.\d %$/, id);
+    assert.equal(await page.getAttribute(id, 'data-value'), null, id);
+  }
+  assert.equal(await page.textContent('#status'), 'stopped by an error');
+  // E = 1 mPa, far too soft for the platens: the run ends at 40 %, stepped
+  // (once it took one step past 40 %), and says it is not quasi-static.
+  await page.fill('#yield_stress_pa', '30000');
   await page.fill('#youngs_modulus_pa', '0.001');
   await page.click('#run');
-  await page.waitForSelector('#results[data-state="done"], #results[data-state="failed"]', { timeout: 60_000 });
-  assert.match(await page.textContent('#sigma-est'), /^n\/a \(no two samples in the 10–40 % window: the run ended at strain \d/);
+  await page.waitForSelector('#results[data-state="done"]', { timeout: 60_000 });
+  assert.match(await page.textContent('#status'), /^done: strain 40\.\d % in .*; NOT quasi-static: /);
+  assert.ok(Number(await page.getAttribute('#steps', 'data-value')) >= 400);
+  assert.match(await page.textContent('#quasi-static'), /^NO: kinetic energy at most [\d.e+]+ % /);
+  await page.fill('#youngs_modulus_pa', '1e6');
   await page.uncheck('#custom');
+  await page.selectOption('#mesh', '8x2');
   assert.deepEqual(problems, []);
 });
 
@@ -187,7 +217,7 @@ test('results are marked once the inputs change, and cleared when inputs are ref
   await page.fill('#yield_stress_pa', 'inf');
   await page.click('#run');
   await page.waitForSelector('#results[data-state="done"]', { timeout: 120_000 });
-  assert.match(await page.textContent('#run-inputs'), /^custom \(from B1\), mesh 4x1: σy = Infinity Pa/);
+  assert.match(await page.textContent('#run-inputs'), /^custom \(from B1\), mesh 4x1: σy = inf Pa/);
   assert.equal(await page.textContent('#sigma-eff0'), 'n/a');
   const [download] = await Promise.all([page.waitForEvent('download'), page.click('#download')]);
   assert.match(download.suggestedFilename(), /^granule_custom-[0-9a-f]{8}_4x1_force_displacement\.csv$/);
@@ -241,4 +271,11 @@ test('the page fits a phone: nothing wider than its 375 px', async () => {
   assert.ok(drawn, `canvas ${backing} px for ${shownWidth} px shown`);
   await page.screenshot({ path: join(OUT, 'phone.png'), fullPage: true });
   await page.setViewportSize({ width: 1000, height: 1100 });
+});
+
+test('opened as a file, the page says how to serve it instead of loading for ever', async () => {
+  const file = await browser.newPage();
+  await file.goto(`file://${join(WWW, 'index.html')}`);
+  assert.match(await file.textContent('#status'), /^this page must be served over http, not opened as a file: run "python3 -m http\.server/);
+  await file.close();
 });

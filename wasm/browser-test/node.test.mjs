@@ -88,6 +88,12 @@ test('typed numbers: a decimal point is read, a comma or junk refused', () => {
     assert.equal(parseDecimal(text, 'x', 'f'), v, text);
   }
   assert.throws(() => parseDecimal('0,3', 'μ', 'friction'), (e) => e.field === 'friction' && /decimal comma: write 0\.3/.test(e.message));
+  // A comma before three digits is not taken for a decimal comma: the fix
+  // of 30,000 Pa was once 30.000, a thousandth of what was meant.
+  assert.throws(() => parseDecimal('30,000', 'σy', 'yield_stress_pa'),
+    (e) => /“30,000” has a comma: write 30000 if it separates thousands, or 30\.000 if it is a decimal comma$/.test(e.message));
+  assert.throws(() => parseDecimal('1,000,000', 'E', 'youngs_modulus_pa'), /“1,000,000” has commas: write 1000000 \(no thousands separators\)$/);
+  assert.throws(() => parseDecimal('2,5', 'x', 'f'), /decimal comma: write 2\.5 \(with a point\)$/);
   for (const bad of ['', '1.5.2', '0x10', 'Infinity', '1,000.5', 'abc', '1e', '-inf']) {
     assert.throws(() => parseDecimal(bad, 'x', 'f'), /“.*” (is empty|is not a number)/, bad);
   }

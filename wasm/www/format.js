@@ -38,11 +38,25 @@ export function parseDecimal(text, label, field) {
   } else {
     why = t === ''
       ? 'is empty'
-      : /^[+-]?\d*,\d+$/.test(t)
-        ? `has a decimal comma: write ${t.replace(',', '.')} (with a point)`
-        : 'is not a number such as 0.3 or 3e4';
+      : commaHint(t) ?? 'is not a number such as 0.3 or 3e4';
   }
   throw Object.assign(new Error(`${label}: “${t}” ${why}`), { field });
+}
+
+// What a number typed with commas meant, said as its fix, or undefined: a
+// comma before exactly three digits (30,000, as Pa are typed) may separate
+// thousands or be a decimal comma, and which one is the student's to say
+// (the page must not read 30,000 Pa as 30 Pa); several such groups
+// (1,000,000) separate thousands; any other single comma (0,5) is a
+// decimal comma.
+function commaHint(t) {
+  if (/^[+-]?\d{1,3},\d{3}$/.test(t)) {
+    return `has a comma: write ${t.replace(',', '')} if it separates thousands, or ${t.replace(',', '.')} ` +
+      'if it is a decimal comma';
+  }
+  if (/^[+-]?\d{1,3}(,\d{3}){2,}$/.test(t)) return `has commas: write ${t.replaceAll(',', '')} (no thousands separators)`;
+  if (/^[+-]?\d*,\d+$/.test(t)) return `has a decimal comma: write ${t.replace(',', '.')} (with a point)`;
+  return undefined;
 }
 
 // A tick label that fits the margin: plain digits for 0.001 ≤ |v| < 1e5,
@@ -62,6 +76,9 @@ export function advice(message) {
     return 'The granule deformed too violently for the simulation: it is probably too soft for the platen speed ' +
       '(try a larger E or σy), or the coarse mesh is too coarse for this deformation (try the standard mesh). ';
   }
-  if (/converge/.test(message)) return 'The plastic return did not converge: check that σy, cp and ηc are in their usual ranges. ';
+  if (/converge/.test(message)) {
+    return 'The plastic return did not converge: parameters far from the types\' (ν near −1 or 0.5, a σy tiny against E, ' +
+      'an extreme cp or ηc) can take it beyond what double precision resolves; move them towards the types\' values. ';
+  }
   return '';
 }

@@ -62,6 +62,9 @@ function refuse(message, fields) {
   showError(message, fields);
   $('run-inputs').textContent = '–';
   $('results').dataset.state = 'rejected';
+  // Nothing ran: the status line says so rather than an earlier run's
+  // result.
+  setStatus('not run: an input was refused (see the message below)');
 }
 
 function clearError() {
@@ -123,7 +126,6 @@ function onWorker(msg) {
       break;
     case 'error':
       setRunning(false);
-      setStatus('stopped');
       refuse(msg.message, msg.field);
       break;
     case 'start':
@@ -184,8 +186,10 @@ function describeRun(run) {
   const p = run.params;
   const head = `${run.custom ? `custom (from ${run.type})` : run.type}, mesh ${run.mesh}`;
   if (!p) return head;
-  return `${head}: σy = ${p.yield_stress_pa} Pa, η0 = ${p.eta0}, E = ${p.youngs_modulus_pa} Pa, ` +
-    `ν = ${p.poisson_ratio}, cp = ${p.cp}, ηc = ${p.eta_c}, μ = ${p.friction}, ` +
+  // As typed: an infinite σy (a purely elastic granule) is written inf.
+  const v = (x) => (Number.isFinite(x) ? String(x) : x > 0 ? 'inf' : '-inf');
+  return `${head}: σy = ${v(p.yield_stress_pa)} Pa, η0 = ${v(p.eta0)}, E = ${v(p.youngs_modulus_pa)} Pa, ` +
+    `ν = ${v(p.poisson_ratio)}, cp = ${v(p.cp)}, ηc = ${v(p.eta_c)}, μ = ${v(p.friction)}, ` +
     `d = ${+(p.diameter_m * 1e3).toPrecision(12)} mm`;
 }
 
@@ -259,18 +263,19 @@ function finish(msg) {
     $(id).textContent = text;
     if (value !== undefined && value !== null) $(id).dataset.value = String(value);
   };
-  // Why σ_est is missing or fitted over less than 10–40 % (as the CLI's
-  // summary notes say).
-  const reached = `${(100 * msg.strain).toFixed(1)} %`;
-  const sigmaNote = msg.sigmaEst === null
-    ? ` (no two samples in the 10–40 % window: the run ended at strain ${reached})`
-    : msg.strain < 0.4 ? ` (fitted over 10 % to ${reached} only: the run ended there)` : '';
-  set('sigma-est', formatStress(msg.sigmaEst) + sigmaNote, msg.sigmaEst);
   set('sigma-eff0', formatStress(msg.sigmaEff0), msg.sigmaEff0);
-  const ratio = msg.sigmaEst !== null && Number.isFinite(msg.sigmaEff0) && msg.sigmaEff0 > 0 ? msg.sigmaEst / msg.sigmaEff0 : null;
-  set('ratio', ratio === null ? 'n/a' : ratio.toFixed(3), ratio);
-  set('slope', formatSlope(msg.slope), msg.slope);
-  set('r2', msg.r2 === null ? 'n/a' : msg.r2.toFixed(5), msg.r2);
+  if (msg.failure) {
+    // A fit of a curve the error cut short is no result (it can even come
+    // out negative): none is shown, only why.
+    const why = `n/a: the run stopped by an error at strain ${(100 * msg.strain).toFixed(1)} %`;
+    for (const id of ['sigma-est', 'ratio', 'slope', 'r2']) set(id, why);
+  } else {
+    set('sigma-est', formatStress(msg.sigmaEst), msg.sigmaEst);
+    const ratio = msg.sigmaEst !== null && Number.isFinite(msg.sigmaEff0) && msg.sigmaEff0 > 0 ? msg.sigmaEst / msg.sigmaEff0 : null;
+    set('ratio', ratio === null ? 'n/a' : ratio.toFixed(3), ratio);
+    set('slope', formatSlope(msg.slope), msg.slope);
+    set('r2', msg.r2 === null ? 'n/a' : msg.r2.toFixed(5), msg.r2);
+  }
   set('steps', String(msg.steps), msg.steps);
   set('quasi-static',
     msg.failure
@@ -291,7 +296,8 @@ function finish(msg) {
   $('progress').value = msg.failure ? $('progress').value : 1;
   if (!msg.failure) {
     runCount += 1;
-    const label = `${current.custom ? `custom-${tag(describeRun(current)).slice(0, 4)}` : current.type} ${current.mesh}`;
+    const label = `${current.custom ? `custom-${tag(describeRun(current)).slice(0, 4)}` : current.type} ${current.mesh}` +
+      (msg.quasiStatic === false ? ' (not quasi-static)' : '');
     // Its colour for as long as it is drawn (by run, not by place in the list).
     const colour = HISTORY_COLOURS[(runCount - 1) % HISTORY_COLOURS.length];
     history.push({ id: runCount, label, colour, x: Array.from(msg.x, (v) => v * 1e3), f: Array.from(msg.f) });
@@ -307,15 +313,22 @@ function finish(msg) {
     $('results').dataset.state = 'failed';
   } else {
     // The result in the status line too: the table may be below the fold.
+    // A run whose inertia was not negligible says so where its result is
+    // read: its curve is the platens' speed's as much as the material's.
+    const inertia = msg.quasiStatic === false
+      ? '; NOT quasi-static: the kinetic energy was not negligible, so this is not the granule\'s ' +
+        'quasi-static response (a granule this soft or light is too slow for the platens)'
+      : '';
     setStatus(`done: strain ${(100 * msg.strain).toFixed(1)} % in ${(msg.wallMs / 1e3).toFixed(2)} s; ` +
-      `σ_est = ${formatStress(msg.sigmaEst)}`);
+      `σ_est = ${formatStress(msg.sigmaEst)}${inertia}`);
     $('results').dataset.state = 'done';
   }
 }
 
-// "0.00057 %" for a ratio.
+// "0.00057 %" for a ratio; "4.7e+17 %" rather than 18 digits.
 function percent(ratio) {
-  return `${+(100 * ratio).toPrecision(2)} %`;
+  const p = 100 * ratio;
+  return `${Math.abs(p) >= 1e6 ? p.toExponential(1) : +p.toPrecision(2)} %`;
 }
 
 function cancel() {
@@ -324,6 +337,10 @@ function cancel() {
   setRunning(false);
   $('run').disabled = true;
   cancelNote = `cancelled at strain ${(100 * lastStrain).toFixed(1)} % (the curve so far is shown)`;
+  // The picture's description says what it shows now (the cancelled
+  // worker took the run's CSV with it: the curve is only drawn).
+  $('plot').setAttribute('aria-label', `platen force against platen approach of a run cancelled at strain ` +
+    `${(100 * lastStrain).toFixed(1)} %: ${view ? view.f.length : 0} points, not saved`);
   setStatus(`${cancelNote}; restarting…`);
   $('progress').value = 0;
   $('results').dataset.state = 'cancelled';
@@ -373,7 +390,7 @@ function drawPlot() {
   const earlier = history.filter((h) => !view || h.id !== view.historyId);
   // The button to forget them whenever there are any drawn.
   $('clear-history').hidden = earlier.length === 0;
-  const xMax = Math.max(view || !earlier.length ? 0.4 * d : 0, ...earlier.flatMap((h) => h.x)) * 1.02;
+  const xMax = Math.max(view || !earlier.length ? 0.4 * d : 0, ...x, ...earlier.flatMap((h) => h.x)) * 1.02;
   const fMax = Math.max(1e-12, ...f, ...earlier.flatMap((h) => h.f)) * 1.08;
   const px = (v) => L + (v / xMax) * (W - L - R);
   const py = (v) => H - B - (v / fMax) * (H - T - B);
