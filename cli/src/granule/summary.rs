@@ -186,7 +186,7 @@ impl Summary {
         match fitted_range {
             None if final_strain < hi => notes.push(format!(
                 "sigma_est needs at least two samples with {lo} <= strain <= {hi}; the run \
-                 ended at strain {final_strain}"
+                 ended at strain {final_strain:.4}"
             )),
             None => notes.push(format!(
                 "sigma_est needs at least two samples with {lo} <= strain <= {hi}; the output \
@@ -194,8 +194,8 @@ impl Summary {
                 p.output_strain_interval
             )),
             Some([a, b]) if final_strain < hi => notes.push(format!(
-                "sigma_est was fitted over strain {a} to {b} only, not {lo} to {hi}: the run \
-                 ended at strain {final_strain}"
+                "sigma_est was fitted over strain {a:.4} to {b:.4} only, not {lo} to {hi}: the \
+                 run ended at strain {final_strain:.4}"
             )),
             // The first fitted sample's nominal strain (the interval's
             // multiple below it: a sample lies up to a step past its nominal
@@ -206,8 +206,8 @@ impl Summary {
                     > lo + 0.25 * p.output_strain_interval =>
             {
                 notes.push(format!(
-                    "sigma_est was fitted over strain {a} to {b} only, not {lo} to {hi}: the \
-                     output interval {} places no sample near {lo}",
+                    "sigma_est was fitted over strain {a:.4} to {b:.4} only, not {lo} to {hi}: \
+                     the output interval {} places no sample near {lo}",
                     p.output_strain_interval
                 ));
             }
