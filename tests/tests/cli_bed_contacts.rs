@@ -60,14 +60,16 @@ fn the_contact_network_balances_the_inner_granules() {
         number(&s["final_density_map"]["densest"], "solid_fraction"),
         densest
     );
-    // The report shows the network's table: a row per snapshot with one.
+    // The report shows the network's table: a row per figure (16), a
+    // column per snapshot with one.
     let html = std::fs::read_to_string(dir.join("report.html")).unwrap();
     let table = &html[html
         .find("<h3>The contact network</h3>")
         .expect("no network table")..];
     let table = &table[..table.find("</table>").unwrap()];
-    assert_eq!(table.matches("<tr>").count(), 1 + last, "{table}");
-    assert!(table.contains("<th>force_fabric_zz</th>"), "{table}");
+    assert_eq!(table.matches("<tr>").count(), 1 + 16, "{table}");
+    assert_eq!(table.matches("<th>snapshot ").count(), last, "{table}");
+    assert!(table.contains("\">force_fabric_zz</th>"), "{table}");
     assert!(html.contains(&format!("href=\"vtk/network_{last}.csv\"")));
     assert!(html.contains(&format!("href=\"vtk/density_map_{last}.csv\"")));
     let table = &html[html

@@ -43,6 +43,7 @@ use super::outputs::{
     final_height_m, heckel_rows, kawakita_doubts, packing_fraction, upper_pressure,
 };
 use super::run::{BedRun, BedSample};
+use crate::numbers::significant;
 use crate::output::write_text;
 use crate::plot::{Mark, Series, xy_svg, xy_svg_from};
 use anyhow::Context as _;
@@ -311,7 +312,12 @@ fn r2_text(r_squared: Option<Real>) -> String {
 /// The Kawakita plot: P/C against P (kPa) of the samples with C > 0, the
 /// fitted ones (C ≥ the fit's window) filled, and the line
 /// P/C = P/a + (1/b)/a over the fitted pressures.
-pub fn kawakita_svg(samples: &[BedSample], fit: &KawakitaSummary) -> anyhow::Result<String> {
+/// `initial_solid_fraction` (D0) judges the fit ([`kawakita_doubts`]).
+pub fn kawakita_svg(
+    samples: &[BedSample],
+    fit: &KawakitaSummary,
+    initial_solid_fraction: Real,
+) -> anyhow::Result<String> {
     let rows = samples.iter().filter(|s| s.mean_strain > 0.0).map(|s| {
         (
             s.upper_pressure_pa * 1e-3,
@@ -327,11 +333,11 @@ pub fn kawakita_svg(samples: &[BedSample], fit: &KawakitaSummary) -> anyhow::Res
     let line = line.as_ref().map(|(a, inv_b, y)| {
         let label = fit_label(
             format!(
-                "a = {a:.4}, 1/b = {:.4} kPa, R² = {}",
-                inv_b * 1e-3,
+                "a = {a:.4}, 1/b = {} kPa, R² = {}",
+                significant(inv_b * 1e-3, 4),
                 r2_text(fit.r_squared)
             ),
-            kawakita_doubts(fit).is_empty(),
+            kawakita_doubts(fit, initial_solid_fraction).is_empty(),
         );
         (label, y as &dyn Fn(f64) -> f64)
     });
@@ -363,8 +369,8 @@ pub fn heckel_svg(
     let line = line.as_ref().map(|y| {
         let label = fit_label(
             format!(
-                "P_y = {:.4} kPa, A = {:.4}, R² = {}",
-                fit.yield_pressure_pa.unwrap_or(f64::NAN) * 1e-3,
+                "P_y = {} kPa, A = {:.4}, R² = {}",
+                significant(fit.yield_pressure_pa.unwrap_or(f64::NAN) * 1e-3, 4),
                 fit.a.unwrap_or(f64::NAN),
                 r2_text(fit.r_squared)
             ),
@@ -551,7 +557,10 @@ pub fn plots(
             pressure_f,
             xy_svg("Punch pressure", C, "pressure P, kPa", &pressure, true)?,
         ),
-        (kawakita_f, kawakita_svg(samples, &summary.kawakita)?),
+        (
+            kawakita_f,
+            kawakita_svg(samples, &summary.kawakita, summary.initial_solid_fraction)?,
+        ),
         (
             heckel_f,
             heckel_svg(heckel_rows(run, upper_pressure), &summary.heckel)?,
@@ -693,16 +702,16 @@ mod tests {
             points: fit.points,
             min_strain: 0.25,
         };
-        let svg = kawakita_svg(&samples, &summary).unwrap();
+        let svg = kawakita_svg(&samples, &summary, 0.3).unwrap();
         assert!(svg.starts_with("<svg"), "{}", &svg[..100]);
-        assert!(svg.contains("fit: a = 0.5000, 1/b = 100.0000 kPa"), "{svg}");
+        assert!(svg.contains("fit: a = 0.5000, 1/b = 100.0 kPa"), "{svg}");
         assert!(svg.contains("C &lt; 0.25"));
         // A fit outside the law's regime (a > 1) is drawn, marked rejected.
         let odd = KawakitaSummary {
             a: Some(3.5),
             ..summary
         };
-        let svg = kawakita_svg(&samples, &odd).unwrap();
+        let svg = kawakita_svg(&samples, &odd, 0.3).unwrap();
         assert!(
             svg.contains("rejected fit (see the warnings): a = 3.5000"),
             "{svg}"
@@ -731,13 +740,13 @@ mod tests {
             min_strain: 0.2,
         };
         let svg = heckel_svg(rows.iter().copied(), &summary).unwrap();
-        assert!(svg.contains("fit: P_y = 80.0000 kPa, A = 0.5000"), "{svg}");
+        assert!(svg.contains("fit: P_y = 80.00 kPa, A = 0.5000"), "{svg}");
         let bent = HeckelSummary {
             r_squared: Some(0.5),
             ..summary
         };
         let svg_bent = heckel_svg(rows.iter().copied(), &bent).unwrap();
-        assert!(svg_bent.contains("rejected fit (see the warnings): P_y = 80.0000 kPa"));
+        assert!(svg_bent.contains("rejected fit (see the warnings): P_y = 80.00 kPa"));
         assert!(svg.contains("C &lt; 0.2") && svg.contains("(fitted)"));
         // Rows the law does not cover are not drawn: D = 0 would plot at
         // ln 1 = 0, D < 0 below it (D > 1 gives NaN, which no plot draws).

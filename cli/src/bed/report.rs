@@ -225,7 +225,9 @@ const FIELDS: [(&str, &str); 118] = [
     ),
     (
         "quasi_static.force_imbalance_rel",
-        "mean |upper − lower − wall friction| / upper punch force (limit 0.05)",
+        "mean |upper − lower − wall friction| / upper punch force (limit 0.05; the bed's \
+         weight, which the lower punch carries too, counts in it: a few tenths of a per cent in \
+         a small bed at low pressure)",
     ),
     (
         "quasi_static.rate_change_rel",
@@ -526,7 +528,7 @@ fn fits_by_window(summary: &Summary<'_>) -> String {
          <th>Heckel P_y, kPa</th><th>rows (Kawakita, Heckel)</th></tr>\n",
     );
     for (k, hk) in summary.kawakita_windows.iter().zip(&summary.heckel_windows) {
-        let ok = super::outputs::kawakita_doubts(k).is_empty();
+        let ok = super::outputs::kawakita_doubts(k, summary.initial_solid_fraction).is_empty();
         let heckel_ok = hk.linear();
         let own = match (
             k.min_strain == summary.kawakita.min_strain,
@@ -557,8 +559,10 @@ fn fits_by_window(summary: &Summary<'_>) -> String {
 }
 
 /// The contact network at each snapshot (`summary.contact_network`):
-/// one row per snapshot, the figures of [`NETWORK_COLUMNS`]. Nothing if
-/// the run has none.
+/// one row per figure of [`NETWORK_COLUMNS`] (its meaning on hover), one
+/// column per snapshot — the 16 figures as columns made a table about
+/// 1650 px wide, cut off in a 960 px page and in print. Nothing if the run
+/// has none.
 fn contact_network(summary: &Summary<'_>) -> String {
     if summary.contact_network.is_empty() {
         return String::new();
@@ -574,16 +578,17 @@ fn contact_network(summary: &Summary<'_>) -> String {
          packings of rigid grains most pairs carry less than ⟨f⟩, the strong pairs align with \
          the compression and the weak ones lie across it (Radjai et al. 1998); the table shows \
          how far this bed follows. A pair slides as a whole when its friction reaches μ f.</p>\n\
-         <table>\n<tr>",
+         <table>\n<tr><th>figure</th>",
     );
-    for (name, _) in NETWORK_COLUMNS {
-        let _ = write!(h, "<th>{name}</th>");
+    for s in &summary.contact_network {
+        let _ = write!(h, "<th>snapshot {} (C = {:.3})</th>", s.snapshot, s.strain);
     }
     h.push_str("</tr>\n");
-    for s in &summary.contact_network {
-        h.push_str("<tr>");
-        for cell in s.fields() {
-            let _ = write!(h, "<td class=\"num\">{}</td>", field_text(cell));
+    let columns: Vec<_> = summary.contact_network.iter().map(|s| s.fields()).collect();
+    for (i, (name, meaning)) in NETWORK_COLUMNS.iter().enumerate() {
+        let _ = write!(h, "<tr><th title=\"{}\">{name}</th>", html_escape(meaning));
+        for fields in &columns {
+            let _ = write!(h, "<td class=\"num\">{}</td>", field_text(fields[i]));
         }
         h.push_str("</tr>\n");
     }
@@ -680,7 +685,7 @@ fn density_map(summary: &Summary<'_>) -> String {
          upper half as in its lower half, the disc at the axis {} times (the tenths at the \
          punches are loose in any bed: spheres touch a flat punch at points). Densest cell: {} \
          (r/R<sub>d</sub> {}, z/H {}); loosest: {} (r/R<sub>d</sub> {}, z/H {}).\
-         </p>\n<table>\n<tr><th>z/H</th>",
+         </p>\n<table>\n<tr><th>z/H \\ r/R<sub>d</sub></th>",
         num(Some(m.strain)),
         num(Some(s.wall_top_to_bottom).filter(|r| r.is_finite())),
         num(Some(s.axis_top_to_bottom).filter(|r| r.is_finite())),
