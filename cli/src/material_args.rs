@@ -121,13 +121,34 @@ impl MaterialArgs {
                 self.granule_type, err.value
             )
         };
-        // η0's range depends on ηc: show the value it was checked against.
-        let related = if err.field == "eta0" {
-            format!(" (with eta_c = {}, see `--eta-c`)", params.eta_c)
+        let related = related_field(err.field, params, true);
+        anyhow::Error::new(err).context(InputError(format!("{origin} rejected{related}")))
+    }
+}
+
+/// " (with …)": the other field a rejected `field`'s range depends on, as
+/// `params` has it, and the bound that follows — η0's on ηc, σ_y's on E —
+/// or nothing. `flags`: name the command-line flag that sets it.
+pub fn related_field(field: &str, params: &MaterialParams, flags: bool) -> String {
+    let see = |flag: &str| {
+        if flags {
+            format!("; see `{flag}`")
         } else {
             String::new()
-        };
-        anyhow::Error::new(err).context(InputError(format!("{origin} rejected{related}")))
+        }
+    };
+    match field {
+        "eta0" => format!(" (with eta_c = {}{})", params.eta_c, see("--eta-c")),
+        "yield_stress_pa" if params.youngs_modulus_pa.is_finite() => format!(
+            " (with youngs_modulus_pa = {}, i.e. at least {} Pa{})",
+            crate::numbers::short(params.youngs_modulus_pa),
+            crate::numbers::short(f64::max(
+                granbed_kernel::material::MIN_YIELD_STRESS_PA,
+                granbed_kernel::material::MIN_YIELD_TO_MODULUS * params.youngs_modulus_pa
+            )),
+            see("--youngs-modulus-pa")
+        ),
+        _ => String::new(),
     }
 }
 

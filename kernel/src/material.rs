@@ -118,11 +118,12 @@ const YOUNGS_MODULUS_ALLOWED: &str = "1e-3 <= E <= 1e13 Pa";
 /// must stay a normal `f64` (a σ_y of 1e-300 made the first step's motion
 /// non-finite).
 pub const MIN_YIELD_STRESS_PA: Real = 1e-3;
-/// The smallest ratio σ_y/E. Below about 1e-7 the return map cannot reach
-/// its tolerance in double precision (the trial stress exceeds the yield
-/// scale by more than the digits it has): a granule of B2's E with σ_y =
-/// 0.1 Pa, or of E = 1e13 Pa with B2's σ_y, stopped with "no
-/// convergence" within a few per cent of strain (session 56).
+/// The smallest ratio σ_y/E, a measured margin rather than a guarantee:
+/// B2's granule stopped with "no convergence" within a few per cent of
+/// strain at σ_y/E = 1e-7 (σ_y = 0.1 Pa) and 3e-9 (E = 1e13 Pa), where the
+/// trial stress exceeds the yield scale by more than the digits of a
+/// double, and ran at 1e-6 (session 56). The yield scale is √a2 σ_y, so
+/// a granule whose η0 lies just above η_c (a2 → 0) has less margin.
 pub const MIN_YIELD_TO_MODULUS: Real = 1e-6;
 /// [`MIN_YIELD_STRESS_PA`] and [`MIN_YIELD_TO_MODULUS`] as an error names
 /// them.

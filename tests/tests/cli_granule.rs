@@ -439,7 +439,7 @@ fn platens_carry_equal_forces() {
 fn bad_input_names_the_flag() {
     let dir = out_dir("bad");
     let out = dir.to_str().unwrap();
-    let cases: [(&[&str], &str); 21] = [
+    let cases: [(&[&str], &str); 22] = [
         (&["--strain", "0"], "--strain"),
         // Numbers a double would misread, and a unit: refused by the
         // number flags' parser with the flag named by clap.
@@ -484,6 +484,12 @@ fn bad_input_names_the_flag() {
             "steps (a stable time step of",
         ),
         (&["--gravity"], "--gravity"),
+        // σy's bound follows from E: the message says which E and bound.
+        (
+            &["--youngs-modulus-pa", "1e11"],
+            "`--yield-stress-pa` (preset B2 value 30000) rejected (with youngs_modulus_pa = \
+             1e11, i.e. at least 100000 Pa",
+        ),
         (&["--mesh", "3x1"], "--mesh"),
         (&["--damping-ratio", "3"], "--damping-ratio"),
         (&["--mass-scaling", "0.5"], "--mass-scaling 0.5"),

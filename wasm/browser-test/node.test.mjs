@@ -94,6 +94,7 @@ test('typed numbers: a decimal point is read, a comma or junk refused', () => {
     (e) => /“30,000” has a comma: write 30000 if it separates thousands, or 30\.000 if it is a decimal comma$/.test(e.message));
   assert.throws(() => parseDecimal('1,000,000', 'E', 'youngs_modulus_pa'), /“1,000,000” has commas: write 1000000 \(no thousands separators\)$/);
   assert.throws(() => parseDecimal('2,5', 'x', 'f'), /decimal comma: write 2\.5 \(with a point\)$/);
+  assert.throws(() => parseDecimal('0,300', 'x', 'f'), /decimal comma: write 0\.300 \(with a point\)$/);
   for (const bad of ['', '1.5.2', '0x10', 'Infinity', '1,000.5', 'abc', '1e', '-inf']) {
     assert.throws(() => parseDecimal(bad, 'x', 'f'), /“.*” (is empty|is not a number)/, bad);
   }

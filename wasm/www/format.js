@@ -47,14 +47,14 @@ export function parseDecimal(text, label, field) {
 // comma before exactly three digits (30,000, as Pa are typed) may separate
 // thousands or be a decimal comma, and which one is the student's to say
 // (the page must not read 30,000 Pa as 30 Pa); several such groups
-// (1,000,000) separate thousands; any other single comma (0,5) is a
-// decimal comma.
+// (1,000,000) separate thousands; any other single comma (0,5, 0,300: no
+// group of thousands starts with 0) is a decimal comma.
 function commaHint(t) {
-  if (/^[+-]?\d{1,3},\d{3}$/.test(t)) {
+  if (/^[+-]?[1-9]\d{0,2},\d{3}$/.test(t)) {
     return `has a comma: write ${t.replace(',', '')} if it separates thousands, or ${t.replace(',', '.')} ` +
       'if it is a decimal comma';
   }
-  if (/^[+-]?\d{1,3}(,\d{3}){2,}$/.test(t)) return `has commas: write ${t.replaceAll(',', '')} (no thousands separators)`;
+  if (/^[+-]?[1-9]\d{0,2}(,\d{3}){2,}$/.test(t)) return `has commas: write ${t.replaceAll(',', '')} (no thousands separators)`;
   if (/^[+-]?\d*,\d+$/.test(t)) return `has a decimal comma: write ${t.replace(',', '.')} (with a point)`;
   return undefined;
 }

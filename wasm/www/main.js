@@ -63,8 +63,10 @@ function refuse(message, fields) {
   $('run-inputs').textContent = '–';
   $('results').dataset.state = 'rejected';
   // Nothing ran: the status line says so rather than an earlier run's
-  // result.
-  setStatus('not run: an input was refused (see the message below)');
+  // result, and blames an input only where one is named (the worker also
+  // reports a module that would not load, or a run that could not start).
+  const named = [].concat(fields ?? []).length > 0;
+  setStatus(named ? 'not run: an input was refused (see the message below)' : 'not run (see the message below)');
 }
 
 function clearError() {
@@ -187,7 +189,7 @@ function describeRun(run) {
   const head = `${run.custom ? `custom (from ${run.type})` : run.type}, mesh ${run.mesh}`;
   if (!p) return head;
   // As typed: an infinite σy (a purely elastic granule) is written inf.
-  const v = (x) => (Number.isFinite(x) ? String(x) : x > 0 ? 'inf' : '-inf');
+  const v = (x) => (Number.isFinite(x) || Number.isNaN(x) ? String(x) : x > 0 ? 'inf' : '-inf');
   return `${head}: σy = ${v(p.yield_stress_pa)} Pa, η0 = ${v(p.eta0)}, E = ${v(p.youngs_modulus_pa)} Pa, ` +
     `ν = ${v(p.poisson_ratio)}, cp = ${v(p.cp)}, ηc = ${v(p.eta_c)}, μ = ${v(p.friction)}, ` +
     `d = ${+(p.diameter_m * 1e3).toPrecision(12)} mm`;
@@ -297,7 +299,7 @@ function finish(msg) {
   if (!msg.failure) {
     runCount += 1;
     const label = `${current.custom ? `custom-${tag(describeRun(current)).slice(0, 4)}` : current.type} ${current.mesh}` +
-      (msg.quasiStatic === false ? ' (not quasi-static)' : '');
+      (judgedNotQuasiStatic(msg) ? ' (not quasi-static)' : '');
     // Its colour for as long as it is drawn (by run, not by place in the list).
     const colour = HISTORY_COLOURS[(runCount - 1) % HISTORY_COLOURS.length];
     history.push({ id: runCount, label, colour, x: Array.from(msg.x, (v) => v * 1e3), f: Array.from(msg.f) });
@@ -315,14 +317,20 @@ function finish(msg) {
     // The result in the status line too: the table may be below the fold.
     // A run whose inertia was not negligible says so where its result is
     // read: its curve is the platens' speed's as much as the material's.
-    const inertia = msg.quasiStatic === false
-      ? '; NOT quasi-static: the kinetic energy was not negligible, so this is not the granule\'s ' +
-        'quasi-static response (a granule this soft or light is too slow for the platens)'
+    const inertia = judgedNotQuasiStatic(msg)
+      ? '; NOT quasi-static: the kinetic energy was not negligible, so the curve carries inertia as ' +
+        'well as the granule\'s response'
       : '';
     setStatus(`done: strain ${(100 * msg.strain).toFixed(1)} % in ${(msg.wallMs / 1e3).toFixed(2)} s; ` +
       `σ_est = ${formatStress(msg.sigmaEst)}${inertia}`);
     $('results').dataset.state = 'done';
   }
+}
+
+// Whether a finished run's certificate was judged and failed (not judged,
+// the table says n/a and nothing is claimed).
+function judgedNotQuasiStatic(msg) {
+  return msg.kineticToInternal !== null && msg.quasiStatic === false;
 }
 
 // "0.00057 %" for a ratio; "4.7e+17 %" rather than 18 digits.
@@ -339,8 +347,11 @@ function cancel() {
   cancelNote = `cancelled at strain ${(100 * lastStrain).toFixed(1)} % (the curve so far is shown)`;
   // The picture's description says what it shows now (the cancelled
   // worker took the run's CSV with it: the curve is only drawn).
+  // (A run cancelled before it started has no curve; `view` is then an
+  // earlier run's or none.)
+  const points = $('results').dataset.state === 'running' && current?.params ? view.f.length : 0;
   $('plot').setAttribute('aria-label', `platen force against platen approach of a run cancelled at strain ` +
-    `${(100 * lastStrain).toFixed(1)} %: ${view ? view.f.length : 0} points, not saved`);
+    `${(100 * lastStrain).toFixed(1)} %: ${points} points, not saved`);
   setStatus(`${cancelNote}; restarting…`);
   $('progress').value = 0;
   $('results').dataset.state = 'cancelled';

@@ -81,7 +81,7 @@ pub struct ComparisonRow {
     /// Output rows in the fit (C ≥ the scene's `kawakita_min_strain`).
     pub kawakita_points: usize,
     /// The Kawakita fit exists and describes the bed (1 in the CSV): none
-    /// of the summary's doubts ([`kawakita_doubts`]: a in (0, 1 − D0], 1/b > 0,
+    /// of the summary's doubts ([`kawakita_doubts`]: a in (0, 1], 1/b > 0,
     /// R² at least [`super::outputs::FIT_MIN_R_SQUARED`]). A fit with 0 is no material
     /// figure; the summary's warning says why.
     pub kawakita_ok: bool,
@@ -162,8 +162,7 @@ impl ComparisonRow {
             points: self.kawakita_points,
             min_strain: Real::NAN,
         };
-        self.kawakita_ok = self.kawakita_a.is_some()
-            && kawakita_doubts(&kawakita, self.initial_solid_fraction).is_empty();
+        self.kawakita_ok = self.kawakita_a.is_some() && kawakita_doubts(&kawakita).is_empty();
         self.heckel_ok = self.heckel_yield_pressure_pa.is_some()
             && self.heckel_r_squared.is_some_and(fit_linear);
         self

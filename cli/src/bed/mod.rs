@@ -112,8 +112,8 @@ Output, in --out DIR (created if missing):
                    final strain past the target by more than an output
                    interval, overlap above 1 % of the element, an element
                    folded at a Gauss point (J <= 0), a Kawakita fit
-                   with a outside (0, 1], 1/b <= 0 or R^2 < 0.9, a Heckel
-                   fit with R^2 < 0.9, a failed
+                   with a outside (0, 1], 1/b <= 0 or R^2 < 0.9 (and a note
+                   where a > 1 - D0), a Heckel fit with R^2 < 0.9, a failed
                    quasi-static certificate, a bed solid fraction D >= 1,
                    scene fields left out whose old values are not the
                    published ones, a withdrawal without lift-off or cut

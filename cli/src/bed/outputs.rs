@@ -828,13 +828,15 @@ fn not_quasi_static(scene: &Scene, run: &BedRun, q: &QuasiStatic) -> Option<Stri
     // A coarse mesh's granules jump more: in a 100-granule bed measured
     // once (session 56), halving the speed on 4x1 took the ratio from 1.5
     // to 1.2 %, the standard mesh at full speed gave 0.5 %.
+    let standard = crate::model::MeshLevel::STANDARD;
     let coarse = match scene.mesh_level() {
-        Ok(level) if level.n < crate::model::MeshLevel::STANDARD.n => format!(
-            "; a coarse mesh (now {}) rearranges by larger jumps than the standard {} mesh, \
+        Ok(level) if level.n <= standard.n && level.m <= standard.m && level != standard => {
+            format!(
+                "; a coarse mesh (now {}) rearranges by larger jumps than the standard {} mesh, \
              which a slower punch cures less",
-            scene.mesh,
-            crate::model::MeshLevel::STANDARD
-        ),
+                scene.mesh, standard
+            )
+        }
         _ => String::new(),
     };
     Some(format!(
@@ -856,24 +858,14 @@ pub const COMPRESSION_CSV: &str = "compression.csv";
 /// File name of the summary.
 pub const SUMMARY_JSON: &str = "summary.json";
 
-/// Why the Kawakita fit `k` of a bed poured to the solid fraction
-/// `initial_solid_fraction` (D0) does not describe it, if it does not: a
-/// outside (0, 1] (a limiting strain; NaN included), a above 1 − D0 (the
-/// bed would end denser than its solid: D∞ = D0/(1 − a) > 1; not judged
-/// for a NaN D0), 1/b ≤ 0, R² below [`FIT_MIN_R_SQUARED`]. Empty for a fit
-/// inside the law's regime.
-pub fn kawakita_doubts(k: &KawakitaSummary, initial_solid_fraction: Real) -> Vec<String> {
+/// Why the Kawakita fit `k` does not describe a bed, if it does not: a
+/// outside (0, 1] (a limiting strain; NaN included), 1/b ≤ 0, R² below
+/// [`FIT_MIN_R_SQUARED`]. Empty for a fit inside the law's regime.
+pub fn kawakita_doubts(k: &KawakitaSummary) -> Vec<String> {
     let mut why = Vec::new();
     if let Some(a) = k.a.filter(|&a| !(a > 0.0 && a <= 1.0)) {
         why.push(format!(
             "a = {a:.3} outside (0, 1] (a is the limiting strain)"
-        ));
-    } else if let Some(a) = k.a.filter(|&a| a > 1.0 - initial_solid_fraction) {
-        why.push(format!(
-            "a = {a:.3} above 1 - D0 = {:.3} (the limiting solid fraction D0/(1 - a) = {:.2} \
-             exceeds 1)",
-            1.0 - initial_solid_fraction,
-            initial_solid_fraction / (1.0 - a)
         ));
     }
     if let Some(inv_b) = k.inv_b_pa.filter(|&x| x <= 0.0) {
@@ -883,6 +875,29 @@ pub fn kawakita_doubts(k: &KawakitaSummary, initial_solid_fraction: Real) -> Vec
         why.push(format!("R^2 = {r2:.3} < {FIT_MIN_R_SQUARED}"));
     }
     why
+}
+
+/// A note on a Kawakita fit `k` (inside the law's regime by
+/// [`kawakita_doubts`]) whose a exceeds 1 − D0, `initial_solid_fraction`
+/// D0 the poured bed's: extrapolated to infinite pressure it would press
+/// the bed past its solid volume (D∞ = D0/(1 − a) > 1), so a is a figure of
+/// the fitted window rather than the bed's limiting strain. A note, not a
+/// rejection: fits over the reference study's C ≥ 0.25 give such an a for
+/// the loosest types (A1 on the published scene fitted a = 0.719,
+/// BENCHMARKS.md; its D0, estimated from B2's 0.425 × 0.6/0.8, leaves
+/// 1 − D0 ≈ 0.68), and the published B2 scene lies just below (a = 0.556
+/// against 0.575). `None` otherwise, or for a NaN D0.
+pub fn kawakita_beyond_solid(k: &KawakitaSummary, initial_solid_fraction: Real) -> Option<String> {
+    let a =
+        k.a.filter(|&a| a > 0.0 && a <= 1.0 && a > 1.0 - initial_solid_fraction)?;
+    Some(format!(
+        "the Kawakita a = {a:.3} exceeds 1 - D0 = {:.3}: extrapolated to infinite pressure the \
+         fit would press the bed past its solid volume (D0/(1 - a) = {:.2}), so a describes the \
+         fitted window (C >= {}) rather than a limiting strain of the bed",
+        1.0 - initial_solid_fraction,
+        initial_solid_fraction / (1.0 - a),
+        k.min_strain
+    ))
 }
 
 /// Whether a fit (Kawakita's or Heckel's) with this R² is linear enough
@@ -1025,7 +1040,7 @@ fn warnings(
             scene.hourglass_kappa
         ));
     }
-    let why = kawakita_doubts(kawakita, bed_solid_fraction(run, 0.0));
+    let why = kawakita_doubts(kawakita);
     if !why.is_empty() {
         w.push(format!(
             "the Kawakita fit over C >= {} ({} points) does not describe this bed: {}; its a \
@@ -1035,6 +1050,8 @@ fn warnings(
             kawakita.points,
             why.join(", ")
         ));
+    } else if let Some(note) = kawakita_beyond_solid(kawakita, bed_solid_fraction(run, 0.0)) {
+        w.push(note);
     }
     for (law, min_strain, flag) in [
         ("Kawakita", kawakita.min_strain, "--kawakita-min-strain"),
@@ -1287,29 +1304,30 @@ mod tests {
             min_strain: 0.25,
         };
         for a in [1.0, 0.4] {
-            assert!(
-                kawakita_doubts(&fit(a, 2e5, 0.99), 0.0).is_empty(),
-                "a = {a}"
-            );
+            assert!(kawakita_doubts(&fit(a, 2e5, 0.99)).is_empty(), "a = {a}");
         }
         for a in [0.0, -6.8, 3.48, Real::NAN] {
-            let why = kawakita_doubts(&fit(a, 2e5, 0.99), 0.0);
+            let why = kawakita_doubts(&fit(a, 2e5, 0.99));
             assert_eq!(why.len(), 1, "a = {a}: {why:?}");
             assert!(why[0].contains("outside (0, 1]"), "{why:?}");
         }
-        // A bed poured to D0 = 0.39 ends at most solid: a ≤ 0.61 (a
-        // session-56 review's 8x2 bed fitted a = 0.6456, a D∞ of 1.10).
-        assert!(kawakita_doubts(&fit(0.61, 2e5, 0.99), 0.39).is_empty());
-        let why = kawakita_doubts(&fit(0.6456, 2e5, 0.99), 0.39);
-        assert_eq!(
-            why,
-            [
-                "a = 0.646 above 1 - D0 = 0.610 (the limiting solid fraction D0/(1 - a) = 1.10 \
-              exceeds 1)"
-            ]
+        // A bed poured to D0 = 0.39 ends at most solid: an a above 0.61 is
+        // noted, not doubted (a session-56 review's 8x2 bed fitted 0.6456,
+        // a D∞ of 1.10); an a outside (0, 1] is the doubt's alone.
+        assert_eq!(kawakita_beyond_solid(&fit(0.6, 2e5, 0.99), 0.39), None);
+        let note = kawakita_beyond_solid(&fit(0.6456, 2e5, 0.99), 0.39).unwrap();
+        assert!(
+            note.starts_with("the Kawakita a = 0.646 exceeds 1 - D0 = 0.610: ")
+                && note.contains("(D0/(1 - a) = 1.10)"),
+            "{note}"
         );
-        assert!(kawakita_doubts(&fit(0.6456, 2e5, 0.99), Real::NAN).is_empty());
-        let why = kawakita_doubts(&fit(0.5, -1.0, 0.5), 0.0);
+        assert!(kawakita_doubts(&fit(0.6456, 2e5, 0.99)).is_empty());
+        assert_eq!(
+            kawakita_beyond_solid(&fit(0.6456, 2e5, 0.99), Real::NAN),
+            None
+        );
+        assert_eq!(kawakita_beyond_solid(&fit(3.48, 2e5, 0.99), 0.39), None);
+        let why = kawakita_doubts(&fit(0.5, -1.0, 0.5));
         assert!(
             why[0].contains("1/b") && why[1].contains("R^2 = 0.500 < 0.9"),
             "{why:?}"
@@ -1322,7 +1340,7 @@ mod tests {
             points: 2,
             min_strain: 0.25,
         };
-        assert!(kawakita_doubts(&none, 0.5).is_empty());
+        assert!(kawakita_doubts(&none).is_empty());
     }
 
     /// The warning of a failed certificate advises lighter masses only

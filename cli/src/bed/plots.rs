@@ -312,12 +312,7 @@ fn r2_text(r_squared: Option<Real>) -> String {
 /// The Kawakita plot: P/C against P (kPa) of the samples with C > 0, the
 /// fitted ones (C ≥ the fit's window) filled, and the line
 /// P/C = P/a + (1/b)/a over the fitted pressures.
-/// `initial_solid_fraction` (D0) judges the fit ([`kawakita_doubts`]).
-pub fn kawakita_svg(
-    samples: &[BedSample],
-    fit: &KawakitaSummary,
-    initial_solid_fraction: Real,
-) -> anyhow::Result<String> {
+pub fn kawakita_svg(samples: &[BedSample], fit: &KawakitaSummary) -> anyhow::Result<String> {
     let rows = samples.iter().filter(|s| s.mean_strain > 0.0).map(|s| {
         (
             s.upper_pressure_pa * 1e-3,
@@ -337,7 +332,7 @@ pub fn kawakita_svg(
                 significant(inv_b * 1e-3, 4),
                 r2_text(fit.r_squared)
             ),
-            kawakita_doubts(fit, initial_solid_fraction).is_empty(),
+            kawakita_doubts(fit).is_empty(),
         );
         (label, y as &dyn Fn(f64) -> f64)
     });
@@ -557,10 +552,7 @@ pub fn plots(
             pressure_f,
             xy_svg("Punch pressure", C, "pressure P, kPa", &pressure, true)?,
         ),
-        (
-            kawakita_f,
-            kawakita_svg(samples, &summary.kawakita, summary.initial_solid_fraction)?,
-        ),
+        (kawakita_f, kawakita_svg(samples, &summary.kawakita)?),
         (
             heckel_f,
             heckel_svg(heckel_rows(run, upper_pressure), &summary.heckel)?,
@@ -702,7 +694,7 @@ mod tests {
             points: fit.points,
             min_strain: 0.25,
         };
-        let svg = kawakita_svg(&samples, &summary, 0.3).unwrap();
+        let svg = kawakita_svg(&samples, &summary).unwrap();
         assert!(svg.starts_with("<svg"), "{}", &svg[..100]);
         assert!(svg.contains("fit: a = 0.5000, 1/b = 100.0 kPa"), "{svg}");
         assert!(svg.contains("C &lt; 0.25"));
@@ -711,7 +703,7 @@ mod tests {
             a: Some(3.5),
             ..summary
         };
-        let svg = kawakita_svg(&samples, &odd, 0.3).unwrap();
+        let svg = kawakita_svg(&samples, &odd).unwrap();
         assert!(
             svg.contains("rejected fit (see the warnings): a = 3.5000"),
             "{svg}"

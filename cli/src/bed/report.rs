@@ -528,7 +528,7 @@ fn fits_by_window(summary: &Summary<'_>) -> String {
          <th>Heckel P_y, kPa</th><th>rows (Kawakita, Heckel)</th></tr>\n",
     );
     for (k, hk) in summary.kawakita_windows.iter().zip(&summary.heckel_windows) {
-        let ok = super::outputs::kawakita_doubts(k, summary.initial_solid_fraction).is_empty();
+        let ok = super::outputs::kawakita_doubts(k).is_empty();
         let heckel_ok = hk.linear();
         let own = match (
             k.min_strain == summary.kawakita.min_strain,

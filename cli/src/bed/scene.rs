@@ -860,8 +860,11 @@ impl Scene {
         let p = self.material_params()?;
         p.validate().map_err(|e| {
             anyhow::Error::new(InputError(format!(
-                "scene field `material.{}` = {} is out of range (allowed: {})",
-                e.field, e.value, e.allowed
+                "scene field `material.{}` = {} is out of range (allowed: {}){}",
+                e.field,
+                e.value,
+                e.allowed,
+                crate::material_args::related_field(e.field, &p, false)
             )))
         })
     }
@@ -1036,10 +1039,24 @@ fn refused_fields(text: &str) -> Vec<(String, bool)> {
     problems
 }
 
-/// The allowed values of a top-level scene field, as
-/// [`Scene::validate`] states them (a range that depends on another field
-/// is stated for the published scene's), or `None`.
+/// The allowed values of a scene field, as [`Scene::validate`] states
+/// them (a range that depends on another field is stated for the
+/// published scene's), a `material.` field's as the material's validation
+/// states it, or `None`.
 fn allowed_range(field: &str) -> Option<String> {
+    if let Some(inner) = field.strip_prefix("material.") {
+        // The published scene with this one override NaN, which every
+        // range refuses: the refusal names its range.
+        let mut table = toml::Table::new();
+        table.insert(inner.to_owned(), toml::Value::Float(f64::NAN));
+        let material: MaterialOverrides = toml::Value::Table(table).try_into().ok()?;
+        let scene = Scene {
+            material,
+            ..Scene::published()
+        };
+        let e = scene.material_params().ok()?.validate().err()?;
+        return (e.field == inner).then(|| e.allowed.to_owned());
+    }
     match field {
         "granule_type" => Some(GRANULE_TYPES.to_owned()),
         "element" => Some(ELEMENTS.to_owned()),
@@ -1060,13 +1077,17 @@ fn plain_types(message: &str) -> String {
         _ => message.to_owned(),
     };
     [
-        ("expected usize", "expected a whole number"),
-        ("expected u32", "expected a whole number up to 4294967295"),
+        ("expected usize", "expected a whole number >= 0"),
         (
-            "expected u64",
-            "expected a whole number up to 18446744073709551615",
+            "expected u32",
+            "expected a whole number from 0 to 4294967295",
         ),
+        ("expected u64", "expected a whole number >= 0"),
         ("expected f64", "expected a number"),
+        (
+            "expected struct MaterialOverrides",
+            "expected a table [material]",
+        ),
         ("expected a sequence", "expected a list [...]"),
     ]
     .iter()
@@ -1143,10 +1164,10 @@ mod tests {
         assert!(e.downcast_ref::<InputError>().is_some(), "{e:#}");
         let text = format!("{e:#}");
         for line in [
-            "  - `granules` = -5: expected a whole number; allowed: 1..=100000",
-            "  - `contact_sweeps` = 99999999999: expected a whole number up to 4294967295; \
+            "  - `granules` = -5: expected a whole number >= 0; allowed: 1..=100000",
+            "  - `contact_sweeps` = 99999999999: expected a whole number from 0 to 4294967295; \
              allowed: 1..=50",
-            "  - `material.friction` = \"high\": expected a number",
+            "  - `material.friction` = \"high\": expected a number; allowed: 0 <= mu <= 10",
             "  - `seed` is missing: it is required",
             "  - `mesh` is missing: it is required (a level NxM such as \"8x2\")",
         ] {

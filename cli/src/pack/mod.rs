@@ -149,7 +149,7 @@ pub struct PackMaterialArgs {
     pub true_density_kg_m3: Option<f64>,
 
     /// Coulomb friction coefficient of the sphere–sphere and the
-    /// sphere–wall (floor and die) contacts, dimensionless (finite, ≥ 0).
+    /// sphere–wall (floor and die) contacts, dimensionless (0 ≤ μ ≤ 10).
     #[arg(value_parser = crate::numbers::real, long, value_name = "MU", allow_negative_numbers = true)]
     pub friction: Option<f64>,
 }

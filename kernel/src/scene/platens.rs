@@ -56,9 +56,10 @@ pub struct PlatenParams {
     pub elements: ElementSettings,
     /// Fraction ξ of critical damping of the lowest deformational mode; 0 ≤ ξ ≤ 2.
     pub damping_ratio: Real,
-    /// Speed at which the platens approach each other, m/s; > 0.
+    /// Speed at which the platens approach each other, m/s; 0 < v ≤ 10.
     pub approach_speed_m_s: Real,
-    /// Coulomb friction between granule and platens; ≥ 0.
+    /// Coulomb friction between granule and platens; 0 ≤ μ ≤
+    /// [`crate::material::MAX_FRICTION`] (10).
     pub friction: Real,
     /// Platen approach / diameter at which the run ends; 0 < strain ≤ 0.9.
     pub final_strain: Real,
@@ -592,16 +593,20 @@ pub struct PlatenScene<'a> {
 }
 
 /// The largest strain the platens may add in one step: a step of the
-/// standard granule at 5 mm/s adds about 10⁻⁵.
+/// standard B2 granule at 5 mm/s adds about 10⁻⁵ (8.6e-6 on the 8x2 mesh,
+/// 1.8e-5 on 4x1).
 pub const MAX_STRAIN_PER_STEP: Real = 1e-3;
 
 /// The time step `dt` (s) limited so that the platens approach by at most
-/// [`MAX_STRAIN_PER_STEP`] × the granule `diameter` (m) per step. The
-/// stable step of a granule so soft that its waves are slower than the
-/// platens (E of a few Pa or less at 5 mm/s) would otherwise carry the run
-/// past its final strain in a single step, with no curve between; for any
-/// usual granule the stable step is two orders of magnitude shorter and
-/// this leaves it unchanged.
+/// [`MAX_STRAIN_PER_STEP`] × the granule `diameter` (m) per step, i.e. it
+/// binds where v·dt_stable > 1e-3 d. For B2's granule that is a platen
+/// speed above about 0.6 m/s on the 8x2 mesh (0.3 m/s on 4x1), a mass
+/// scaling above about 10⁴ at 5 mm/s, or E below 100–300 Pa: there the
+/// runs take more steps than before the cap and their curves change.
+/// Without it a granule so soft that its waves are slower than the
+/// platens (E = 1e-3 Pa) went past its final strain in a single step,
+/// with no curve between, and a 10 m/s platen moved 5 % of the diameter
+/// per step.
 fn capped_step(dt: Real, params: &PlatenParams, diameter: Real) -> Real {
     crate::math::min(
         dt,
