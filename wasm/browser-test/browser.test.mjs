@@ -279,3 +279,11 @@ test('opened as a file, the page says how to serve it instead of loading for eve
   assert.match(await file.textContent('#status'), /^this page must be served over http, not opened as a file: run "python3 -m http\.server/);
   await file.close();
 });
+
+test('the CSV\'s columns are explained on the page, as the CLI\'s glossary has them', async () => {
+  const names = await page.$$eval('#csv-columns-body th', (ths) => ths.map((t) => t.textContent));
+  assert.equal(names.length, 18);
+  assert.deepEqual(names.slice(0, 4), ['time_s', 'displacement_m', 'strain', 'force_n']);
+  const meaning = await page.$eval('#csv-columns-body tr:nth-child(4) td', (td) => td.textContent);
+  assert.equal(meaning, 'mean of the upper and lower platen forces, N');
+});

@@ -376,7 +376,7 @@ impl Experiment {
     /// The samples as CSV, the CLI's `force_displacement.csv` byte for byte.
     pub fn csv(&self) -> String {
         let mut out = String::new();
-        out.push_str(&SAMPLE_COLUMNS.join(",")); // the CLI's header
+        out.push_str(&SAMPLE_COLUMNS.map(|c| c.0).join(",")); // the CLI's header
         out.push('\n');
         for s in &self.samples {
             let reals = s.values();

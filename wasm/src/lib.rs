@@ -165,6 +165,19 @@ pub fn preset(name: &str) -> Result<JsValue, JsValue> {
     Ok(obj.into())
 }
 
+/// The CSV's columns, `[[name, meaning], …]` in the file's order: the
+/// kernel's `SAMPLE_COLUMNS`, which the CLI's `force_displacement.csv`
+/// and its report's glossary use too.
+#[wasm_bindgen]
+pub fn csv_columns() -> js_sys::Array {
+    granbed_kernel::scene::platens::SAMPLE_COLUMNS
+        .iter()
+        .map(|(name, meaning)| {
+            js_sys::Array::of2(&JsValue::from_str(name), &JsValue::from_str(meaning))
+        })
+        .collect()
+}
+
 /// The version of granbed this module was built from.
 #[wasm_bindgen]
 pub fn version() -> String {

@@ -118,6 +118,7 @@ function onWorker(msg) {
       $('run').disabled = running;
       setStatus(cancelNote ? `${cancelNote}; ready` : 'ready');
       $('version').textContent = `granbed ${msg.version}`;
+      fillColumns(msg.columns);
       if (!$('custom').checked) requestPreset();
       break;
     case 'preset':
@@ -148,6 +149,21 @@ function onWorker(msg) {
       break;
     default:
       break;
+  }
+}
+
+// The CSV's columns and their meanings, from the module (the CLI's
+// glossary of force_displacement.csv), once.
+function fillColumns(columns) {
+  const body = $('csv-columns-body');
+  if (!columns || body.rows.length) return;
+  for (const [name, meaning] of columns) {
+    const row = body.insertRow();
+    const th = document.createElement('th');
+    th.scope = 'row';
+    th.textContent = name;
+    row.appendChild(th);
+    row.insertCell().textContent = meaning;
   }
 }
 

@@ -2,7 +2,7 @@
 // experiment at a time in chunks of time steps and posts the growing curve
 // and the node positions after each chunk. The page cancels a run by
 // terminating this worker.
-import init, { Granule, preset, version } from './pkg/granbed_wasm.js';
+import init, { Granule, csv_columns as csvColumns, preset, version } from './pkg/granbed_wasm.js';
 
 // Time steps per chunk: about 0.1 s of work on the standard mesh.
 const CHUNK = 1500;
@@ -94,7 +94,7 @@ onmessage = async (ev) => {
     return;
   }
   if (msg.cmd === 'hello') {
-    postMessage({ kind: 'ready', version: version() });
+    postMessage({ kind: 'ready', version: version(), columns: csvColumns() });
   } else if (msg.cmd === 'preset') {
     try {
       postMessage({ kind: 'preset', type: msg.type, chosen: msg.chosen === true, values: preset(msg.type) });

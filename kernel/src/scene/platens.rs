@@ -443,28 +443,51 @@ pub struct PlatenSample {
     pub energy: EnergyLedger,
 }
 
-/// Column names of a sample's table row (units in the names; energies are
-/// whole-granule equivalents): [`PlatenSample::values`], then `steps`.
-/// The CLI's `force_displacement.csv` and the browser's CSV use them.
-pub const SAMPLE_COLUMNS: [&str; 18] = [
-    "time_s",
-    "displacement_m",
-    "strain",
-    "force_n",
-    "force_upper_n",
-    "force_lower_n",
-    "kinetic_j",
-    "internal_work_j",
-    "elastic_j",
-    "plastic_j",
-    "hourglass_j",
-    "damping_j",
-    "contact_work_j",
-    "gravity_work_j",
-    "platen_work_j",
-    "min_jacobian",
-    "dt_s",
-    "steps",
+/// The columns of a sample's table row, (name, meaning with its unit;
+/// units in the names, energies whole-granule equivalents):
+/// [`PlatenSample::values`], then `steps`. The CLI's
+/// `force_displacement.csv` and its report's glossary, and the browser's
+/// CSV and page, use them.
+pub const SAMPLE_COLUMNS: [(&str, &str); 18] = [
+    ("time_s", "simulated time, s"),
+    (
+        "displacement_m",
+        "platen approach x (both platens together), m",
+    ),
+    ("strain", "x/d, d the granule's diameter"),
+    ("force_n", "mean of the upper and lower platen forces, N"),
+    (
+        "force_upper_n",
+        "upper platen force, averaged over the sample interval, N",
+    ),
+    (
+        "force_lower_n",
+        "lower platen force, N (the upper's in an octant run)",
+    ),
+    ("kinetic_j", "kinetic energy, J"),
+    (
+        "internal_work_j",
+        "work of the internal and hourglass forces, J",
+    ),
+    ("elastic_j", "elastic energy Ψ, J"),
+    ("plastic_j", "plastic dissipation, J"),
+    (
+        "hourglass_j",
+        "energy in the one-point element's hourglass modes, J",
+    ),
+    ("damping_j", "energy removed by the damping, J"),
+    (
+        "contact_work_j",
+        "work of the platen contacts on the nodes, J",
+    ),
+    ("gravity_work_j", "work of gravity, J"),
+    ("platen_work_j", "work of the moving platens, J"),
+    (
+        "min_jacobian",
+        "smallest element volume ratio J of the sample's last step",
+    ),
+    ("dt_s", "time step, s"),
+    ("steps", "time steps so far"),
 ];
 
 /// σ_est of a run ([`PlatenSample::sigma_est`]).
