@@ -39,11 +39,6 @@ pub const TYPES_COLUMNS: [&str; 12] = [
     "return_map_gap_rel",
 ];
 
-/// The columns of `force_displacement.csv`, with their meanings (the
-/// kernel's [`SAMPLE_COLUMNS`], which the browser's CSV and page share):
-/// the file's header and the report's glossary.
-pub const FORCE_COLUMNS: [(&str, &str); 18] = SAMPLE_COLUMNS;
-
 /// The cells of one sample, in the order of [`SAMPLE_COLUMNS`] (the header
 /// of [`FORCE_CSV`]).
 pub fn force_row(s: &PlatenSample) -> [Field; SAMPLE_COLUMNS.len()] {
@@ -53,7 +48,7 @@ pub fn force_row(s: &PlatenSample) -> [Field; SAMPLE_COLUMNS.len()] {
 
 /// Writes `samples` as [`FORCE_CSV`] rows to `path`.
 pub fn write_force_csv(path: &Path, samples: &[PlatenSample]) -> anyhow::Result<()> {
-    write_table(path, &FORCE_COLUMNS, samples.iter().map(force_row))
+    write_table(path, &SAMPLE_COLUMNS, samples.iter().map(force_row))
 }
 
 /// Writes `summary` as pretty-printed JSON to `path` (see
@@ -93,15 +88,4 @@ pub fn write_types_csv(path: &Path, runs: &[(GranuleType, &Summary)]) -> anyhow:
         csv.write_row(&types_row(*t, s)).with_context(ctx)?;
     }
     finish_file(csv.into_inner(), path)
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    /// The glossary names the CSV's columns, in the kernel's order.
-    #[test]
-    fn the_glossary_follows_the_csv_header() {
-        assert!(FORCE_COLUMNS.iter().all(|c| !c.1.is_empty()));
-    }
 }

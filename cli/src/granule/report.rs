@@ -12,7 +12,7 @@ use std::path::Path;
 use granbed_kernel::Real;
 use granbed_kernel::scene::platens::PlatenSample;
 
-use super::outputs::{FORCE_COLUMNS, FORCE_CSV, FORCE_SVG, SUMMARY_JSON, TYPES_CSV, TYPES_SVG};
+use super::outputs::{FORCE_CSV, FORCE_SVG, SUMMARY_JSON, TYPES_CSV, TYPES_SVG};
 use super::section::{DENSITY_SVG, SECTION_SVG};
 use super::summary::Summary;
 use crate::html::{
@@ -20,6 +20,7 @@ use crate::html::{
     summary_table, warnings_section,
 };
 use crate::output::write_text;
+use granbed_kernel::scene::platens::SAMPLE_COLUMNS;
 
 /// File name of a report page (a run's, and a `--types` series').
 pub const REPORT_FILE: &str = "report.html";
@@ -277,7 +278,7 @@ pub fn report_html(
         "One row per sample: the unloaded state, then every output_strain_interval of \
          approach; energies are the totals so far. An octant run reports the whole granule's \
          forces and energies.",
-        &FORCE_COLUMNS,
+        &SAMPLE_COLUMNS,
     ));
     h.push_str("</body>\n</html>\n");
     Ok(h)

@@ -102,18 +102,18 @@ pub unsafe extern "C" fn granbed_hex_reference(
         for ((x, o), code) in x.iter().zip(out.iter_mut()).zip(codes.iter_mut()) {
             *code = if !x.iter().all(|v| v.is_finite()) {
                 GRANBED_ERR_NON_FINITE
-            } else if let Some(r) = hex_reference(&coords(x)) {
-                encode(&r, o);
-                // Finite coordinates whose volume or geometry factor
-                // overflows (a side of 1e103 m): no record the forces
-                // could use.
-                if r.usable() {
-                    GRANBED_OK
-                } else {
-                    GRANBED_ERR_NON_FINITE
-                }
             } else {
-                GRANBED_ERR_DEGENERATE
+                match hex_reference(&coords(x)) {
+                    Some(r) if r.usable() => {
+                        encode(&r, o);
+                        GRANBED_OK
+                    }
+                    // Finite coordinates whose volume or geometry factor
+                    // overflows (a side of 1e103 m): no record the forces
+                    // could use.
+                    Some(_) => GRANBED_ERR_NON_FINITE,
+                    None => GRANBED_ERR_DEGENERATE,
+                }
             };
             if *code != GRANBED_OK {
                 *o = [0.0; GRANBED_HEX_REFERENCE_LEN];

@@ -97,9 +97,9 @@ pub fn max_frequency(
         buf.mode.len(),
         buf.x_pert.len(),
         buf.f_plus.len(),
+        buf.f_minus.len(),
     ]
     .into_iter()
-    .chain([buf.f_minus.len()])
     .any(|n| n != nodes)
         || buf.cp_scratch.len() != cp_inv.len()
     {

@@ -490,6 +490,16 @@ pub const SAMPLE_COLUMNS: [(&str, &str); 18] = [
     ("steps", "time steps so far"),
 ];
 
+// Every column has a meaning (the glossaries show it), checked when the
+// kernel compiles.
+const _: () = {
+    let mut i = 0;
+    while i < SAMPLE_COLUMNS.len() {
+        assert!(!SAMPLE_COLUMNS[i].1.is_empty());
+        i += 1;
+    }
+};
+
 /// σ_est of a run ([`PlatenSample::sigma_est`]).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct SigmaEst {
@@ -617,7 +627,8 @@ pub struct PlatenScene<'a> {
 
 /// The largest strain the platens may add in one step: a step of the
 /// standard B2 granule at 5 mm/s adds about 10⁻⁵ (8.6e-6 on the 8x2 mesh,
-/// 1.8e-5 on 4x1).
+/// 1.8e-5 on 4x1: the first `dt_s` of `granbed-cli granule`'s
+/// `force_displacement.csv` × 5 mm/s / 1 mm).
 pub const MAX_STRAIN_PER_STEP: Real = 1e-3;
 
 /// The time step `dt` (s) limited so that the platens approach by at most
