@@ -94,7 +94,9 @@ impl MaterialArgs {
     /// naming its flag (see [`MaterialArgs::param_error`]).
     pub fn material(&self) -> anyhow::Result<Material> {
         let params = self.params();
-        params.validate().map_err(|e| self.param_error(&params, e))
+        params
+            .validate()
+            .map_err(|_| every_refusal(&params, |e| self.param_error(&params, e)))
     }
 
     /// Turns the kernel's `ParamError` into a usage error whose message names
@@ -123,6 +125,30 @@ impl MaterialArgs {
         };
         let related = related_field(err.field, params, true);
         anyhow::Error::new(err).context(InputError(format!("{origin} rejected{related}")))
+    }
+}
+
+/// One usage error for every field `params` refuses
+/// ([`MaterialParams::refusals`]), each worded by `one`, one per line with
+/// the first refused field's first: a user who gave two bad values reads
+/// both at once. With one refused field, `one`'s error itself.
+pub fn every_refusal(
+    params: &MaterialParams,
+    one: impl Fn(ParamError) -> anyhow::Error,
+) -> anyhow::Error {
+    let mut errors: Vec<anyhow::Error> = params.refusals().into_iter().map(one).collect();
+    match errors.len() {
+        // Not reached after a refused `validate` (its error is the first
+        // refusal); said rather than assumed.
+        0 => crate::error::input_error("the material parameters were refused"),
+        1 => errors.remove(0),
+        _ => crate::error::input_error(
+            errors
+                .iter()
+                .map(|e| format!("{e:#}"))
+                .collect::<Vec<_>>()
+                .join("\n"),
+        ),
     }
 }
 
@@ -354,6 +380,20 @@ mod tests {
         assert!(msg.contains("eta_c = 0.9"), "{msg}");
         let e = parse(&["--poisson-ratio", "-1.5"]).material().unwrap_err();
         assert!(format!("{e:#}").starts_with("`--poisson-ratio -1.5` rejected"));
+        // Every bad value at once, a line each, in the kernel's order.
+        let e = parse(&["--friction", "11", "--poisson-ratio", "0.6"])
+            .material()
+            .unwrap_err();
+        let msg = format!("{e:#}");
+        let lines: Vec<&str> = msg.lines().collect();
+        assert_eq!(lines.len(), 2, "{msg}");
+        assert!(
+            lines[0].starts_with("`--poisson-ratio 0.6` rejected"),
+            "{msg}"
+        );
+        assert!(lines[1].starts_with("`--friction 11` rejected"), "{msg}");
+        assert!(lines[1].contains("0 <= mu <= 10"), "{msg}");
+        assert!(crate::error::is_usage_error(&e));
         assert_eq!(flag_for_field("true_density_kg_m3"), "--true-density-kg-m3");
     }
 }

@@ -208,6 +208,41 @@ impl MaterialParams {
             density0: p.eta0 * p.true_density_kg_m3,
         })
     }
+
+    /// Every field [`Self::validate`] refuses, in the order it checks them,
+    /// each at most once; empty when it accepts them all. After each
+    /// refusal the field is given its most permissive valid value (the
+    /// smallest E, ν = 0, σ_y = +∞, η_c = 0, η0 = 1, c_p = 0, μ = 0, water's
+    /// density), so that a later refusal never comes from a value put in
+    /// for an earlier one: with η_c = 2 and η0 = 0.5 only η_c is refused,
+    /// with E = 1e13 and σ_y = 1 Pa σ_y is (it is below 10⁻⁶ E). For a
+    /// caller that names every bad input at once; the first entry is
+    /// `validate`'s error.
+    pub fn refusals(&self) -> heapless::Vec<ParamError, 8> {
+        let mut p = *self;
+        let mut out = heapless::Vec::new();
+        while let Err(e) = p.validate() {
+            // One entry per field, and at most one per field of the
+            // struct (the capacity): a field refused again after its
+            // permissive value would be a check that no value passes.
+            if out.iter().any(|seen: &ParamError| seen.field == e.field) || out.push(e).is_err() {
+                break;
+            }
+            let (field, permissive) = match e.field {
+                "youngs_modulus_pa" => (&mut p.youngs_modulus_pa, YOUNGS_MODULUS_RANGE_PA[0]),
+                "poisson_ratio" => (&mut p.poisson_ratio, 0.0),
+                "yield_stress_pa" => (&mut p.yield_stress_pa, Real::INFINITY),
+                "eta_c" => (&mut p.eta_c, 0.0),
+                "eta0" => (&mut p.eta0, 1.0),
+                "cp" => (&mut p.cp, 0.0),
+                "true_density_kg_m3" => (&mut p.true_density_kg_m3, 1000.0),
+                "friction" => (&mut p.friction, 0.0),
+                _ => break,
+            };
+            *field = permissive;
+        }
+        out
+    }
 }
 
 /// The nine standard granule types of the published study: the letter sets
@@ -429,5 +464,85 @@ mod tests {
         for (e, sy) in [(1e13, 1e7), (1e6, 1.0), (1e13, Real::INFINITY)] {
             assert!(stiff(e, sy).validate().is_ok(), "E {e}, sigma_y {sy}");
         }
+    }
+
+    /// `refusals` names every bad field once, in `validate`'s order, with
+    /// the first entry `validate`'s error; a field whose range depends on
+    /// one already refused is judged against that one's permissive value,
+    /// so it is not blamed for it.
+    #[test]
+    fn refusals_name_every_bad_field_once() {
+        let b2 = GranuleType::B2.params();
+        assert!(b2.refusals().is_empty());
+        let fields = |p: MaterialParams| {
+            p.refusals()
+                .iter()
+                .map(|e| e.field)
+                .collect::<std::vec::Vec<_>>()
+        };
+        let all_bad = MaterialParams {
+            youngs_modulus_pa: -1.0,
+            poisson_ratio: 0.7,
+            yield_stress_pa: Real::NAN,
+            eta0: 2.0,
+            cp: -1.0,
+            eta_c: 1.5,
+            true_density_kg_m3: 0.0,
+            friction: 11.0,
+        };
+        assert_eq!(
+            fields(all_bad),
+            [
+                "youngs_modulus_pa",
+                "poisson_ratio",
+                "yield_stress_pa",
+                "eta_c",
+                "eta0",
+                "cp",
+                "true_density_kg_m3",
+                "friction"
+            ]
+        );
+        assert_eq!(all_bad.refusals()[0], all_bad.validate().unwrap_err());
+        assert_eq!(all_bad.refusals()[4].value, 2.0);
+        // η0 = 0.5 is refused only for η_c = 0.9, and not for η_c = 1.5,
+        // which is refused itself.
+        assert_eq!(
+            fields(MaterialParams {
+                eta_c: 0.9,
+                eta0: 0.5,
+                ..b2
+            }),
+            ["eta0"]
+        );
+        assert_eq!(
+            fields(MaterialParams {
+                eta_c: 1.5,
+                eta0: 0.5,
+                ..b2
+            }),
+            ["eta_c"]
+        );
+        // σ_y = 0.5 Pa is too small for E = 1 MPa, not for a refused E.
+        let soft = MaterialParams {
+            yield_stress_pa: 0.5,
+            ..b2
+        };
+        assert_eq!(fields(soft), ["yield_stress_pa"]);
+        assert_eq!(
+            fields(MaterialParams {
+                youngs_modulus_pa: -1.0,
+                ..soft
+            }),
+            ["youngs_modulus_pa"]
+        );
+        assert_eq!(
+            fields(MaterialParams {
+                friction: -0.1,
+                cp: 2e3,
+                ..b2
+            }),
+            ["cp", "friction"]
+        );
     }
 }

@@ -149,6 +149,9 @@ pub struct Error {
     pub value: Option<Real>,
     /// The allowed range.
     pub allowed: Option<&'static str>,
+    /// Every refused input field, `field` first: more than one when
+    /// several inputs were out of range at once ([`Error::all`]).
+    pub fields: Vec<&'static str>,
 }
 
 impl Error {
@@ -163,6 +166,30 @@ impl Error {
             field: Some(field),
             value: Some(value),
             allowed: Some(allowed),
+            fields: alloc::vec![field],
+        }
+    }
+
+    /// The refusals `errors` (at least one) as one error: their messages a
+    /// line each, the first one's field, value and range, and every field
+    /// in [`Error::fields`].
+    pub fn all(errors: Vec<Error>) -> Self {
+        let message = errors
+            .iter()
+            .map(|e| e.message.as_str())
+            .collect::<Vec<_>>()
+            .join("\n");
+        let fields = errors
+            .iter()
+            .flat_map(|e| e.fields.iter().copied())
+            .collect();
+        match errors.into_iter().next() {
+            Some(first) => Self {
+                message,
+                fields,
+                ..first
+            },
+            None => Self::other("the inputs were refused".into()),
         }
     }
 
@@ -173,6 +200,7 @@ impl Error {
             field: None,
             value: None,
             allowed: None,
+            fields: Vec::new(),
         }
     }
 }
@@ -194,6 +222,24 @@ impl From<SceneError> for Error {
             other => Self::other(format!("the simulation stopped: {other}")),
         }
     }
+}
+
+/// Every input of `inputs` out of its range, each as [`Experiment::new`]
+/// names it: the material's fields in the kernel's order
+/// ([`MaterialParams::refusals`]), then the diameter. Empty when all are in
+/// range. For a page that marks every bad field at once.
+pub fn refusals(inputs: &Inputs) -> Vec<Error> {
+    let mut out: Vec<Error> = inputs
+        .material_params()
+        .refusals()
+        .into_iter()
+        .map(Error::from)
+        .collect();
+    let d = inputs.diameter_m;
+    if !(DIAMETER_RANGE_M[0]..=DIAMETER_RANGE_M[1]).contains(&d) {
+        out.push(Error::invalid("diameter_m", d, "1e-6 <= d <= 1 m"));
+    }
+    out
 }
 
 /// σ_est and the fit behind it, σ_y,eff0.
@@ -227,11 +273,12 @@ impl Experiment {
     /// (octant, 5 mm/s, ξ = 0.5, to 40 % strain: `PlatenParams::standard`,
     /// exactly what `granbed-cli granule` runs by default).
     pub fn new(inputs: Inputs) -> Result<Self, Error> {
+        let refused = refusals(&inputs);
+        if !refused.is_empty() {
+            return Err(Error::all(refused));
+        }
         let material = inputs.material_params().validate()?;
         let d = inputs.diameter_m;
-        if !(DIAMETER_RANGE_M[0]..=DIAMETER_RANGE_M[1]).contains(&d) {
-            return Err(Error::invalid("diameter_m", d, "1e-6 <= d <= 1 m"));
-        }
         let (n, m) = inputs.mesh;
         let mesh = octant_mesh(0.5 * d, n, m).ok_or_else(|| {
             Error::other(format!(

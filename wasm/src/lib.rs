@@ -7,7 +7,9 @@
 //! frames) and reads the curve, the surface and, at the end, σ_est,
 //! σ_y,eff0 and the CSV. Every failure comes back as a JavaScript `Error`
 //! whose message names the field and its allowed range, with the fields
-//! `field`, `value` and `allowed` set; nothing here panics on bad input.
+//! `field`, `value` and `allowed` set (several inputs out of range: every
+//! one named, a line each, and listed in `fields`); nothing here panics on
+//! bad input.
 //!
 //! The logic lives in [`experiment`] (plain Rust, tested natively); this
 //! file only converts between it and JavaScript values.
@@ -45,6 +47,10 @@ fn js_error(e: &Error) -> JsValue {
     if let Some(allowed) = e.allowed {
         set("allowed", JsValue::from_str(allowed));
     }
+    if !e.fields.is_empty() {
+        let fields: js_sys::Array = e.fields.iter().map(|f| JsValue::from_str(f)).collect();
+        set("fields", fields.into());
+    }
     err.into()
 }
 
@@ -59,6 +65,7 @@ fn granule_type(name: &str) -> Result<GranuleType, JsValue> {
              (field `type`)"
         ));
         e.field = Some("type");
+        e.fields = alloc::vec!["type"];
         e.allowed = Some("A1 … C3");
         js_error(&e)
     })
@@ -115,6 +122,7 @@ fn inputs_from_js(obj: &JsValue) -> Result<Inputs, JsValue> {
             inputs.set(field, v);
         }
     }
+    let mut diameter_refused = None;
     match (number("diameter_m")?, number("diameter_mm")?) {
         (Some(_), Some(_)) => {
             return Err(message(
@@ -122,9 +130,11 @@ fn inputs_from_js(obj: &JsValue) -> Result<Inputs, JsValue> {
             ));
         }
         (Some(d), None) => inputs.diameter_m = d,
-        (None, Some(d_mm)) => {
-            inputs.diameter_m = experiment::diameter_m_of_mm(d_mm).map_err(|e| js_error(&e))?;
-        }
+        (None, Some(d_mm)) => match experiment::diameter_m_of_mm(d_mm) {
+            Ok(d) => inputs.diameter_m = d,
+            // Named with every other input out of range, in mm.
+            Err(e) => diameter_refused = Some(e),
+        },
         (None, None) => {}
     }
     if let Some(v) = get("mesh") {
@@ -134,6 +144,11 @@ fn inputs_from_js(obj: &JsValue) -> Result<Inputs, JsValue> {
                 "mesh level `{text}` is not NxM such as \"8x2\" (field `mesh`)"
             ))
         })?;
+    }
+    if let Some(e) = diameter_refused {
+        let mut all = experiment::refusals(&inputs);
+        all.push(e);
+        return Err(js_error(&Error::all(all)));
     }
     Ok(inputs)
 }
@@ -197,8 +212,10 @@ impl Granule {
     /// yield_stress_pa, eta0, youngs_modulus_pa, poisson_ratio, cp, eta_c,
     /// friction, true_density_kg_m3 }`: the preset of `type` (default B2)
     /// with every given field overriding it. The diameter may be given in
-    /// mm instead (`diameter_mm`, its errors in mm), not both. Throws an `Error` naming the
-    /// field and its allowed range (`field`, `value`, `allowed` set).
+    /// mm instead (`diameter_mm`, its errors in mm), not both. Throws an
+    /// `Error` naming the field and its allowed range (`field`, `value`,
+    /// `allowed` set), or every field out of range at once, a line each
+    /// (`fields` lists them all, `field` and the rest are the first's).
     #[wasm_bindgen(constructor)]
     pub fn new(inputs: &JsValue) -> Result<Granule, JsValue> {
         let inputs = inputs_from_js(inputs)?;

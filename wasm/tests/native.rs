@@ -110,6 +110,30 @@ fn bad_inputs_name_the_field_and_range() {
     assert!(e.message.contains("3x1"), "{}", e.message);
 
     assert!(!Inputs::standard(GranuleType::B2).set("nonsense", 1.0));
+
+    // Several inputs out of range: every one named, a line each, in the
+    // kernel's order and the diameter last; `field` is the first's.
+    let mut inputs = Inputs {
+        diameter_m: 5.0,
+        ..Inputs::standard(GranuleType::B2)
+    };
+    inputs.set("friction", 20.0);
+    inputs.set("eta0", 0.1);
+    inputs.set("youngs_modulus_pa", 0.0);
+    let Err(e) = Experiment::new(inputs) else {
+        panic!("four bad inputs accepted")
+    };
+    assert_eq!(
+        e.fields,
+        ["youngs_modulus_pa", "eta0", "friction", "diameter_m"]
+    );
+    assert_eq!((e.field, e.value), (Some("youngs_modulus_pa"), Some(0.0)));
+    let lines: Vec<&str> = e.message.lines().collect();
+    assert_eq!(lines.len(), 4, "{}", e.message);
+    assert!(lines[1].contains("η0 = 0.1"), "{}", e.message);
+    assert!(lines[3].contains("1e-6 <= d <= 1 m"), "{}", e.message);
+    assert_eq!(granbed_wasm::experiment::refusals(&inputs).len(), 4);
+    assert!(granbed_wasm::experiment::refusals(&Inputs::standard(GranuleType::C3)).is_empty());
 }
 
 #[test]

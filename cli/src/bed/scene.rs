@@ -855,17 +855,20 @@ impl Scene {
         .params())
     }
 
-    /// The validated material; a rejection names `material.<field>`.
+    /// The validated material; a rejection names `material.<field>`, every
+    /// refused one on a line of its own.
     pub fn material(&self) -> anyhow::Result<Material> {
         let p = self.material_params()?;
-        p.validate().map_err(|e| {
-            anyhow::Error::new(InputError(format!(
-                "scene field `material.{}` = {} is out of range (allowed: {}){}",
-                e.field,
-                e.value,
-                e.allowed,
-                crate::material_args::related_field(e.field, &p, false)
-            )))
+        p.validate().map_err(|_| {
+            crate::material_args::every_refusal(&p, |e| {
+                anyhow::Error::new(InputError(format!(
+                    "scene field `material.{}` = {} is out of range (allowed: {}){}",
+                    e.field,
+                    e.value,
+                    e.allowed,
+                    crate::material_args::related_field(e.field, &p, false)
+                )))
+            })
         })
     }
 
@@ -1263,6 +1266,11 @@ mod tests {
         assert!(bad("version = 1", "version = 2").contains("`version`"));
         assert!(bad("mesh = \"8x2\"", "mesh = \"3x1\"").contains("`mesh`"));
         assert!(bad("friction = 0.1", "friction = -1").contains("material.friction"));
+        // Two bad material values: both named, a line each.
+        let two = bad("friction = 0.1", "friction = -1\npoisson_ratio = 0.5");
+        assert_eq!(two.lines().count(), 2, "{two}");
+        assert!(two.contains("`material.poisson_ratio` = 0.5"), "{two}");
+        assert!(two.contains("`material.friction` = -1"), "{two}");
         assert!(bad("seed = 1", "seed = 1\ncolour = 3").contains("colour"));
         // A die a million granule diameters wide ran the pour out of
         // memory; intervals below the strain's round-off never ended.

@@ -16,7 +16,7 @@ use std::path::PathBuf;
 
 use clap::Args;
 use granbed_kernel::dem::pour::{PourError, PourParams};
-use granbed_kernel::material::{GranuleType, Material};
+use granbed_kernel::material::{GranuleType, Material, MaterialParams, ParamError};
 
 use crate::error::{InputError, input_error};
 use crate::material_args::MaterialArgs;
@@ -176,18 +176,24 @@ impl PackMaterialArgs {
     pub fn material(&self) -> anyhow::Result<Material> {
         let args = self.material_args();
         let params = args.params();
-        params.validate().map_err(|e| {
-            if e.field == "eta0" {
-                // MaterialArgs would point at `--eta-c`, which pack lacks.
-                let message = format!(
-                    "`--eta0 {}` rejected (the type's critical density eta_c is {})",
-                    e.value, params.eta_c
-                );
-                anyhow::Error::new(e).context(InputError(message))
-            } else {
-                args.param_error(&params, e)
-            }
+        params.validate().map_err(|_| {
+            crate::material_args::every_refusal(&params, |e| param_error(&args, &params, e))
         })
+    }
+}
+
+/// One refused material parameter of `pack` as a usage error naming its
+/// flag.
+fn param_error(args: &MaterialArgs, params: &MaterialParams, e: ParamError) -> anyhow::Error {
+    if e.field == "eta0" {
+        // MaterialArgs would point at `--eta-c`, which pack lacks.
+        let message = format!(
+            "`--eta0 {}` rejected (the type's critical density eta_c is {})",
+            e.value, params.eta_c
+        );
+        anyhow::Error::new(e).context(InputError(message))
+    } else {
+        args.param_error(params, e)
     }
 }
 
