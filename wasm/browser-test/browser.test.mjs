@@ -1,7 +1,8 @@
 // The page in Debian's headless chromium: run B2, compare the shown σ_est
 // with granbed-cli's, download the CSV (the CLI's bytes, named by the inputs
-// that ran), cancel a run (the inputs locked while it goes), provoke bad
-// inputs (ν = 0.6, a decimal comma, two at once, 1e400), show a failed and
+// that ran), cancel a run (the inputs locked while it goes; the CSV so far
+// a prefix of the CLI's), provoke bad inputs (ν = 0.6, a decimal comma, two
+// at once, out of range or unreadable, 1e400, a unit), show a failed and
 // a not quasi-static run as such, mark results stale when the inputs
 // change, lay the page out at a phone's width, and open it as a file.
 // Screenshots go to out/.
@@ -85,19 +86,33 @@ test('B2: the shown sigma_est is the native one; the CSV is the CLI\'s', async (
   assert.deepEqual(problems, []);
 });
 
-test('Cancel stops a run and the page can run again', async () => {
+test('Cancel stops a run, keeps its CSV so far, and the page can run again', async () => {
+  const ref = native('GRANBED_NATIVE_B2');
   await page.click('#run');
   await page.waitForSelector('#cancel:not([disabled])');
   // The inputs are locked while the run goes.
   for (const id of ['#type', '#mesh', '#custom']) assert.equal(await page.isDisabled(id), true, id);
+  // Past a few samples (one per 0.5 % of strain).
+  await page.waitForFunction(() => document.getElementById('progress').value > 0.1, null, { timeout: 120_000 });
   await page.click('#cancel');
   await page.waitForSelector('#results[data-state="cancelled"]');
   await page.waitForSelector('#run:not([disabled])', { timeout: 60_000 });
-  assert.equal(await page.textContent('#sigma-est'), '–');
+  // No fit of the cut-short curve, only why.
+  assert.match(await page.textContent('#sigma-est'), /^n\/a: the run was cancelled at strain \d+\.\d %$/);
+  assert.equal(await page.getAttribute('#sigma-est', 'data-value'), null);
   // The status keeps saying that the run was cancelled, and where.
-  assert.match(await page.textContent('#status'), /^cancelled at strain \d+\.\d % \(the curve so far is shown\); ready$/);
-  // The plot's description is the cancelled run's, not "no run yet".
-  assert.match(await page.getAttribute('#plot', 'aria-label'), /of a run cancelled at strain \d+\.\d %: \d+ points, not saved$/);
+  assert.match(await page.textContent('#status'),
+    /^cancelled at strain \d+\.\d %: the curve so far is shown, and its CSV can be downloaded$/);
+  assert.match(await page.getAttribute('#plot', 'aria-label'), /of a run cancelled at strain \d+\.\d %: \d+ points, .* the values are in the CSV$/);
+  // The CSV so far: the CLI's rows up to where the run stopped.
+  const [download] = await Promise.all([page.waitForEvent('download'), page.click('#download')]);
+  assert.equal(download.suggestedFilename(), 'granule_B2_8x2_cancelled_force_displacement.csv');
+  const file = join(OUT, download.suggestedFilename());
+  await download.saveAs(file);
+  const csv = readFileSync(file, 'utf8');
+  assert.ok(csv.split('\n').length > 5, csv);
+  assert.ok(ref.csv.startsWith(csv), 'the cancelled CSV is not a prefix of the CLI\'s');
+  assert.ok(csv.length < ref.csv.length);
   assert.deepEqual(problems, []);
 });
 
@@ -115,6 +130,16 @@ test('nu = 0.6 gives a readable error naming the field and its range', async () 
   // The status line says nothing ran, not an earlier run's result.
   assert.equal(await page.textContent('#status'), 'not run: an input was refused (see the message below)');
   await page.screenshot({ path: join(OUT, 'error.png') });
+  // Two values out of range: both named, a line each, both marked.
+  await page.fill('#friction', '20');
+  await page.click('#run');
+  await page.waitForSelector('#results[data-state="rejected"]');
+  const both = (await page.textContent('#error')).split('\n');
+  assert.equal(both.length, 2, both.join('\n'));
+  assert.match(both[0], /Poisson's ratio ν = 0\.6/);
+  assert.match(both[1], /friction coefficient μ = 20 .*0 <= mu <= 10/);
+  for (const id of ['#poisson_ratio', '#friction']) assert.equal(await page.getAttribute(id, 'aria-invalid'), 'true', id);
+  await page.fill('#friction', '0.1');
   assert.deepEqual(problems, []);
 });
 
@@ -187,12 +212,12 @@ test('results are marked once the inputs change, and cleared when inputs are ref
   await page.waitForFunction(() => document.getElementById('yield_stress_pa').value === '30000');
   assert.equal(await page.inputValue('#eta0'), '0.6');
   // Two fields unreadable: both named and marked; the old results go.
-  await page.fill('#youngs_modulus_pa', '1 MPa');
+  await page.fill('#youngs_modulus_pa', '1 N');
   await page.fill('#poisson_ratio', '0,3');
   await page.click('#run');
   await page.waitForSelector('#results[data-state="rejected"]');
   const text = await page.textContent('#error');
-  assert.match(text, /^E: “1 MPa” is not a number/);
+  assert.match(text, /^E: “1 N” has the unit “N”: the units are Pa, kPa, MPa, GPa/);
   assert.match(text, /\nν: “0,3” has a decimal comma/);
   for (const id of ['#youngs_modulus_pa', '#poisson_ratio']) {
     assert.equal(await page.getAttribute(id, 'aria-invalid'), 'true', id);
@@ -207,7 +232,8 @@ test('results are marked once the inputs change, and cleared when inputs are ref
   // The earlier runs' curves stay, named (B2 8x2 twice, B2 4x1 once).
   assert.match(await page.getAttribute('#plot', 'aria-label'), /^platen force against displacement of \d earlier run\(s\): .*B2 4x1$/);
   // A number beyond a double is refused, not read as infinity...
-  await page.fill('#youngs_modulus_pa', '1e6');
+  // (E with its unit: read as 1e6 Pa.)
+  await page.fill('#youngs_modulus_pa', '1 MPa');
   await page.fill('#poisson_ratio', '0.3');
   await page.fill('#yield_stress_pa', '1e400');
   await page.click('#run');
@@ -217,7 +243,7 @@ test('results are marked once the inputs change, and cleared when inputs are ref
   await page.fill('#yield_stress_pa', 'inf');
   await page.click('#run');
   await page.waitForSelector('#results[data-state="done"]', { timeout: 120_000 });
-  assert.match(await page.textContent('#run-inputs'), /^custom \(from B1\), mesh 4x1: σy = inf Pa/);
+  assert.match(await page.textContent('#run-inputs'), /^custom \(from B1\), mesh 4x1: σy = inf Pa, .*E = 1000000 Pa/);
   assert.equal(await page.textContent('#sigma-eff0'), 'n/a');
   const [download] = await Promise.all([page.waitForEvent('download'), page.click('#download')]);
   assert.match(download.suggestedFilename(), /^granule_custom-[0-9a-f]{8}_4x1_force_displacement\.csv$/);

@@ -5,7 +5,7 @@ import assert from 'node:assert/strict';
 import { readFileSync } from 'node:fs';
 import { join } from 'node:path';
 import { WWW, native } from './common.js';
-import { advice, parseDecimal, tick } from '../www/format.js';
+import { advice, MM_UNITS, PA_UNITS, parseDecimal, tick } from '../www/format.js';
 
 const pkg = await import(join(WWW, 'pkg', 'granbed_wasm.js'));
 pkg.initSync({ module: readFileSync(join(WWW, 'pkg', 'granbed_wasm_bg.wasm')) });
@@ -106,6 +106,42 @@ test('typed numbers: a decimal point is read, a comma or junk refused', () => {
   // Below the smallest double: refused, not read as 0; zero itself is read.
   assert.throws(() => parseDecimal('1e-400', 'μ', 'friction'), /too small for a number/);
   for (const zero of ['0', '0.0', '-0', '0e5', '.0']) assert.equal(parseDecimal(zero, 'x', 'f'), 0, zero);
+});
+
+test('a stress may be typed with its unit, read exactly as the plain number', () => {
+  // The unit scales the decimal text (1.1 kPa is 1.1e3), so the double is
+  // the one typing 1100 gives, not 1.1 * 1000 = 1100.0000000000002.
+  const cases = [['30 kPa', 30000], ['1.1kPa', 1100], ['1.5 MPa', 1.5e6], ['2e-3 GPa', 2e6], ['0.07 MPa', 70000],
+    ['30000 Pa', 30000], ['inf Pa', Infinity], ['1e6', 1e6], ['-0 kPa', 0]];
+  for (const [text, v] of cases) assert.equal(parseDecimal(text, 'σy', 'yield_stress_pa', PA_UNITS), v, text);
+  assert.equal(parseDecimal('2 mm', 'd', 'diameter_mm', MM_UNITS), 2);
+  // Other capitals are refused with the spelling (mPa would be a
+  // millipascal, a billionth of a megapascal); a field without a unit
+  // takes none.
+  assert.throws(() => parseDecimal('1 mPa', 'E', 'youngs_modulus_pa', PA_UNITS),
+    (e) => e.field === 'youngs_modulus_pa' && /“1 mPa” has the unit “mPa”: mPa is millipascals: write 1 MPa/.test(e.message));
+  assert.throws(() => parseDecimal('30 kpa', 'σy', 'f', PA_UNITS), /has the unit “kpa”: write 30 kPa$/);
+  assert.throws(() => parseDecimal('30 N', 'σy', 'f', PA_UNITS), /the units are Pa, kPa, MPa, GPa$/);
+  assert.throws(() => parseDecimal('30,000 Pa', 'σy', 'f', PA_UNITS), /has a comma: write 30000 if/);
+  assert.throws(() => parseDecimal('1e305 GPa', 'E', 'f', PA_UNITS), /too large for a number/);
+  assert.throws(() => parseDecimal('0.3 kPa', 'ν', 'poisson_ratio'), /is not a number such as 0\.3 or 3e4$/);
+});
+
+test('every input out of range is named at once, the diameter in mm too', () => {
+  assert.throws(
+    () => new pkg.Granule({ type: 'B2', friction: 20, poisson_ratio: 0.6, diameter_mm: 5000 }),
+    (e) => {
+      assert.deepEqual(e.fields, ['poisson_ratio', 'friction', 'diameter_mm']);
+      assert.equal(e.field, 'poisson_ratio');
+      const lines = e.message.split('\n');
+      assert.equal(lines.length, 3, e.message);
+      assert.match(lines[1], /μ = 20 .*0 <= mu <= 10/);
+      assert.match(lines[2], /d \(mm\) = 5000 .*0\.001 <= d <= 1000 mm/);
+      return true;
+    },
+  );
+  // One bad input: `fields` lists it alone.
+  assert.throws(() => new pkg.Granule({ type: 'B2', cp: -1 }), (e) => e.field === 'cp' && e.fields.length === 1);
 });
 
 test('a stopped run gets advice for the kernel\'s failures', () => {

@@ -14,20 +14,32 @@ export function formatSlope(nPerM) {
 
 // A decimal number as typed: digits with a decimal point and an optional
 // exponent (0.3, .5, 3e4, -1E-2), or inf (the kernel judges whether the
-// field takes it: σy does, for a purely elastic granule). Anything else is
-// refused, a decimal comma with its own message, never read as another
-// number; so is a number too large for a double (1e400), which would
-// otherwise be read as infinity without a word.
+// field takes it: σy does, for a purely elastic granule), and for a field
+// with a unit the unit or a multiple of it after the number (`units`, e.g.
+// PA_UNITS: 30 kPa, 1.5MPa). Anything else is refused, a decimal comma
+// with its own message, never read as another number; so is a number too
+// large for a double (1e400), which would otherwise be read as infinity
+// without a word.
 const DECIMAL = /^[+-]?(\d+\.?\d*|\.\d+)([eE][+-]?\d+)?$/;
 const INFINITY = /^\+?inf$/i;
 
-export function parseDecimal(text, label, field) {
+/** The units a stress field takes, with their powers of ten. */
+export const PA_UNITS = { Pa: 0, kPa: 3, MPa: 6, GPa: 9 };
+/** The unit a length in mm may be followed by. */
+export const MM_UNITS = { mm: 0 };
+
+export function parseDecimal(text, label, field, units = null) {
   const t = text.trim();
-  if (INFINITY.test(t)) return Infinity;
+  const [number, unit] = units ? splitUnit(t, label, field, units) : [t, null];
+  if (INFINITY.test(number)) return Infinity;
   let why;
-  if (DECIMAL.test(t)) {
-    const v = Number(t);
-    const zero = /^[+-]?[0.]*([eE].*)?$/.test(t);
+  if (DECIMAL.test(number)) {
+    // Scaled by the unit in the decimal text itself (1.1 kPa is read as
+    // 1.1e3, exactly the double that 1100 gives), not by a multiplication.
+    const power = unit === null ? 0 : units[unit];
+    const [mantissa, exponent = '0'] = number.split(/[eE]/);
+    const v = Number(power ? `${mantissa}e${Number(exponent) + power}` : number);
+    const zero = /^[+-]?[0.]*([eE].*)?$/.test(number);
     // (-0 is read as 0.)
     if (Number.isFinite(v) && (v !== 0 || zero)) return v === 0 ? 0 : v;
     why = v === 0
@@ -38,9 +50,28 @@ export function parseDecimal(text, label, field) {
   } else {
     why = t === ''
       ? 'is empty'
-      : commaHint(t) ?? 'is not a number such as 0.3 or 3e4';
+      : commaHint(number) ?? `is not a number such as 0.3 or 3e4${units ? ` (units: ${Object.keys(units).join(', ')})` : ''}`;
   }
   throw Object.assign(new Error(`${label}: “${t}” ${why}`), { field });
+}
+
+// The number and the unit of `t` ("30 kPa" → ["30", "kPa"]; no unit: [t,
+// null]). A unit written in other capitals is refused with the spelling
+// it takes (mPa would be millipascals, kpa is not a unit).
+function splitUnit(t, label, field, units) {
+  const m = /^(.*?\d|.*?inf)\s*([A-Za-zµ]+)$/i.exec(t);
+  // (1e is a number's exponent left unfinished, not a unit.)
+  if (!m || INFINITY.test(t) || /^e$/i.test(m[2])) return [t, null];
+  const [, number, unit] = m;
+  if (Object.hasOwn(units, unit)) return [number.trim(), unit];
+  const known = Object.keys(units);
+  const meant = known.find((u) => u.toLowerCase() === unit.toLowerCase());
+  const hint = unit === 'mPa'
+    ? `mPa is millipascals: write ${number.trim()} MPa for megapascals, or the millipascals in Pa (1 mPa = 0.001 Pa)`
+    : meant
+      ? `write ${number.trim()} ${meant}`
+      : `the units are ${known.join(', ')}`;
+  throw Object.assign(new Error(`${label}: “${t}” has the unit “${unit}”: ${hint}`), { field });
 }
 
 // What a number typed with commas meant, said as its fix, or undefined: a

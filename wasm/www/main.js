@@ -1,6 +1,6 @@
 // The page: the form, the worker that runs the simulation, the live plot,
 // the granule view, the results table and the CSV download.
-import { advice, formatStress, formatSlope, parseDecimal, tick } from './format.js';
+import { advice, formatStress, formatSlope, MM_UNITS, PA_UNITS, parseDecimal, tick } from './format.js';
 
 const $ = (id) => document.getElementById(id);
 const FIELDS = ['yield_stress_pa', 'eta0', 'youngs_modulus_pa', 'poisson_ratio', 'cp', 'eta_c', 'friction'];
@@ -8,6 +8,8 @@ const LABELS = {
   yield_stress_pa: 'σy', eta0: 'η0', youngs_modulus_pa: 'E', poisson_ratio: 'ν', cp: 'cp',
   eta_c: 'ηc', friction: 'μ', diameter_mm: 'd',
 };
+// The fields that take a unit after the number (30 kPa, 1 MPa; 2 mm).
+const UNITS = { yield_stress_pa: PA_UNITS, youngs_modulus_pa: PA_UNITS, diameter_mm: MM_UNITS };
 
 let worker = null;
 let running = false;
@@ -20,10 +22,14 @@ const HISTORY_MAX = 5;
 const HISTORY_COLOURS = ['#e08a2c', '#3a9d3a', '#9467bd', '#8c564b', '#e377c2'];
 let history = [];
 let runCount = 0;
-// The status line's note on the last cancelled run (kept when the new
-// worker says it is ready), and the strain the run had reached.
+// The status line's note on a run abandoned with its worker (kept when
+// the new worker says it is ready), and the strain the run had reached.
 let cancelNote = null;
 let lastStrain = 0;
+// A cancel asked of the worker: the timer that terminates it if it does
+// not stop the run (between two chunks, about 0.1 s) in time.
+let cancelTimer = null;
+const CANCEL_WAIT_MS = 5000;
 // The run in progress or last run: its type (or "custom"), mesh, the
 // parameters it used (from the worker) and its start time.
 let current = null;
@@ -128,6 +134,8 @@ function onWorker(msg) {
       if (msg.chosen && $('custom').checked) setStatus(`parameters set to ${msg.type}'s values; edit them and Run`);
       break;
     case 'error':
+      clearTimeout(cancelTimer);
+      cancelTimer = null;
       setRunning(false);
       refuse(msg.message, msg.field);
       break;
@@ -188,7 +196,7 @@ function readInputs() {
   const errors = [];
   for (const k of [...FIELDS, 'diameter_mm']) {
     try {
-      inputs[k] = parseDecimal($(k).value, LABELS[k], k);
+      inputs[k] = parseDecimal($(k).value, LABELS[k], k, UNITS[k]);
     } catch (e) {
       errors.push(e);
     }
@@ -267,25 +275,30 @@ function run(ev) {
 }
 
 function finish(msg) {
+  clearTimeout(cancelTimer);
+  cancelTimer = null;
   setRunning(false);
   Object.assign(view, { positions: msg.positions, x: msg.x, f: msg.f });
-  if (msg.slope !== null) {
+  // A cut-short curve's fit is no result: not drawn either.
+  const whole = !msg.failure && !msg.cancelled;
+  if (whole && msg.slope !== null) {
     view.fit = { slope: msg.slope, intercept: msg.intercept, x0: 0.1 * msg.diameter, x1: Math.min(0.4, msg.strain) * msg.diameter };
   }
   drawAll();
   const last = msg.f.length ? msg.f[msg.f.length - 1] : 0;
   $('plot').setAttribute('aria-label',
-    `platen force against platen approach: ${msg.f.length} points, to x = ${(1e3 * (msg.x[msg.x.length - 1] ?? 0)).toPrecision(3)} mm ` +
+    `platen force against platen approach${msg.cancelled ? ` of a run cancelled at strain ${(100 * msg.strain).toFixed(1)} %` : ''}: ` +
+    `${msg.f.length} points, to x = ${(1e3 * (msg.x[msg.x.length - 1] ?? 0)).toPrecision(3)} mm ` +
     `and F = ${last.toPrecision(3)} N; the values are in the CSV`);
   const set = (id, text, value) => {
     $(id).textContent = text;
     if (value !== undefined && value !== null) $(id).dataset.value = String(value);
   };
   set('sigma-eff0', formatStress(msg.sigmaEff0), msg.sigmaEff0);
-  if (msg.failure) {
-    // A fit of a curve the error cut short is no result (it can even come
-    // out negative): none is shown, only why.
-    const why = `n/a: the run stopped by an error at strain ${(100 * msg.strain).toFixed(1)} %`;
+  if (!whole) {
+    // A fit of a curve cut short is no result (after an error it can even
+    // come out negative): none is shown, only why.
+    const why = `n/a: the run ${msg.failure ? 'stopped by an error' : 'was cancelled'} at strain ${(100 * msg.strain).toFixed(1)} %`;
     for (const id of ['sigma-est', 'ratio', 'slope', 'r2']) set(id, why);
   } else {
     set('sigma-est', formatStress(msg.sigmaEst), msg.sigmaEst);
@@ -296,7 +309,7 @@ function finish(msg) {
   }
   set('steps', String(msg.steps), msg.steps);
   set('quasi-static',
-    msg.failure
+    !whole
       ? 'n/a: the run stopped early'
       : msg.kineticToInternal === null
       ? 'n/a'
@@ -308,11 +321,11 @@ function finish(msg) {
   const a = $('download');
   a.href = csvUrl;
   const name = current.custom ? `custom-${tag(describeRun(current))}` : current.type;
-  a.download = `granule_${name}_${current.mesh}_force_displacement.csv`;
+  a.download = `granule_${name}_${current.mesh}${msg.cancelled ? '_cancelled' : ''}_force_displacement.csv`;
   a.textContent = `Download CSV (${a.download})`;
   a.hidden = false;
-  $('progress').value = msg.failure ? $('progress').value : 1;
-  if (!msg.failure) {
+  $('progress').value = whole ? 1 : $('progress').value;
+  if (whole) {
     runCount += 1;
     const label = `${current.custom ? `custom-${tag(describeRun(current)).slice(0, 4)}` : current.type} ${current.mesh}` +
       (judgedNotQuasiStatic(msg) ? ' (not quasi-static)' : '');
@@ -323,7 +336,10 @@ function finish(msg) {
     view.historyId = runCount;
     drawPlot();
   }
-  if (msg.failure) {
+  if (msg.cancelled) {
+    setStatus(`cancelled at strain ${(100 * msg.strain).toFixed(1)} %: the curve so far is shown, and its CSV can be downloaded`);
+    $('results').dataset.state = 'cancelled';
+  } else if (msg.failure) {
     setStatus('stopped by an error');
     showError(`${msg.failure.message}\n${advice(msg.failure.message)}The curve up to that point is shown and in the CSV; ` +
       'the picture shows the granule after the last chunk of steps that succeeded (within about 1 % strain of the failure).',
@@ -355,7 +371,21 @@ function percent(ratio) {
   return `${Math.abs(p) >= 1e6 ? p.toExponential(1) : +p.toPrecision(2)} %`;
 }
 
+// Asks the worker to stop the run between two chunks: it answers with the
+// run so far (`finish`, with its CSV). One that does not answer in
+// CANCEL_WAIT_MS is terminated (`abandon`).
 function cancel() {
+  if (!running || cancelTimer !== null) return;
+  $('cancel').disabled = true;
+  setStatus('cancelling…');
+  worker.postMessage({ cmd: 'stop' });
+  cancelTimer = setTimeout(abandon, CANCEL_WAIT_MS);
+}
+
+// The run abandoned with its worker: the curve drawn so far stays, its CSV
+// is lost; a new worker is started.
+function abandon() {
+  cancelTimer = null;
   if (!running) return;
   worker.terminate();
   setRunning(false);

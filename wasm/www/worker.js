@@ -1,7 +1,9 @@
 // The simulation's Web Worker: loads the WebAssembly module, runs one
 // experiment at a time in chunks of time steps and posts the growing curve
-// and the node positions after each chunk. The page cancels a run by
-// terminating this worker.
+// and the node positions after each chunk. Between chunks it reads its
+// messages: a `stop` ends the run there, and the run is posted as done
+// (cancelled, with its CSV so far). The page terminates the worker only if
+// it does not answer.
 import init, { Granule, csv_columns as csvColumns, preset, version } from './pkg/granbed_wasm.js';
 
 // Time steps per chunk: about 0.1 s of work on the standard mesh.
@@ -12,7 +14,8 @@ const ready = init();
 function errorMessage(e) {
   return {
     message: e instanceof Error ? e.message : String(e),
-    field: e && e.field !== undefined ? e.field : null,
+    // Every field refused at once where the module lists them.
+    field: e && e.fields !== undefined ? e.fields : e && e.field !== undefined ? e.field : null,
   };
 }
 
@@ -20,7 +23,21 @@ function curve(g) {
   return { x: g.displacements_m(), f: g.forces_n() };
 }
 
-function run(inputs) {
+// Set by a `stop` message; read between chunks.
+let stopRequested = false;
+
+// Lets the worker's queued messages (a `stop`) be handled: a message to
+// itself, which unlike setTimeout is not clamped to 4 ms.
+function yieldToMessages() {
+  return new Promise((resolve) => {
+    const channel = new MessageChannel();
+    channel.port1.onmessage = () => resolve();
+    channel.port2.postMessage(null);
+  });
+}
+
+async function run(inputs) {
+  stopRequested = false;
   const t0 = performance.now();
   let g;
   try {
@@ -45,8 +62,14 @@ function run(inputs) {
   // The positions after the last chunk that succeeded: after a failure the
   // granule's own are not a state to show.
   let positions = g.positions();
+  let cancelled = false;
   try {
     while (!g.finished()) {
+      await yieldToMessages();
+      if (stopRequested) {
+        cancelled = true;
+        break;
+      }
       const progress = g.step(CHUNK);
       positions = g.positions();
       postMessage({
@@ -80,6 +103,7 @@ function run(inputs) {
     positions,
     csv: g.csv(),
     failure,
+    cancelled,
     ...curve(g),
   });
   g.free();
@@ -102,6 +126,8 @@ onmessage = async (ev) => {
       postMessage({ kind: 'error', ...errorMessage(e) });
     }
   } else if (msg.cmd === 'run') {
-    run(msg.inputs);
+    await run(msg.inputs);
+  } else if (msg.cmd === 'stop') {
+    stopRequested = true;
   }
 };
