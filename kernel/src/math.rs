@@ -15,7 +15,9 @@ use crate::Real;
 /// 167) that made the AVX2 element 2.8x slower than the scalar one
 /// (BENCHMARKS.md, "The AVX2 element and libm's square root"). The intrinsic
 /// is LLVM's `sqrt`, encoded `vsqrtsd` where AVX is on; both are IEEE's
-/// correctly rounded square root, so the bits are the same.
+/// correctly rounded square root, so the bits are the same. On WebAssembly
+/// with SIMD, the instruction `f64x2.sqrt` on one lane, correctly rounded
+/// as well.
 #[inline]
 pub fn sqrt(x: Real) -> Real {
     #[cfg(target_arch = "x86_64")]
@@ -28,7 +30,19 @@ pub fn sqrt(x: Real) -> Real {
             _mm_cvtsd_f64(_mm_sqrt_pd(_mm_set_sd(x)))
         }
     }
-    #[cfg(not(target_arch = "x86_64"))]
+    // WebAssembly has the instruction (f64.sqrt), but core exposes it on
+    // stable Rust only as a SIMD lane; libm's software square root took a
+    // fifth of the browser's run (BENCHMARKS.md, "The browser's module
+    // with SIMD and the square root instruction").
+    #[cfg(all(target_arch = "wasm32", target_feature = "simd128"))]
+    {
+        use core::arch::wasm32::{f64x2_extract_lane, f64x2_splat, f64x2_sqrt};
+        f64x2_extract_lane::<0>(f64x2_sqrt(f64x2_splat(x)))
+    }
+    #[cfg(not(any(
+        target_arch = "x86_64",
+        all(target_arch = "wasm32", target_feature = "simd128")
+    )))]
     {
         libm::sqrt(x)
     }

@@ -168,6 +168,16 @@ test('tick labels fit the margin at any scale', () => {
   for (const v of [3e-12, 4.5e-5, 0.001, 1, 99999, 1e5, 1.8e10]) assert.ok(tick(v).length <= 7, `${v}: ${tick(v)}`);
 });
 
+test('the SIMD probe is a valid module here, and one wrong byte makes it invalid', async () => {
+  const { SIMD_PROBE, hasSimd } = await import('../www/simd.js');
+  assert.equal(hasSimd(), true);
+  // The splat's opcode cut off: no longer a valid module (the probe is
+  // judged on its SIMD instruction, not accepted whatever it holds).
+  const broken = SIMD_PROBE.slice();
+  broken[broken.length - 2] = 0xff;
+  assert.equal(WebAssembly.validate(broken), false);
+});
+
 test('presets are the kernel types', () => {
   const p = pkg.preset('c3');
   assert.equal(p.yield_stress_pa, 100e3);

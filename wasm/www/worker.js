@@ -5,11 +5,22 @@
 // (cancelled, with its CSV so far). The page terminates the worker only if
 // it does not answer.
 import init, { Granule, csv_columns as csvColumns, preset, version } from './pkg/granbed_wasm.js';
+import { hasSimd } from './simd.js';
 
 // Time steps per chunk: about 0.1 s of work on the standard mesh.
 const CHUNK = 1500;
 
 const ready = init();
+
+// Why the module did not load: a browser without WebAssembly SIMD, which
+// the module is built with (.cargo/config.toml), or the error itself.
+function loadFailure(e) {
+  const why = hasSimd()
+    ? errorMessage(e).message
+    : 'this browser\'s WebAssembly has no SIMD, which the module needs (Chrome or Edge 91, Firefox 89, ' +
+      'Safari 16.4 or later have it)';
+  return `cannot load the WebAssembly module: ${why}`;
+}
 
 function errorMessage(e) {
   return {
@@ -114,7 +125,7 @@ onmessage = async (ev) => {
   try {
     await ready;
   } catch (e) {
-    postMessage({ kind: 'error', message: `cannot load the WebAssembly module: ${errorMessage(e).message}` });
+    postMessage({ kind: 'error', message: loadFailure(e) });
     return;
   }
   if (msg.cmd === 'hello') {

@@ -34,7 +34,8 @@
 //! (the build's vector width: 2 lanes with x86-64's SSE2), or batches compiled
 //! for AVX2 (4 lanes), taken only when the processor has it (detected at run
 //! time with `cpuid`, no `std` needed). All three give the same bits;
-//! [`ElementPath::fastest`] is AVX2 where available, else element by element.
+//! [`ElementPath::fastest`] is AVX2 where available, the portable batches
+//! in a WebAssembly build with SIMD, else element by element.
 //! The run-time choice is for a kernel built for baseline x86-64, as another
 //! project may link it; this workspace builds everything for x86-64-v3
 //! (`.cargo/config.toml`), where all three paths are AVX2 code.
@@ -85,9 +86,19 @@ pub enum ElementPath {
 impl ElementPath {
     /// The fastest path this processor supports: AVX2 batches if it has
     /// AVX2, otherwise element by element (portable batches at SSE2's two
-    /// lanes measured slower than the scalar element: BENCHMARKS.md).
+    /// lanes measured slower than the scalar element: BENCHMARKS.md). In a
+    /// WebAssembly build with SIMD, the portable batches: there they run
+    /// as pairs of f64x2 and took the browser's B2 run from 2.7 to 2.1 s
+    /// in Node (BENCHMARKS.md, "The browser's module with SIMD and the
+    /// square root instruction").
     pub fn fastest() -> Self {
-        if has_avx2() { Self::Avx2 } else { Self::Scalar }
+        if cfg!(all(target_arch = "wasm32", target_feature = "simd128")) {
+            Self::Batched
+        } else if has_avx2() {
+            Self::Avx2
+        } else {
+            Self::Scalar
+        }
     }
 }
 
