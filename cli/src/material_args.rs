@@ -154,7 +154,7 @@ pub fn every_refusal(
 
 /// " (with …)": the other field a rejected `field`'s range depends on, as
 /// `params` has it, and the bound that follows — η0's on ηc, σ_y's on E —
-/// or nothing. `flags`: name the command-line flag that sets it.
+/// or nothing (also when that field is out of range itself). `flags`: name the command-line flag that sets it.
 pub fn related_field(field: &str, params: &MaterialParams, flags: bool) -> String {
     let see = |flag: &str| {
         if flags {
@@ -163,17 +163,24 @@ pub fn related_field(field: &str, params: &MaterialParams, flags: bool) -> Strin
             String::new()
         }
     };
+    // A related field itself out of range is refused on its own line, and
+    // the bound was judged without it (`MaterialParams::refusals`).
+    let e_range = granbed_kernel::material::YOUNGS_MODULUS_RANGE_PA;
     match field {
-        "eta0" => format!(" (with eta_c = {}{})", params.eta_c, see("--eta-c")),
-        "yield_stress_pa" if params.youngs_modulus_pa.is_finite() => format!(
-            " (with youngs_modulus_pa = {}, i.e. at least {} Pa{})",
-            crate::numbers::short(params.youngs_modulus_pa),
-            crate::numbers::short(f64::max(
-                granbed_kernel::material::MIN_YIELD_STRESS_PA,
-                granbed_kernel::material::MIN_YIELD_TO_MODULUS * params.youngs_modulus_pa
-            )),
-            see("--youngs-modulus-pa")
-        ),
+        "eta0" if (0.0..1.0).contains(&params.eta_c) => {
+            format!(" (with eta_c = {}{})", params.eta_c, see("--eta-c"))
+        }
+        "yield_stress_pa" if (e_range[0]..=e_range[1]).contains(&params.youngs_modulus_pa) => {
+            format!(
+                " (with youngs_modulus_pa = {}, i.e. at least {} Pa{})",
+                crate::numbers::short(params.youngs_modulus_pa),
+                crate::numbers::short(f64::max(
+                    granbed_kernel::material::MIN_YIELD_STRESS_PA,
+                    granbed_kernel::material::MIN_YIELD_TO_MODULUS * params.youngs_modulus_pa
+                )),
+                see("--youngs-modulus-pa")
+            )
+        }
         _ => String::new(),
     }
 }
@@ -394,6 +401,13 @@ mod tests {
         assert!(lines[1].starts_with("`--friction 11` rejected"), "{msg}");
         assert!(lines[1].contains("0 <= mu <= 10"), "{msg}");
         assert!(crate::error::is_usage_error(&e));
+        // σ_y's bound is not given from an E that is refused itself.
+        let e = parse(&["--youngs-modulus-pa", "1e14", "--yield-stress-pa", "1e-4"])
+            .material()
+            .unwrap_err();
+        let msg = format!("{e:#}");
+        assert_eq!(msg.lines().count(), 2, "{msg}");
+        assert!(!msg.contains("i.e. at least"), "{msg}");
         assert_eq!(flag_for_field("true_density_kg_m3"), "--true-density-kg-m3");
     }
 }

@@ -54,11 +54,11 @@ test('standard B2 (8x2) to 40 % equals granbed-cli bit for bit', () => {
 
 test('bad inputs throw an Error naming the field and its range', () => {
   const cases = [
-    [{ type: 'B2', poisson_ratio: 0.6 }, 'poisson_ratio', /-1 < nu < 0\.5/],
-    [{ type: 'B2', eta0: 0.1 }, 'eta0', /eta_c < eta0 <= 1/],
-    [{ type: 'B2', diameter_m: 0 }, 'diameter_m', /1e-6 <= d <= 1 m/],
-    [{ type: 'B2', diameter_mm: 0.0001 }, 'diameter_mm', /d \(mm\) = 0\.0001 .*0\.001 <= d <= 1000 mm/],
-    [{ type: 'B2', diameter_mm: 2000 }, 'diameter_mm', /0\.001 <= d <= 1000 mm/],
+    [{ type: 'B2', poisson_ratio: 0.6 }, 'poisson_ratio', /-1 < ν < 0\.5$/],
+    [{ type: 'B2', eta0: 0.1 }, 'eta0', /ηc < η0 ≤ 1$/],
+    [{ type: 'B2', diameter_m: 0 }, 'diameter_m', /1e-6 ≤ d ≤ 1 m$/],
+    [{ type: 'B2', diameter_mm: 0.0001 }, 'diameter_mm', /d \(mm\) = 0\.0001 .*0\.001 ≤ d ≤ 1000 mm$/],
+    [{ type: 'B2', diameter_mm: 2000 }, 'diameter_mm', /0\.001 ≤ d ≤ 1000 mm$/],
     [{ type: 'D4' }, 'type', /A1, A2/],
   ];
   for (const [inputs, field, allowed] of cases) {
@@ -121,8 +121,17 @@ test('a stress may be typed with its unit, read exactly as the plain number', ()
   assert.throws(() => parseDecimal('1 mPa', 'E', 'youngs_modulus_pa', PA_UNITS),
     (e) => e.field === 'youngs_modulus_pa' && /“1 mPa” has the unit “mPa”: mPa is millipascals: write 1 MPa/.test(e.message));
   assert.throws(() => parseDecimal('30 kpa', 'σy', 'f', PA_UNITS), /has the unit “kpa”: write 30 kPa$/);
-  assert.throws(() => parseDecimal('30 N', 'σy', 'f', PA_UNITS), /the units are Pa, kPa, MPa, GPa$/);
-  assert.throws(() => parseDecimal('30,000 Pa', 'σy', 'f', PA_UNITS), /has a comma: write 30000 if/);
+  assert.throws(() => parseDecimal('30 N', 'σy', 'f', PA_UNITS), /is not a number such as 0\.3 or 3e4 \(units: Pa, kPa, MPa, GPa\)$/);
+  for (const bad of ['infinity', '1ekPa', '1e kPa']) {
+    assert.throws(() => parseDecimal(bad, 'σy', 'f', PA_UNITS), /is not a number/, bad);
+  }
+  // Exponents beyond any double's: 0 and too small, not misread.
+  assert.equal(parseDecimal('0e9999999999999999999999 kPa', 'σy', 'f', PA_UNITS), 0);
+  assert.throws(() => parseDecimal('1e-9999999999999999999999 kPa', 'σy', 'f', PA_UNITS), /too small/);
+  assert.throws(() => parseDecimal('1e9999999999999999999999 kPa', 'σy', 'f', PA_UNITS), /too large/);
+  // A comma's fix keeps the unit: 3.5, as told, would be pascals.
+  assert.throws(() => parseDecimal('30,000 Pa', 'σy', 'f', PA_UNITS), /has a comma: write 30000 Pa if .* or 30\.000 Pa if/);
+  assert.throws(() => parseDecimal('3,5 kPa', 'σy', 'f', PA_UNITS), /has a decimal comma: write 3\.5 kPa \(with a point\)$/);
   assert.throws(() => parseDecimal('1e305 GPa', 'E', 'f', PA_UNITS), /too large for a number/);
   assert.throws(() => parseDecimal('0.3 kPa', 'ν', 'poisson_ratio'), /is not a number such as 0\.3 or 3e4$/);
 });
@@ -135,11 +144,19 @@ test('every input out of range is named at once, the diameter in mm too', () => 
       assert.equal(e.field, 'poisson_ratio');
       const lines = e.message.split('\n');
       assert.equal(lines.length, 3, e.message);
-      assert.match(lines[1], /μ = 20 .*0 <= mu <= 10/);
-      assert.match(lines[2], /d \(mm\) = 5000 .*0\.001 <= d <= 1000 mm/);
+      assert.match(lines[1], /μ = 20 .*0 ≤ μ ≤ 10$/);
+      assert.match(lines[2], /d \(mm\) = 5000 .*0\.001 ≤ d ≤ 1000 mm$/);
       return true;
     },
   );
+  // check() judges without building a run; a NaN stands in for a field a
+  // page could not read and is refused like any other.
+  assert.equal(pkg.check({ type: 'B2', mesh: '4x1', poisson_ratio: 0.3 }), undefined);
+  assert.throws(() => pkg.check({ type: 'B2', poisson_ratio: 0.6, youngs_modulus_pa: NaN, diameter_mm: NaN }),
+    (e) => {
+      assert.deepEqual(e.fields, ['youngs_modulus_pa', 'poisson_ratio', 'diameter_mm']);
+      return true;
+    });
   // One bad input: `fields` lists it alone.
   assert.throws(() => new pkg.Granule({ type: 'B2', cp: -1 }), (e) => e.field === 'cp' && e.fields.length === 1);
 });

@@ -136,6 +136,27 @@ impl Inputs {
     }
 }
 
+/// A range as the kernel writes it (`-1 < nu < 0.5`, `0 <= mu <= 10`) with
+/// the symbols the page labels its fields with (`-1 < ν < 0.5`,
+/// `0 ≤ μ ≤ 10`): word by word, so `E` and the numbers stay.
+pub fn readable_range(allowed: &str) -> String {
+    allowed
+        .split(' ')
+        .map(|word| match word {
+            "<=" => "≤",
+            ">=" => "≥",
+            "nu" => "ν",
+            "mu" => "μ",
+            "eta_c" => "ηc",
+            "eta0" => "η0",
+            "rho" => "ρ",
+            "kg/m3" => "kg/m³",
+            other => other,
+        })
+        .collect::<Vec<_>>()
+        .join(" ")
+}
+
 /// A rejected input or a failed run: a readable message and, for a rejected
 /// parameter, the field, the value and the allowed range.
 #[derive(Clone, Debug, PartialEq)]
@@ -155,13 +176,16 @@ pub struct Error {
 }
 
 impl Error {
-    /// A rejected input `field` = `value`, allowed `allowed`.
+    /// A rejected input `field` = `value`, allowed `allowed` (the kernel's
+    /// ASCII text, kept as it is in [`Error::allowed`]; the message shows it
+    /// with the page's symbols, [`readable_range`]).
     pub fn invalid(field: &'static str, value: Real, allowed: &'static str) -> Self {
         Self {
             message: format!(
-                "{} = {} is not allowed: the allowed range is {allowed} (field `{field}`)",
+                "{} = {} is not allowed: the allowed range is {}",
                 field_label(field),
-                granbed_host::text::short(value)
+                granbed_host::text::short(value),
+                readable_range(allowed)
             ),
             field: Some(field),
             value: Some(value),
@@ -225,16 +249,14 @@ impl From<SceneError> for Error {
 }
 
 /// Every input of `inputs` out of its range, each as [`Experiment::new`]
-/// names it: the material's fields in the kernel's order
-/// ([`MaterialParams::refusals`]), then the diameter. Empty when all are in
-/// range. For a page that marks every bad field at once.
+/// names it: the material's fields ([`MaterialParams::refusals`]) in the
+/// order of [`MATERIAL_FIELDS`], the page's form, then the diameter. Empty
+/// when all are in range. For a page that marks every bad field at once
+/// and focuses the first.
 pub fn refusals(inputs: &Inputs) -> Vec<Error> {
-    let mut out: Vec<Error> = inputs
-        .material_params()
-        .refusals()
-        .into_iter()
-        .map(Error::from)
-        .collect();
+    let mut material = inputs.material_params().refusals();
+    material.sort_unstable_by_key(|e| MATERIAL_FIELDS.iter().position(|f| *f == e.field));
+    let mut out: Vec<Error> = material.into_iter().map(Error::from).collect();
     let d = inputs.diameter_m;
     if !(DIAMETER_RANGE_M[0]..=DIAMETER_RANGE_M[1]).contains(&d) {
         out.push(Error::invalid("diameter_m", d, "1e-6 <= d <= 1 m"));

@@ -193,6 +193,25 @@ pub fn csv_columns() -> js_sys::Array {
         .collect()
 }
 
+/// Checks `inputs` as [`Granule::new`] reads and checks them, without
+/// setting up a run: throws the same `Error` (every input out of range, a
+/// line each, `fields` listing them), or returns. A field given as NaN is
+/// refused and judged as [`MaterialParams::refusals`] judges a refused one,
+/// so a page can check the fields it could read while naming those it
+/// could not (passed as NaN) itself.
+///
+/// [`MaterialParams::refusals`]: granbed_kernel::material::MaterialParams::refusals
+#[wasm_bindgen]
+pub fn check(inputs: &JsValue) -> Result<(), JsValue> {
+    let inputs = inputs_from_js(inputs)?;
+    let refused = experiment::refusals(&inputs);
+    if refused.is_empty() {
+        Ok(())
+    } else {
+        Err(js_error(&Error::all(refused)))
+    }
+}
+
 /// The version of granbed this module was built from.
 #[wasm_bindgen]
 pub fn version() -> String {

@@ -91,7 +91,7 @@ fn bad_inputs_name_the_field_and_range() {
     assert_eq!(e.field, Some("poisson_ratio"));
     assert_eq!(e.value, Some(0.6));
     assert!(e.message.contains("Poisson's ratio"), "{}", e.message);
-    assert!(e.message.contains("-1 < nu < 0.5"), "{}", e.message);
+    assert!(e.message.contains("-1 < ν < 0.5"), "{}", e.message);
 
     let mut inputs = Inputs::standard(GranuleType::B2);
     inputs.diameter_m = -1.0;
@@ -112,7 +112,8 @@ fn bad_inputs_name_the_field_and_range() {
     assert!(!Inputs::standard(GranuleType::B2).set("nonsense", 1.0));
 
     // Several inputs out of range: every one named, a line each, in the
-    // kernel's order and the diameter last; `field` is the first's.
+    // form's order (MATERIAL_FIELDS) and the diameter last; `field` is the
+    // first's.
     let mut inputs = Inputs {
         diameter_m: 5.0,
         ..Inputs::standard(GranuleType::B2)
@@ -125,13 +126,13 @@ fn bad_inputs_name_the_field_and_range() {
     };
     assert_eq!(
         e.fields,
-        ["youngs_modulus_pa", "eta0", "friction", "diameter_m"]
+        ["eta0", "youngs_modulus_pa", "friction", "diameter_m"]
     );
-    assert_eq!((e.field, e.value), (Some("youngs_modulus_pa"), Some(0.0)));
+    assert_eq!((e.field, e.value), (Some("eta0"), Some(0.1)));
     let lines: Vec<&str> = e.message.lines().collect();
     assert_eq!(lines.len(), 4, "{}", e.message);
-    assert!(lines[1].contains("η0 = 0.1"), "{}", e.message);
-    assert!(lines[3].contains("1e-6 <= d <= 1 m"), "{}", e.message);
+    assert!(lines[1].contains("E (Pa) = 0"), "{}", e.message);
+    assert!(lines[3].contains("1e-6 ≤ d ≤ 1 m"), "{}", e.message);
     assert_eq!(granbed_wasm::experiment::refusals(&inputs).len(), 4);
     assert!(granbed_wasm::experiment::refusals(&Inputs::standard(GranuleType::C3)).is_empty());
 }
@@ -162,7 +163,7 @@ fn a_diameter_in_mm_is_refused_in_mm() {
         assert_eq!(e.field, Some("diameter_mm"));
         assert!(
             e.message.contains("granule diameter d (mm)")
-                && e.message.contains("0.001 <= d <= 1000 mm"),
+                && e.message.contains("0.001 ≤ d ≤ 1000 mm"),
             "{}",
             e.message
         );

@@ -38,7 +38,11 @@ export function parseDecimal(text, label, field, units = null) {
     // 1.1e3, exactly the double that 1100 gives), not by a multiplication.
     const power = unit === null ? 0 : units[unit];
     const [mantissa, exponent = '0'] = number.split(/[eE]/);
-    const v = Number(power ? `${mantissa}e${Number(exponent) + power}` : number);
+    const scaled = Number(exponent) + power;
+    // (An exponent beyond any double's, ±1e21 and more, is not written out
+    // again: the number is then 0 or infinite whatever the unit.)
+    const v = power === 0 ? Number(number)
+      : Math.abs(scaled) < 1e6 ? Number(`${mantissa}e${scaled}`) : Number(number) * 10 ** power;
     const zero = /^[+-]?[0.]*([eE].*)?$/.test(number);
     // (-0 is read as 0.)
     if (Number.isFinite(v) && (v !== 0 || zero)) return v === 0 ? 0 : v;
@@ -50,27 +54,28 @@ export function parseDecimal(text, label, field, units = null) {
   } else {
     why = t === ''
       ? 'is empty'
-      : commaHint(number) ?? `is not a number such as 0.3 or 3e4${units ? ` (units: ${Object.keys(units).join(', ')})` : ''}`;
+      : commaHint(number, unit) ?? `is not a number such as 0.3 or 3e4${units ? ` (units: ${Object.keys(units).join(', ')})` : ''}`;
   }
   throw Object.assign(new Error(`${label}: “${t}” ${why}`), { field });
 }
 
 // The number and the unit of `t` ("30 kPa" → ["30", "kPa"]; no unit: [t,
 // null]). A unit written in other capitals is refused with the spelling
-// it takes (mPa would be millipascals, kpa is not a unit).
+// it takes (mPa would be millipascals, kpa is not a unit); other letters
+// are left to be refused as no number.
 function splitUnit(t, label, field, units) {
   const m = /^(.*?\d|.*?inf)\s*([A-Za-zµ]+)$/i.exec(t);
-  // (1e is a number's exponent left unfinished, not a unit.)
-  if (!m || INFINITY.test(t) || /^e$/i.test(m[2])) return [t, null];
+  if (!m || INFINITY.test(t)) return [t, null];
   const [, number, unit] = m;
-  if (Object.hasOwn(units, unit)) return [number.trim(), unit];
+  if (Object.prototype.hasOwnProperty.call(units, unit)) return [number.trim(), unit];
   const known = Object.keys(units);
   const meant = known.find((u) => u.toLowerCase() === unit.toLowerCase());
+  // Letters that are no unit in any capitals (1e, 1ekPa, infinity): not a
+  // number, said as such.
+  if (!meant) return [t, null];
   const hint = unit === 'mPa'
     ? `mPa is millipascals: write ${number.trim()} MPa for megapascals, or the millipascals in Pa (1 mPa = 0.001 Pa)`
-    : meant
-      ? `write ${number.trim()} ${meant}`
-      : `the units are ${known.join(', ')}`;
+    : `write ${number.trim()} ${meant}`;
   throw Object.assign(new Error(`${label}: “${t}” has the unit “${unit}”: ${hint}`), { field });
 }
 
@@ -80,13 +85,16 @@ function splitUnit(t, label, field, units) {
 // (the page must not read 30,000 Pa as 30 Pa); several such groups
 // (1,000,000) separate thousands; any other single comma (0,5, 0,300: no
 // group of thousands starts with 0) is a decimal comma.
-function commaHint(t) {
+// The fix keeps the unit typed after the number (`unit`, or null): 3,5 kPa
+// is to be written 3.5 kPa, not 3.5 (which would be pascals).
+function commaHint(t, unit = null) {
+  const u = unit ? ` ${unit}` : '';
   if (/^[+-]?[1-9]\d{0,2},\d{3}$/.test(t)) {
-    return `has a comma: write ${t.replace(',', '')} if it separates thousands, or ${t.replace(',', '.')} ` +
+    return `has a comma: write ${t.replace(',', '')}${u} if it separates thousands, or ${t.replace(',', '.')}${u} ` +
       'if it is a decimal comma';
   }
-  if (/^[+-]?[1-9]\d{0,2}(,\d{3}){2,}$/.test(t)) return `has commas: write ${t.replaceAll(',', '')} (no thousands separators)`;
-  if (/^[+-]?\d*,\d+$/.test(t)) return `has a decimal comma: write ${t.replace(',', '.')} (with a point)`;
+  if (/^[+-]?[1-9]\d{0,2}(,\d{3}){2,}$/.test(t)) return `has commas: write ${t.replaceAll(',', '')}${u} (no thousands separators)`;
+  if (/^[+-]?\d*,\d+$/.test(t)) return `has a decimal comma: write ${t.replace(',', '.')}${u} (with a point)`;
   return undefined;
 }
 

@@ -10,6 +10,8 @@ const LABELS = {
 };
 // The fields that take a unit after the number (30 kPa, 1 MPa; 2 mm).
 const UNITS = { yield_stress_pa: PA_UNITS, youngs_modulus_pa: PA_UNITS, diameter_mm: MM_UNITS };
+// The parameter fields in the form's order: refusals are listed in it.
+const FORM_ORDER = [...FIELDS, 'diameter_mm'];
 
 let worker = null;
 let running = false;
@@ -112,6 +114,8 @@ function startWorker() {
   worker = new Worker(new URL('./worker.js', import.meta.url), { type: 'module' });
   worker.onmessage = (ev) => onWorker(ev.data);
   worker.onerror = (ev) => {
+    clearTimeout(cancelTimer);
+    cancelTimer = null;
     setRunning(false);
     showError(`the simulation worker failed: ${ev.message || 'unknown error'}`);
   };
@@ -133,6 +137,9 @@ function onWorker(msg) {
       if (!$('custom').checked || msg.chosen) fillParams(msg.values);
       if (msg.chosen && $('custom').checked) setStatus(`parameters set to ${msg.type}'s values; edit them and Run`);
       break;
+    case 'checked':
+      onChecked(msg.refused);
+      break;
     case 'error':
       clearTimeout(cancelTimer);
       cancelTimer = null;
@@ -148,7 +155,8 @@ function onWorker(msg) {
     case 'progress':
       lastStrain = msg.strain;
       $('progress').value = msg.progress;
-      setStatus(`strain ${(100 * msg.strain).toFixed(1)} %, ${msg.steps} steps${timeLeft(msg.progress)}`);
+      // (A chunk that ends after a cancel was asked for keeps "cancelling…".)
+      if (cancelTimer === null) setStatus(`strain ${(100 * msg.strain).toFixed(1)} %, ${msg.steps} steps${timeLeft(msg.progress)}`);
       Object.assign(view, { positions: msg.positions, x: msg.x, f: msg.f });
       drawAll();
       break;
@@ -187,24 +195,48 @@ function requestPreset(chosen = false) {
 }
 
 // The inputs object of granbed-wasm's Granule: the type and mesh, and with
-// "custom" every parameter field (the diameter in mm, as typed). Every
-// field that cannot be read is named at once (an Error with `field` the
-// list of them); the ranges are the kernel's to check.
+// "custom" every parameter field (the diameter in mm, as typed), and the
+// errors of the fields that cannot be read, which stand in the inputs as
+// NaN (the ranges are the kernel's to check: `checkThenRefuse`).
 function readInputs() {
   const inputs = { type: $('type').value, mesh: $('mesh').value };
-  if (!$('custom').checked) return inputs;
-  const errors = [];
-  for (const k of [...FIELDS, 'diameter_mm']) {
+  const unreadable = [];
+  if (!$('custom').checked) return { inputs, unreadable };
+  for (const k of FORM_ORDER) {
     try {
       inputs[k] = parseDecimal($(k).value, LABELS[k], k, UNITS[k]);
     } catch (e) {
-      errors.push(e);
+      unreadable.push({ message: e.message, field: e.field });
+      inputs[k] = NaN;
     }
   }
-  if (errors.length) {
-    throw Object.assign(new Error(errors.map((e) => e.message).join('\n')), { field: errors.map((e) => e.field) });
-  }
-  return inputs;
+  return { inputs, unreadable };
+}
+
+// Fields that could not be read: the worker checks the others' ranges
+// (`check`), and every bad field is named at once, in the form's order
+// (`onChecked`).
+let unreadableFields = null;
+
+function checkThenRefuse(inputs, unreadable) {
+  unreadableFields = unreadable;
+  worker.postMessage({ cmd: 'check', inputs });
+}
+
+function onChecked(refused) {
+  const unreadable = unreadableFields ?? [];
+  unreadableFields = null;
+  const named = new Set(unreadable.map((u) => u.field));
+  const page = (f) => (f === 'diameter_m' ? 'diameter_mm' : f);
+  // An unreadable field's own message says more than the range of the
+  // NaN it stood in as.
+  const lines = [...unreadable, ...refused.filter((r) => !named.has(page(r.field)))];
+  const rank = (f) => {
+    const i = FORM_ORDER.indexOf(page(f));
+    return i < 0 ? FORM_ORDER.length : i;
+  };
+  lines.sort((a, b) => rank(a.field) - rank(b.field));
+  refuse(lines.map((l) => l.message).join('\n'), lines.map((l) => page(l.field)).filter((f) => f));
 }
 
 // "B2, mesh 8x2: σy = 30000 Pa, …" for the results table.
@@ -253,11 +285,9 @@ function run(ev) {
   ev.preventDefault();
   if (running) return;
   clearError();
-  let inputs;
-  try {
-    inputs = readInputs();
-  } catch (e) {
-    refuse(e.message, e.field);
+  const { inputs, unreadable } = readInputs();
+  if (unreadable.length) {
+    checkThenRefuse(inputs, unreadable);
     return;
   }
   resetResults();
@@ -315,20 +345,30 @@ function finish(msg) {
       ? 'n/a'
       : `${msg.quasiStatic ? 'yes' : 'NO'}: kinetic energy at most ${percent(msg.kineticToInternal)} of the internal work ` +
         `(limit ${100 * msg.kineticLimit} %)${msg.massScaling === 1 ? '' : `, masses ×${msg.massScaling}`}`,
-    msg.quasiStatic);
+    whole ? msg.quasiStatic : undefined);
   set('wall', `${(msg.wallMs / 1e3).toFixed(2)} s`, msg.wallMs / 1e3);
-  csvUrl = URL.createObjectURL(new Blob([msg.csv], { type: 'text/csv' }));
-  const a = $('download');
-  a.href = csvUrl;
-  const name = current.custom ? `custom-${tag(describeRun(current))}` : current.type;
-  a.download = `granule_${name}_${current.mesh}${msg.cancelled ? '_cancelled' : ''}_force_displacement.csv`;
-  a.textContent = `Download CSV (${a.download})`;
-  a.hidden = false;
+  // A run cancelled before its first sample (every 0.5 % of strain) has
+  // only the unloaded row: nothing to download or draw.
+  const sampled = msg.f.length > 1;
+  // The strain of the CSV's last row (the run went on to msg.strain).
+  const lastRow = sampled ? (100 * msg.x[msg.x.length - 1]) / msg.diameter : 0;
+  if (whole || sampled) {
+    csvUrl = URL.createObjectURL(new Blob([msg.csv], { type: 'text/csv' }));
+    const a = $('download');
+    a.href = csvUrl;
+    const name = current.custom ? `custom-${tag(describeRun(current))}` : current.type;
+    a.download = `granule_${name}_${current.mesh}${msg.cancelled ? '_cancelled' : ''}_force_displacement.csv`;
+    a.textContent = `Download CSV (${a.download})`;
+    a.hidden = false;
+  }
   $('progress').value = whole ? 1 : $('progress').value;
-  if (whole) {
+  // A cancelled run's curve is kept with the finished ones (marked), so
+  // that a refused input or the next run does not lose it.
+  if (whole || (msg.cancelled && sampled)) {
     runCount += 1;
     const label = `${current.custom ? `custom-${tag(describeRun(current)).slice(0, 4)}` : current.type} ${current.mesh}` +
-      (judgedNotQuasiStatic(msg) ? ' (not quasi-static)' : '');
+      (msg.cancelled ? ` (cancelled at ${lastRow.toFixed(1)} %)` : '') +
+      (whole && judgedNotQuasiStatic(msg) ? ' (not quasi-static)' : '');
     // Its colour for as long as it is drawn (by run, not by place in the list).
     const colour = HISTORY_COLOURS[(runCount - 1) % HISTORY_COLOURS.length];
     history.push({ id: runCount, label, colour, x: Array.from(msg.x, (v) => v * 1e3), f: Array.from(msg.f) });
@@ -337,7 +377,10 @@ function finish(msg) {
     drawPlot();
   }
   if (msg.cancelled) {
-    setStatus(`cancelled at strain ${(100 * msg.strain).toFixed(1)} %: the curve so far is shown, and its CSV can be downloaded`);
+    const at = `cancelled at strain ${(100 * msg.strain).toFixed(1)} %`;
+    setStatus(sampled
+      ? `${at}: the curve so far is shown, and its CSV can be downloaded (its last row at ${lastRow.toFixed(1)} %)`
+      : `${at}, before the first sample (one every 0.5 % of strain): nothing to show`);
     $('results').dataset.state = 'cancelled';
   } else if (msg.failure) {
     setStatus('stopped by an error');
@@ -584,6 +627,8 @@ $('custom').addEventListener('change', () => {
   $('params').disabled = !$('custom').checked;
   if (!$('custom').checked) {
     clearError();
+    // The refusal's message is gone with the custom values.
+    if ($('results').dataset.state === 'rejected') setStatus('ready');
     requestPreset();
   }
 });

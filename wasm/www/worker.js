@@ -4,7 +4,7 @@
 // messages: a `stop` ends the run there, and the run is posted as done
 // (cancelled, with its CSV so far). The page terminates the worker only if
 // it does not answer.
-import init, { Granule, csv_columns as csvColumns, preset, version } from './pkg/granbed_wasm.js';
+import init, { Granule, check, csv_columns as csvColumns, preset, version } from './pkg/granbed_wasm.js';
 import { hasSimd } from './simd.js';
 
 // Time steps per chunk: about 0.1 s of work on the standard mesh.
@@ -18,7 +18,7 @@ function loadFailure(e) {
   const why = hasSimd()
     ? errorMessage(e).message
     : 'this browser\'s WebAssembly has no SIMD, which the module needs (Chrome or Edge 91, Firefox 89, ' +
-      'Safari 16.4 or later have it)';
+      'Safari 16.4 or later have it; the page\'s module worker needs Firefox 114)';
   return `cannot load the WebAssembly module: ${why}`;
 }
 
@@ -138,6 +138,17 @@ onmessage = async (ev) => {
     }
   } else if (msg.cmd === 'run') {
     await run(msg.inputs);
+  } else if (msg.cmd === 'check') {
+    // The inputs the page could read, those it could not as NaN: every
+    // refusal, a message and a field each (none: all in range).
+    const refused = [];
+    try {
+      check(msg.inputs);
+    } catch (e) {
+      const fields = e.fields ?? [e.field ?? null];
+      e.message.split('\n').forEach((message, i) => refused.push({ message, field: fields[i] ?? null }));
+    }
+    postMessage({ kind: 'checked', refused });
   } else if (msg.cmd === 'stop') {
     stopRequested = true;
   }

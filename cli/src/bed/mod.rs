@@ -296,7 +296,11 @@ pub struct BedArgs {
           value_parser = crate::numbers::whole::<usize>(1, crate::bed::scene::MAX_GRANULES as u64))]
     pub granules: Option<usize>,
 
-    /// Override: mesh level NxM (8x2 = 1280 hexes, 4x1 = 160).
+    /// Override: mesh level NxM (8x2 = 1280 hexes, 4x1 = 160). 4x1 is
+    /// about 14 times faster but biased: its faceted granules hold 5 % less
+    /// volume, and a bed's pressure at a given strain came 13–21 % lower
+    /// at 30 % (Kawakita 1/b 19–46 %) than on 8x2 from the same pours
+    /// (BENCHMARKS.md); compare beds on one mesh.
     #[arg(long, value_name = "NxM")]
     pub mesh: Option<MeshLevel>,
 

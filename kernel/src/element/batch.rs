@@ -37,8 +37,9 @@
 //! [`ElementPath::fastest`] is AVX2 where available, the portable batches
 //! in a WebAssembly build with SIMD, else element by element.
 //! The run-time choice is for a kernel built for baseline x86-64, as another
-//! project may link it; this workspace builds everything for x86-64-v3
-//! (`.cargo/config.toml`), where all three paths are AVX2 code.
+//! project may link it; this workspace builds every x86-64 binary for
+//! x86-64-v3 (`.cargo/config.toml`), where all three paths are AVX2 code,
+//! and the browser's wasm32 module with SIMD.
 //!
 //! This is, with the SSE2 square root of [`crate::math::sqrt`], the
 //! kernel's only `unsafe` code (the workspace denies it elsewhere), allowed
