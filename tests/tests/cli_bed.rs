@@ -189,6 +189,8 @@ fn a_small_bed_runs_end_to_end_and_is_thread_independent() {
     let (k, a) = (number(heckel, "k_per_pa"), number(heckel, "a"));
     assert_eq!(number(&s, "heckel_yield_pressure_pa"), 1.0 / k);
     assert_eq!(number(heckel, "d_a"), -(-a).exp_m1());
+    // D_B: D_A less D0, the table's first D.
+    assert_eq!(number(heckel, "d_b"), number(heckel, "d_a") - solid[0]);
     let solid_mean: Vec<f64> = (0..n)
         .map(|i| solid[i] * (1.0 - strain[i]) / (1.0 - mean[i]))
         .collect();

@@ -70,8 +70,9 @@ Output, in --out DIR (created if missing):
                    with mean_strain >= kawakita_min_strain, 0.25, each
                    pressure at its interval's mean strain), Heckel fit of
                    ln(1/(1 - D)) = K P + A (yield pressure P_y = 1/K, A,
-                   D_A = 1 - exp(-A), R^2, points; C >= heckel_min_strain,
-                   0.25), the Kawakita fit again over C >= 0.10, 0.15, 0.20
+                   D_A = 1 - exp(-A), D_B = D_A - D0, R^2, points;
+                   C >= heckel_min_strain, 0.25), the Kawakita fit again
+                   over C >= 0.10, 0.15, 0.20
                    and 0.25 (kawakita_windows) and the Heckel fit likewise
                    (heckel_windows), the Heckel fit on the mean punch
                    pressure (heckel_mean_pressure), the granules' packing

@@ -282,6 +282,11 @@ pub struct HeckelSummary {
     pub a: Option<Real>,
     /// D_A = 1 − e^(−A).
     pub d_a: Option<Real>,
+    /// D_B = D_A − D0, D0 the bed's solid fraction before the first step
+    /// (`initial_solid_fraction`): Heckel's densification by the granules'
+    /// rearrangement, the part of D_A the fit's line does not account for
+    /// by plastic flow.
+    pub d_b: Option<Real>,
     /// R² of the fit.
     pub r_squared: Option<Real>,
     /// Points used: the output rows with C ≥ `min_strain`, P finite and
@@ -567,6 +572,7 @@ pub fn heckel(run: &BedRun, min_strain: Real, pressure: fn(&BedSample) -> Real) 
         k_per_pa: fit.map(|f| f.k_per_pa),
         a: fit.map(|f| f.a),
         d_a: fit.map(|f| f.d_a),
+        d_b: fit.map(|f| f.d_a - bed_solid_fraction(run, 0.0)),
         r_squared: fit.map(|f| f.r_squared),
         points: fit.map_or_else(
             || window.filter(|&(p, d)| heckel_usable(p, d)).count(),
@@ -1407,6 +1413,7 @@ mod tests {
             k_per_pa: None,
             a: None,
             d_a: None,
+            d_b: None,
             r_squared: None,
             points: 0,
             min_strain: 0.25,

@@ -727,6 +727,7 @@ mod tests {
             k_per_pa: Some(fit.k_per_pa),
             a: Some(fit.a),
             d_a: Some(fit.d_a),
+            d_b: None,
             r_squared: Some(fit.r_squared),
             points: fit.points,
             min_strain: 0.2,

@@ -30,7 +30,7 @@ pub const REPORT_FILE: &str = "report.html";
 /// meaning; any other field follows (nested objects such as `kawakita` and
 /// `heckel` are flattened to `kawakita.<field>`; the scene, `scene` and
 /// `scene_toml`, is shown as TOML instead).
-const FIELDS: [(&str, &str); 118] = [
+const FIELDS: [(&str, &str); 120] = [
     ("kawakita_a", "Kawakita a (limiting strain)"),
     ("kawakita_inv_b_pa", "Kawakita 1/b, Pa"),
     (
@@ -50,6 +50,10 @@ const FIELDS: [(&str, &str); 118] = [
     ("heckel.k_per_pa", "Heckel slope K, 1/Pa"),
     ("heckel.d_a", "D_A = 1 − exp(−A)"),
     (
+        "heckel.d_b",
+        "D_B = D_A − D0: the densification by rearrangement, beyond the fit's line",
+    ),
+    (
         "heckel.r_squared",
         "R² of the Heckel line ln(1/(1 − D)) against P",
     ),
@@ -68,6 +72,7 @@ const FIELDS: [(&str, &str); 118] = [
     ),
     ("heckel_mean_pressure.k_per_pa", "its slope K, 1/Pa"),
     ("heckel_mean_pressure.d_a", "its D_A = 1 − exp(−A)"),
+    ("heckel_mean_pressure.d_b", "its D_B = D_A − D0"),
     ("heckel_mean_pressure.r_squared", "its R²"),
     ("heckel_mean_pressure.points", "output rows in that fit"),
     (
