@@ -267,21 +267,23 @@ pub fn xy_svg_from(
         let root = SVGBackend::with_string(&mut svg, SIZE).into_drawing_area();
         root.fill(&WHITE)?;
         let mut chart = ChartBuilder::on(&root)
-            .caption(title, ("sans-serif", 20))
+            .caption(title, ("sans-serif", 24))
             .margin(20)
-            .x_label_area_size(50)
-            .y_label_area_size(80)
+            .x_label_area_size(58)
+            .y_label_area_size(92)
             .build_cartesian_2d(x_range.clone(), y_range.clone())?;
         let x_labels = exponent_labels(&x_range);
         let y_labels = exponent_labels(&y_range);
         let (x_plain, y_plain) = (plain_labels(&x_range), plain_labels(&y_range));
         let mut mesh = chart.configure_mesh();
-        // Text a little larger than plotters' default (about 10 px on the
-        // 900 × 600 canvas), and the minor grid lighter, for a printed page.
+        // Text larger than plotters' default (about 10 px on the 900 × 600
+        // canvas; 13 px, as it was, still read small in a report shown at
+        // its width: the powder review of session 56), and the minor grid
+        // lighter, for a printed page.
         mesh.x_desc(x_desc)
             .y_desc(y_desc)
-            .label_style(("sans-serif", 13))
-            .axis_desc_style(("sans-serif", 15))
+            .label_style(("sans-serif", 16))
+            .axis_desc_style(("sans-serif", 18))
             .light_line_style(BLACK.mix(0.05));
         match &x_labels {
             Some(f) => mesh.x_label_formatter(f),
@@ -341,7 +343,7 @@ pub fn xy_svg_from(
             let corner = legend_corner(series, &x_range, &y_range, series.len());
             chart
                 .configure_series_labels()
-                .label_font(("sans-serif", 13))
+                .label_font(("sans-serif", 15))
                 .position(corner)
                 .background_style(WHITE.mix(0.85))
                 .border_style(BLACK)
