@@ -206,7 +206,7 @@ impl Quantity {
                 (
                     format!("−σzz, {unit}"),
                     per,
-                    "darkest: no load; red: tension; grey: no value; the scale ends at the 99th percentile",
+                    "darkest: no load; red: tension (its bar below); grey: no value; the scale ends at the 99th percentile",
                 )
             }
             Quantity::RelativeDensity => (
@@ -430,8 +430,11 @@ pub fn section_svg(input: &SectionInput<'_>) -> String {
         left + bar + 6.0,
         height - 13.0
     );
-    // The colour bar.
-    let (bx, by, bh) = (WIDTH - right + 30.0, top, (height - top - bottom).max(60.0));
+    // The colour bar; for the axial stress, the tension's reds under it,
+    // from no load down to a tension as large as the bar's top.
+    let (bx, by, full) = (WIDTH - right + 30.0, top, (height - top - bottom).max(60.0));
+    let tension = input.quantity == Quantity::AxialStress;
+    let bh = if tension { 0.75 * full } else { full };
     let steps = 50;
     for i in 0..steps {
         let t = (i as Real + 0.5) / steps as Real;
@@ -444,6 +447,29 @@ pub fn section_svg(input: &SectionInput<'_>) -> String {
         );
     }
     let (name, per_unit, footnote) = input.quantity.legend(hi);
+    if tension {
+        let (ty, th) = (by + 0.8 * full, 0.2 * full);
+        let red_steps = 20;
+        for i in 0..red_steps {
+            let t = (i as Real + 0.5) / red_steps as Real;
+            let _ = writeln!(
+                s,
+                "<rect x=\"{bx:.1}\" y=\"{:.1}\" width=\"18\" height=\"{:.2}\" fill=\"{}\"/>",
+                ty + th * i as Real / red_steps as Real,
+                th / red_steps as Real + 0.5,
+                tension_red(t)
+            );
+        }
+        let _ = writeln!(
+            s,
+            "<text x=\"{:.1}\" y=\"{:.1}\" font-size=\"13\">tension</text>\n             <text x=\"{:.1}\" y=\"{:.1}\" font-size=\"13\">{}</text>",
+            bx + 24.0,
+            ty + 9.0,
+            bx + 24.0,
+            ty + th + 4.0,
+            tick_text(-hi / per_unit, 0.25 * hi / per_unit)
+        );
+    }
     let step = 0.25 * (hi - lo) / per_unit;
     for i in 0..=4 {
         let f = i as Real / 4.0;
