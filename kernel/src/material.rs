@@ -228,21 +228,44 @@ impl MaterialParams {
             if out.iter().any(|seen: &ParamError| seen.field == e.field) || out.push(e).is_err() {
                 break;
             }
-            let (field, permissive) = match e.field {
-                "youngs_modulus_pa" => (&mut p.youngs_modulus_pa, YOUNGS_MODULUS_RANGE_PA[0]),
-                "poisson_ratio" => (&mut p.poisson_ratio, 0.0),
-                "yield_stress_pa" => (&mut p.yield_stress_pa, Real::INFINITY),
-                "eta_c" => (&mut p.eta_c, 0.0),
-                "eta0" => (&mut p.eta0, 1.0),
-                "cp" => (&mut p.cp, 0.0),
-                "true_density_kg_m3" => (&mut p.true_density_kg_m3, 1000.0),
-                "friction" => (&mut p.friction, 0.0),
+            match (p.field_mut(e.field), permissive_value(e.field)) {
+                (Some(field), Some(value)) => *field = value,
                 _ => break,
-            };
-            *field = permissive;
+            }
         }
         out
     }
+}
+
+impl MaterialParams {
+    /// The field named `field` (a name of this struct), if there is one.
+    fn field_mut(&mut self, field: &str) -> Option<&mut Real> {
+        Some(match field {
+            "youngs_modulus_pa" => &mut self.youngs_modulus_pa,
+            "poisson_ratio" => &mut self.poisson_ratio,
+            "yield_stress_pa" => &mut self.yield_stress_pa,
+            "eta_c" => &mut self.eta_c,
+            "eta0" => &mut self.eta0,
+            "cp" => &mut self.cp,
+            "true_density_kg_m3" => &mut self.true_density_kg_m3,
+            "friction" => &mut self.friction,
+            _ => return None,
+        })
+    }
+}
+
+/// The value [`MaterialParams::refusals`] gives a refused field: valid
+/// whatever the other fields hold, and the one that widens the ranges
+/// depending on it most (σ_y's lower bound grows with E, η0's with η_c).
+fn permissive_value(field: &str) -> Option<Real> {
+    Some(match field {
+        "youngs_modulus_pa" => YOUNGS_MODULUS_RANGE_PA[0],
+        "yield_stress_pa" => Real::INFINITY,
+        "eta0" => 1.0,
+        "true_density_kg_m3" => 1000.0,
+        "poisson_ratio" | "eta_c" | "cp" | "friction" => 0.0,
+        _ => return None,
+    })
 }
 
 /// The nine standard granule types of the published study: the letter sets
@@ -544,5 +567,22 @@ mod tests {
             }),
             ["cp", "friction"]
         );
+        // Every permissive value is valid with every other one (so none can
+        // be refused again and end the list early).
+        let mut permissive = b2;
+        for field in [
+            "youngs_modulus_pa",
+            "poisson_ratio",
+            "yield_stress_pa",
+            "eta_c",
+            "eta0",
+            "cp",
+            "true_density_kg_m3",
+            "friction",
+        ] {
+            *permissive.field_mut(field).unwrap() = permissive_value(field).unwrap();
+        }
+        assert!(permissive.validate().is_ok(), "{permissive:?}");
+        assert!(permissive.refusals().is_empty());
     }
 }

@@ -39,8 +39,9 @@ export function parseDecimal(text, label, field, units = null) {
     const power = unit === null ? 0 : units[unit];
     const [mantissa, exponent = '0'] = number.split(/[eE]/);
     const scaled = Number(exponent) + power;
-    // (An exponent beyond any double's, ±1e21 and more, is not written out
-    // again: the number is then 0 or infinite whatever the unit.)
+    // (An exponent of a million or more, far beyond any double's, is not
+    // written out again, where it could print as 1e+21: the number is then
+    // 0 or infinite whatever the unit.)
     const v = power === 0 ? Number(number)
       : Math.abs(scaled) < 1e6 ? Number(`${mantissa}e${scaled}`) : Number(number) * 10 ** power;
     const zero = /^[+-]?[0.]*([eE].*)?$/.test(number);

@@ -117,7 +117,10 @@ function startWorker() {
     clearTimeout(cancelTimer);
     cancelTimer = null;
     setRunning(false);
-    showError(`the simulation worker failed: ${ev.message || 'unknown error'}`);
+    // A browser that cannot run a module worker (Firefox before 114) ends
+    // here, before the worker can say anything itself.
+    showError(`the simulation worker failed: ${ev.message || 'unknown error'}. The page needs a browser that runs ` +
+      'module Web Workers and WebAssembly SIMD (Chrome or Edge 91, Firefox 114, Safari 16.4 or later).');
   };
   worker.postMessage({ cmd: 'hello' });
 }
@@ -138,7 +141,7 @@ function onWorker(msg) {
       if (msg.chosen && $('custom').checked) setStatus(`parameters set to ${msg.type}'s values; edit them and Run`);
       break;
     case 'checked':
-      onChecked(msg.refused);
+      onChecked(msg.refused, msg.id);
       break;
     case 'error':
       clearTimeout(cancelTimer);
@@ -216,15 +219,20 @@ function readInputs() {
 // Fields that could not be read: the worker checks the others' ranges
 // (`check`), and every bad field is named at once, in the form's order
 // (`onChecked`).
+// Each check is numbered: only the latest one's answer is shown, and
+// none once a run has started.
 let unreadableFields = null;
+let checkId = 0;
 
 function checkThenRefuse(inputs, unreadable) {
   unreadableFields = unreadable;
-  worker.postMessage({ cmd: 'check', inputs });
+  checkId += 1;
+  worker.postMessage({ cmd: 'check', inputs, id: checkId });
 }
 
-function onChecked(refused) {
-  const unreadable = unreadableFields ?? [];
+function onChecked(refused, id) {
+  if (id !== checkId || running || unreadableFields === null) return;
+  const unreadable = unreadableFields;
   unreadableFields = null;
   const named = new Set(unreadable.map((u) => u.field));
   const page = (f) => (f === 'diameter_m' ? 'diameter_mm' : f);
@@ -290,6 +298,8 @@ function run(ev) {
     checkThenRefuse(inputs, unreadable);
     return;
   }
+  // (An answer to an earlier check is no longer wanted.)
+  unreadableFields = null;
   resetResults();
   clearStale();
   cancelNote = null;
@@ -367,7 +377,7 @@ function finish(msg) {
   if (whole || (msg.cancelled && sampled)) {
     runCount += 1;
     const label = `${current.custom ? `custom-${tag(describeRun(current)).slice(0, 4)}` : current.type} ${current.mesh}` +
-      (msg.cancelled ? ` (cancelled at ${lastRow.toFixed(1)} %)` : '') +
+      (msg.cancelled ? ` (to ${lastRow.toFixed(1)} %, cancelled)` : '') +
       (whole && judgedNotQuasiStatic(msg) ? ' (not quasi-static)' : '');
     // Its colour for as long as it is drawn (by run, not by place in the list).
     const colour = HISTORY_COLOURS[(runCount - 1) % HISTORY_COLOURS.length];
@@ -384,7 +394,10 @@ function finish(msg) {
     $('results').dataset.state = 'cancelled';
   } else if (msg.failure) {
     setStatus('stopped by an error');
-    showError(`${msg.failure.message}\n${advice(msg.failure.message)}The curve up to that point is shown and in the CSV; ` +
+    const kept = sampled
+      ? 'The curve up to that point is shown and in the CSV; '
+      : 'It stopped before the first sample (0.5 % of strain): there is no curve to show; ';
+    showError(`${msg.failure.message}\n${advice(msg.failure.message)}${kept}` +
       'the picture shows the granule after the last chunk of steps that succeeded (within about 1 % strain of the failure).',
     msg.failure.field);
     $('results').dataset.state = 'failed';

@@ -18,7 +18,7 @@ function loadFailure(e) {
   const why = hasSimd()
     ? errorMessage(e).message
     : 'this browser\'s WebAssembly has no SIMD, which the module needs (Chrome or Edge 91, Firefox 89, ' +
-      'Safari 16.4 or later have it; the page\'s module worker needs Firefox 114)';
+      'Safari 16.4 or later have it)';
   return `cannot load the WebAssembly module: ${why}`;
 }
 
@@ -148,7 +148,7 @@ onmessage = async (ev) => {
       const fields = e.fields ?? [e.field ?? null];
       e.message.split('\n').forEach((message, i) => refused.push({ message, field: fields[i] ?? null }));
     }
-    postMessage({ kind: 'checked', refused });
+    postMessage({ kind: 'checked', refused, id: msg.id });
   } else if (msg.cmd === 'stop') {
     stopRequested = true;
   }

@@ -460,11 +460,12 @@ pub fn section_svg(input: &SectionInput<'_>) -> String {
                 tension_red(t)
             );
         }
+        // Its one label at its foot (the footnote names the reds), a
+        // quarter of the bar's height (at least 15 px) under the main
+        // bar's 0.
         let _ = writeln!(
             s,
-            "<text x=\"{:.1}\" y=\"{:.1}\" font-size=\"13\">tension</text>\n             <text x=\"{:.1}\" y=\"{:.1}\" font-size=\"13\">{}</text>",
-            bx + 24.0,
-            ty + 9.0,
+            "<text x=\"{:.1}\" y=\"{:.1}\" font-size=\"13\">{}</text>",
             bx + 24.0,
             ty + th + 4.0,
             tick_text(-hi / per_unit, 0.25 * hi / per_unit)
