@@ -513,19 +513,18 @@ mod tests {
             true_density_kg_m3: 0.0,
             friction: 11.0,
         };
-        assert_eq!(
-            fields(all_bad),
-            [
-                "youngs_modulus_pa",
-                "poisson_ratio",
-                "yield_stress_pa",
-                "eta_c",
-                "eta0",
-                "cp",
-                "true_density_kg_m3",
-                "friction"
-            ]
-        );
+        // Every field, in the order `validate` checks them.
+        const CHECKED: [&str; 8] = [
+            "youngs_modulus_pa",
+            "poisson_ratio",
+            "yield_stress_pa",
+            "eta_c",
+            "eta0",
+            "cp",
+            "true_density_kg_m3",
+            "friction",
+        ];
+        assert_eq!(fields(all_bad), CHECKED);
         assert_eq!(all_bad.refusals()[0], all_bad.validate().unwrap_err());
         assert_eq!(all_bad.refusals()[4].value, 2.0);
         // η0 = 0.5 is refused only for η_c = 0.9, and not for η_c = 1.5,
@@ -570,16 +569,7 @@ mod tests {
         // Every permissive value is valid with every other one (so none can
         // be refused again and end the list early).
         let mut permissive = b2;
-        for field in [
-            "youngs_modulus_pa",
-            "poisson_ratio",
-            "yield_stress_pa",
-            "eta_c",
-            "eta0",
-            "cp",
-            "true_density_kg_m3",
-            "friction",
-        ] {
+        for field in CHECKED {
             *permissive.field_mut(field).unwrap() = permissive_value(field).unwrap();
         }
         assert!(permissive.validate().is_ok(), "{permissive:?}");
