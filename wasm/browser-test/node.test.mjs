@@ -129,6 +129,11 @@ test('a stress may be typed with its unit, read exactly as the plain number', ()
   assert.equal(parseDecimal('0e9999999999999999999999 kPa', 'σy', 'f', PA_UNITS), 0);
   assert.throws(() => parseDecimal('1e-9999999999999999999999 kPa', 'σy', 'f', PA_UNITS), /too small/);
   assert.throws(() => parseDecimal('1e9999999999999999999999 kPa', 'σy', 'f', PA_UNITS), /too large/);
+  // A typographic minus is a minus; spaces between thousands get their fix.
+  assert.equal(parseDecimal('\u22120.5', 'ν', 'poisson_ratio'), -0.5);
+  assert.equal(parseDecimal('1e\u22123 GPa', 'E', 'f', PA_UNITS), 1e6);
+  assert.throws(() => parseDecimal('30 000', 'σy', 'f'), /“30 000” has spaces: write 30000 \(no thousands separators\)$/);
+  assert.throws(() => parseDecimal('1 000 000 Pa', 'E', 'f', PA_UNITS), /has spaces: write 1000000 Pa \(no/);
   // A comma's fix keeps the unit: 3.5, as told, would be pascals.
   assert.throws(() => parseDecimal('30,000 Pa', 'σy', 'f', PA_UNITS), /has a comma: write 30000 Pa if .* or 30\.000 Pa if/);
   assert.throws(() => parseDecimal('3,5 kPa', 'σy', 'f', PA_UNITS), /has a decimal comma: write 3\.5 kPa \(with a point\)$/);

@@ -29,7 +29,8 @@ export const PA_UNITS = { Pa: 0, kPa: 3, MPa: 6, GPa: 9 };
 export const MM_UNITS = { mm: 0 };
 
 export function parseDecimal(text, label, field, units = null) {
-  const t = text.trim();
+  // A typographic minus (−, as a word processor writes it) is a minus.
+  const t = text.trim().replace(/\u2212/g, '-');
   const [number, unit] = units ? splitUnit(t, label, field, units) : [t, null];
   if (INFINITY.test(number)) return Infinity;
   let why;
@@ -55,7 +56,7 @@ export function parseDecimal(text, label, field, units = null) {
   } else {
     why = t === ''
       ? 'is empty'
-      : commaHint(number, unit) ?? `is not a number such as 0.3 or 3e4${units ? ` (units: ${Object.keys(units).join(', ')})` : ''}`;
+      : separatorHint(number, unit) ?? `is not a number such as 0.3 or 3e4${units ? ` (units: ${Object.keys(units).join(', ')})` : ''}`;
   }
   throw Object.assign(new Error(`${label}: “${t}” ${why}`), { field });
 }
@@ -80,15 +81,16 @@ function splitUnit(t, label, field, units) {
   throw Object.assign(new Error(`${label}: “${t}” has the unit “${unit}”: ${hint}`), { field });
 }
 
-// What a number typed with commas meant, said as its fix, or undefined: a
-// comma before exactly three digits (30,000, as Pa are typed) may separate
-// thousands or be a decimal comma, and which one is the student's to say
-// (the page must not read 30,000 Pa as 30 Pa); several such groups
-// (1,000,000) separate thousands; any other single comma (0,5, 0,300: no
-// group of thousands starts with 0) is a decimal comma.
+// What a number typed with separators meant, said as its fix, or
+// undefined: a comma before exactly three digits (30,000, as Pa are typed)
+// may separate thousands or be a decimal comma, and which one is the
+// student's to say (the page must not read 30,000 Pa as 30 Pa); several
+// such groups (1,000,000) separate thousands; any other single comma (0,5,
+// 0,300: no group of thousands starts with 0) is a decimal comma; spaces
+// between groups of three digits (30 000) separate thousands.
 // The fix keeps the unit typed after the number (`unit`, or null): 3,5 kPa
 // is to be written 3.5 kPa, not 3.5 (which would be pascals).
-function commaHint(t, unit = null) {
+function separatorHint(t, unit = null) {
   const u = unit ? ` ${unit}` : '';
   if (/^[+-]?[1-9]\d{0,2},\d{3}$/.test(t)) {
     return `has a comma: write ${t.replace(',', '')}${u} if it separates thousands, or ${t.replace(',', '.')}${u} ` +
@@ -96,6 +98,10 @@ function commaHint(t, unit = null) {
   }
   if (/^[+-]?[1-9]\d{0,2}(,\d{3}){2,}$/.test(t)) return `has commas: write ${t.replaceAll(',', '')}${u} (no thousands separators)`;
   if (/^[+-]?\d*,\d+$/.test(t)) return `has a decimal comma: write ${t.replace(',', '.')}${u} (with a point)`;
+  // Spaces as thousands separators (30 000, as many languages write it).
+  if (/^[+-]?[1-9]\d{0,2}([ \u00a0\u202f]\d{3})+$/.test(t)) {
+    return `has spaces: write ${t.replace(/[ \u00a0\u202f]/g, '')}${u} (no thousands separators)`;
+  }
   return undefined;
 }
 

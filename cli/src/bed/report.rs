@@ -801,7 +801,10 @@ fn plot_caption(name: &str, summary: &Summary<'_>) -> Option<String> {
              the averaged P belongs to; filled: the rows fitted (C ≥ {}), \
              rings: the others. The line's slope is 1/a and its intercept 1/(ab); a is the \
              limiting strain, extrapolated beyond the strain reached, and the fit depends on its \
-             window (kawakita_min_strain).",
+             window (kawakita_min_strain). R² says how straight the line is, not how far another \
+             pour of the same bed would move a and 1/b: on a 125-granule bed three pours spread \
+             1/b by 78–148 % (BENCHMARKS.md); `granbed-cli bed --seeds 1,2,3` measures it for \
+             this scene.",
             window(summary.kawakita.min_strain)
         ),
         "heckel.svg" => format!(
