@@ -96,7 +96,7 @@ impl MaterialArgs {
         let params = self.params();
         params
             .validate()
-            .map_err(|_| every_refusal(&params, |e| self.param_error(&params, e)))
+            .map_err(|first| every_refusal(&params, first, |e| self.param_error(&params, e)))
     }
 
     /// Turns the kernel's `ParamError` into a usage error whose message names
@@ -130,31 +130,30 @@ impl MaterialArgs {
 
 /// One usage error for every field `params` refuses
 /// ([`MaterialParams::refusals`]), each worded by `one`, one per line with
-/// the first refused field's first: a user who gave two bad values reads
-/// both at once. With one refused field, `one`'s error itself.
+/// `validate`'s error `first` first: a user who gave two bad values reads
+/// both at once. With one refused field, `one(first)` itself.
 pub fn every_refusal(
     params: &MaterialParams,
+    first: ParamError,
     one: impl Fn(ParamError) -> anyhow::Error,
 ) -> anyhow::Error {
-    let mut errors: Vec<anyhow::Error> = params.refusals().into_iter().map(one).collect();
-    match errors.len() {
-        // Not reached after a refused `validate` (its error is the first
-        // refusal); said rather than assumed.
-        0 => crate::error::input_error("the material parameters were refused"),
-        1 => errors.remove(0),
-        _ => crate::error::input_error(
-            errors
-                .iter()
-                .map(|e| format!("{e:#}"))
-                .collect::<Vec<_>>()
-                .join("\n"),
-        ),
+    let refused = params.refusals();
+    if refused.len() <= 1 {
+        return one(first);
     }
+    crate::error::input_error(
+        refused
+            .into_iter()
+            .map(|e| format!("{:#}", one(e)))
+            .collect::<Vec<_>>()
+            .join("\n"),
+    )
 }
 
 /// " (with …)": the other field a rejected `field`'s range depends on, as
 /// `params` has it, and the bound that follows — η0's on ηc, σ_y's on E —
-/// or nothing (also when that field is out of range itself). `flags`: name the command-line flag that sets it.
+/// or nothing (also when that field is refused itself). `flags`: name the
+/// command-line flag that sets it.
 pub fn related_field(field: &str, params: &MaterialParams, flags: bool) -> String {
     let see = |flag: &str| {
         if flags {
@@ -165,12 +164,12 @@ pub fn related_field(field: &str, params: &MaterialParams, flags: bool) -> Strin
     };
     // A related field itself out of range is refused on its own line, and
     // the bound was judged without it (`MaterialParams::refusals`).
-    let e_range = granbed_kernel::material::YOUNGS_MODULUS_RANGE_PA;
+    let refused = |related: &str| params.refusals().iter().any(|e| e.field == related);
     match field {
-        "eta0" if (0.0..1.0).contains(&params.eta_c) => {
+        "eta0" if !refused("eta_c") => {
             format!(" (with eta_c = {}{})", params.eta_c, see("--eta-c"))
         }
-        "yield_stress_pa" if (e_range[0]..=e_range[1]).contains(&params.youngs_modulus_pa) => {
+        "yield_stress_pa" if !refused("youngs_modulus_pa") => {
             format!(
                 " (with youngs_modulus_pa = {}, i.e. at least {} Pa{})",
                 crate::numbers::short(params.youngs_modulus_pa),

@@ -859,8 +859,8 @@ impl Scene {
     /// refused one on a line of its own.
     pub fn material(&self) -> anyhow::Result<Material> {
         let p = self.material_params()?;
-        p.validate().map_err(|_| {
-            crate::material_args::every_refusal(&p, |e| {
+        p.validate().map_err(|first| {
+            crate::material_args::every_refusal(&p, first, |e| {
                 anyhow::Error::new(InputError(format!(
                     "scene field `material.{}` = {} is out of range (allowed: {}){}",
                     e.field,

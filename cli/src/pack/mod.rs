@@ -176,8 +176,8 @@ impl PackMaterialArgs {
     pub fn material(&self) -> anyhow::Result<Material> {
         let args = self.material_args();
         let params = args.params();
-        params.validate().map_err(|_| {
-            crate::material_args::every_refusal(&params, |e| param_error(&args, &params, e))
+        params.validate().map_err(|first| {
+            crate::material_args::every_refusal(&params, first, |e| param_error(&args, &params, e))
         })
     }
 }
