@@ -156,12 +156,11 @@ test('every input out of range is named at once, the diameter in mm too', () => 
   );
   // check() judges without building a run; a NaN stands in for a field a
   // page could not read and is refused like any other.
-  assert.equal(pkg.check({ type: 'B2', mesh: '4x1', poisson_ratio: 0.3 }), undefined);
-  assert.throws(() => pkg.check({ type: 'B2', poisson_ratio: 0.6, youngs_modulus_pa: NaN, diameter_mm: NaN }),
-    (e) => {
-      assert.deepEqual(e.fields, ['youngs_modulus_pa', 'poisson_ratio', 'diameter_mm']);
-      return true;
-    });
+  assert.deepEqual(pkg.check({ type: 'B2', mesh: '4x1', poisson_ratio: 0.3 }), []);
+  const refused = pkg.check({ type: 'B2', poisson_ratio: 0.6, youngs_modulus_pa: NaN, diameter_mm: NaN });
+  assert.deepEqual(refused.map((r) => r.field), ['youngs_modulus_pa', 'poisson_ratio', 'diameter_mm']);
+  assert.match(refused[1].message, /^Poisson's ratio ν = 0\.6 is not allowed/);
+  assert.throws(() => pkg.check({ type: 'B2', nu: 0.3 }), /unknown input `nu`/);
   // One bad input: `fields` lists it alone.
   assert.throws(() => new pkg.Granule({ type: 'B2', cp: -1 }), (e) => e.field === 'cp' && e.fields.length === 1);
 });

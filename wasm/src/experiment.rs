@@ -194,10 +194,10 @@ impl Error {
         }
     }
 
-    /// The refusals `errors` (at least one) as one error: their messages a
-    /// line each, the first one's field, value and range, and every field
-    /// in [`Error::fields`].
-    pub fn all(errors: Vec<Error>) -> Self {
+    /// The refusals `errors` as one error, `None` if there are none: their
+    /// messages a line each, the first one's field, value and range, and
+    /// every field in [`Error::fields`].
+    pub fn all(errors: Vec<Error>) -> Option<Self> {
         let message = errors
             .iter()
             .map(|e| e.message.as_str())
@@ -207,14 +207,12 @@ impl Error {
             .iter()
             .flat_map(|e| e.fields.iter().copied())
             .collect();
-        match errors.into_iter().next() {
-            Some(first) => Self {
-                message,
-                fields,
-                ..first
-            },
-            None => Self::other("the inputs were refused".into()),
-        }
+        let first = errors.into_iter().next()?;
+        Some(Self {
+            message,
+            fields,
+            ..first
+        })
     }
 
     /// A message without a field.
@@ -295,9 +293,8 @@ impl Experiment {
     /// (octant, 5 mm/s, ξ = 0.5, to 40 % strain: `PlatenParams::standard`,
     /// exactly what `granbed-cli granule` runs by default).
     pub fn new(inputs: Inputs) -> Result<Self, Error> {
-        let refused = refusals(&inputs);
-        if !refused.is_empty() {
-            return Err(Error::all(refused));
+        if let Some(e) = Error::all(refusals(&inputs)) {
+            return Err(e);
         }
         let material = inputs.material_params().validate()?;
         let d = inputs.diameter_m;

@@ -77,8 +77,10 @@ fn mesh_level(text: &str) -> Option<(u32, u32)> {
     Some((n.trim().parse().ok()?, m.trim().parse().ok()?))
 }
 
-/// Reads the inputs object (see [`Granule::new`]).
-fn inputs_from_js(obj: &JsValue) -> Result<Inputs, JsValue> {
+/// Reads the inputs object (see [`Granule::new`]), with every input out of
+/// range: [`experiment::refusals`] and a diameter in mm that is (checked
+/// while reading, to be named in mm).
+fn inputs_from_js(obj: &JsValue) -> Result<(Inputs, Vec<Error>), JsValue> {
     if !obj.is_object() {
         return Err(message(
             "the inputs must be an object such as { type: \"B2\", poisson_ratio: 0.3 }".into(),
@@ -145,12 +147,9 @@ fn inputs_from_js(obj: &JsValue) -> Result<Inputs, JsValue> {
             ))
         })?;
     }
-    if let Some(e) = diameter_refused {
-        let mut all = experiment::refusals(&inputs);
-        all.push(e);
-        return Err(js_error(&Error::all(all)));
-    }
-    Ok(inputs)
+    let mut refused = experiment::refusals(&inputs);
+    refused.extend(diameter_refused);
+    Ok((inputs, refused))
 }
 
 /// The preset material parameters of granule type `name` (A1 … C3) as an
@@ -194,22 +193,28 @@ pub fn csv_columns() -> js_sys::Array {
 }
 
 /// Checks `inputs` as [`Granule::new`] reads and checks them, without
-/// setting up a run: throws the same `Error` (every input out of range, a
-/// line each, `fields` listing them), or returns. A field given as NaN is
-/// refused and judged as [`MaterialParams::refusals`] judges a refused one,
-/// so a page can check the fields it could read while naming those it
-/// could not (passed as NaN) itself.
+/// setting up a run: every input out of range as `[{ message, field }, …]`
+/// in the order `new` names them (empty: all in range); throws only where
+/// `new` throws before any range is judged (an unknown key, a value not a
+/// number, a bad type or mesh). A field given as NaN is refused and judged
+/// as [`MaterialParams::refusals`] judges a refused one, so a page can
+/// check the fields it could read while naming those it could not (passed
+/// as NaN) itself.
 ///
 /// [`MaterialParams::refusals`]: granbed_kernel::material::MaterialParams::refusals
 #[wasm_bindgen]
-pub fn check(inputs: &JsValue) -> Result<(), JsValue> {
-    let inputs = inputs_from_js(inputs)?;
-    let refused = experiment::refusals(&inputs);
-    if refused.is_empty() {
-        Ok(())
-    } else {
-        Err(js_error(&Error::all(refused)))
-    }
+pub fn check(inputs: &JsValue) -> Result<js_sys::Array, JsValue> {
+    let (_, refused) = inputs_from_js(inputs)?;
+    refused
+        .iter()
+        .map(|e| {
+            let entry = js_sys::Object::new();
+            js_sys::Reflect::set(&entry, &"message".into(), &JsValue::from_str(&e.message))?;
+            let field = e.field.map_or(JsValue::NULL, JsValue::from_str);
+            js_sys::Reflect::set(&entry, &"field".into(), &field)?;
+            Ok::<JsValue, JsValue>(entry.into())
+        })
+        .collect()
 }
 
 /// The version of granbed this module was built from.
@@ -237,7 +242,10 @@ impl Granule {
     /// (`fields` lists them all, `field` and the rest are the first's).
     #[wasm_bindgen(constructor)]
     pub fn new(inputs: &JsValue) -> Result<Granule, JsValue> {
-        let inputs = inputs_from_js(inputs)?;
+        let (inputs, refused) = inputs_from_js(inputs)?;
+        if let Some(e) = Error::all(refused) {
+            return Err(js_error(&e));
+        }
         let run = Experiment::new(inputs).map_err(|e| js_error(&e))?;
         Ok(Self { run })
     }

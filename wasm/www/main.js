@@ -12,6 +12,9 @@ const LABELS = {
 const UNITS = { yield_stress_pa: PA_UNITS, youngs_modulus_pa: PA_UNITS, diameter_mm: MM_UNITS };
 // The parameter fields in the form's order: refusals are listed in it.
 const FORM_ORDER = [...FIELDS, 'diameter_mm'];
+// The form's field of a module's field name (the kernel's `diameter_m` is
+// the page's `diameter_mm`).
+const formField = (f) => (f === 'diameter_m' ? 'diameter_mm' : f);
 
 let worker = null;
 let running = false;
@@ -49,7 +52,7 @@ function showError(message, fields) {
     input.removeAttribute('aria-invalid');
     input.removeAttribute('aria-describedby');
   }
-  const ids = [].concat(fields ?? []).map((f) => (f === 'diameter_m' ? 'diameter_mm' : f)).filter((id) => $(id));
+  const ids = [].concat(fields ?? []).map(formField).filter((id) => $(id));
   for (const id of ids) {
     $(id).setAttribute('aria-invalid', 'true');
     $(id).setAttribute('aria-describedby', 'error');
@@ -235,16 +238,15 @@ function onChecked(refused, id) {
   const unreadable = unreadableFields;
   unreadableFields = null;
   const named = new Set(unreadable.map((u) => u.field));
-  const page = (f) => (f === 'diameter_m' ? 'diameter_mm' : f);
   // An unreadable field's own message says more than the range of the
   // NaN it stood in as.
-  const lines = [...unreadable, ...refused.filter((r) => !named.has(page(r.field)))];
+  const lines = [...unreadable, ...refused.filter((r) => !named.has(formField(r.field)))];
   const rank = (f) => {
-    const i = FORM_ORDER.indexOf(page(f));
+    const i = FORM_ORDER.indexOf(formField(f));
     return i < 0 ? FORM_ORDER.length : i;
   };
   lines.sort((a, b) => rank(a.field) - rank(b.field));
-  refuse(lines.map((l) => l.message).join('\n'), lines.map((l) => page(l.field)).filter((f) => f));
+  refuse(lines.map((l) => l.message).join('\n'), lines.map((l) => formField(l.field)).filter((f) => f));
 }
 
 // "B2, mesh 8x2: σy = 30000 Pa, …" for the results table.

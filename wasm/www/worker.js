@@ -140,13 +140,12 @@ onmessage = async (ev) => {
     await run(msg.inputs);
   } else if (msg.cmd === 'check') {
     // The inputs the page could read, those it could not as NaN: every
-    // refusal, a message and a field each (none: all in range).
-    const refused = [];
+    // refusal, `{ message, field }` each (none: all in range).
+    let refused;
     try {
-      check(msg.inputs);
+      refused = check(msg.inputs);
     } catch (e) {
-      const fields = e.fields ?? [e.field ?? null];
-      e.message.split('\n').forEach((message, i) => refused.push({ message, field: fields[i] ?? null }));
+      refused = [{ message: errorMessage(e).message, field: e.field ?? null }];
     }
     postMessage({ kind: 'checked', refused, id: msg.id });
   } else if (msg.cmd === 'stop') {

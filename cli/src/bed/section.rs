@@ -435,31 +435,27 @@ pub fn section_svg(input: &SectionInput<'_>) -> String {
     let (bx, by, full) = (WIDTH - right + 30.0, top, (height - top - bottom).max(60.0));
     let tension = input.quantity == Quantity::AxialStress;
     let bh = if tension { 0.75 * full } else { full };
-    let steps = 50;
-    for i in 0..steps {
-        let t = (i as Real + 0.5) / steps as Real;
-        let y = by + bh * (1.0 - (i + 1) as Real / steps as Real);
-        let _ = writeln!(
-            s,
-            "<rect x=\"{bx:.1}\" y=\"{y:.1}\" width=\"18\" height=\"{:.2}\" fill=\"{}\"/>",
-            bh / steps as Real + 0.5,
-            viridis(t)
-        );
-    }
-    let (name, per_unit, footnote) = input.quantity.legend(hi);
-    if tension {
-        let (ty, th) = (by + 0.8 * full, 0.2 * full);
-        let red_steps = 20;
-        for i in 0..red_steps {
-            let t = (i as Real + 0.5) / red_steps as Real;
+    // A bar from `y` down `h` px in `steps` bands, each coloured at its
+    // middle's fraction of the way down.
+    let mut strip = |y: Real, h: Real, steps: u32, colour: &dyn Fn(Real) -> String| {
+        for i in 0..steps {
             let _ = writeln!(
                 s,
                 "<rect x=\"{bx:.1}\" y=\"{:.1}\" width=\"18\" height=\"{:.2}\" fill=\"{}\"/>",
-                ty + th * i as Real / red_steps as Real,
-                th / red_steps as Real + 0.5,
-                tension_red(t)
+                y + h * Real::from(i) / Real::from(steps),
+                h / Real::from(steps) + 0.5,
+                colour((Real::from(i) + 0.5) / Real::from(steps))
             );
         }
+    };
+    // Largest at the top.
+    strip(by, bh, 50, &|down| viridis(1.0 - down));
+    let (ty, th) = (by + 0.8 * full, 0.2 * full);
+    if tension {
+        strip(ty, th, 20, &tension_red);
+    }
+    let (name, per_unit, footnote) = input.quantity.legend(hi);
+    if tension {
         // Its one label at its foot (the footnote names the reds), a
         // quarter of the bar's height (at least 15 px) under the main
         // bar's 0.
