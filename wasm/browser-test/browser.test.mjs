@@ -106,7 +106,9 @@ test('Cancel stops a run, keeps its CSV so far, and the page can run again', asy
   assert.match(await page.getAttribute('#plot', 'aria-label'), /of a run cancelled at strain \d+\.\d %: \d+ points, .* the values are in the CSV$/);
   // The CSV so far: the CLI's rows up to where the run stopped.
   const [download] = await Promise.all([page.waitForEvent('download'), page.click('#download')]);
-  assert.equal(download.suggestedFilename(), 'granule_B2_8x2_cancelled_force_displacement.csv');
+  const lastRowInName = download.suggestedFilename().match(/^granule_B2_8x2_cancelled_to_(\d+\.\d)pct_force_displacement\.csv$/);
+  assert.ok(lastRowInName, download.suggestedFilename());
+  assert.equal(lastRowInName[1], (await page.textContent('#status')).match(/last row at (\d+\.\d) %/)[1]);
   const file = join(OUT, download.suggestedFilename());
   await download.saveAs(file);
   const csv = readFileSync(file, 'utf8');

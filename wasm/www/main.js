@@ -297,6 +297,10 @@ function run(ev) {
   clearError();
   const { inputs, unreadable } = readInputs();
   if (unreadable.length) {
+    // Until the worker's range checks answer, the page is neither the
+    // earlier refusal (its message is cleared) nor a run.
+    $('results').dataset.state = 'checking';
+    setStatus('checking the inputs…');
     checkThenRefuse(inputs, unreadable);
     return;
   }
@@ -369,7 +373,10 @@ function finish(msg) {
     const a = $('download');
     a.href = csvUrl;
     const name = current.custom ? `custom-${tag(describeRun(current))}` : current.type;
-    a.download = `granule_${name}_${current.mesh}${msg.cancelled ? '_cancelled' : ''}_force_displacement.csv`;
+    // A cancelled run's file names where its rows end, so that two
+    // cancelled runs of one preset are told apart.
+    const cut = msg.cancelled ? `_cancelled_to_${lastRow.toFixed(1)}pct` : '';
+    a.download = `granule_${name}_${current.mesh}${cut}_force_displacement.csv`;
     a.textContent = `Download CSV (${a.download})`;
     a.hidden = false;
   }
