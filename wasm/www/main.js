@@ -124,6 +124,8 @@ function startWorker() {
     // here, before the worker can say anything itself.
     showError(`the simulation worker failed: ${ev.message || 'unknown error'}. The page needs a browser that runs ` +
       'module Web Workers and WebAssembly SIMD (Chrome or Edge 91, Firefox 114, Safari 16.4 or later).');
+    // Not "checking the inputs…" or a run's progress for ever.
+    setStatus('stopped: the simulation worker failed (see the message below)');
   };
   worker.postMessage({ cmd: 'hello' });
 }
