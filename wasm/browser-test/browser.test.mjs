@@ -179,7 +179,11 @@ test('a decimal comma is refused with its fix, not read as another number', asyn
   await page.waitForSelector('#results[data-state="rejected"]');
   assert.match(await page.textContent('#error'), /σy: “30,000” has a comma: write 30000 if it separates thousands, or 30\.000 if/);
   await page.fill('#yield_stress_pa', '30000');
+  // "custom" off: the refusal goes with the custom values.
   await page.uncheck('#custom');
+  assert.equal(await page.getAttribute('#results', 'data-state'), null);
+  assert.equal(await page.textContent('#status'), 'ready');
+  assert.equal(await page.isHidden('#error'), true);
   assert.deepEqual(problems, []);
 });
 

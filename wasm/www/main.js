@@ -651,8 +651,13 @@ $('custom').addEventListener('change', () => {
   $('params').disabled = !$('custom').checked;
   if (!$('custom').checked) {
     clearError();
-    // The refusal's message is gone with the custom values.
-    if ($('results').dataset.state === 'rejected') setStatus('ready');
+    // The custom values are gone, and with them a refusal's message and
+    // the answer of a check still pending (`onChecked` drops it).
+    unreadableFields = null;
+    if (['rejected', 'checking'].includes($('results').dataset.state)) {
+      delete $('results').dataset.state;
+      setStatus('ready');
+    }
     requestPreset();
   }
 });
