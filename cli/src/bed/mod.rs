@@ -298,7 +298,8 @@ pub struct BedArgs {
     pub granules: Option<usize>,
 
     /// Override: mesh level NxM (8x2 = 1280 hexes, 4x1 = 160). 4x1 is
-    /// about 14 times faster but biased: its faceted granules hold 5 % less
+    /// about 11 times faster (the bed study's rows, BENCHMARKS.md) but
+    /// biased: its faceted granules hold 5 % less
     /// volume, and a bed's pressure at a given strain came 13–21 % lower
     /// at 30 % (Kawakita 1/b 19–46 %) than on 8x2 from the same pours
     /// (BENCHMARKS.md); compare beds on one mesh.
